@@ -1,0 +1,174 @@
+//! GPU device selection: a hardware adapter first, Mesa's lavapipe (a real Vulkan device on
+//! the CPU) otherwise. `FERROVOL_BACKEND` (vulkan, gl, metal, dx12) restricts the backends,
+//! `FERROVOL_ADAPTER` picks the first adapter whose name contains the given text
+//! (case-insensitive, e.g. `llvmpipe` or `nvidia`).
+
+use crate::error::{Error, Result};
+
+/// What the renderer needs to know about the device it runs on.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+    pub vendor: u32,
+    pub device: u32,
+    pub limits: wgpu::Limits,
+    /// R32Float is filterable (linear sampling of float32 volumes without conversion).
+    pub float32_filterable: bool,
+    /// R16Unorm / R16Snorm textures (16-bit volumes stored losslessly).
+    pub norm16: bool,
+    /// GPU timestamp queries inside passes.
+    pub timestamps: bool,
+}
+
+/// An adapter, a device and its queue. Cheap to share by reference; `Send + Sync`.
+pub struct Context {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: DeviceInfo,
+}
+
+fn backends_from_env() -> Result<wgpu::Backends> {
+    match std::env::var("FERROVOL_BACKEND") {
+        Err(_) => Ok(wgpu::Backends::VULKAN | wgpu::Backends::GL | wgpu::Backends::METAL | wgpu::Backends::DX12),
+        Ok(s) => {
+            let mut b = wgpu::Backends::empty();
+            for part in s.split(',').map(|p| p.trim().to_ascii_lowercase()) {
+                b |= match part.as_str() {
+                    "vulkan" | "vk" => wgpu::Backends::VULKAN,
+                    "gl" | "gles" | "opengl" => wgpu::Backends::GL,
+                    "metal" => wgpu::Backends::METAL,
+                    "dx12" | "d3d12" => wgpu::Backends::DX12,
+                    other => {
+                        return Err(Error::InvalidParameter(format!(
+                            "FERROVOL_BACKEND='{s}': unknown backend '{other}' (use vulkan, gl, metal or dx12)"
+                        )))
+                    }
+                };
+            }
+            Ok(b)
+        }
+    }
+}
+
+fn type_rank(t: wgpu::DeviceType) -> u32 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+impl Context {
+    /// Picks an adapter (environment overrides honoured) and creates a device on it.
+    pub fn new() -> Result<Context> {
+        pollster::block_on(Self::new_async())
+    }
+
+    async fn new_async() -> Result<Context> {
+        let backends = backends_from_env()?;
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        let mut adapters = instance.enumerate_adapters(backends).await;
+        let wanted = std::env::var("FERROVOL_ADAPTER").ok().map(|s| s.to_lowercase());
+        if let Some(w) = &wanted {
+            adapters.retain(|a| a.get_info().name.to_lowercase().contains(w.as_str()));
+        }
+        // Hardware first; among equals prefer Vulkan (the path shared with GL interop).
+        adapters.sort_by_key(|a| {
+            let i = a.get_info();
+            (type_rank(i.device_type), i.backend != wgpu::Backend::Vulkan)
+        });
+        let Some(adapter) = adapters.into_iter().next() else {
+            let mut why = format!(" for backends {backends:?}");
+            if let Some(w) = wanted {
+                why.push_str(&format!(" whose name contains '{w}'"));
+            }
+            return Err(Error::NoAdapter(why));
+        };
+        let ai = adapter.get_info();
+        let feats = adapter.features();
+        let mut required = wgpu::Features::empty();
+        for f in [
+            wgpu::Features::FLOAT32_FILTERABLE,
+            wgpu::Features::TEXTURE_FORMAT_16BIT_NORM,
+            wgpu::Features::TIMESTAMP_QUERY,
+        ] {
+            if feats.contains(f) {
+                required |= f;
+            }
+        }
+        // Ask for everything the adapter has: large volumes need large textures and buffers.
+        let limits = adapter.limits();
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("ferrovol"),
+                required_features: required,
+                required_limits: limits.clone(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| Error::RequestDevice { adapter: ai.name.clone(), message: e.to_string() })?;
+        let info = DeviceInfo {
+            name: ai.name.clone(),
+            backend: format!("{:?}", ai.backend),
+            device_type: format!("{:?}", ai.device_type),
+            driver: ai.driver.clone(),
+            driver_info: ai.driver_info.clone(),
+            vendor: ai.vendor,
+            device: ai.device,
+            limits: device.limits(),
+            float32_filterable: required.contains(wgpu::Features::FLOAT32_FILTERABLE),
+            norm16: required.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM),
+            timestamps: required.contains(wgpu::Features::TIMESTAMP_QUERY),
+        };
+        Ok(Context { adapter, device, queue, info })
+    }
+
+    /// Runs `f` and turns any wgpu validation or out-of-memory error it caused into an [`Error`].
+    pub fn checked<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let val = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let out = f();
+        let v = pollster::block_on(val.pop());
+        let o = pollster::block_on(oom.pop());
+        if let Some(e) = o {
+            return Err(Error::Gpu(format!("{what}: out of GPU memory: {e}")));
+        }
+        if let Some(e) = v {
+            return Err(Error::Gpu(format!("{what}: {e}")));
+        }
+        Ok(out)
+    }
+
+    /// Blocks until the GPU has finished all submitted work.
+    pub fn wait_idle(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+    }
+}
+
+impl std::fmt::Display for DeviceInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "adapter:   {}", self.name)?;
+        writeln!(f, "backend:   {}", self.backend)?;
+        writeln!(f, "type:      {}", self.device_type)?;
+        writeln!(f, "driver:    {} {}", self.driver, self.driver_info)?;
+        writeln!(f, "ids:       vendor 0x{:04x} device 0x{:04x}", self.vendor, self.device)?;
+        writeln!(f, "max 3D texture:     {}", self.limits.max_texture_dimension_3d)?;
+        writeln!(f, "max buffer size:    {}", self.limits.max_buffer_size)?;
+        writeln!(f, "max storage buffer: {}", self.limits.max_storage_buffer_binding_size)?;
+        writeln!(f, "float32 filterable: {}", self.float32_filterable)?;
+        writeln!(f, "16-bit norm:        {}", self.norm16)?;
+        write!(f, "timestamps:         {}", self.timestamps)
+    }
+}

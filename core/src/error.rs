@@ -1,0 +1,33 @@
+//! The one error type of ferrovol-core. Every message says what was wrong and, where it
+//! helps, what to do.
+
+/// Errors from the renderer core.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// No wgpu adapter matched (or none exists at all).
+    #[error("no GPU adapter found{0}; install a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1 for the CPU device lavapipe) or relax FERROVOL_ADAPTER / FERROVOL_BACKEND")]
+    NoAdapter(String),
+    /// The adapter refused to create a device.
+    #[error("could not create a GPU device on adapter '{adapter}': {message}")]
+    RequestDevice { adapter: String, message: String },
+    /// The volume description is inconsistent or not renderable.
+    #[error("invalid volume: {0}")]
+    InvalidVolume(String),
+    /// A transfer function is malformed.
+    #[error("invalid transfer function: {0}")]
+    InvalidTransferFunction(String),
+    /// A render parameter is out of range.
+    #[error("invalid parameter: {0}")]
+    InvalidParameter(String),
+    /// The device lacks something this request needs.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+    /// The GPU reported an error (validation, out of memory, device lost).
+    #[error("GPU error: {0}")]
+    Gpu(String),
+    /// Writing an image failed.
+    #[error("could not write image '{path}': {message}")]
+    ImageWrite { path: String, message: String },
+}
+
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,146 @@
+//! Rust mirrors of the WGSL structs in shaders/lib/common.wgsl and shaders/lib/volume.wgsl.
+//! Only vec4-sized fields, so std140/std430 and `repr(C)` agree; `layout_tests` checks every
+//! field offset against naga's reflection of the WGSL.
+
+use bytemuck::{Pod, Zeroable};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLight {
+    pub position: [f32; 4],
+    pub spot: [f32; 4],
+    pub diffuse: [f32; 4],
+    pub specular: [f32; 4],
+    pub ambient: [f32; 4],
+    pub attenuation: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniforms {
+    pub inv_view_proj: [f32; 16],
+    pub view_proj: [f32; 16],
+    pub world_to_index: [f32; 16],
+    pub index_to_data: [f32; 16],
+    pub gradient_to_world: [f32; 16],
+    pub index_to_world: [f32; 16],
+    pub camera_position: [f32; 4],
+    pub dims: [f32; 4],
+    pub scalar_scale: [f32; 4],
+    pub scalar_shift: [f32; 4],
+    pub tf_lo: [f32; 4],
+    pub tf_inv_width: [f32; 4],
+    pub go_lo: [f32; 4],
+    pub go_inv_width: [f32; 4],
+    pub weights: [f32; 4],
+    pub material: [f32; 4],
+    pub crop_lo: [f32; 4],
+    pub crop_hi: [f32; 4],
+    pub misc: [f32; 4],
+    pub average_range: [f32; 4],
+    pub additive_scale: [f32; 4],
+    pub clip: [[f32; 4]; 6],
+    pub lights: [GpuLight; 8],
+    pub viewport: [u32; 4],
+    pub mode: [u32; 4],
+    pub counts: [u32; 4],
+    pub occupancy_dims: [u32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BrickUniforms {
+    pub core_lo: [f32; 4],
+    pub core_hi: [f32; 4],
+    pub tex_lo: [f32; 4],
+    pub tex_size: [f32; 4],
+}
+
+/// Per-pixel ray state (PixelState in WGSL), 48 bytes.
+pub const PIXEL_STATE_BYTES: u64 = 48;
+
+// Flag bits (FLAG_* in common.wgsl).
+pub const FLAG_SHADE: u32 = 1;
+pub const FLAG_JITTER: u32 = 2;
+pub const FLAG_FORWARD_DIFF: u32 = 4;
+pub const FLAG_CROP: u32 = 8;
+pub const FLAG_TWO_SIDED: u32 = 16;
+pub const FLAG_GRADIENT_OPACITY: u32 = 32;
+pub const FLAG_INDEPENDENT: u32 = 64;
+pub const FLAG_DEPTH_INPUT: u32 = 128;
+pub const FLAG_SKIP_EMPTY: u32 = 256;
+pub const FLAG_PARALLEL: u32 = 512;
+pub const FLAG_AVERAGE_RANGE: u32 = 1024;
+
+pub fn mat(m: glam::DMat4) -> [f32; 16] {
+    m.as_mat4().to_cols_array()
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+    use std::mem::{offset_of, size_of};
+
+    fn module(pass: &str) -> naga::Module {
+        naga::front::wgsl::parse_str(&crate::shaders::compose(pass)).expect("WGSL parses")
+    }
+
+    /// (member name, offset) of a WGSL struct, and its size.
+    fn wgsl_struct(m: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(m.to_ctx()).unwrap();
+        for (h, t) in m.types.iter() {
+            if t.name.as_deref() == Some(name) {
+                if let naga::TypeInner::Struct { members, span } = &t.inner {
+                    let _ = h;
+                    return (members.iter().map(|mm| (mm.name.clone().unwrap(), mm.offset)).collect(), *span);
+                }
+            }
+        }
+        panic!("struct {name} not found");
+    }
+
+    macro_rules! check {
+        ($m:expr, $wgsl:literal, $rust:ty, [$($field:ident),* $(,)?]) => {{
+            let (members, size) = wgsl_struct(&$m, $wgsl);
+            let rust: Vec<(String, u32)> = vec![$((stringify!($field).to_string(), offset_of!($rust, $field) as u32)),*];
+            assert_eq!(members, rust, "{} field offsets differ between WGSL and Rust", $wgsl);
+            assert_eq!(size as usize, size_of::<$rust>(), "{} size differs", $wgsl);
+        }};
+    }
+
+    #[test]
+    fn frame_uniforms_match_wgsl() {
+        let m = module("dvr.wgsl");
+        check!(m, "Frame", FrameUniforms, [inv_view_proj, view_proj, world_to_index, index_to_data,
+            gradient_to_world, index_to_world, camera_position, dims, scalar_scale, scalar_shift, tf_lo,
+            tf_inv_width, go_lo, go_inv_width, weights, material, crop_lo, crop_hi, misc, average_range, additive_scale,
+            clip, lights, viewport, mode, counts, occupancy_dims]);
+        check!(m, "Light", GpuLight, [position, spot, diffuse, specular, ambient, attenuation]);
+        check!(m, "Brick", BrickUniforms, [core_lo, core_hi, tex_lo, tex_size]);
+        let (_, ps) = wgsl_struct(&m, "PixelState");
+        assert_eq!(ps as u64, PIXEL_STATE_BYTES);
+    }
+
+    #[test]
+    fn flags_match_wgsl() {
+        let src = crate::shaders::compose("dvr.wgsl");
+        for (name, v) in [("FLAG_SHADE", FLAG_SHADE), ("FLAG_JITTER", FLAG_JITTER), ("FLAG_FORWARD_DIFF", FLAG_FORWARD_DIFF),
+            ("FLAG_CROP", FLAG_CROP), ("FLAG_TWO_SIDED", FLAG_TWO_SIDED), ("FLAG_GRADIENT_OPACITY", FLAG_GRADIENT_OPACITY),
+            ("FLAG_INDEPENDENT", FLAG_INDEPENDENT), ("FLAG_DEPTH_INPUT", FLAG_DEPTH_INPUT), ("FLAG_SKIP_EMPTY", FLAG_SKIP_EMPTY),
+            ("FLAG_PARALLEL", FLAG_PARALLEL), ("FLAG_AVERAGE_RANGE", FLAG_AVERAGE_RANGE)] {
+            let decl = format!("const {name}: u32 = {v}u;");
+            assert!(src.contains(&decl), "WGSL lacks `{decl}`");
+        }
+    }
+
+    #[test]
+    fn every_pass_validates_with_naga() {
+        for pass in crate::shaders::PASSES {
+            let m = module(pass);
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                .validate(&m)
+                .unwrap_or_else(|e| panic!("{pass} fails validation: {e:?}"));
+        }
+    }
+}

@@ -1,0 +1,195 @@
+//! Per-frame render parameters (the small things that change between frames without
+//! touching the volume or the tables).
+
+use crate::error::{Error, Result};
+use glam::{DMat4, DVec3};
+
+/// How samples along a ray combine (VTK's vtkVolumeMapper blend modes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BlendMode {
+    /// Front-to-back alpha compositing with early ray termination.
+    Composite,
+    /// Maximum intensity projection.
+    Maximum,
+    /// Minimum intensity projection.
+    Minimum,
+    /// Average of the samples inside [`RenderParams::average_range`].
+    Average,
+    /// Sum of opacity-weighted scalars along the ray.
+    Additive,
+}
+
+impl BlendMode {
+    pub(crate) fn code(self) -> u32 {
+        match self {
+            BlendMode::Composite => 0,
+            BlendMode::Maximum => 1,
+            BlendMode::Minimum => 2,
+            BlendMode::Average => 3,
+            BlendMode::Additive => 4,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interpolation {
+    Nearest,
+    Linear,
+}
+
+/// Gradient estimator for shading and gradient opacity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GradientMethod {
+    /// Central differences, 6 extra samples (default).
+    Central,
+    /// Forward differences, 3 extra samples.
+    Forward,
+}
+
+/// Blinn–Phong material (vtkVolumeProperty's Shade, Ambient, Diffuse, Specular, SpecularPower).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    pub enabled: bool,
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub specular_power: f32,
+    /// Light the back side of gradients too (VTK renderers default to two-sided lighting).
+    pub two_sided: bool,
+}
+
+impl Default for Shading {
+    /// VTK's vtkVolumeProperty defaults, shading off.
+    fn default() -> Self {
+        Shading { enabled: false, ambient: 0.1, diffuse: 0.7, specular: 0.2, specular_power: 10.0, two_sided: true }
+    }
+}
+
+/// VTK's cropping: six planes in data coordinates (xmin, xmax, ymin, ymax, zmin, zmax)
+/// splitting space into 27 regions; bit `rx + 3·ry + 9·rz` of `regions` makes region
+/// (rx, ry, rz) visible, where r = 0 below the first plane, 1 between, 2 above.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cropping {
+    pub planes: [f64; 6],
+    pub regions: u32,
+}
+
+impl Cropping {
+    /// vtkVolumeMapper::CroppingRegionFlags presets.
+    pub const SUBVOLUME: u32 = 0x0002000;
+    pub const FENCE: u32 = 0x2ebfeba;
+    pub const INVERTED_FENCE: u32 = 0x5140145;
+    pub const CROSS: u32 = 0x0417410;
+    pub const INVERTED_CROSS: u32 = 0x7be8bef;
+}
+
+/// A clipping plane: points with dot(normal, p − origin) ≥ 0 are kept (VTK's convention:
+/// the normal points into the kept half-space).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipPlane {
+    pub origin: DVec3,
+    pub normal: DVec3,
+}
+
+pub const MAX_CLIP_PLANES: usize = 6;
+pub const MAX_LIGHTS: usize = 8;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderParams {
+    pub blend: BlendMode,
+    pub interpolation: Interpolation,
+    /// World distance between samples; `None` picks the smallest voxel spacing (after the
+    /// volume matrix), VTK's AutoAdjustSampleDistances choice for a still frame.
+    pub sample_distance: Option<f64>,
+    /// Offset each ray's first sample by a per-pixel deterministic fraction of a step.
+    pub jitter: bool,
+    /// Early ray termination: stop compositing once opacity reaches this (VTK: 1 − 1/255).
+    pub termination_threshold: f32,
+    pub gradient: GradientMethod,
+    pub shading: Shading,
+    pub cropping: Option<Cropping>,
+    pub clip_planes: Vec<ClipPlane>,
+    /// AverageIPScalarRange: samples outside are ignored by the average blend mode.
+    pub average_range: Option<[f64; 2]>,
+    /// Skip blocks classified empty by the transfer function (composite mode).
+    pub empty_space_skipping: bool,
+    /// Depth output: the first sample where accumulated opacity exceeds this (0: the first
+    /// sample with any opacity, as VTK's RenderToImage depth).
+    pub depth_threshold: f32,
+    /// The vtkVolume's matrix (data → world).
+    pub volume_matrix: DMat4,
+}
+
+impl Default for RenderParams {
+    fn default() -> Self {
+        RenderParams {
+            blend: BlendMode::Composite,
+            interpolation: Interpolation::Linear,
+            sample_distance: None,
+            jitter: false,
+            termination_threshold: 1.0 - 1.0 / 255.0,
+            gradient: GradientMethod::Central,
+            shading: Shading::default(),
+            cropping: None,
+            clip_planes: Vec::new(),
+            average_range: None,
+            empty_space_skipping: true,
+            depth_threshold: 0.0,
+            volume_matrix: DMat4::IDENTITY,
+        }
+    }
+}
+
+impl RenderParams {
+    pub fn validate(&self) -> Result<()> {
+        if let Some(d) = self.sample_distance {
+            if !(d.is_finite() && d > 0.0) {
+                return Err(Error::InvalidParameter(format!("sample distance {d} must be positive")));
+            }
+        }
+        if !(self.termination_threshold > 0.0 && self.termination_threshold <= 1.0) {
+            return Err(Error::InvalidParameter(format!(
+                "early termination threshold {} must be in (0, 1]",
+                self.termination_threshold
+            )));
+        }
+        if !(0.0..1.0).contains(&self.depth_threshold) {
+            return Err(Error::InvalidParameter(format!(
+                "depth threshold {} must be in [0, 1)",
+                self.depth_threshold
+            )));
+        }
+        if self.clip_planes.len() > MAX_CLIP_PLANES {
+            return Err(Error::InvalidParameter(format!(
+                "{} clipping planes; at most {MAX_CLIP_PLANES} are supported",
+                self.clip_planes.len()
+            )));
+        }
+        for p in &self.clip_planes {
+            if !p.origin.is_finite() || !p.normal.is_finite() || p.normal.length() < 1e-12 {
+                return Err(Error::InvalidParameter(format!("clipping plane {p:?} needs a finite origin and a non-zero normal")));
+            }
+        }
+        if let Some(c) = &self.cropping {
+            if c.planes.iter().any(|v| !v.is_finite()) || c.planes[0] > c.planes[1] || c.planes[2] > c.planes[3] || c.planes[4] > c.planes[5] {
+                return Err(Error::InvalidParameter(format!(
+                    "cropping planes {:?} must be finite with min ≤ max on each axis",
+                    c.planes
+                )));
+            }
+            if c.regions >= 1 << 27 {
+                return Err(Error::InvalidParameter(format!("cropping region flags 0x{:x} use more than 27 bits", c.regions)));
+            }
+        }
+        let s = &self.shading;
+        for (n, v) in [("ambient", s.ambient), ("diffuse", s.diffuse), ("specular", s.specular), ("specular power", s.specular_power)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidParameter(format!("shading {n} {v} must be finite and non-negative")));
+            }
+        }
+        if self.volume_matrix.determinant().abs() < 1e-12 || !self.volume_matrix.is_finite() {
+            return Err(Error::InvalidParameter("the volume matrix is singular or not finite".into()));
+        }
+        Ok(())
+    }
+}

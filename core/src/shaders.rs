@@ -1,0 +1,45 @@
+//! WGSL sources. Each pass is one file in shaders/; shared pieces live in shaders/lib/ and
+//! are pulled in with `#include "lib/NAME.wgsl"` lines, expanded here (each file once).
+
+/// (path relative to shaders/, source) for every WGSL file.
+pub const FILES: &[(&str, &str)] = &[
+    ("lib/common.wgsl", include_str!("../../shaders/lib/common.wgsl")),
+    ("lib/ray.wgsl", include_str!("../../shaders/lib/ray.wgsl")),
+    ("lib/volume.wgsl", include_str!("../../shaders/lib/volume.wgsl")),
+    ("lib/shading.wgsl", include_str!("../../shaders/lib/shading.wgsl")),
+    ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
+    ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
+];
+
+/// The passes (entry files, not library pieces).
+pub const PASSES: &[&str] = &["dvr.wgsl", "resolve.wgsl"];
+
+fn source(path: &str) -> Option<&'static str> {
+    FILES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s)
+}
+
+/// The complete source of a pass with its includes expanded.
+pub fn compose(path: &str) -> String {
+    let mut out = String::new();
+    let mut seen = Vec::new();
+    expand(path, &mut out, &mut seen);
+    out
+}
+
+fn expand(path: &str, out: &mut String, seen: &mut Vec<String>) {
+    if seen.iter().any(|s| s == path) {
+        return;
+    }
+    seen.push(path.to_string());
+    let src = source(path).unwrap_or_else(|| panic!("shader '{path}' is not listed in shaders::FILES"));
+    for line in src.lines() {
+        let t = line.trim();
+        if let Some(rest) = t.strip_prefix("#include") {
+            let inc = rest.trim().trim_matches('"');
+            expand(inc, out, seen);
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+}

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs what ferrovol needs on a Debian bookworm machine. Idempotent: when everything
+# is present it only checks (a few seconds). VTK comes from ParaView 5.11's packages
+# (see docs/ARCHITECTURE.md, Machines): never libvtk9-dev / python3-vtk9.
+set -euo pipefail
+PKGS=(mesa-vulkan-drivers libvulkan1 xvfb xauth cmake ninja-build pkg-config
+      paraview paraview-dev python3-paraview python3-numpy zlib1g-dev)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+command -v cargo >/dev/null || { echo "install-deps: cargo (Rust toolchain) is required" >&2; exit 1; }

@@ -1,0 +1,213 @@
+// Direct volume rendering: marches each pixel's ray through one brick and carries the
+// ray's state (colour, running max/min/sum, depth) to the next brick in visibility order.
+// Samples sit on one lattice per ray, t_k = t_entry + (k + jitter)·Δ, whatever the
+// bricking, so a bricked volume gives the same samples as an unbricked one.
+#include "lib/common.wgsl"
+#include "lib/ray.wgsl"
+#include "lib/volume.wgsl"
+#include "lib/shading.wgsl"
+
+@group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
+// Per block of the occupancy grid: 1 when the transfer function gives some block voxel a
+// non-zero opacity, 0 when the whole block is transparent.
+@group(0) @binding(3) var<storage, read> occupancy: array<u32>;
+@group(0) @binding(4) var depth_in: texture_2d<f32>;
+
+// Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
+fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
+    let ncomp = frame.counts.w;
+    let need_grad = has_flag(FLAG_SHADE) || has_flag(FLAG_GRADIENT_OPACITY);
+    if (!has_flag(FLAG_INDEPENDENT)) {
+        // Dependent components: 2 = (colour scalar, opacity scalar); 4 = RGB + opacity scalar.
+        let oc = ncomp - 1u;
+        let u = scalar_coord(0u, s[oc]);
+        var a = table_lookup(0u, 1u, u).x;
+        if (a <= 0.0) {
+            return vec4<f32>(0.0);
+        }
+        var rgb = classify(0u, s.x).rgb;
+        if (ncomp == 4u) {
+            rgb = clamp(sample_texel(p).rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+        }
+        if (need_grad) {
+            let g = world_gradient(gradient_at(p, s), oc);
+            if (has_flag(FLAG_GRADIENT_OPACITY)) {
+                a = a * table_lookup(0u, 1u, (length(g) - frame.go_lo.x) * frame.go_inv_width.x).y;
+            }
+            if (has_flag(FLAG_SHADE)) {
+                rgb = shade(rgb, g, pos, view_dir);
+            }
+        }
+        return vec4<f32>(rgb, a);
+    }
+    // Independent components, mixed as VTK does: colour weighted by opacity × weight,
+    // opacity the opacity-weighted mean of the components' opacities.
+    var alpha = vec4<f32>(0.0);
+    var any = false;
+    for (var c = 0u; c < ncomp; c = c + 1u) {
+        alpha[c] = table_lookup(c, 1u, scalar_coord(c, s[c])).x;
+        any = any || alpha[c] * frame.weights[c] > 0.0;
+    }
+    if (!any) {
+        return vec4<f32>(0.0);
+    }
+    var g: Gradient;
+    if (need_grad) {
+        g = gradient_at(p, s);
+    }
+    var rgb_sum = vec3<f32>(0.0);
+    var a_sq = 0.0;
+    var total = 0.0;
+    for (var c = 0u; c < ncomp; c = c + 1u) {
+        var a = alpha[c];
+        let w = frame.weights[c];
+        if (a <= 0.0 || w <= 0.0) {
+            continue;
+        }
+        var rgb = classify(c, s[c]).rgb;
+        if (need_grad) {
+            let gw = world_gradient(g, c);
+            if (has_flag(FLAG_GRADIENT_OPACITY)) {
+                a = a * table_lookup(c, 1u, (length(gw) - frame.go_lo[c]) * frame.go_inv_width[c]).y;
+            }
+            if (has_flag(FLAG_SHADE)) {
+                rgb = shade(rgb, gw, pos, view_dir);
+            }
+        }
+        rgb_sum = rgb_sum + a * w * rgb;
+        a_sq = a_sq + a * a * w;
+        total = total + a * w;
+    }
+    if (total <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(rgb_sum / total, min(a_sq / total, 1.0));
+}
+
+// Opacity × normalised scalar per component (average and additive blend modes), the
+// opacity scaled by `scale` per component.
+fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
+    for (var c = 0u; c < frame.counts.w; c = c + 1u) {
+        let u = clamp(scalar_coord(c, s[c]), 0.0, 1.0);
+        out[c] = classify(c, s[c]).a * u * scale[c];
+    }
+    return out;
+}
+
+fn in_crop(p: vec3<f32>) -> bool {
+    let d = (frame.index_to_data * vec4<f32>(p, 1.0)).xyz;
+    let r = select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_lo.xyz)
+          + select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_hi.xyz);
+    let bit = r.x + 3u * r.y + 9u * r.z;
+    return ((frame.mode.z >> bit) & 1u) != 0u;
+}
+
+fn block_occupied(p: vec3<f32>) -> bool {
+    let bs = f32(frame.counts.z);
+    let b = min(vec3<u32>(max(floor(p / bs), vec3<f32>(0.0))), frame.occupancy_dims.xyz - 1u);
+    let d = frame.occupancy_dims;
+    return occupancy[(b.z * d.y + b.y) * d.x + b.x] != 0u;
+}
+
+// Distance at which the ray leaves the occupancy block holding p.
+fn block_exit(r: Ray, p: vec3<f32>) -> f32 {
+    let bs = f32(frame.counts.z);
+    let lo = floor(p / bs) * bs;
+    return box_interval(r, lo, lo + bs).y;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= frame.viewport.x || gid.y >= frame.viewport.y) {
+        return;
+    }
+    let pix = gid.y * frame.viewport.x + gid.x;
+    let blend = frame.mode.x;
+    var st = state[pix];
+    let ert = frame.misc.y;
+    if (blend == BLEND_COMPOSITE && st.color.a >= ert) {
+        return;
+    }
+    let ray = make_ray(gid.xy);
+    // The whole ray segment inside the volume, near/far planes, opaque depth and clip planes.
+    var seg = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    seg.x = max(seg.x, 0.0);
+    seg.y = min(seg.y, ray.far);
+    if (has_flag(FLAG_DEPTH_INPUT)) {
+        let d = textureLoad(depth_in, vec2<i32>(gid.xy), 0).x;
+        seg.y = min(seg.y, depth_to_distance(ray, gid.xy, d));
+    }
+    seg = clip_interval(ray, seg);
+    // This brick's part of it.
+    let b = box_interval(ray, brick.core_lo.xyz, brick.core_hi.xyz);
+    let t_lo = max(b.x, seg.x);
+    let t_hi = min(b.y, seg.y);
+    if (t_lo >= t_hi) {
+        return;
+    }
+    let dt = frame.misc.x;
+    var jit = 0.0;
+    if (has_flag(FLAG_JITTER)) {
+        jit = hash01(pix ^ frame.viewport.w);
+    }
+    var k = max(ceil((t_lo - seg.x) / dt - jit), 0.0);
+    let k_end = ceil((t_hi - seg.x) / dt - jit);
+    let skip = has_flag(FLAG_SKIP_EMPTY) && blend == BLEND_COMPOSITE;
+    let crop = has_flag(FLAG_CROP);
+    var color = st.color;
+    var value = st.value;
+    var misc = st.misc;
+    loop {
+        if (k >= k_end) {
+            break;
+        }
+        let t = seg.x + (k + jit) * dt;
+        let p = ray.index_origin + t * ray.index_dir;
+        if (skip && !block_occupied(p)) {
+            k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+            continue;
+        }
+        if (crop && !in_crop(p)) {
+            k = k + 1.0;
+            continue;
+        }
+        let s = sample_scalars(p);
+        if (blend == BLEND_COMPOSITE) {
+            let c = classify_sample(s, p, ray.origin + t * ray.dir, ray.dir);
+            if (c.a > 0.0) {
+                let w = (1.0 - color.a) * c.a;
+                color = vec4<f32>(color.rgb + w * c.rgb, color.a + w);
+                if (misc.z == 0.0 && color.a > frame.misc.z) {
+                    misc.y = distance_to_depth(ray, t);
+                    misc.z = 1.0;
+                }
+                if (color.a >= ert) {
+                    break;
+                }
+            }
+        } else if (blend == BLEND_MAXIMUM) {
+            value = select(max(value, s), s, misc.x == 0.0);
+            misc.x = misc.x + 1.0;
+        } else if (blend == BLEND_MINIMUM) {
+            value = select(min(value, s), s, misc.x == 0.0);
+            misc.x = misc.x + 1.0;
+        } else if (blend == BLEND_AVERAGE) {
+            // VTK: opacity-weighted normalised scalars of the samples inside the range
+            let r = frame.average_range;
+            if (!has_flag(FLAG_AVERAGE_RANGE) || (s.x >= r.x && s.x <= r.y)) {
+                value = value + projection_term(s, vec4<f32>(1.0));
+                misc.x = misc.x + 1.0;
+            }
+        } else {
+            // VTK: additive sums the same terms, opacity scaled linearly by step / unit distance
+            value = value + projection_term(s, frame.additive_scale);
+            misc.x = misc.x + 1.0;
+        }
+        k = k + 1.0;
+    }
+    st.color = color;
+    st.value = value;
+    st.misc = misc;
+    state[pix] = st;
+}

@@ -1,0 +1,115 @@
+// Shared by every pass: the per-frame uniform block, its constants, the lookup tables and
+// small helpers. Mirrored in core/src/gpu.rs (FrameUniforms); a unit test checks the
+// layouts agree.
+
+const BLEND_COMPOSITE: u32 = 0u;
+const BLEND_MAXIMUM: u32 = 1u;
+const BLEND_MINIMUM: u32 = 2u;
+const BLEND_AVERAGE: u32 = 3u;
+const BLEND_ADDITIVE: u32 = 4u;
+
+const FLAG_SHADE: u32 = 1u;
+const FLAG_JITTER: u32 = 2u;
+const FLAG_FORWARD_DIFF: u32 = 4u;
+const FLAG_CROP: u32 = 8u;
+const FLAG_TWO_SIDED: u32 = 16u;
+const FLAG_GRADIENT_OPACITY: u32 = 32u;
+const FLAG_INDEPENDENT: u32 = 64u;
+const FLAG_DEPTH_INPUT: u32 = 128u;
+const FLAG_SKIP_EMPTY: u32 = 256u;
+const FLAG_PARALLEL: u32 = 512u;
+const FLAG_AVERAGE_RANGE: u32 = 1024u;
+
+const MAX_LIGHTS: u32 = 8u;
+const MAX_CLIP: u32 = 6u;
+
+struct Light {
+    // xyz: world position (positional) or unit vector toward the light (directional);
+    // w: 1 positional, 0 directional
+    position: vec4<f32>,
+    // xyz: unit spot axis (from the light toward its focal point); w: cos(cone angle),
+    // -2 when the light has no cone
+    spot: vec4<f32>,
+    // diffuse colour × intensity; w: spot exponent
+    diffuse: vec4<f32>,
+    // specular colour × intensity
+    specular: vec4<f32>,
+    // ambient colour × intensity
+    ambient: vec4<f32>,
+    // constant, linear, quadratic attenuation
+    attenuation: vec4<f32>,
+}
+
+struct Frame {
+    inv_view_proj: mat4x4<f32>,   // clip → world
+    view_proj: mat4x4<f32>,       // world → clip
+    world_to_index: mat4x4<f32>,  // world → volume index space (i, j, k)
+    index_to_data: mat4x4<f32>,   // index → data coordinates (for cropping)
+    gradient_to_world: mat4x4<f32>, // index-space gradient → world gradient (inverse transpose)
+    index_to_world: mat4x4<f32>,
+    camera_position: vec4<f32>,   // world
+    dims: vec4<f32>,              // points per axis; w: components
+    scalar_scale: vec4<f32>,      // texel value → scalar, per component
+    scalar_shift: vec4<f32>,
+    tf_lo: vec4<f32>,             // per component: scalar at the first table entry
+    tf_inv_width: vec4<f32>,      // per component: 1 / table scalar width
+    go_lo: vec4<f32>,             // gradient-opacity table range, per component
+    go_inv_width: vec4<f32>,
+    weights: vec4<f32>,           // component weights (independent components)
+    material: vec4<f32>,          // ambient, diffuse, specular, specular power
+    crop_lo: vec4<f32>,           // cropping planes, data coordinates
+    crop_hi: vec4<f32>,
+    misc: vec4<f32>,              // sample distance, termination threshold, depth threshold, gradient epsilon
+    average_range: vec4<f32>,     // xy: scalar range the average blend mode keeps
+    additive_scale: vec4<f32>,    // per component: sample distance / unit distance
+    clip: array<vec4<f32>, 6>,    // index-space planes: keep dot(xyz, p) + w >= 0
+    lights: array<Light, 8>,
+    viewport: vec4<u32>,          // width, height, pixel count, seed
+    mode: vec4<u32>,              // blend, flags, crop regions, table size
+    counts: vec4<u32>,            // clip planes, lights, occupancy block size, components
+    occupancy_dims: vec4<u32>,    // blocks per axis
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+// Per component c: TABLE entries (r, g, b, alpha) at [2·c·N, 2·c·N + N), then
+// (alpha corrected for the step, gradient opacity, 0, 0) at [2·c·N + N, 2·c·N + 2N).
+@group(0) @binding(1) var<storage, read> tables: array<vec4<f32>>;
+
+// Per-pixel ray state carried across brick passes.
+struct PixelState {
+    color: vec4<f32>,   // premultiplied RGBA accumulated front to back
+    value: vec4<f32>,   // per component: max (MIP), min (MinIP), sum (average, additive)
+    misc: vec4<f32>,    // x: samples counted, y: window depth of the depth sample, z: 1 once depth is set
+}
+
+fn has_flag(f: u32) -> bool {
+    return (frame.mode.y & f) != 0u;
+}
+
+// Linear lookup into table `which` (0: colour+alpha, 1: corrected alpha & gradient opacity)
+// of component `c` at normalised coordinate u in [0, 1] (clamped, like VTK's tables).
+fn table_lookup(c: u32, which: u32, u: f32) -> vec4<f32> {
+    let n = frame.mode.w;
+    let x = clamp(u, 0.0, 1.0) * f32(n - 1u);
+    let i0 = u32(floor(x));
+    let i1 = min(i0 + 1u, n - 1u);
+    let base = (2u * c + which) * n;
+    return mix(tables[base + i0], tables[base + i1], x - f32(i0));
+}
+
+fn scalar_coord(c: u32, s: f32) -> f32 {
+    return (s - frame.tf_lo[c]) * frame.tf_inv_width[c];
+}
+
+// Colour and un-corrected opacity of scalar s for component c.
+fn classify(c: u32, s: f32) -> vec4<f32> {
+    return table_lookup(c, 0u, scalar_coord(c, s));
+}
+
+// Hash of a pixel index to [0, 1): deterministic jitter (PCG).
+fn hash01(v: u32) -> f32 {
+    var s = v * 747796405u + 2891336453u;
+    s = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    s = (s >> 22u) ^ s;
+    return f32(s >> 8u) / 16777216.0;
+}

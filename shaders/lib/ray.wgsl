@@ -1,0 +1,72 @@
+// Rays: one per pixel through the pixel centre, in world space and in the volume's index
+// space, parameterised by world distance from the near plane.
+
+struct Ray {
+    origin: vec3<f32>,      // world, on the near plane
+    dir: vec3<f32>,         // world, unit
+    far: f32,               // world distance to the far plane
+    index_origin: vec3<f32>,
+    index_dir: vec3<f32>,   // index-space change per world unit along the ray
+}
+
+fn unproject(ndc: vec3<f32>) -> vec3<f32> {
+    let p = frame.inv_view_proj * vec4<f32>(ndc, 1.0);
+    return p.xyz / p.w;
+}
+
+fn pixel_ndc(px: vec2<u32>) -> vec2<f32> {
+    let size = vec2<f32>(f32(frame.viewport.x), f32(frame.viewport.y));
+    let uv = (vec2<f32>(px) + 0.5) / size;
+    return vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+}
+
+fn make_ray(px: vec2<u32>) -> Ray {
+    let ndc = pixel_ndc(px);
+    let near = unproject(vec3<f32>(ndc, -1.0));
+    let far = unproject(vec3<f32>(ndc, 1.0));
+    var r: Ray;
+    r.origin = near;
+    r.far = length(far - near);
+    r.dir = (far - near) / r.far;
+    r.index_origin = (frame.world_to_index * vec4<f32>(near, 1.0)).xyz;
+    r.index_dir = (frame.world_to_index * vec4<f32>(r.dir, 0.0)).xyz;
+    return r;
+}
+
+// Entry and exit distances of the ray through the box [lo, hi] (index space).
+fn box_interval(r: Ray, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
+    let inv = 1.0 / r.index_dir;
+    let t0 = (lo - r.index_origin) * inv;
+    let t1 = (hi - r.index_origin) * inv;
+    let tmin = min(t0, t1);
+    let tmax = max(t0, t1);
+    return vec2<f32>(max(max(tmin.x, tmin.y), tmin.z), min(min(tmax.x, tmax.y), tmax.z));
+}
+
+// Distance along the ray of a window depth value (0 near … 1 far).
+fn depth_to_distance(r: Ray, px: vec2<u32>, depth: f32) -> f32 {
+    let p = unproject(vec3<f32>(pixel_ndc(px), depth * 2.0 - 1.0));
+    return dot(p - r.origin, r.dir);
+}
+
+fn distance_to_depth(r: Ray, t: f32) -> f32 {
+    let c = frame.view_proj * vec4<f32>(r.origin + t * r.dir, 1.0);
+    return clamp(0.5 * c.z / c.w + 0.5, 0.0, 1.0);
+}
+
+// Narrows [t.x, t.y] by the clipping planes.
+fn clip_interval(r: Ray, t_in: vec2<f32>) -> vec2<f32> {
+    var t = t_in;
+    for (var i = 0u; i < frame.counts.x; i = i + 1u) {
+        let pl = frame.clip[i];
+        let dist = dot(pl.xyz, r.index_origin) + pl.w;   // signed, at t = 0
+        let rate = dot(pl.xyz, r.index_dir);
+        if (abs(rate) < 1e-12) {
+            if (dist < 0.0) { t.y = t.x; }
+        } else {
+            let th = -dist / rate;
+            if (rate > 0.0) { t.x = max(t.x, th); } else { t.y = min(t.y, th); }
+        }
+    }
+    return t;
+}

@@ -1,0 +1,59 @@
+// Phong local illumination with VTK's volume shading conventions
+// (vtkVolumeShaderComposer.h): the normal is the negated normalised gradient; ambient and
+// diffuse modulate the sample colour, specular adds the lights' specular colour (white
+// highlights); the specular term uses the reflection vector, as VTK does; with two-sided
+// lighting a light behind the surface lights its back. Where the gradient vanishes there
+// is no normal and only the ambient term remains.
+
+fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec3<f32> {
+    let glen = length(grad);
+    var ambient = vec3<f32>(0.0);
+    var diffuse = vec3<f32>(0.0);
+    var specular = vec3<f32>(0.0);
+    let has_normal = glen > frame.misc.w;
+    var n = vec3<f32>(0.0);
+    if (has_normal) {
+        n = -grad / glen;
+    }
+    let v = -view_dir;
+    for (var i = 0u; i < frame.counts.y; i = i + 1u) {
+        let light = frame.lights[i];
+        ambient = ambient + light.ambient.rgb;
+        if (!has_normal) {
+            continue;
+        }
+        var l = light.position.xyz;
+        var atten = 1.0;
+        if (light.position.w > 0.5) {
+            let lv = light.position.xyz - pos;
+            let d = length(lv);
+            l = lv / max(d, 1e-20);
+            let a = light.attenuation;
+            atten = 1.0 / max(a.x + a.y * d + a.z * d * d, 1e-20);
+            if (light.spot.w > -1.5) {
+                let cos_a = dot(-l, light.spot.xyz);
+                if (cos_a < light.spot.w) {
+                    atten = 0.0;
+                } else {
+                    atten = atten * pow(max(cos_a, 0.0), light.diffuse.w);
+                }
+            }
+        }
+        var nl = n;
+        var ndl = dot(nl, l);
+        if (ndl < 0.0 && has_flag(FLAG_TWO_SIDED)) {
+            nl = -nl;
+            ndl = -ndl;
+        }
+        if (ndl > 0.0) {
+            diffuse = diffuse + atten * ndl * light.diffuse.rgb;
+            let r = 2.0 * ndl * nl - l;
+            let rdv = dot(r, v);
+            if (rdv > 0.0) {
+                specular = specular + atten * pow(rdv, frame.material.w) * light.specular.rgb;
+            }
+        }
+    }
+    let lit = color * (frame.material.x * ambient + frame.material.y * diffuse) + frame.material.z * specular;
+    return clamp(lit, vec3<f32>(0.0), vec3<f32>(1.0));
+}
