@@ -7,6 +7,16 @@
 #include "lib/volume.wgsl"
 #include "lib/shading.wgsl"
 
+// Pipeline constants: each combination is its own pipeline, so the ray loop carries only
+// the code of the mode it runs (core/src/renderer.rs, DvrVariant).
+override BLEND: u32 = 0u;
+override NCOMP: u32 = 1u;
+override INDEPENDENT: bool = true;
+override SHADE: bool = false;
+override GRAD_OPACITY: bool = false;
+override SKIP: bool = false;
+override CROP: bool = false;
+
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
 // Per block of the occupancy grid: 1 when the transfer function gives some block voxel a
 // non-zero opacity, 0 when the whole block is transparent.
@@ -15,9 +25,9 @@
 
 // Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
 fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
-    let ncomp = frame.counts.w;
-    let need_grad = has_flag(FLAG_SHADE) || has_flag(FLAG_GRADIENT_OPACITY);
-    if (!has_flag(FLAG_INDEPENDENT)) {
+    let ncomp = NCOMP;
+    let need_grad = SHADE || GRAD_OPACITY;
+    if (!INDEPENDENT) {
         // Dependent components: 2 = (colour scalar, opacity scalar); 4 = RGB + opacity scalar.
         let oc = ncomp - 1u;
         let u = scalar_coord(0u, s[oc]);
@@ -31,10 +41,10 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         }
         if (need_grad) {
             let g = world_gradient(gradient_at(p, s), oc);
-            if (has_flag(FLAG_GRADIENT_OPACITY)) {
+            if (GRAD_OPACITY) {
                 a = a * table_lookup(0u, 1u, (length(g) - frame.go_lo.x) * frame.go_inv_width.x).y;
             }
-            if (has_flag(FLAG_SHADE)) {
+            if (SHADE) {
                 rgb = shade(rgb, g, pos, view_dir);
             }
         }
@@ -67,10 +77,10 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         var rgb = classify(c, s[c]).rgb;
         if (need_grad) {
             let gw = world_gradient(g, c);
-            if (has_flag(FLAG_GRADIENT_OPACITY)) {
+            if (GRAD_OPACITY) {
                 a = a * table_lookup(c, 1u, (length(gw) - frame.go_lo[c]) * frame.go_inv_width[c]).y;
             }
-            if (has_flag(FLAG_SHADE)) {
+            if (SHADE) {
                 rgb = shade(rgb, gw, pos, view_dir);
             }
         }
@@ -88,7 +98,7 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
 // opacity scaled by `scale` per component.
 fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     var out = vec4<f32>(0.0);
-    for (var c = 0u; c < frame.counts.w; c = c + 1u) {
+    for (var c = 0u; c < NCOMP; c = c + 1u) {
         let u = clamp(scalar_coord(c, s[c]), 0.0, 1.0);
         out[c] = classify(c, s[c]).a * u * scale[c];
     }
@@ -123,7 +133,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pix = gid.y * frame.viewport.x + gid.x;
-    let blend = frame.mode.x;
+    let blend = BLEND;
     var st = state[pix];
     let ert = frame.misc.y;
     if (blend == BLEND_COMPOSITE && st.color.a >= ert) {
@@ -153,8 +163,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var k = max(ceil((t_lo - seg.x) / dt - jit), 0.0);
     let k_end = ceil((t_hi - seg.x) / dt - jit);
-    let skip = has_flag(FLAG_SKIP_EMPTY) && blend == BLEND_COMPOSITE;
-    let crop = has_flag(FLAG_CROP);
     var color = st.color;
     var value = st.value;
     var misc = st.misc;
@@ -164,11 +172,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         let t = seg.x + (k + jit) * dt;
         let p = ray.index_origin + t * ray.index_dir;
-        if (skip && !block_occupied(p)) {
+        if (SKIP && !block_occupied(p)) {
             k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
             continue;
         }
-        if (crop && !in_crop(p)) {
+        if (CROP && !in_crop(p)) {
             k = k + 1.0;
             continue;
         }

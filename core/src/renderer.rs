@@ -117,9 +117,38 @@ struct TableKey {
     step_bits: u64,
 }
 
+/// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct DvrVariant {
+    blend: u32,
+    components: u32,
+    independent: bool,
+    shade: bool,
+    gradient_opacity: bool,
+    skip: bool,
+    crop: bool,
+}
+
+impl DvrVariant {
+    fn constants(&self) -> [(&'static str, f64); 7] {
+        let b = |v: bool| if v { 1.0 } else { 0.0 };
+        [
+            ("BLEND", self.blend as f64),
+            ("NCOMP", self.components as f64),
+            ("INDEPENDENT", b(self.independent)),
+            ("SHADE", b(self.shade)),
+            ("GRAD_OPACITY", b(self.gradient_opacity)),
+            ("SKIP", b(self.skip)),
+            ("CROP", b(self.crop)),
+        ]
+    }
+}
+
 pub struct Renderer {
     ctx: Context,
-    dvr: wgpu::ComputePipeline,
+    dvr_module: wgpu::ShaderModule,
+    dvr_layout: wgpu::PipelineLayout,
+    dvr_variants: std::collections::HashMap<DvrVariant, wgpu::ComputePipeline>,
     resolve: wgpu::ComputePipeline,
     dvr_bgl: wgpu::BindGroupLayout,
     brick_bgl: wgpu::BindGroupLayout,
@@ -195,29 +224,31 @@ impl Renderer {
                 }),
             ],
         });
-        let pipeline = |name: &str, bgls: &[Option<&wgpu::BindGroupLayout>]| -> Result<wgpu::ComputePipeline> {
+        let module = |name: &str| -> Result<wgpu::ShaderModule> {
             ctx.checked(&format!("compiling shader {name}"), || {
-                let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+                d.create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some(name),
                     source: wgpu::ShaderSource::Wgsl(crate::shaders::compose(name).into()),
-                });
-                let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(name),
-                    bind_group_layouts: bgls,
-                    immediate_size: 0,
-                });
-                d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(name),
-                    layout: Some(&layout),
-                    module: &module,
-                    entry_point: Some("main"),
-                    compilation_options: Default::default(),
-                    cache: None,
                 })
             })
         };
-        let dvr = pipeline("dvr.wgsl", &[Some(&dvr_bgl), Some(&brick_bgl)])?;
-        let resolve = pipeline("resolve.wgsl", &[Some(&resolve_bgl)])?;
+        let layout = |name: &str, bgls: &[Option<&wgpu::BindGroupLayout>]| {
+            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(name), bind_group_layouts: bgls, immediate_size: 0 })
+        };
+        let dvr_module = module("dvr.wgsl")?;
+        let dvr_layout = layout("dvr.wgsl", &[Some(&dvr_bgl), Some(&brick_bgl)]);
+        let resolve_module = module("resolve.wgsl")?;
+        let resolve_layout = layout("resolve.wgsl", &[Some(&resolve_bgl)]);
+        let resolve = ctx.checked("creating the resolve pipeline", || {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("resolve"),
+                layout: Some(&resolve_layout),
+                module: &resolve_module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
         let sampler = |f: wgpu::FilterMode| {
             d.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("volume"),
@@ -239,7 +270,9 @@ impl Renderer {
         });
         Ok(Renderer {
             ctx,
-            dvr,
+            dvr_module,
+            dvr_layout,
+            dvr_variants: Default::default(),
             resolve,
             dvr_bgl,
             brick_bgl,
@@ -673,6 +706,30 @@ impl Renderer {
             }
         }
         let u = self.frame_uniforms(view, params, step, depth.is_some())?;
+        let variant = DvrVariant {
+            blend: params.blend.code(),
+            components: u.counts[3],
+            independent: u.mode[1] & FLAG_INDEPENDENT != 0,
+            shade: u.mode[1] & FLAG_SHADE != 0,
+            gradient_opacity: u.mode[1] & FLAG_GRADIENT_OPACITY != 0,
+            skip,
+            crop: u.mode[1] & FLAG_CROP != 0,
+        };
+        if !self.dvr_variants.contains_key(&variant) {
+            let constants = variant.constants();
+            let p = self.ctx.checked("creating a ray-casting pipeline", || {
+                self.ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("dvr"),
+                    layout: Some(&self.dvr_layout),
+                    module: &self.dvr_module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, zero_initialize_workgroup_memory: false },
+                    cache: None,
+                })
+            })?;
+            self.dvr_variants.insert(variant, p);
+        }
+        let dvr = &self.dvr_variants[&variant];
         let order = self.brick_order(view, params);
         let t = self.targets.as_ref().expect("targets allocated above");
         let vol = self.volume.as_ref().expect("checked in frame_uniforms");
@@ -720,7 +777,7 @@ impl Renderer {
         for i in order {
             let b = &vol.bricks[i];
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("dvr"), timestamp_writes: None });
-            pass.set_pipeline(&self.dvr);
+            pass.set_pipeline(dvr);
             pass.set_bind_group(0, &dvr_bg, &[]);
             let bg = if params.interpolation == Interpolation::Nearest { &b.bind_nearest } else { &b.bind_linear };
             pass.set_bind_group(1, bg, &[]);

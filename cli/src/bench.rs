@@ -1,0 +1,165 @@
+//! `ferrovol bench`: VTK's TestGPURayCastMapperBenchmark scene (wavelet over extent
+//! −127..128, 900×900, colour/opacity as VTK's test, camera azimuth +1° and elevation +1°
+//! per frame), unshaded then shaded; optionally the same scene through VTK's
+//! vtkGPUVolumeRayCastMapper in the same run, and the ratio.
+
+use crate::{presets, spinner, CliError};
+use ferrovol_core::{synth, Context, Interpolation, RenderParams, Renderer, View};
+use glam::DVec3;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    #[arg(long, default_value = "900x900", value_parser = crate::parse_size)]
+    size: (u32, u32),
+    /// Frames timed per configuration (after two warm-up frames).
+    #[arg(long, default_value_t = 20)]
+    frames: u32,
+    /// Half-extent of the wavelet: −N+1..N... VTK's benchmark uses 127 (−127..128, 256³).
+    #[arg(long, default_value_t = 127)]
+    extent: i32,
+    /// Also run VTK's vtkGPUVolumeRayCastMapper on the same scene (needs a display, e.g. Xvfb).
+    #[arg(long)]
+    vtk: bool,
+    /// Python with Debian ParaView's VTK 9.2.
+    #[arg(long, default_value = "/usr/bin/python3")]
+    vtk_python: String,
+    /// The VTK benchmark script.
+    #[arg(long, default_value = "bench/vtk_bench.py")]
+    vtk_script: String,
+    /// Write the last frame of each configuration to DIR/ferrovol-{unshaded,shaded}.png.
+    #[arg(long)]
+    png_dir: Option<std::path::PathBuf>,
+}
+
+/// Samples a full march would take (no early termination or skipping), summed over pixels.
+fn nominal_samples(view: &View, bounds: [f64; 6], step: f64) -> f64 {
+    let vp_inv = view.camera.view_projection(view.aspect()).inverse();
+    let lo = DVec3::new(bounds[0], bounds[2], bounds[4]);
+    let hi = DVec3::new(bounds[1], bounds[3], bounds[5]);
+    let mut total = 0.0;
+    for y in 0..view.height {
+        for x in 0..view.width {
+            let nx = 2.0 * (x as f64 + 0.5) / view.width as f64 - 1.0;
+            let ny = 1.0 - 2.0 * (y as f64 + 0.5) / view.height as f64;
+            let a = vp_inv.project_point3(DVec3::new(nx, ny, -1.0));
+            let b = vp_inv.project_point3(DVec3::new(nx, ny, 1.0));
+            let d = (b - a).normalize();
+            let t0 = (lo - a) / d;
+            let t1 = (hi - a) / d;
+            let tmin = t0.min(t1).max_element().max(0.0);
+            let tmax = t0.max(t1).min_element();
+            if tmax > tmin {
+                total += ((tmax - tmin) / step).ceil();
+            }
+        }
+    }
+    total
+}
+
+struct Figures {
+    ms_per_frame: f64,
+    samples_per_s: f64,
+}
+
+fn time_config(r: &mut Renderer, base: &View, params: &RenderParams, frames: u32, bounds: [f64; 6]) -> Result<Figures, CliError> {
+    let mut view = base.clone();
+    let step = r.sample_distance(params)?;
+    let advance = |v: &mut View| {
+        v.camera.azimuth(1.0);
+        v.camera.elevation(1.0);
+        v.camera.orthogonalize_view_up();
+        v.camera.reset_clipping_range(bounds);
+    };
+    for _ in 0..2 {
+        advance(&mut view);
+        r.render(&view, params, None)?;
+        r.context().wait_idle()?;
+    }
+    let pb = indicatif::ProgressBar::new(frames as u64);
+    let mut samples = 0.0;
+    let mut elapsed = 0.0;
+    for _ in 0..frames {
+        advance(&mut view);
+        let t = Instant::now();
+        r.render(&view, params, None)?;
+        r.context().wait_idle()?;
+        elapsed += t.elapsed().as_secs_f64();
+        if std::env::var("FERROVOL_BENCH_TRACE").is_ok() { eprintln!("frame {:.1} ms", t.elapsed().as_secs_f64() * 1e3); }
+        samples += nominal_samples(&view, bounds, step);
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+    Ok(Figures { ms_per_frame: 1e3 * elapsed / frames as f64, samples_per_s: samples / elapsed })
+}
+
+/// Runs VTK's mapper on the scene; returns (unshaded, shaded) ms/frame.
+fn run_vtk(a: &BenchArgs) -> Result<(f64, f64), CliError> {
+    let out = std::process::Command::new(&a.vtk_python)
+        .args([&a.vtk_script, "--frames", &a.frames.to_string(), "--size", &format!("{}x{}", a.size.0, a.size.1), "--extent", &a.extent.to_string()])
+        .output()
+        .map_err(|e| CliError::Usage(format!("cannot run {} {}: {e}", a.vtk_python, a.vtk_script)))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        return Err(CliError::Usage(format!(
+            "VTK benchmark failed ({}): {}{}",
+            out.status,
+            text,
+            String::from_utf8_lossy(&out.stderr)
+        )));
+    }
+    let find = |key: &str| -> Result<f64, CliError> {
+        text.lines()
+            .find(|l| l.starts_with(key))
+            .and_then(|l| l.split("ms_per_frame=").nth(1))
+            .and_then(|v| v.split_whitespace().next())
+            .and_then(|v| v.parse().ok())
+            .ok_or_else(|| CliError::Usage(format!("VTK benchmark printed no '{key} ms_per_frame=' line:\n{text}")))
+    };
+    for l in text.lines().filter(|l| l.starts_with('#')) {
+        println!("{l}");
+    }
+    Ok((find("vtk_gpu unshaded")?, find("vtk_gpu shaded")?))
+}
+
+pub fn run(a: BenchArgs) -> Result<(), CliError> {
+    if a.extent < 1 || a.frames == 0 {
+        return Err(CliError::Usage("--extent and --frames must be at least 1".into()));
+    }
+    let pb = spinner("generating the wavelet");
+    let e = a.extent;
+    let vol = synth::wavelet([-e, e + 1, -e, e + 1, -e, e + 1]);
+    let bounds = vol.bounds();
+    pb.set_message("uploading");
+    let mut r = Renderer::new(Context::new()?)?;
+    r.set_volume(&vol)?;
+    r.set_transfer_function(&presets::wavelet_tf())?;
+    pb.finish_and_clear();
+    if let Ok(s) = std::env::var("FERROVOL_BENCH_SLEEP") { std::thread::sleep(std::time::Duration::from_secs_f64(s.parse().unwrap_or(0.0))); }
+    let (w, h) = a.size;
+    let view = View::fit(bounds, w, h);
+    println!("# ferrovol bench: wavelet {}^3 float32, {w}x{h}, {} frames, adapter {} ({})", 2 * e + 2, a.frames, r.context().info.name, r.context().info.backend);
+    println!("# timing: wall clock per frame (submit to GPU idle); samples = nominal ray samples without early termination");
+    let mut ours = Vec::new();
+    for shaded in [false, true] {
+        // VTK's benchmark keeps vtkVolumeProperty's default nearest interpolation.
+        let mut params = RenderParams { interpolation: Interpolation::Nearest, ..Default::default() };
+        params.shading.enabled = shaded;
+        let f = time_config(&mut r, &view, &params, a.frames, bounds)?;
+        let name = if shaded { "shaded" } else { "unshaded" };
+        println!("ferrovol {name} ms_per_frame={:.1} samples_per_s={:.3e} occupied_blocks={:.3}", f.ms_per_frame, f.samples_per_s, r.occupied_fraction().unwrap_or(1.0));
+        if let Some(dir) = &a.png_dir {
+            std::fs::create_dir_all(dir).map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
+            r.read_image()?.save_png(&dir.join(format!("ferrovol-{name}.png")), [0.0; 3])?;
+        }
+        ours.push(f.ms_per_frame);
+    }
+    if a.vtk {
+        let (vu, vs) = run_vtk(&a)?;
+        println!("vtk_gpu unshaded ms_per_frame={vu:.1}");
+        println!("vtk_gpu shaded ms_per_frame={vs:.1}");
+        println!("ratio unshaded ferrovol/vtk={:.3}", ours[0] / vu);
+        println!("ratio shaded ferrovol/vtk={:.3}", ours[1] / vs);
+    }
+    Ok(())
+}

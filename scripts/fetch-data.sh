@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Installs the real test volumes from Debian packages (../shared/DATA.md) and converts them
+# once into build/data/ (never committed). Idempotent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mkdir -p build/data
+need=()
+dpkg-query -W -f='${Status}' invesalius-examples 2>/dev/null | grep -q "install ok installed" || need+=(invesalius-examples)
+dpkg-query -W -f='${Status}' mricron-data 2>/dev/null | grep -q "install ok installed" || need+=(mricron-data)
+if [ ${#need[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
+fi
+[ -f build/data/cranium.vti ] || python3 scripts/convert_inv3.py \
+  /usr/share/doc/invesalius-examples/examples/Cranium.inv3 build/data/cranium.vti
+[ -f build/data/colin27.nii.gz ] || cp /usr/share/mricron/templates/ch2.nii.gz build/data/colin27.nii.gz
+ls -la build/data
