@@ -30,8 +30,7 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
     if (!INDEPENDENT) {
         // Dependent components: 2 = (colour scalar, opacity scalar); 4 = RGB + opacity scalar.
         let oc = ncomp - 1u;
-        let u = scalar_coord(0u, s[oc]);
-        var a = table_lookup(0u, 1u, u).x;
+        var a = classify(0u, s[oc]).a;
         if (a <= 0.0) {
             return vec4<f32>(0.0);
         }
@@ -42,7 +41,7 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         if (need_grad) {
             let g = world_gradient(gradient_at(p, s), oc);
             if (GRAD_OPACITY) {
-                a = a * table_lookup(0u, 1u, (length(g) - frame.go_lo.x) * frame.go_inv_width.x).y;
+                a = a * gradient_opacity(0u, length(g));
             }
             if (SHADE) {
                 rgb = shade(rgb, g, pos, view_dir);
@@ -52,11 +51,11 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
     }
     // Independent components, mixed as VTK does: colour weighted by opacity × weight,
     // opacity the opacity-weighted mean of the components' opacities.
-    var alpha = vec4<f32>(0.0);
+    var entry: array<vec4<f32>, 4>;
     var any = false;
     for (var c = 0u; c < ncomp; c = c + 1u) {
-        alpha[c] = table_lookup(c, 1u, scalar_coord(c, s[c])).x;
-        any = any || alpha[c] * frame.weights[c] > 0.0;
+        entry[c] = classify(c, s[c]);
+        any = any || entry[c].a * frame.weights[c] > 0.0;
     }
     if (!any) {
         return vec4<f32>(0.0);
@@ -69,16 +68,16 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
     var a_sq = 0.0;
     var total = 0.0;
     for (var c = 0u; c < ncomp; c = c + 1u) {
-        var a = alpha[c];
+        var a = entry[c].a;
         let w = frame.weights[c];
         if (a <= 0.0 || w <= 0.0) {
             continue;
         }
-        var rgb = classify(c, s[c]).rgb;
+        var rgb = entry[c].rgb;
         if (need_grad) {
             let gw = world_gradient(g, c);
             if (GRAD_OPACITY) {
-                a = a * table_lookup(c, 1u, (length(gw) - frame.go_lo[c]) * frame.go_inv_width[c]).y;
+                a = a * gradient_opacity(c, length(gw));
             }
             if (SHADE) {
                 rgb = shade(rgb, gw, pos, view_dir);
@@ -100,7 +99,7 @@ fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     var out = vec4<f32>(0.0);
     for (var c = 0u; c < NCOMP; c = c + 1u) {
         let u = clamp(scalar_coord(c, s[c]), 0.0, 1.0);
-        out[c] = classify(c, s[c]).a * u * scale[c];
+        out[c] = raw_alpha(c, s[c]) * u * scale[c];
     }
     return out;
 }

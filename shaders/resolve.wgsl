@@ -14,13 +14,13 @@ fn classify_value(v: vec4<f32>) -> vec4<f32> {
     let ncomp = frame.counts.w;
     if (!has_flag(FLAG_INDEPENDENT)) {
         let oc = ncomp - 1u;
-        let a = classify(0u, v[oc]).a;
+        let a = raw_alpha(0u, v[oc]);
         return vec4<f32>(classify(0u, v.x).rgb * a, a);
     }
     var out = vec4<f32>(0.0);
     for (var c = 0u; c < ncomp; c = c + 1u) {
         let e = classify(c, v[c]);
-        let a = e.a * frame.weights[c];
+        let a = raw_alpha(c, v[c]) * frame.weights[c];
         out = out + vec4<f32>(e.rgb * a, a);
     }
     return out;

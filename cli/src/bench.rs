@@ -27,6 +27,12 @@ pub struct BenchArgs {
     /// The VTK benchmark script.
     #[arg(long, default_value = "bench/vtk_bench.py")]
     vtk_script: String,
+    /// Bench this volume file instead of the wavelet (no VTK run; adds skipping on/off).
+    #[arg(long)]
+    input: Option<std::path::PathBuf>,
+    /// Transfer-function preset or JSON for --input.
+    #[arg(long, default_value = "auto")]
+    tf: String,
     /// Write the last frame of each configuration to DIR/ferrovol-{unshaded,shaded}.png.
     #[arg(long)]
     png_dir: Option<std::path::PathBuf>,
@@ -62,7 +68,13 @@ struct Figures {
     samples_per_s: f64,
 }
 
-fn time_config(r: &mut Renderer, base: &View, params: &RenderParams, frames: u32, bounds: [f64; 6]) -> Result<Figures, CliError> {
+fn time_config(
+    r: &mut Renderer,
+    base: &View,
+    params: &RenderParams,
+    frames: u32,
+    bounds: [f64; 6],
+) -> Result<Figures, CliError> {
     let mut view = base.clone();
     let step = r.sample_distance(params)?;
     let advance = |v: &mut View| {
@@ -85,20 +97,35 @@ fn time_config(r: &mut Renderer, base: &View, params: &RenderParams, frames: u32
         r.render(&view, params, None)?;
         r.context().wait_idle()?;
         elapsed += t.elapsed().as_secs_f64();
-        if std::env::var("FERROVOL_BENCH_TRACE").is_ok() { eprintln!("frame {:.1} ms", t.elapsed().as_secs_f64() * 1e3); }
+        if std::env::var("FERROVOL_BENCH_TRACE").is_ok() {
+            eprintln!("frame {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+        }
         samples += nominal_samples(&view, bounds, step);
         pb.inc(1);
     }
     pb.finish_and_clear();
-    Ok(Figures { ms_per_frame: 1e3 * elapsed / frames as f64, samples_per_s: samples / elapsed })
+    Ok(Figures {
+        ms_per_frame: 1e3 * elapsed / frames as f64,
+        samples_per_s: samples / elapsed,
+    })
 }
 
 /// Runs VTK's mapper on the scene; returns (unshaded, shaded) ms/frame.
 fn run_vtk(a: &BenchArgs) -> Result<(f64, f64), CliError> {
     let out = std::process::Command::new(&a.vtk_python)
-        .args([&a.vtk_script, "--frames", &a.frames.to_string(), "--size", &format!("{}x{}", a.size.0, a.size.1), "--extent", &a.extent.to_string()])
+        .args([
+            &a.vtk_script,
+            "--frames",
+            &a.frames.to_string(),
+            "--size",
+            &format!("{}x{}", a.size.0, a.size.1),
+            "--extent",
+            &a.extent.to_string(),
+        ])
         .output()
-        .map_err(|e| CliError::Usage(format!("cannot run {} {}: {e}", a.vtk_python, a.vtk_script)))?;
+        .map_err(|e| {
+            CliError::Usage(format!("cannot run {} {}: {e}", a.vtk_python, a.vtk_script))
+        })?;
     let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
         return Err(CliError::Usage(format!(
@@ -114,7 +141,11 @@ fn run_vtk(a: &BenchArgs) -> Result<(f64, f64), CliError> {
             .and_then(|l| l.split("ms_per_frame=").nth(1))
             .and_then(|v| v.split_whitespace().next())
             .and_then(|v| v.parse().ok())
-            .ok_or_else(|| CliError::Usage(format!("VTK benchmark printed no '{key} ms_per_frame=' line:\n{text}")))
+            .ok_or_else(|| {
+                CliError::Usage(format!(
+                    "VTK benchmark printed no '{key} ms_per_frame=' line:\n{text}"
+                ))
+            })
     };
     for l in text.lines().filter(|l| l.starts_with('#')) {
         println!("{l}");
@@ -124,35 +155,79 @@ fn run_vtk(a: &BenchArgs) -> Result<(f64, f64), CliError> {
 
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
     if a.extent < 1 || a.frames == 0 {
-        return Err(CliError::Usage("--extent and --frames must be at least 1".into()));
+        return Err(CliError::Usage(
+            "--extent and --frames must be at least 1".into(),
+        ));
     }
-    let pb = spinner("generating the wavelet");
+    let pb = spinner("loading the volume");
     let e = a.extent;
-    let vol = synth::wavelet([-e, e + 1, -e, e + 1, -e, e + 1]);
+    let (vol, tf, name) = match &a.input {
+        Some(p) => {
+            let v = crate::readers::read_volume(p)?;
+            let tf = presets::transfer_function(&a.tf, &v)?;
+            (v, tf, p.display().to_string())
+        }
+        None => (
+            synth::wavelet([-e, e + 1, -e, e + 1, -e, e + 1]),
+            presets::wavelet_tf(),
+            format!("wavelet {}^3 float32", 2 * e + 2),
+        ),
+    };
     let bounds = vol.bounds();
     pb.set_message("uploading");
     let mut r = Renderer::new(Context::new()?)?;
     r.set_volume(&vol)?;
-    r.set_transfer_function(&presets::wavelet_tf())?;
+    r.set_transfer_function(&tf)?;
     pb.finish_and_clear();
-    if let Ok(s) = std::env::var("FERROVOL_BENCH_SLEEP") { std::thread::sleep(std::time::Duration::from_secs_f64(s.parse().unwrap_or(0.0))); }
+    if let Ok(s) = std::env::var("FERROVOL_BENCH_SLEEP") {
+        std::thread::sleep(std::time::Duration::from_secs_f64(s.parse().unwrap_or(0.0)));
+    }
     let (w, h) = a.size;
     let view = View::fit(bounds, w, h);
-    println!("# ferrovol bench: wavelet {}^3 float32, {w}x{h}, {} frames, adapter {} ({})", 2 * e + 2, a.frames, r.context().info.name, r.context().info.backend);
+    println!(
+        "# ferrovol bench: {name}, {w}x{h}, {} frames, adapter {} ({})",
+        a.frames,
+        r.context().info.name,
+        r.context().info.backend
+    );
     println!("# timing: wall clock per frame (submit to GPU idle); samples = nominal ray samples without early termination");
     let mut ours = Vec::new();
-    for shaded in [false, true] {
-        // VTK's benchmark keeps vtkVolumeProperty's default nearest interpolation.
-        let mut params = RenderParams { interpolation: Interpolation::Nearest, ..Default::default() };
-        params.shading.enabled = shaded;
-        let f = time_config(&mut r, &view, &params, a.frames, bounds)?;
-        let name = if shaded { "shaded" } else { "unshaded" };
-        println!("ferrovol {name} ms_per_frame={:.1} samples_per_s={:.3e} occupied_blocks={:.3}", f.ms_per_frame, f.samples_per_s, r.occupied_fraction().unwrap_or(1.0));
-        if let Some(dir) = &a.png_dir {
-            std::fs::create_dir_all(dir).map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
-            r.read_image()?.save_png(&dir.join(format!("ferrovol-{name}.png")), [0.0; 3])?;
+    let skips: &[bool] = if a.input.is_some() {
+        &[true, false]
+    } else {
+        &[true]
+    };
+    for &skip in skips {
+        for shaded in [false, true] {
+            // VTK's benchmark keeps vtkVolumeProperty's default nearest interpolation.
+            let mut params = RenderParams {
+                interpolation: Interpolation::Nearest,
+                empty_space_skipping: skip,
+                ..Default::default()
+            };
+            params.shading.enabled = shaded;
+            let f = time_config(&mut r, &view, &params, a.frames, bounds)?;
+            let name = if shaded { "shaded" } else { "unshaded" };
+            let skip_note = if skip {
+                format!(
+                    "skipping=on occupied_blocks={:.3}",
+                    r.occupied_fraction().unwrap_or(1.0)
+                )
+            } else {
+                "skipping=off".to_string()
+            };
+            println!(
+                "ferrovol {name} ms_per_frame={:.1} samples_per_s={:.3e} {skip_note}",
+                f.ms_per_frame, f.samples_per_s
+            );
+            if let Some(dir) = &a.png_dir {
+                std::fs::create_dir_all(dir)
+                    .map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
+                r.read_image()?
+                    .save_png(&dir.join(format!("ferrovol-{name}.png")), [0.0; 3])?;
+            }
+            ours.push(f.ms_per_frame);
         }
-        ours.push(f.ms_per_frame);
     }
     if a.vtk {
         let (vu, vs) = run_vtk(&a)?;

@@ -6,7 +6,8 @@ mod readers;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
-    synth, BlendMode, Context, GradientMethod, Interpolation, RenderParams, Renderer, UploadOptions, View, VolumeData,
+    synth, BlendMode, Context, GradientMethod, Interpolation, RenderParams, Renderer,
+    UploadOptions, View, VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -112,9 +113,17 @@ struct RenderArgs {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size '{s}' must look like 512x512"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("width '{w}' is not a positive integer"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("height '{h}' is not a positive integer"))?;
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size '{s}' must look like 512x512"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("width '{w}' is not a positive integer"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("height '{h}' is not a positive integer"))?;
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(format!("size {w}x{h}: each side must be 1 to 16384"));
     }
@@ -122,10 +131,16 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
-    let v: Vec<f32> = s.split(',').map(|p| p.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| format!("colour '{s}' must be r,g,b"))?;
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("colour '{s}' must be r,g,b"))?;
     match v.as_slice() {
         [r, g, b] if v.iter().all(|c| (0.0..=1.0).contains(c)) => Ok([*r, *g, *b]),
-        _ => Err(format!("colour '{s}' must be three numbers in [0, 1] separated by commas")),
+        _ => Err(format!(
+            "colour '{s}' must be three numbers in [0, 1] separated by commas"
+        )),
     }
 }
 
@@ -181,7 +196,13 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     pb.set_message("starting the GPU");
     let mut r = Renderer::new(Context::new()?)?;
     pb.set_message("uploading");
-    r.set_volume_with(&vol, UploadOptions { max_brick_points: a.brick, max_brick_bytes: None })?;
+    r.set_volume_with(
+        &vol,
+        UploadOptions {
+            max_brick_points: a.brick,
+            max_brick_bytes: None,
+        },
+    )?;
     r.set_transfer_function(&tf)?;
     let (w, h) = a.size;
     let mut view = View::fit(vol.bounds(), w, h);
@@ -199,8 +220,16 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             Mode::Average => BlendMode::Average,
             Mode::Additive => BlendMode::Additive,
         },
-        interpolation: if a.interpolation == InterpArg::Nearest { Interpolation::Nearest } else { Interpolation::Linear },
-        gradient: if a.gradient == GradArg::Forward { GradientMethod::Forward } else { GradientMethod::Central },
+        interpolation: if a.interpolation == InterpArg::Nearest {
+            Interpolation::Nearest
+        } else {
+            Interpolation::Linear
+        },
+        gradient: if a.gradient == GradArg::Forward {
+            GradientMethod::Forward
+        } else {
+            GradientMethod::Central
+        },
         sample_distance: a.sample_distance,
         jitter: a.jitter,
         empty_space_skipping: !a.no_skip,
@@ -211,7 +240,10 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     let img = r.render_image(&view, &params)?;
     img.save_png(&a.out, a.background)?;
     pb.finish_and_clear();
-    let src = a.input.as_ref().map_or_else(|| format!("built-in {:?}", a.demo), |p| p.display().to_string());
+    let src = a.input.as_ref().map_or_else(
+        || format!("built-in {:?}", a.demo),
+        |p| p.display().to_string(),
+    );
     println!(
         "ferrovol: rendered {src} ({}x{}x{} {}, {} brick(s)) at {w}x{h} on {} -> {}",
         vol.dims[0],
@@ -230,7 +262,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(a) => render(a),
         Command::Bench(a) => bench::run(a),
-        Command::Info => Context::new().map(|c| println!("{}", c.info)).map_err(CliError::from),
+        Command::Info => Context::new()
+            .map(|c| println!("{}", c.info))
+            .map_err(CliError::from),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

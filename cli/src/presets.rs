@@ -8,19 +8,33 @@ use crate::CliError;
 use ferrovol_core::{ComponentTransfer, Piecewise, TransferFunction, VolumeData};
 use std::path::Path;
 
-pub const PRESETS: &[&str] = &["auto", "wavelet", "marschner-lobb", "sphere", "ct-bone", "ct-skin-bone", "mri", "grey"];
+pub const PRESETS: &[&str] = &[
+    "auto",
+    "wavelet",
+    "marschner-lobb",
+    "sphere",
+    "ct-bone",
+    "ct-skin-bone",
+    "mri",
+    "grey",
+];
 
 /// VTK's TestGPURayCastMapperBenchmark transfer function (for the wavelet).
 pub fn wavelet_tf() -> TransferFunction {
     tf(
-        &[(37.3531, [0.2, 0.29, 1.0]), (157.091, [0.87, 0.87, 0.87]), (276.829, [0.7, 0.015, 0.15])],
+        &[
+            (37.3531, [0.2, 0.29, 1.0]),
+            (157.091, [0.87, 0.87, 0.87]),
+            (276.829, [0.7, 0.015, 0.15]),
+        ],
         &[(37.3531, 0.0), (276.829, 1.0)],
     )
 }
 
 fn tf(color: &[(f64, [f32; 3])], opacity: &[(f64, f32)]) -> TransferFunction {
     let c = Piecewise::new(color.to_vec()).expect("preset points are finite");
-    let o = Piecewise::new(opacity.iter().map(|&(x, a)| (x, [a])).collect()).expect("preset points are finite");
+    let o = Piecewise::new(opacity.iter().map(|&(x, a)| (x, [a])).collect())
+        .expect("preset points are finite");
     TransferFunction::single(ComponentTransfer::new(c, o))
 }
 
@@ -31,21 +45,56 @@ pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunctio
     let mut t = match name {
         "wavelet" => wavelet_tf(),
         "marschner-lobb" => tf(
-            &[(0.0, [0.9, 0.5, 0.3]), (0.5, [1.0, 0.85, 0.6]), (1.0, [1.0, 1.0, 1.0])],
+            &[
+                (0.0, [0.9, 0.5, 0.3]),
+                (0.5, [1.0, 0.85, 0.6]),
+                (1.0, [1.0, 1.0, 1.0]),
+            ],
             &[(0.0, 0.0), (0.45, 0.0), (0.5, 0.6), (0.55, 0.0), (1.0, 0.0)],
         ),
-        "sphere" => tf(&[(-2.0, [1.0, 0.9, 0.7]), (2.0, [0.8, 0.4, 0.2])], &[(-2.0, 0.0), (-0.5, 0.9), (0.5, 0.9), (2.0, 0.0)]),
+        "sphere" => tf(
+            &[(-2.0, [1.0, 0.9, 0.7]), (2.0, [0.8, 0.4, 0.2])],
+            &[(-2.0, 0.0), (-0.5, 0.9), (0.5, 0.9), (2.0, 0.0)],
+        ),
         "ct-bone" => tf(
-            &[(-1000.0, [0.0, 0.0, 0.0]), (200.0, [0.9, 0.8, 0.7]), (1500.0, [1.0, 1.0, 0.95])],
+            &[
+                (-1000.0, [0.0, 0.0, 0.0]),
+                (200.0, [0.9, 0.8, 0.7]),
+                (1500.0, [1.0, 1.0, 0.95]),
+            ],
             &[(-1000.0, 0.0), (200.0, 0.0), (400.0, 0.6), (1500.0, 0.9)],
         ),
         "ct-skin-bone" => tf(
-            &[(-1000.0, [0.0, 0.0, 0.0]), (-500.0, [0.75, 0.5, 0.4]), (0.0, [0.9, 0.65, 0.55]), (300.0, [1.0, 0.95, 0.85]), (1500.0, [1.0, 1.0, 1.0])],
-            &[(-1000.0, 0.0), (-600.0, 0.0), (-400.0, 0.15), (-100.0, 0.0), (200.0, 0.0), (400.0, 0.8), (1500.0, 0.95)],
+            &[
+                (-1000.0, [0.0, 0.0, 0.0]),
+                (-500.0, [0.75, 0.5, 0.4]),
+                (0.0, [0.9, 0.65, 0.55]),
+                (300.0, [1.0, 0.95, 0.85]),
+                (1500.0, [1.0, 1.0, 1.0]),
+            ],
+            &[
+                (-1000.0, 0.0),
+                (-600.0, 0.0),
+                (-400.0, 0.15),
+                (-100.0, 0.0),
+                (200.0, 0.0),
+                (400.0, 0.8),
+                (1500.0, 0.95),
+            ],
         ),
         "mri" => tf(
-            &[(at(0.0), [0.0, 0.0, 0.0]), (at(0.3), [0.8, 0.55, 0.45]), (at(0.7), [1.0, 0.9, 0.8]), (at(1.0), [1.0, 1.0, 1.0])],
-            &[(at(0.0), 0.0), (at(0.15), 0.0), (at(0.35), 0.15), (at(1.0), 0.8)],
+            &[
+                (at(0.0), [0.0, 0.0, 0.0]),
+                (at(0.3), [0.8, 0.55, 0.45]),
+                (at(0.7), [1.0, 0.9, 0.8]),
+                (at(1.0), [1.0, 1.0, 1.0]),
+            ],
+            &[
+                (at(0.0), 0.0),
+                (at(0.15), 0.0),
+                (at(0.35), 0.15),
+                (at(1.0), 0.8),
+            ],
         ),
         "grey" | "auto" => tf(&[(lo, [0.0; 3]), (hi, [1.0; 3])], &[(lo, 0.0), (hi, 0.5)]),
         other => {
@@ -64,20 +113,40 @@ pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunctio
     Ok(t)
 }
 
-fn points<const N: usize>(path: &Path, v: &serde_json::Value, key: &str) -> Result<Option<Piecewise<N>>, CliError> {
-    let bad = |m: String| CliError::Usage(format!("{}: transfer function '{key}': {m}", path.display()));
-    let Some(arr) = v.get(key) else { return Ok(None) };
-    let arr = arr.as_array().ok_or_else(|| bad("must be an array of points".into()))?;
+fn points<const N: usize>(
+    path: &Path,
+    v: &serde_json::Value,
+    key: &str,
+) -> Result<Option<Piecewise<N>>, CliError> {
+    let bad = |m: String| {
+        CliError::Usage(format!(
+            "{}: transfer function '{key}': {m}",
+            path.display()
+        ))
+    };
+    let Some(arr) = v.get(key) else {
+        return Ok(None);
+    };
+    let arr = arr
+        .as_array()
+        .ok_or_else(|| bad("must be an array of points".into()))?;
     let mut pts = Vec::new();
     for (i, p) in arr.iter().enumerate() {
         let nums: Vec<f64> = p
             .as_array()
             .ok_or_else(|| bad(format!("point {i} must be an array")))?
             .iter()
-            .map(|x| x.as_f64().ok_or_else(|| bad(format!("point {i} has a non-number"))))
+            .map(|x| {
+                x.as_f64()
+                    .ok_or_else(|| bad(format!("point {i} has a non-number")))
+            })
             .collect::<Result<_, _>>()?;
         if nums.len() != N + 1 {
-            return Err(bad(format!("point {i} has {} numbers, expected {}", nums.len(), N + 1)));
+            return Err(bad(format!(
+                "point {i} has {} numbers, expected {}",
+                nums.len(),
+                N + 1
+            )));
         }
         let mut val = [0f32; N];
         for c in 0..N {
@@ -85,24 +154,37 @@ fn points<const N: usize>(path: &Path, v: &serde_json::Value, key: &str) -> Resu
         }
         pts.push((nums[0], val));
     }
-    Piecewise::new(pts).map(Some).map_err(|e| bad(e.to_string()))
+    Piecewise::new(pts)
+        .map(Some)
+        .map_err(|e| bad(e.to_string()))
 }
 
 fn from_json(path: &Path) -> Result<TransferFunction, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Usage(format!("{}: cannot read: {e}", path.display())))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CliError::Usage(format!("{}: not valid JSON: {e}", path.display())))?;
-    let color = points::<3>(path, &v, "color")?
-        .ok_or_else(|| CliError::Usage(format!("{}: a 'color' array of [x, r, g, b] points is required", path.display())))?;
-    let opacity = points::<1>(path, &v, "opacity")?
-        .ok_or_else(|| CliError::Usage(format!("{}: an 'opacity' array of [x, a] points is required", path.display())))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::Usage(format!("{}: cannot read: {e}", path.display())))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| CliError::Usage(format!("{}: not valid JSON: {e}", path.display())))?;
+    let color = points::<3>(path, &v, "color")?.ok_or_else(|| {
+        CliError::Usage(format!(
+            "{}: a 'color' array of [x, r, g, b] points is required",
+            path.display()
+        ))
+    })?;
+    let opacity = points::<1>(path, &v, "opacity")?.ok_or_else(|| {
+        CliError::Usage(format!(
+            "{}: an 'opacity' array of [x, a] points is required",
+            path.display()
+        ))
+    })?;
     let mut c = ComponentTransfer::new(color, opacity);
     c.gradient_opacity = points::<1>(path, &v, "gradient_opacity")?;
     if let Some(u) = v.get("unit_distance") {
-        c.unit_distance = u
-            .as_f64()
-            .filter(|u| *u > 0.0)
-            .ok_or_else(|| CliError::Usage(format!("{}: 'unit_distance' must be a positive number", path.display())))?;
+        c.unit_distance = u.as_f64().filter(|u| *u > 0.0).ok_or_else(|| {
+            CliError::Usage(format!(
+                "{}: 'unit_distance' must be a positive number",
+                path.display()
+            ))
+        })?;
     }
     Ok(TransferFunction::single(c))
 }

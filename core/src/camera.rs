@@ -43,12 +43,18 @@ impl Camera {
             0.5 * (bounds[2] + bounds[3]),
             0.5 * (bounds[4] + bounds[5]),
         );
-        let w = DVec3::new(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]);
+        let w = DVec3::new(
+            bounds[1] - bounds[0],
+            bounds[3] - bounds[2],
+            bounds[5] - bounds[4],
+        );
         let mut radius = 0.5 * w.length();
         if radius == 0.0 {
             radius = 0.5;
         }
-        let dir = (self.position - self.focal_point).try_normalize().unwrap_or(DVec3::Z);
+        let dir = (self.position - self.focal_point)
+            .try_normalize()
+            .unwrap_or(DVec3::Z);
         let distance = radius / (0.5 * self.view_angle.to_radians()).sin();
         self.focal_point = center;
         self.position = center + dir * distance;
@@ -81,7 +87,9 @@ impl Camera {
 
     /// Unit vector from position to focal point.
     pub fn direction(&self) -> DVec3 {
-        (self.focal_point - self.position).try_normalize().unwrap_or(DVec3::NEG_Z)
+        (self.focal_point - self.position)
+            .try_normalize()
+            .unwrap_or(DVec3::NEG_Z)
     }
 
     pub fn distance(&self) -> f64 {
@@ -127,7 +135,10 @@ impl Camera {
     /// Makes view up perpendicular to the direction of projection (vtkCamera::OrthogonalizeViewUp).
     pub fn orthogonalize_view_up(&mut self) {
         let d = self.direction();
-        let right = d.cross(self.view_up).try_normalize().unwrap_or_else(|| d.any_orthonormal_vector());
+        let right = d
+            .cross(self.view_up)
+            .try_normalize()
+            .unwrap_or_else(|| d.any_orthonormal_vector());
         self.view_up = right.cross(d).normalize();
     }
 
@@ -185,8 +196,16 @@ mod tests {
     fn azimuth_keeps_distance_and_turns() {
         let mut c = Camera::default();
         c.azimuth(90.0);
-        assert!((c.position - DVec3::new(1.0, 0.0, 0.0)).length() < 1e-12, "{:?}", c.position);
+        assert!(
+            (c.position - DVec3::new(1.0, 0.0, 0.0)).length() < 1e-12,
+            "{:?}",
+            c.position
+        );
         c.elevation(90.0);
-        assert!((c.position - DVec3::new(0.0, 1.0, 0.0)).length() < 1e-12, "{:?}", c.position);
+        assert!(
+            (c.position - DVec3::new(0.0, 1.0, 0.0)).length() < 1e-12,
+            "{:?}",
+            c.position
+        );
     }
 }

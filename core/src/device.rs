@@ -34,7 +34,10 @@ pub struct Context {
 
 fn backends_from_env() -> Result<wgpu::Backends> {
     match std::env::var("FERROVOL_BACKEND") {
-        Err(_) => Ok(wgpu::Backends::VULKAN | wgpu::Backends::GL | wgpu::Backends::METAL | wgpu::Backends::DX12),
+        Err(_) => Ok(wgpu::Backends::VULKAN
+            | wgpu::Backends::GL
+            | wgpu::Backends::METAL
+            | wgpu::Backends::DX12),
         Ok(s) => {
             let mut b = wgpu::Backends::empty();
             for part in s.split(',').map(|p| p.trim().to_ascii_lowercase()) {
@@ -77,7 +80,9 @@ impl Context {
         desc.backends = backends;
         let instance = wgpu::Instance::new(desc);
         let mut adapters = instance.enumerate_adapters(backends).await;
-        let wanted = std::env::var("FERROVOL_ADAPTER").ok().map(|s| s.to_lowercase());
+        let wanted = std::env::var("FERROVOL_ADAPTER")
+            .ok()
+            .map(|s| s.to_lowercase());
         if let Some(w) = &wanted {
             adapters.retain(|a| a.get_info().name.to_lowercase().contains(w.as_str()));
         }
@@ -115,7 +120,10 @@ impl Context {
                 ..Default::default()
             })
             .await
-            .map_err(|e| Error::RequestDevice { adapter: ai.name.clone(), message: e.to_string() })?;
+            .map_err(|e| Error::RequestDevice {
+                adapter: ai.name.clone(),
+                message: e.to_string(),
+            })?;
         let info = DeviceInfo {
             name: ai.name.clone(),
             backend: format!("{:?}", ai.backend),
@@ -129,7 +137,12 @@ impl Context {
             norm16: required.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM),
             timestamps: required.contains(wgpu::Features::TIMESTAMP_QUERY),
         };
-        Ok(Context { adapter, device, queue, info })
+        Ok(Context {
+            adapter,
+            device,
+            queue,
+            info,
+        })
     }
 
     /// Runs `f` and turns any wgpu validation or out-of-memory error it caused into an [`Error`].
@@ -163,10 +176,22 @@ impl std::fmt::Display for DeviceInfo {
         writeln!(f, "backend:   {}", self.backend)?;
         writeln!(f, "type:      {}", self.device_type)?;
         writeln!(f, "driver:    {} {}", self.driver, self.driver_info)?;
-        writeln!(f, "ids:       vendor 0x{:04x} device 0x{:04x}", self.vendor, self.device)?;
-        writeln!(f, "max 3D texture:     {}", self.limits.max_texture_dimension_3d)?;
+        writeln!(
+            f,
+            "ids:       vendor 0x{:04x} device 0x{:04x}",
+            self.vendor, self.device
+        )?;
+        writeln!(
+            f,
+            "max 3D texture:     {}",
+            self.limits.max_texture_dimension_3d
+        )?;
         writeln!(f, "max buffer size:    {}", self.limits.max_buffer_size)?;
-        writeln!(f, "max storage buffer: {}", self.limits.max_storage_buffer_binding_size)?;
+        writeln!(
+            f,
+            "max storage buffer: {}",
+            self.limits.max_storage_buffer_binding_size
+        )?;
         writeln!(f, "float32 filterable: {}", self.float32_filterable)?;
         writeln!(f, "16-bit norm:        {}", self.norm16)?;
         write!(f, "timestamps:         {}", self.timestamps)

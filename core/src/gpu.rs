@@ -54,6 +54,7 @@ pub struct BrickUniforms {
     pub core_hi: [f32; 4],
     pub tex_lo: [f32; 4],
     pub tex_size: [f32; 4],
+    pub tex_inv_size: [f32; 4],
 }
 
 /// Per-pixel ray state (PixelState in WGSL), 48 bytes.
@@ -68,8 +69,6 @@ pub const FLAG_TWO_SIDED: u32 = 16;
 pub const FLAG_GRADIENT_OPACITY: u32 = 32;
 pub const FLAG_INDEPENDENT: u32 = 64;
 pub const FLAG_DEPTH_INPUT: u32 = 128;
-pub const FLAG_SKIP_EMPTY: u32 = 256;
-pub const FLAG_PARALLEL: u32 = 512;
 pub const FLAG_AVERAGE_RANGE: u32 = 1024;
 
 pub fn mat(m: glam::DMat4) -> [f32; 16] {
@@ -93,7 +92,13 @@ mod layout_tests {
             if t.name.as_deref() == Some(name) {
                 if let naga::TypeInner::Struct { members, span } = &t.inner {
                     let _ = h;
-                    return (members.iter().map(|mm| (mm.name.clone().unwrap(), mm.offset)).collect(), *span);
+                    return (
+                        members
+                            .iter()
+                            .map(|mm| (mm.name.clone().unwrap(), mm.offset))
+                            .collect(),
+                        *span,
+                    );
                 }
             }
         }
@@ -112,12 +117,52 @@ mod layout_tests {
     #[test]
     fn frame_uniforms_match_wgsl() {
         let m = module("dvr.wgsl");
-        check!(m, "Frame", FrameUniforms, [inv_view_proj, view_proj, world_to_index, index_to_data,
-            gradient_to_world, index_to_world, camera_position, dims, scalar_scale, scalar_shift, tf_lo,
-            tf_inv_width, go_lo, go_inv_width, weights, material, crop_lo, crop_hi, misc, average_range, additive_scale,
-            clip, lights, viewport, mode, counts, occupancy_dims]);
-        check!(m, "Light", GpuLight, [position, spot, diffuse, specular, ambient, attenuation]);
-        check!(m, "Brick", BrickUniforms, [core_lo, core_hi, tex_lo, tex_size]);
+        check!(
+            m,
+            "Frame",
+            FrameUniforms,
+            [
+                inv_view_proj,
+                view_proj,
+                world_to_index,
+                index_to_data,
+                gradient_to_world,
+                index_to_world,
+                camera_position,
+                dims,
+                scalar_scale,
+                scalar_shift,
+                tf_lo,
+                tf_inv_width,
+                go_lo,
+                go_inv_width,
+                weights,
+                material,
+                crop_lo,
+                crop_hi,
+                misc,
+                average_range,
+                additive_scale,
+                clip,
+                lights,
+                viewport,
+                mode,
+                counts,
+                occupancy_dims
+            ]
+        );
+        check!(
+            m,
+            "Light",
+            GpuLight,
+            [position, spot, diffuse, specular, ambient, attenuation]
+        );
+        check!(
+            m,
+            "Brick",
+            BrickUniforms,
+            [core_lo, core_hi, tex_lo, tex_size, tex_inv_size]
+        );
         let (_, ps) = wgsl_struct(&m, "PixelState");
         assert_eq!(ps as u64, PIXEL_STATE_BYTES);
     }
@@ -125,10 +170,17 @@ mod layout_tests {
     #[test]
     fn flags_match_wgsl() {
         let src = crate::shaders::compose("dvr.wgsl");
-        for (name, v) in [("FLAG_SHADE", FLAG_SHADE), ("FLAG_JITTER", FLAG_JITTER), ("FLAG_FORWARD_DIFF", FLAG_FORWARD_DIFF),
-            ("FLAG_CROP", FLAG_CROP), ("FLAG_TWO_SIDED", FLAG_TWO_SIDED), ("FLAG_GRADIENT_OPACITY", FLAG_GRADIENT_OPACITY),
-            ("FLAG_INDEPENDENT", FLAG_INDEPENDENT), ("FLAG_DEPTH_INPUT", FLAG_DEPTH_INPUT), ("FLAG_SKIP_EMPTY", FLAG_SKIP_EMPTY),
-            ("FLAG_PARALLEL", FLAG_PARALLEL), ("FLAG_AVERAGE_RANGE", FLAG_AVERAGE_RANGE)] {
+        for (name, v) in [
+            ("FLAG_SHADE", FLAG_SHADE),
+            ("FLAG_JITTER", FLAG_JITTER),
+            ("FLAG_FORWARD_DIFF", FLAG_FORWARD_DIFF),
+            ("FLAG_CROP", FLAG_CROP),
+            ("FLAG_TWO_SIDED", FLAG_TWO_SIDED),
+            ("FLAG_GRADIENT_OPACITY", FLAG_GRADIENT_OPACITY),
+            ("FLAG_INDEPENDENT", FLAG_INDEPENDENT),
+            ("FLAG_DEPTH_INPUT", FLAG_DEPTH_INPUT),
+            ("FLAG_AVERAGE_RANGE", FLAG_AVERAGE_RANGE),
+        ] {
             let decl = format!("const {name}: u32 = {v}u;");
             assert!(src.contains(&decl), "WGSL lacks `{decl}`");
         }
@@ -138,9 +190,12 @@ mod layout_tests {
     fn every_pass_validates_with_naga() {
         for pass in crate::shaders::PASSES {
             let m = module(pass);
-            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-                .validate(&m)
-                .unwrap_or_else(|e| panic!("{pass} fails validation: {e:?}"));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&m)
+            .unwrap_or_else(|e| panic!("{pass} fails validation: {e:?}"));
         }
     }
 }

@@ -32,7 +32,9 @@ pub use camera::Camera;
 pub use device::{Context, DeviceInfo};
 pub use error::{Error, Result};
 pub use light::{Light, LightSpace};
-pub use params::{BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading};
+pub use params::{
+    BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
+};
 pub use renderer::{Image, Renderer, Stats, UploadOptions, View};
 pub use transfer::{ComponentTransfer, Piecewise, TransferFunction};
 pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

@@ -57,12 +57,23 @@ impl Light {
     /// A directional light in world space shining from `from` toward `to` (no ambient
     /// colour, as vtkLight's default).
     pub fn directional(from: DVec3, to: DVec3, intensity: f32) -> Light {
-        Light { space: LightSpace::World, position: from, focal_point: to, intensity, ambient: [0.0; 3], ..Light::headlight() }
+        Light {
+            space: LightSpace::World,
+            position: from,
+            focal_point: to,
+            intensity,
+            ambient: [0.0; 3],
+            ..Light::headlight()
+        }
     }
 
     /// A positional light in world space.
     pub fn positional(at: DVec3, toward: DVec3, intensity: f32) -> Light {
-        Light { positional: true, cone_angle: 180.0, ..Light::directional(at, toward, intensity) }
+        Light {
+            positional: true,
+            cone_angle: 180.0,
+            ..Light::directional(at, toward, intensity)
+        }
     }
 
     /// Position and focal point in world space for this camera.

@@ -61,7 +61,14 @@ pub struct Shading {
 impl Default for Shading {
     /// VTK's vtkVolumeProperty defaults, shading off.
     fn default() -> Self {
-        Shading { enabled: false, ambient: 0.1, diffuse: 0.7, specular: 0.2, specular_power: 10.0, two_sided: true }
+        Shading {
+            enabled: false,
+            ambient: 0.1,
+            diffuse: 0.7,
+            specular: 0.2,
+            specular_power: 10.0,
+            two_sided: true,
+        }
     }
 }
 
@@ -144,7 +151,9 @@ impl RenderParams {
     pub fn validate(&self) -> Result<()> {
         if let Some(d) = self.sample_distance {
             if !(d.is_finite() && d > 0.0) {
-                return Err(Error::InvalidParameter(format!("sample distance {d} must be positive")));
+                return Err(Error::InvalidParameter(format!(
+                    "sample distance {d} must be positive"
+                )));
             }
         }
         if !(self.termination_threshold > 0.0 && self.termination_threshold <= 1.0) {
@@ -167,28 +176,46 @@ impl RenderParams {
         }
         for p in &self.clip_planes {
             if !p.origin.is_finite() || !p.normal.is_finite() || p.normal.length() < 1e-12 {
-                return Err(Error::InvalidParameter(format!("clipping plane {p:?} needs a finite origin and a non-zero normal")));
+                return Err(Error::InvalidParameter(format!(
+                    "clipping plane {p:?} needs a finite origin and a non-zero normal"
+                )));
             }
         }
         if let Some(c) = &self.cropping {
-            if c.planes.iter().any(|v| !v.is_finite()) || c.planes[0] > c.planes[1] || c.planes[2] > c.planes[3] || c.planes[4] > c.planes[5] {
+            if c.planes.iter().any(|v| !v.is_finite())
+                || c.planes[0] > c.planes[1]
+                || c.planes[2] > c.planes[3]
+                || c.planes[4] > c.planes[5]
+            {
                 return Err(Error::InvalidParameter(format!(
                     "cropping planes {:?} must be finite with min ≤ max on each axis",
                     c.planes
                 )));
             }
             if c.regions >= 1 << 27 {
-                return Err(Error::InvalidParameter(format!("cropping region flags 0x{:x} use more than 27 bits", c.regions)));
+                return Err(Error::InvalidParameter(format!(
+                    "cropping region flags 0x{:x} use more than 27 bits",
+                    c.regions
+                )));
             }
         }
         let s = &self.shading;
-        for (n, v) in [("ambient", s.ambient), ("diffuse", s.diffuse), ("specular", s.specular), ("specular power", s.specular_power)] {
+        for (n, v) in [
+            ("ambient", s.ambient),
+            ("diffuse", s.diffuse),
+            ("specular", s.specular),
+            ("specular power", s.specular_power),
+        ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::InvalidParameter(format!("shading {n} {v} must be finite and non-negative")));
+                return Err(Error::InvalidParameter(format!(
+                    "shading {n} {v} must be finite and non-negative"
+                )));
             }
         }
         if self.volume_matrix.determinant().abs() < 1e-12 || !self.volume_matrix.is_finite() {
-            return Err(Error::InvalidParameter("the volume matrix is singular or not finite".into()));
+            return Err(Error::InvalidParameter(
+                "the volume matrix is singular or not finite".into(),
+            ));
         }
         Ok(())
     }

@@ -26,7 +26,12 @@ impl View {
     pub fn fit(bounds: [f64; 6], width: u32, height: u32) -> View {
         let mut camera = Camera::default();
         camera.reset(bounds);
-        View { camera, lights: vec![Light::headlight()], width, height }
+        View {
+            camera,
+            lights: vec![Light::headlight()],
+            width,
+            height,
+        }
     }
     pub fn aspect(&self) -> f64 {
         self.width as f64 / self.height as f64
@@ -74,7 +79,10 @@ impl Image {
                 px.0[c] = v.round().clamp(0.0, 255.0) as u8;
             }
         }
-        out.save(path).map_err(|e| Error::ImageWrite { path: path.display().to_string(), message: e.to_string() })
+        out.save(path).map_err(|e| Error::ImageWrite {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
     }
 
     /// Pixel (x, y) as premultiplied RGBA in [0, 1].
@@ -116,6 +124,9 @@ struct TableKey {
     tf: TransferFunction,
     step_bits: u64,
 }
+
+/// Empty-space skipping is used only when fewer blocks than this fraction are occupied.
+const SKIP_MAX_OCCUPANCY: f64 = 0.9;
 
 /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -165,15 +176,34 @@ pub struct Renderer {
 }
 
 fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
 }
 
 fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    entry(binding, wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None })
+    entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    entry(binding, wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None })
+    entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
 }
 
 impl Renderer {
@@ -187,23 +217,32 @@ impl Renderer {
                 storage_entry(1, true),
                 storage_entry(2, false),
                 storage_entry(3, true),
-                entry(2 + 2, wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                }),
+                entry(
+                    2 + 2,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
             ],
         });
         let brick_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("brick"),
             entries: &[
                 uniform_entry(0),
-                entry(1, wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D3,
-                    multisampled: false,
-                }),
-                entry(2, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+                entry(
+                    1,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D3,
+                        multisampled: false,
+                    },
+                ),
+                entry(
+                    2,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
             ],
         });
         let resolve_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -212,16 +251,22 @@ impl Renderer {
                 uniform_entry(0),
                 storage_entry(1, true),
                 storage_entry(2, true),
-                entry(3, wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: wgpu::TextureFormat::Rgba8Unorm,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                }),
-                entry(4, wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: wgpu::TextureFormat::R32Float,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                }),
+                entry(
+                    3,
+                    wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba8Unorm,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                ),
+                entry(
+                    4,
+                    wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::R32Float,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                ),
             ],
         });
         let module = |name: &str| -> Result<wgpu::ShaderModule> {
@@ -233,7 +278,11 @@ impl Renderer {
             })
         };
         let layout = |name: &str, bgls: &[Option<&wgpu::BindGroupLayout>]| {
-            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(name), bind_group_layouts: bgls, immediate_size: 0 })
+            d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(name),
+                bind_group_layouts: bgls,
+                immediate_size: 0,
+            })
         };
         let dvr_module = module("dvr.wgsl")?;
         let dvr_layout = layout("dvr.wgsl", &[Some(&dvr_bgl), Some(&brick_bgl)]);
@@ -316,17 +365,39 @@ impl Renderer {
         v.validate()?;
         let info = &self.ctx.info;
         let (storage, format, texel_bytes, scale, shift) = upload::choose_storage(v, info);
-        let max_points = opts.max_brick_points.unwrap_or(info.limits.max_texture_dimension_3d).min(info.limits.max_texture_dimension_3d);
+        let max_points = opts
+            .max_brick_points
+            .unwrap_or(info.limits.max_texture_dimension_3d)
+            .min(info.limits.max_texture_dimension_3d);
         if max_points < 2 * upload::BRICK_OVERLAP + 2 {
-            return Err(Error::InvalidParameter(format!("brick edge {max_points} is too small (at least {})", 2 * upload::BRICK_OVERLAP + 2)));
+            return Err(Error::InvalidParameter(format!(
+                "brick edge {max_points} is too small (at least {})",
+                2 * upload::BRICK_OVERLAP + 2
+            )));
         }
-        let max_bytes = opts.max_brick_bytes.unwrap_or(info.limits.max_buffer_size.min(1 << 30));
-        let (brick_cells, extents) = upload::plan_bricks(v.dims, texel_bytes, max_points, max_bytes);
-        let layout = Layout { storage, format, texel_bytes, channels: if v.components >= 3 { 4 } else { v.components }, scale, shift, brick_cells, bricks: extents.clone() };
+        let max_bytes = opts
+            .max_brick_bytes
+            .unwrap_or(info.limits.max_buffer_size.min(1 << 30));
+        let (brick_cells, extents) =
+            upload::plan_bricks(v.dims, texel_bytes, max_points, max_bytes);
+        let layout = Layout {
+            storage,
+            format,
+            texel_bytes,
+            channels: if v.components >= 3 { 4 } else { v.components },
+            scale,
+            shift,
+            brick_cells,
+            bricks: extents.clone(),
+        };
         let d = &self.ctx.device;
         let mut bricks = Vec::with_capacity(extents.len());
         for e in &extents {
-            let size = wgpu::Extent3d { width: e.tex_size[0], height: e.tex_size[1], depth_or_array_layers: e.tex_size[2] };
+            let size = wgpu::Extent3d {
+                width: e.tex_size[0],
+                height: e.tex_size[1],
+                depth_or_array_layers: e.tex_size[2],
+            };
             let texels = upload::brick_texels(v, &layout, e);
             let (texture, uniform) = self.ctx.checked("uploading the volume", || {
                 let texture = d.create_texture(&wgpu::TextureDescriptor {
@@ -340,16 +411,51 @@ impl Renderer {
                     view_formats: &[],
                 });
                 self.ctx.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &texture,
+                        mip_level: 0,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::All,
+                    },
                     &texels,
-                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(e.tex_size[0] * texel_bytes), rows_per_image: Some(e.tex_size[1]) },
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(e.tex_size[0] * texel_bytes),
+                        rows_per_image: Some(e.tex_size[1]),
+                    },
                     size,
                 );
                 let bu = BrickUniforms {
-                    core_lo: [e.core_lo[0] as f32, e.core_lo[1] as f32, e.core_lo[2] as f32, 0.0],
-                    core_hi: [e.core_hi[0] as f32, e.core_hi[1] as f32, e.core_hi[2] as f32, 0.0],
-                    tex_lo: [e.tex_lo[0] as f32, e.tex_lo[1] as f32, e.tex_lo[2] as f32, 0.0],
-                    tex_size: [e.tex_size[0] as f32, e.tex_size[1] as f32, e.tex_size[2] as f32, 0.0],
+                    core_lo: [
+                        e.core_lo[0] as f32,
+                        e.core_lo[1] as f32,
+                        e.core_lo[2] as f32,
+                        0.0,
+                    ],
+                    core_hi: [
+                        e.core_hi[0] as f32,
+                        e.core_hi[1] as f32,
+                        e.core_hi[2] as f32,
+                        0.0,
+                    ],
+                    tex_lo: [
+                        e.tex_lo[0] as f32,
+                        e.tex_lo[1] as f32,
+                        e.tex_lo[2] as f32,
+                        0.0,
+                    ],
+                    tex_size: [
+                        e.tex_size[0] as f32,
+                        e.tex_size[1] as f32,
+                        e.tex_size[2] as f32,
+                        0.0,
+                    ],
+                    tex_inv_size: [
+                        1.0 / e.tex_size[0] as f32,
+                        1.0 / e.tex_size[1] as f32,
+                        1.0 / e.tex_size[2] as f32,
+                        0.0,
+                    ],
                 };
                 let uniform = d.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("brick uniforms"),
@@ -357,7 +463,9 @@ impl Renderer {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 });
-                self.ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&bu));
+                self.ctx
+                    .queue
+                    .write_buffer(&uniform, 0, bytemuck::bytes_of(&bu));
                 (texture, uniform)
             })?;
             let view = texture.create_view(&Default::default());
@@ -366,15 +474,30 @@ impl Renderer {
                     label: Some("brick"),
                     layout: &self.brick_bgl,
                     entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
-                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(s) },
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: uniform.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::Sampler(s),
+                        },
                     ],
                 })
             };
             let bind_linear = bind(&self.linear);
             let bind_nearest = bind(&self.nearest);
-            bricks.push(GpuBrick { extent: *e, _texture: texture, _uniform: uniform, bind_linear, bind_nearest });
+            bricks.push(GpuBrick {
+                extent: *e,
+                _texture: texture,
+                _uniform: uniform,
+                bind_linear,
+                bind_nearest,
+            });
         }
         self.volume = Some(GpuVolume {
             data_dims: v.dims,
@@ -391,7 +514,10 @@ impl Renderer {
 
     /// Sets the transfer function; its tables are (re)built at the next frame if it changed.
     pub fn set_transfer_function(&mut self, tf: &TransferFunction) -> Result<()> {
-        let comps = self.volume.as_ref().map_or(tf.components.len() as u32, |v| v.components);
+        let comps = self
+            .volume
+            .as_ref()
+            .map_or(tf.components.len() as u32, |v| v.components);
         tf.validate(comps)?;
         self.tf = Some(tf.clone());
         Ok(())
@@ -399,20 +525,33 @@ impl Renderer {
 
     /// The world distance between samples these parameters give for the current volume.
     pub fn sample_distance(&self, params: &RenderParams) -> Result<f64> {
-        let vol = self.volume.as_ref().ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
+        let vol = self
+            .volume
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
         Ok(match params.sample_distance {
             Some(d) => d,
             None => {
                 let m = params.volume_matrix * vol.index_to_data;
-                let s = [m.x_axis.truncate().length(), m.y_axis.truncate().length(), m.z_axis.truncate().length()];
+                let s = [
+                    m.x_axis.truncate().length(),
+                    m.y_axis.truncate().length(),
+                    m.z_axis.truncate().length(),
+                ];
                 s.iter().cloned().fold(f64::INFINITY, f64::min)
             }
         })
     }
 
     fn ensure_tables(&mut self, step: f64) -> Result<()> {
-        let tf = self.tf.as_ref().ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
-        let key = TableKey { tf: tf.clone(), step_bits: step.to_bits() };
+        let tf = self
+            .tf
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
+        let key = TableKey {
+            tf: tf.clone(),
+            step_bits: step.to_bits(),
+        };
         if self.tables.as_ref().is_some_and(|(k, _)| *k == key) {
             return Ok(());
         }
@@ -441,15 +580,24 @@ impl Renderer {
     /// value in the block's range has non-zero opacity.
     fn ensure_occupancy(&mut self, step: f64) -> Result<()> {
         let (Some(tf), Some(vol)) = (self.tf.as_ref(), self.volume.as_ref()) else {
-            return Err(Error::InvalidParameter("a volume and a transfer function are needed".into()));
+            return Err(Error::InvalidParameter(
+                "a volume and a transfer function are needed".into(),
+            ));
         };
-        let key = TableKey { tf: tf.clone(), step_bits: step.to_bits() };
+        let key = TableKey {
+            tf: tf.clone(),
+            step_bits: step.to_bits(),
+        };
         if self.occupancy.as_ref().is_some_and(|(k, _, _)| *k == key) {
             return Ok(());
         }
         let nc = vol.components as usize;
         // Which components drive opacity, and prefix counts of non-zero table entries.
-        let opacity_comps: Vec<usize> = if tf.independent { (0..nc).collect() } else { vec![nc - 1] };
+        let opacity_comps: Vec<usize> = if tf.independent {
+            (0..nc).collect()
+        } else {
+            vec![nc - 1]
+        };
         let prefix: Vec<(usize, [f64; 2], Vec<u32>)> = opacity_comps
             .iter()
             .map(|&c| {
@@ -457,7 +605,8 @@ impl Renderer {
                 let tables = build_tables(ct, step);
                 let mut p = vec![0u32; TABLE_SIZE + 1];
                 for i in 0..TABLE_SIZE {
-                    let nz = tables[TABLE_SIZE + i][0] > 0.0 && (!tf.independent || ct.weight > 0.0);
+                    let nz =
+                        tables[i][3] > 0.0 && (!tf.independent || ct.weight > 0.0);
                     p[i + 1] = p[i] + nz as u32;
                 }
                 (c, ct.table_range(), p)
@@ -469,8 +618,12 @@ impl Renderer {
         for (b, o) in occ.iter_mut().enumerate() {
             for (c, [lo, hi], p) in &prefix {
                 let [mn, mx] = vol.minmax.ranges[b * nc + c];
-                let x0 = ((mn as f64 - lo) / (hi - lo) * last).floor().clamp(0.0, last) as usize;
-                let x1 = ((mx as f64 - lo) / (hi - lo) * last).ceil().clamp(0.0, last) as usize;
+                let x0 = ((mn as f64 - lo) / (hi - lo) * last)
+                    .floor()
+                    .clamp(0.0, last) as usize;
+                let x1 = ((mx as f64 - lo) / (hi - lo) * last)
+                    .ceil()
+                    .clamp(0.0, last) as usize;
                 if p[x1 + 1] > p[x0] {
                     *o = 1;
                     break;
@@ -483,7 +636,9 @@ impl Renderer {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        self.ctx.queue.write_buffer(&buf, 0, bytemuck::cast_slice(&occ));
+        self.ctx
+            .queue
+            .write_buffer(&buf, 0, bytemuck::cast_slice(&occ));
         let fraction = occ.iter().filter(|&&o| o != 0).count() as f64 / occ.len().max(1) as f64;
         self.occupancy = Some((key, buf, fraction));
         self.stats.occupancy_updates += 1;
@@ -496,19 +651,29 @@ impl Renderer {
     }
 
     fn ensure_targets(&mut self, width: u32, height: u32) -> Result<()> {
-        if self.targets.as_ref().is_some_and(|t| t.width == width && t.height == height) {
+        if self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height)
+        {
             return Ok(());
         }
         let max = self.ctx.info.limits.max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
-            return Err(Error::InvalidParameter(format!("image size {width}x{height}: each side must be 1 to {max}")));
+            return Err(Error::InvalidParameter(format!(
+                "image size {width}x{height}: each side must be 1 to {max}"
+            )));
         }
         let d = &self.ctx.device;
         let targets = self.ctx.checked("allocating the frame", || {
             let tex = |label, format, usage| {
                 d.create_texture(&wgpu::TextureDescriptor {
                     label: Some(label),
-                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                    size: wgpu::Extent3d {
+                        width,
+                        height,
+                        depth_or_array_layers: 1,
+                    },
                     mip_level_count: 1,
                     sample_count: 1,
                     dimension: wgpu::TextureDimension::D2,
@@ -517,7 +682,9 @@ impl Renderer {
                     view_formats: &[],
                 })
             };
-            let out_usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING;
+            let out_usage = wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING;
             Targets {
                 width,
                 height,
@@ -529,16 +696,32 @@ impl Renderer {
                 }),
                 color: tex("color", wgpu::TextureFormat::Rgba8Unorm, out_usage),
                 depth: tex("depth", wgpu::TextureFormat::R32Float, out_usage),
-                depth_in: tex("depth in", wgpu::TextureFormat::R32Float, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST),
+                depth_in: tex(
+                    "depth in",
+                    wgpu::TextureFormat::R32Float,
+                    wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                ),
             }
         })?;
         self.targets = Some(targets);
         Ok(())
     }
 
-    fn frame_uniforms(&self, view: &View, params: &RenderParams, step: f64, depth_input: bool) -> Result<FrameUniforms> {
-        let vol = self.volume.as_ref().ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
-        let tf = self.tf.as_ref().ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
+    fn frame_uniforms(
+        &self,
+        view: &View,
+        params: &RenderParams,
+        step: f64,
+        depth_input: bool,
+    ) -> Result<FrameUniforms> {
+        let vol = self
+            .volume
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
+        let tf = self
+            .tf
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
         let aspect = view.aspect();
         let vp = view.camera.view_projection(aspect);
         if !vp.is_finite() || vp.determinant().abs() < 1e-300 {
@@ -556,7 +739,12 @@ impl Renderer {
         let cp = view.camera.position;
         u.camera_position = [cp.x as f32, cp.y as f32, cp.z as f32, 1.0];
         let dd = vol.data_dims;
-        u.dims = [dd[0] as f32, dd[1] as f32, dd[2] as f32, vol.components as f32];
+        u.dims = [
+            dd[0] as f32,
+            dd[1] as f32,
+            dd[2] as f32,
+            vol.components as f32,
+        ];
         u.scalar_scale = vol.layout.scale;
         u.scalar_shift = vol.layout.shift;
         let mut any_go = false;
@@ -577,11 +765,26 @@ impl Renderer {
         let mut flags = 0;
         if let Some(c) = &params.cropping {
             flags |= FLAG_CROP;
-            u.crop_lo = [c.planes[0] as f32, c.planes[2] as f32, c.planes[4] as f32, 0.0];
-            u.crop_hi = [c.planes[1] as f32, c.planes[3] as f32, c.planes[5] as f32, 0.0];
+            u.crop_lo = [
+                c.planes[0] as f32,
+                c.planes[2] as f32,
+                c.planes[4] as f32,
+                0.0,
+            ];
+            u.crop_hi = [
+                c.planes[1] as f32,
+                c.planes[3] as f32,
+                c.planes[5] as f32,
+                0.0,
+            ];
             u.mode[2] = c.regions;
         }
-        u.misc = [step as f32, params.termination_threshold, params.depth_threshold, 0.0];
+        u.misc = [
+            step as f32,
+            params.termination_threshold,
+            params.depth_threshold,
+            0.0,
+        ];
         if let Some(r) = params.average_range {
             flags |= FLAG_AVERAGE_RANGE;
             u.average_range = [r[0] as f32, r[1] as f32, 0.0, 0.0];
@@ -602,14 +805,23 @@ impl Renderer {
                 if l.positional {
                     g.position = [pos.x as f32, pos.y as f32, pos.z as f32, 1.0];
                     let axis = (focal - pos).try_normalize().unwrap_or(DVec3::NEG_Z);
-                    let cone = if l.cone_angle < 90.0 { (l.cone_angle as f64).to_radians().cos() as f32 } else { -2.0 };
+                    let cone = if l.cone_angle < 90.0 {
+                        (l.cone_angle as f64).to_radians().cos() as f32
+                    } else {
+                        -2.0
+                    };
                     g.spot = [axis.x as f32, axis.y as f32, axis.z as f32, cone];
                 } else {
                     let dir = (pos - focal).try_normalize().unwrap_or(DVec3::Z);
                     g.position = [dir.x as f32, dir.y as f32, dir.z as f32, 0.0];
                     g.spot = [0.0, 0.0, 0.0, -2.0];
                 }
-                g.diffuse = [l.diffuse[0] * k, l.diffuse[1] * k, l.diffuse[2] * k, l.exponent];
+                g.diffuse = [
+                    l.diffuse[0] * k,
+                    l.diffuse[1] * k,
+                    l.diffuse[2] * k,
+                    l.exponent,
+                ];
                 g.specular = [l.specular[0] * k, l.specular[1] * k, l.specular[2] * k, 0.0];
                 g.ambient = [l.ambient[0] * k, l.ambient[1] * k, l.ambient[2] * k, 0.0];
                 g.attenuation = [l.attenuation[0], l.attenuation[1], l.attenuation[2], 0.0];
@@ -635,18 +847,27 @@ impl Renderer {
         if depth_input {
             flags |= FLAG_DEPTH_INPUT;
         }
-        if params.empty_space_skipping {
-            flags |= FLAG_SKIP_EMPTY;
-        }
-        if view.camera.parallel {
-            flags |= FLAG_PARALLEL;
-        }
-        u.viewport = [view.width, view.height, view.width * view.height, 0x9e37_79b9];
+        u.viewport = [
+            view.width,
+            view.height,
+            view.width * view.height,
+            0x9e37_79b9,
+        ];
         u.mode[0] = params.blend.code();
         u.mode[1] = flags;
         u.mode[3] = TABLE_SIZE as u32;
-        u.counts = [params.clip_planes.len() as u32, nl as u32, BLOCK_SIZE, vol.components];
-        u.occupancy_dims = [vol.minmax.dims[0], vol.minmax.dims[1], vol.minmax.dims[2], 0];
+        u.counts = [
+            params.clip_planes.len() as u32,
+            nl as u32,
+            BLOCK_SIZE,
+            vol.components,
+        ];
+        u.occupancy_dims = [
+            vol.minmax.dims[0],
+            vol.minmax.dims[1],
+            vol.minmax.dims[2],
+            0,
+        ];
         Ok(u)
     }
 
@@ -654,7 +875,9 @@ impl Renderer {
     /// camera's side of a brick boundary come first. For a grid of boxes this order is a
     /// valid visibility order for perspective and parallel projection alike.
     fn brick_order(&self, view: &View, params: &RenderParams) -> Vec<usize> {
-        let Some(vol) = self.volume.as_ref() else { return vec![] };
+        let Some(vol) = self.volume.as_ref() else {
+            return vec![];
+        };
         let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
         let cam = world_to_index.transform_point3(view.camera.position);
         let dir = world_to_index.transform_vector3(view.camera.direction());
@@ -667,7 +890,11 @@ impl Renderer {
                 // distance in brick steps from the camera's slab along this axis
                 let steps = if view.camera.parallel {
                     // parallel rays: order by the view direction only
-                    if dir[a] >= 0.0 { lo / bc } else { -hi / bc }
+                    if dir[a] >= 0.0 {
+                        lo / bc
+                    } else {
+                        -hi / bc
+                    }
                 } else if cam[a] < lo {
                     (lo - cam[a]) / bc
                 } else if cam[a] > hi {
@@ -687,22 +914,36 @@ impl Renderer {
 
     /// Renders one frame and returns once it is submitted; read it with [`Renderer::read_image`].
     /// `depth` (window depth per pixel, rows top to bottom) terminates rays at opaque geometry.
-    pub fn render(&mut self, view: &View, params: &RenderParams, depth: Option<&[f32]>) -> Result<()> {
+    pub fn render(
+        &mut self,
+        view: &View,
+        params: &RenderParams,
+        depth: Option<&[f32]>,
+    ) -> Result<()> {
         params.validate()?;
         if view.lights.len() > MAX_LIGHTS && params.shading.enabled {
-            return Err(Error::InvalidParameter(format!("{} lights; at most {MAX_LIGHTS} are supported", view.lights.len())));
+            return Err(Error::InvalidParameter(format!(
+                "{} lights; at most {MAX_LIGHTS} are supported",
+                view.lights.len()
+            )));
         }
         let step = self.sample_distance(params)?;
         self.ensure_tables(step)?;
-        let skip = params.empty_space_skipping && params.blend == BlendMode::Composite;
-        if skip || self.occupancy.is_none() {
-            self.ensure_occupancy(step)?;
-        }
+        self.ensure_occupancy(step)?;
+        // Skipping costs a block lookup per sample; where nearly every block is occupied
+        // (the wavelet under its benchmark transfer function) it cannot pay for itself.
+        let occupied = self.occupancy.as_ref().map_or(1.0, |o| o.2);
+        let skip = params.empty_space_skipping && params.blend == BlendMode::Composite && occupied < SKIP_MAX_OCCUPANCY;
         self.ensure_targets(view.width, view.height)?;
         if let Some(d) = depth {
             let n = (view.width * view.height) as usize;
             if d.len() != n {
-                return Err(Error::InvalidParameter(format!("depth image has {} values for a {}x{} frame ({n} expected)", d.len(), view.width, view.height)));
+                return Err(Error::InvalidParameter(format!(
+                    "depth image has {} values for a {}x{} frame ({n} expected)",
+                    d.len(),
+                    view.width,
+                    view.height
+                )));
             }
         }
         let u = self.frame_uniforms(view, params, step, depth.is_some())?;
@@ -718,14 +959,19 @@ impl Renderer {
         if !self.dvr_variants.contains_key(&variant) {
             let constants = variant.constants();
             let p = self.ctx.checked("creating a ray-casting pipeline", || {
-                self.ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("dvr"),
-                    layout: Some(&self.dvr_layout),
-                    module: &self.dvr_module,
-                    entry_point: Some("main"),
-                    compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, zero_initialize_workgroup_memory: false },
-                    cache: None,
-                })
+                self.ctx
+                    .device
+                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("dvr"),
+                        layout: Some(&self.dvr_layout),
+                        module: &self.dvr_module,
+                        entry_point: Some("main"),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants: &constants,
+                            zero_initialize_workgroup_memory: false,
+                        },
+                        cache: None,
+                    })
             })?;
             self.dvr_variants.insert(variant, p);
         }
@@ -740,10 +986,23 @@ impl Renderer {
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&u));
         if let Some(depth) = depth {
             q.write_texture(
-                wgpu::TexelCopyTextureInfo { texture: &t.depth_in, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+                wgpu::TexelCopyTextureInfo {
+                    texture: &t.depth_in,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
                 bytemuck::cast_slice(depth),
-                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * view.width), rows_per_image: None },
-                wgpu::Extent3d { width: view.width, height: view.height, depth_or_array_layers: 1 },
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * view.width),
+                    rows_per_image: None,
+                },
+                wgpu::Extent3d {
+                    width: view.width,
+                    height: view.height,
+                    depth_or_array_layers: 1,
+                },
             );
         }
         let depth_in_view = t.depth_in.create_view(&Default::default());
@@ -751,11 +1010,26 @@ impl Renderer {
             label: Some("dvr frame"),
             layout: &self.dvr_bgl,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.frame_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: tables.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: t.state.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: occupancy.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&depth_in_view) },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.frame_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: tables.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: t.state.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: occupancy.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&depth_in_view),
+                },
             ],
         });
         let color_view = t.color.create_view(&Default::default());
@@ -764,27 +1038,54 @@ impl Renderer {
             label: Some("resolve"),
             layout: &self.resolve_bgl,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.frame_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: tables.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: t.state.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&color_view) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&depth_view) },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.frame_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: tables.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: t.state.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&color_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&depth_view),
+                },
             ],
         });
         let groups = [view.width.div_ceil(8), view.height.div_ceil(8)];
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame"),
+        });
         enc.clear_buffer(&t.state, 0, None);
         for i in order {
             let b = &vol.bricks[i];
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("dvr"), timestamp_writes: None });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dvr"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(dvr);
             pass.set_bind_group(0, &dvr_bg, &[]);
-            let bg = if params.interpolation == Interpolation::Nearest { &b.bind_nearest } else { &b.bind_linear };
+            let bg = if params.interpolation == Interpolation::Nearest {
+                &b.bind_nearest
+            } else {
+                &b.bind_linear
+            };
             pass.set_bind_group(1, bg, &[]);
             pass.dispatch_workgroups(groups[0], groups[1], 1);
         }
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("resolve"), timestamp_writes: None });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("resolve"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(&self.resolve);
             pass.set_bind_group(0, &resolve_bg, &[]);
             pass.dispatch_workgroups(groups[0], groups[1], 1);
@@ -801,17 +1102,26 @@ impl Renderer {
 
     /// Waits for the last frame and copies its colour and depth to the CPU.
     pub fn read_image(&self) -> Result<Image> {
-        let t = self.targets.as_ref().ok_or_else(|| Error::InvalidParameter("nothing has been rendered yet".into()))?;
+        let t = self
+            .targets
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("nothing has been rendered yet".into()))?;
         let rgba = self.read_texture(&t.color, 4)?;
         let depth_bytes = self.read_texture(&t.depth, 4)?;
         let depth = bytemuck::cast_slice::<u8, f32>(&depth_bytes).to_vec();
-        Ok(Image { width: t.width, height: t.height, rgba, depth })
+        Ok(Image {
+            width: t.width,
+            height: t.height,
+            rgba,
+            depth,
+        })
     }
 
     fn read_texture(&self, tex: &wgpu::Texture, bpp: u32) -> Result<Vec<u8>> {
         let (w, h) = (tex.width(), tex.height());
         let row = w * bpp;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let d = &self.ctx.device;
         let buf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -821,9 +1131,25 @@ impl Renderer {
         });
         let mut enc = d.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture: tex, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-            wgpu::TexelCopyBufferInfo { buffer: &buf, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: None } },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            wgpu::TexelCopyTextureInfo {
+                texture: tex,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buf,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
         );
         self.ctx.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
@@ -834,7 +1160,10 @@ impl Renderer {
         rx.recv()
             .map_err(|_| Error::Gpu("readback never completed".into()))?
             .map_err(|e| Error::Gpu(format!("mapping the readback buffer: {e}")))?;
-        let view = buf.slice(..).get_mapped_range().map_err(|e| Error::Gpu(format!("{e:?}")))?;
+        let view = buf
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| Error::Gpu(format!("{e:?}")))?;
         let mut out = Vec::with_capacity((row * h) as usize);
         for y in 0..h as usize {
             out.extend_from_slice(&view[y * padded as usize..y * padded as usize + row as usize]);

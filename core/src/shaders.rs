@@ -3,10 +3,19 @@
 
 /// (path relative to shaders/, source) for every WGSL file.
 pub const FILES: &[(&str, &str)] = &[
-    ("lib/common.wgsl", include_str!("../../shaders/lib/common.wgsl")),
+    (
+        "lib/common.wgsl",
+        include_str!("../../shaders/lib/common.wgsl"),
+    ),
     ("lib/ray.wgsl", include_str!("../../shaders/lib/ray.wgsl")),
-    ("lib/volume.wgsl", include_str!("../../shaders/lib/volume.wgsl")),
-    ("lib/shading.wgsl", include_str!("../../shaders/lib/shading.wgsl")),
+    (
+        "lib/volume.wgsl",
+        include_str!("../../shaders/lib/volume.wgsl"),
+    ),
+    (
+        "lib/shading.wgsl",
+        include_str!("../../shaders/lib/shading.wgsl"),
+    ),
     ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
 ];
@@ -31,7 +40,8 @@ fn expand(path: &str, out: &mut String, seen: &mut Vec<String>) {
         return;
     }
     seen.push(path.to_string());
-    let src = source(path).unwrap_or_else(|| panic!("shader '{path}' is not listed in shaders::FILES"));
+    let src =
+        source(path).unwrap_or_else(|| panic!("shader '{path}' is not listed in shaders::FILES"));
     for line in src.lines() {
         let t = line.trim();
         if let Some(rest) = t.strip_prefix("#include") {

@@ -16,9 +16,14 @@ pub struct Piecewise<const N: usize> {
 impl<const N: usize> Piecewise<N> {
     pub fn new(mut points: Vec<(f64, [f32; N])>) -> Result<Self> {
         if points.is_empty() {
-            return Err(Error::InvalidTransferFunction("a function needs at least one point".into()));
+            return Err(Error::InvalidTransferFunction(
+                "a function needs at least one point".into(),
+            ));
         }
-        if points.iter().any(|(x, v)| !x.is_finite() || v.iter().any(|c| !c.is_finite())) {
+        if points
+            .iter()
+            .any(|(x, v)| !x.is_finite() || v.iter().any(|c| !c.is_finite()))
+        {
             return Err(Error::InvalidTransferFunction(format!(
                 "non-finite value among the points {points:?}"
             )));
@@ -44,7 +49,11 @@ impl<const N: usize> Piecewise<N> {
         let i = p.partition_point(|q| q.0 <= x);
         let (x0, v0) = p[i - 1];
         let (x1, v1) = p[i];
-        let f = if x1 > x0 { ((x - x0) / (x1 - x0)) as f32 } else { 1.0 };
+        let f = if x1 > x0 {
+            ((x - x0) / (x1 - x0)) as f32
+        } else {
+            1.0
+        };
         let mut out = [0.0; N];
         for c in 0..N {
             out[c] = v0[c] + (v1[c] - v0[c]) * f;
@@ -68,7 +77,13 @@ pub struct ComponentTransfer {
 
 impl ComponentTransfer {
     pub fn new(color: Piecewise<3>, opacity: Piecewise<1>) -> Self {
-        ComponentTransfer { color, opacity, gradient_opacity: None, unit_distance: 1.0, weight: 1.0 }
+        ComponentTransfer {
+            color,
+            opacity,
+            gradient_opacity: None,
+            unit_distance: 1.0,
+            weight: 1.0,
+        }
     }
 
     /// The scalar range the colour/opacity table spans: the union of both functions' points.
@@ -87,7 +102,11 @@ impl ComponentTransfer {
         match &self.gradient_opacity {
             Some(g) => {
                 let r = g.range();
-                if r[1] > r[0] { r } else { [r[0], r[0] + 1.0] }
+                if r[1] > r[0] {
+                    r
+                } else {
+                    [r[0], r[0] + 1.0]
+                }
             }
             None => [0.0, 1.0],
         }
@@ -107,13 +126,18 @@ pub struct TransferFunction {
 impl TransferFunction {
     /// One component, one colour ramp and one opacity ramp.
     pub fn single(c: ComponentTransfer) -> Self {
-        TransferFunction { components: vec![c], independent: true }
+        TransferFunction {
+            components: vec![c],
+            independent: true,
+        }
     }
 
     /// A grey ramp over `range` with opacity rising linearly from 0 to `max_opacity`.
     pub fn ramp(range: [f64; 2], max_opacity: f32) -> Self {
-        let color = Piecewise::new(vec![(range[0], [0.0; 3]), (range[1], [1.0; 3])]).expect("finite");
-        let opacity = Piecewise::new(vec![(range[0], [0.0]), (range[1], [max_opacity])]).expect("finite");
+        let color =
+            Piecewise::new(vec![(range[0], [0.0; 3]), (range[1], [1.0; 3])]).expect("finite");
+        let opacity =
+            Piecewise::new(vec![(range[0], [0.0]), (range[1], [max_opacity])]).expect("finite");
         Self::single(ComponentTransfer::new(color, opacity))
     }
 
@@ -160,8 +184,8 @@ pub fn correct_opacity(alpha: f32, step: f64, unit_distance: f64) -> f32 {
 }
 
 /// The lookup tables of one component, laid out as the shader reads them: `TABLE_SIZE`
-/// entries of (r, g, b, α) then `TABLE_SIZE` entries of (α corrected for the step,
-/// gradient opacity, 0, 0).
+/// entries of (r, g, b, α corrected for the step) then `TABLE_SIZE` entries of
+/// (α, gradient opacity, 0, 0).
 pub fn build_tables(c: &ComponentTransfer, step: f64) -> Vec<[f32; 4]> {
     let [lo, hi] = c.table_range();
     let [glo, ghi] = c.gradient_range();
@@ -171,15 +195,16 @@ pub fn build_tables(c: &ComponentTransfer, step: f64) -> Vec<[f32; 4]> {
         let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;
         let rgb = c.color.eval(x);
         let a = c.opacity.eval(x)[0].clamp(0.0, 1.0);
-        out.push([rgb[0], rgb[1], rgb[2], a]);
+        out.push([rgb[0], rgb[1], rgb[2], correct_opacity(a, step, c.unit_distance)]);
     }
     for i in 0..n {
-        let a = out[i][3];
+        let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;
+        let a = c.opacity.eval(x)[0].clamp(0.0, 1.0);
         let g = match &c.gradient_opacity {
             Some(go) => go.eval(glo + (ghi - glo) * i as f64 / (n - 1) as f64)[0].clamp(0.0, 1.0),
             None => 1.0,
         };
-        out.push([correct_opacity(a, step, c.unit_distance), g, 0.0, 0.0]);
+        out.push([a, g, 0.0, 0.0]);
     }
     out
 }

@@ -58,11 +58,18 @@ pub struct BrickExtent {
 }
 
 fn channels_for(components: u32) -> u32 {
-    if components >= 3 { 4 } else { components }
+    if components >= 3 {
+        4
+    } else {
+        components
+    }
 }
 
 /// Picks the storage for a volume on a device.
-pub fn choose_storage(v: &VolumeData, info: &DeviceInfo) -> (Storage, wgpu::TextureFormat, u32, [f32; 4], [f32; 4]) {
+pub fn choose_storage(
+    v: &VolumeData,
+    info: &DeviceInfo,
+) -> (Storage, wgpu::TextureFormat, u32, [f32; 4], [f32; 4]) {
     use wgpu::TextureFormat as F;
     let ch = channels_for(v.components);
     let pick = |f1: F, f2: F, f4: F| match ch {
@@ -78,15 +85,27 @@ pub fn choose_storage(v: &VolumeData, info: &DeviceInfo) -> (Storage, wgpu::Text
             let offset = if t == ScalarType::I8 { 128.0 } else { 0.0 };
             scale = [255.0; 4];
             shift = [-offset as f32; 4];
-            (Storage::Unorm8 { offset }, pick(F::R8Unorm, F::Rg8Unorm, F::Rgba8Unorm), 1)
+            (
+                Storage::Unorm8 { offset },
+                pick(F::R8Unorm, F::Rg8Unorm, F::Rgba8Unorm),
+                1,
+            )
         }
         ScalarType::U16 | ScalarType::I16 if info.norm16 => {
             let offset = if t == ScalarType::I16 { 32768.0 } else { 0.0 };
             scale = [65535.0; 4];
             shift = [-offset as f32; 4];
-            (Storage::Unorm16 { offset }, pick(F::R16Unorm, F::Rg16Unorm, F::Rgba16Unorm), 2)
+            (
+                Storage::Unorm16 { offset },
+                pick(F::R16Unorm, F::Rg16Unorm, F::Rgba16Unorm),
+                2,
+            )
         }
-        _ if info.float32_filterable => (Storage::Float32, pick(F::R32Float, F::Rg32Float, F::Rgba32Float), 4),
+        _ if info.float32_filterable => (
+            Storage::Float32,
+            pick(F::R32Float, F::Rg32Float, F::Rgba32Float),
+            4,
+        ),
         _ => {
             for c in 0..v.components {
                 let [lo, hi] = v.range(c);
@@ -94,7 +113,11 @@ pub fn choose_storage(v: &VolumeData, info: &DeviceInfo) -> (Storage, wgpu::Text
                 scale[c as usize] = w as f32;
                 shift[c as usize] = lo as f32;
             }
-            (Storage::Float16Normalized, pick(F::R16Float, F::Rg16Float, F::Rgba16Float), 2)
+            (
+                Storage::Float16Normalized,
+                pick(F::R16Float, F::Rg16Float, F::Rgba16Float),
+                2,
+            )
         }
     };
     (storage, format, bytes * ch, scale, shift)
@@ -102,7 +125,12 @@ pub fn choose_storage(v: &VolumeData, info: &DeviceInfo) -> (Storage, wgpu::Text
 
 /// Splits the volume into bricks no larger than `max_points` per axis (overlap included)
 /// and `max_bytes` per texture. A volume that fits is one brick with no overlap.
-pub fn plan_bricks(dims: [u32; 3], texel_bytes: u32, max_points: u32, max_bytes: u64) -> (u32, Vec<BrickExtent>) {
+pub fn plan_bricks(
+    dims: [u32; 3],
+    texel_bytes: u32,
+    max_points: u32,
+    max_bytes: u64,
+) -> (u32, Vec<BrickExtent>) {
     let fits = |n: [u32; 3]| {
         n.iter().all(|&d| d <= max_points)
             && n.iter().map(|&d| d as u64).product::<u64>() * texel_bytes as u64 <= max_bytes
@@ -113,7 +141,10 @@ pub fn plan_bricks(dims: [u32; 3], texel_bytes: u32, max_points: u32, max_bytes:
         max_cells
     } else {
         // largest brick edge whose texture (core + overlap on both sides) fits
-        let mut b = max_points.saturating_sub(2 * BRICK_OVERLAP + 1).max(1).min(max_cells);
+        let mut b = max_points
+            .saturating_sub(2 * BRICK_OVERLAP + 1)
+            .max(1)
+            .min(max_cells);
         while b > 1 && !fits([b + 2 * BRICK_OVERLAP + 1; 3]) {
             b = (b * 7 / 8).max(1);
         }
@@ -133,12 +164,26 @@ pub fn plan_bricks(dims: [u32; 3], texel_bytes: u32, max_points: u32, max_bytes:
                     core_lo[a] = cell[a] * brick_cells;
                     core_hi[a] = ((cell[a] + 1) * brick_cells).min(dims[a] - 1);
                     let single = counts[a] == 1;
-                    let lo = if single { 0 } else { core_lo[a].saturating_sub(BRICK_OVERLAP) };
-                    let hi = if single { dims[a] - 1 } else { (core_hi[a] + BRICK_OVERLAP).min(dims[a] - 1) };
+                    let lo = if single {
+                        0
+                    } else {
+                        core_lo[a].saturating_sub(BRICK_OVERLAP)
+                    };
+                    let hi = if single {
+                        dims[a] - 1
+                    } else {
+                        (core_hi[a] + BRICK_OVERLAP).min(dims[a] - 1)
+                    };
                     tex_lo[a] = lo;
                     tex_size[a] = hi - lo + 1;
                 }
-                bricks.push(BrickExtent { cell, core_lo, core_hi, tex_lo, tex_size });
+                bricks.push(BrickExtent {
+                    cell,
+                    core_lo,
+                    core_hi,
+                    tex_lo,
+                    tex_size,
+                });
             }
         }
     }
@@ -154,16 +199,19 @@ pub fn brick_texels(v: &VolumeData, layout: &Layout, b: &BrickExtent) -> Vec<u8>
     let (nx, ny) = (v.dims[0] as usize, v.dims[1] as usize);
     for k in 0..b.tex_size[2] as usize {
         for j in 0..b.tex_size[1] as usize {
-            let row = ((b.tex_lo[2] as usize + k) * ny + b.tex_lo[1] as usize + j) * nx + b.tex_lo[0] as usize;
+            let row = ((b.tex_lo[2] as usize + k) * ny + b.tex_lo[1] as usize + j) * nx
+                + b.tex_lo[0] as usize;
             for i in 0..b.tex_size[0] as usize {
                 let p = (row + i) * nc;
                 for c in 0..ch {
                     let val = if c < nc { v.scalars.get(p + c) } else { 0.0 };
                     match layout.storage {
-                        Storage::Unorm8 { offset } => out.push((val + offset).round().clamp(0.0, 255.0) as u8),
-                        Storage::Unorm16 { offset } => {
-                            out.extend_from_slice(&((val + offset).round().clamp(0.0, 65535.0) as u16).to_le_bytes())
+                        Storage::Unorm8 { offset } => {
+                            out.push((val + offset).round().clamp(0.0, 255.0) as u8)
                         }
+                        Storage::Unorm16 { offset } => out.extend_from_slice(
+                            &((val + offset).round().clamp(0.0, 65535.0) as u16).to_le_bytes(),
+                        ),
                         Storage::Float32 => out.extend_from_slice(&(val as f32).to_le_bytes()),
                         Storage::Float16Normalized => {
                             let t = (val - layout.shift[c] as f64) / layout.scale[c] as f64;
@@ -224,7 +272,11 @@ impl MinMaxGrid {
                 }
             }
         }
-        MinMaxGrid { dims, components: nc, ranges }
+        MinMaxGrid {
+            dims,
+            components: nc,
+            ranges,
+        }
     }
 }
 

@@ -241,9 +241,10 @@ impl VolumeData {
     /// Value of component `c` at point (i, j, k).
     #[inline]
     pub fn value(&self, i: u32, j: u32, k: u32, c: u32) -> f64 {
-        let idx = (k as usize * self.dims[1] as usize + j as usize) * self.dims[0] as usize
-            + i as usize;
-        self.scalars.get(idx * self.components as usize + c as usize)
+        let idx =
+            (k as usize * self.dims[1] as usize + j as usize) * self.dims[0] as usize + i as usize;
+        self.scalars
+            .get(idx * self.components as usize + c as usize)
     }
 
     /// The 4×4 (column-major, glam) matrix from index space (i, j, k) to data coordinates.
@@ -271,9 +272,21 @@ impl VolumeData {
         ];
         for corner in 0..8u32 {
             let ijk = glam::DVec3::new(
-                if corner & 1 != 0 { (self.dims[0] - 1) as f64 } else { 0.0 },
-                if corner & 2 != 0 { (self.dims[1] - 1) as f64 } else { 0.0 },
-                if corner & 4 != 0 { (self.dims[2] - 1) as f64 } else { 0.0 },
+                if corner & 1 != 0 {
+                    (self.dims[0] - 1) as f64
+                } else {
+                    0.0
+                },
+                if corner & 2 != 0 {
+                    (self.dims[1] - 1) as f64
+                } else {
+                    0.0
+                },
+                if corner & 4 != 0 {
+                    (self.dims[2] - 1) as f64
+                } else {
+                    0.0
+                },
             );
             let p = m.transform_point3(ijk);
             for a in 0..3 {

@@ -16,8 +16,6 @@ const FLAG_TWO_SIDED: u32 = 16u;
 const FLAG_GRADIENT_OPACITY: u32 = 32u;
 const FLAG_INDEPENDENT: u32 = 64u;
 const FLAG_DEPTH_INPUT: u32 = 128u;
-const FLAG_SKIP_EMPTY: u32 = 256u;
-const FLAG_PARALLEL: u32 = 512u;
 const FLAG_AVERAGE_RANGE: u32 = 1024u;
 
 const MAX_LIGHTS: u32 = 8u;
@@ -71,8 +69,9 @@ struct Frame {
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// Per component c: TABLE entries (r, g, b, alpha) at [2·c·N, 2·c·N + N), then
-// (alpha corrected for the step, gradient opacity, 0, 0) at [2·c·N + N, 2·c·N + 2N).
+// Per component c: N entries (r, g, b, alpha corrected for the step) at [2·c·N, 2·c·N + N),
+// then (alpha as given, gradient opacity, 0, 0) at [2·c·N + N, 2·c·N + 2N). Composite
+// reads one entry per sample.
 @group(0) @binding(1) var<storage, read> tables: array<vec4<f32>>;
 
 // Per-pixel ray state carried across brick passes.
@@ -86,7 +85,7 @@ fn has_flag(f: u32) -> bool {
     return (frame.mode.y & f) != 0u;
 }
 
-// Linear lookup into table `which` (0: colour+alpha, 1: corrected alpha & gradient opacity)
+// Linear lookup into table `which` (0: colour + corrected alpha, 1: alpha & gradient opacity)
 // of component `c` at normalised coordinate u in [0, 1] (clamped, like VTK's tables).
 fn table_lookup(c: u32, which: u32, u: f32) -> vec4<f32> {
     let n = frame.mode.w;
@@ -101,9 +100,19 @@ fn scalar_coord(c: u32, s: f32) -> f32 {
     return (s - frame.tf_lo[c]) * frame.tf_inv_width[c];
 }
 
-// Colour and un-corrected opacity of scalar s for component c.
+// Colour and opacity corrected for the sample distance of scalar s for component c.
 fn classify(c: u32, s: f32) -> vec4<f32> {
     return table_lookup(c, 0u, scalar_coord(c, s));
+}
+
+// Opacity of scalar s as the transfer function gives it (no step correction).
+fn raw_alpha(c: u32, s: f32) -> f32 {
+    return table_lookup(c, 1u, scalar_coord(c, s)).x;
+}
+
+// Gradient-opacity factor for gradient magnitude m of component c.
+fn gradient_opacity(c: u32, m: f32) -> f32 {
+    return table_lookup(c, 1u, (m - frame.go_lo[c]) * frame.go_inv_width[c]).y;
 }
 
 // Hash of a pixel index to [0, 1): deterministic jitter (PCG).

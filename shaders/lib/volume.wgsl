@@ -9,6 +9,7 @@ struct Brick {
     // extends past the core by an overlap so interpolation and gradients see no seam
     tex_lo: vec4<f32>,
     tex_size: vec4<f32>,
+    tex_inv_size: vec4<f32>,
 }
 
 @group(1) @binding(0) var<uniform> brick: Brick;
@@ -17,7 +18,7 @@ struct Brick {
 
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
-    let tc = (p - brick.tex_lo.xyz + 0.5) / brick.tex_size.xyz;
+    let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
     return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
 }
 

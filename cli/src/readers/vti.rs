@@ -82,7 +82,6 @@ struct ArrayDesc {
 struct Section {
     scalars: Option<String>,
     kept: Vec<ArrayDesc>,
-    seen: usize,
 }
 
 impl Section {
@@ -498,7 +497,6 @@ fn parse_xml(path: &Path, xml: &str) -> Result<Header, ReadError> {
                                 Which::Point => &mut h.point,
                                 Which::Cell => &mut h.cell,
                             };
-                            sec.seen += 1;
                             let name = get(&attrs, "Name").unwrap_or_default();
                             if sec.wants(&name) {
                                 let desc = ArrayDesc {
@@ -548,6 +546,14 @@ fn parse_xml(path: &Path, xml: &str) -> Result<Header, ReadError> {
                 }
             }
             _ => {}
+        }
+    }
+    // A file cut inside a <DataArray>: keep what was read, so that the short data is
+    // reported as truncated.
+    if let (Some(desc), Some(which)) = (current, section) {
+        match which {
+            Which::Point => h.point.kept.push(desc),
+            Which::Cell => h.cell.kept.push(desc),
         }
     }
     Ok(h)
@@ -1166,6 +1172,30 @@ mod tests {
             "{m}"
         );
         assert!(m.contains("expected 24 bytes, found 10"), "{m}");
+    }
+
+    #[test]
+    fn readers_vti_truncated_inline_binary() {
+        let dir = TempDir::new("vti");
+        let bytes: Vec<u8> = u16_values().iter().flat_map(|v| v.to_le_bytes()).collect();
+        let text = b64(&raw_block(&bytes, false, false));
+        let piece = format!(
+            "<PointData><DataArray type=\"UInt16\" Name=\"x\" format=\"binary\">{text}</DataArray></PointData>"
+        );
+        let file = doc("", GEOM, &piece, None);
+        let cut = file
+            .windows(text.len())
+            .position(|w| w == text.as_bytes())
+            .unwrap()
+            + 20;
+        let p = dir.write("cut.vti", &file[..cut]);
+        let m = msg(read_volume(&p));
+        assert!(
+            m.contains(
+                "truncated binary (base64) DataArray 'x' (data): expected 24 bytes, found 11"
+            ),
+            "{m}"
+        );
     }
 
     #[test]
