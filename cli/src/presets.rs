@@ -50,7 +50,7 @@ pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunctio
                 (0.5, [1.0, 0.85, 0.6]),
                 (1.0, [1.0, 1.0, 1.0]),
             ],
-            &[(0.0, 0.0), (0.45, 0.0), (0.5, 0.6), (0.55, 0.0), (1.0, 0.0)],
+            &[(0.0, 0.0), (0.4, 0.0), (0.5, 0.8), (0.6, 0.0), (1.0, 0.0)],
         ),
         "sphere" => tf(
             &[(-2.0, [1.0, 0.9, 0.7]), (2.0, [0.8, 0.4, 0.2])],
@@ -108,8 +108,9 @@ pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunctio
             return from_json(p);
         }
     };
-    // Presets for data of another kind still need a sensible unit distance: VTK's default 1.
-    t.components[0].unit_distance = 1.0;
+    // Preset opacities are per voxel: the unit distance is the mean spacing (as ParaView
+    // derives ScalarOpacityUnitDistance from the data), so a preset looks alike at any scale.
+    t.components[0].unit_distance = vol.spacing.iter().sum::<f64>() / 3.0;
     Ok(t)
 }
 

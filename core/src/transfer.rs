@@ -162,7 +162,7 @@ impl TransferFunction {
                 )));
             }
         }
-        if !self.independent && !(volume_components == 2 || volume_components == 4) {
+        if !(self.independent || volume_components == 2 || volume_components == 4) {
             return Err(Error::InvalidTransferFunction(format!(
                 "dependent components need 2 or 4 components per point, the volume has {volume_components}"
             )));
@@ -195,7 +195,12 @@ pub fn build_tables(c: &ComponentTransfer, step: f64) -> Vec<[f32; 4]> {
         let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;
         let rgb = c.color.eval(x);
         let a = c.opacity.eval(x)[0].clamp(0.0, 1.0);
-        out.push([rgb[0], rgb[1], rgb[2], correct_opacity(a, step, c.unit_distance)]);
+        out.push([
+            rgb[0],
+            rgb[1],
+            rgb[2],
+            correct_opacity(a, step, c.unit_distance),
+        ]);
     }
     for i in 0..n {
         let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;

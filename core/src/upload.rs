@@ -312,10 +312,11 @@ mod tests {
             }
         }
         for br in &bricks {
-            for a in 0..3 {
+            for (a, &dim) in dims.iter().enumerate() {
                 assert!(br.tex_size[a] <= 20);
                 assert!(br.tex_lo[a] + 2 <= br.core_lo[a] || br.tex_lo[a] == 0);
-                assert!(br.tex_lo[a] + br.tex_size[a] - 1 >= (br.core_hi[a] + 2).min(dims[a] - 1));
+                let tex_hi = br.tex_lo[a] + br.tex_size[a] - 1;
+                assert!(tex_hi >= (br.core_hi[a] + 2).min(dim - 1));
             }
         }
     }

@@ -90,7 +90,16 @@ impl Scalars {
     /// Value `i` (flat index into the interleaved array) as f64.
     #[inline]
     pub fn get(&self, i: usize) -> f64 {
-        each_scalars!(self, v => v[i] as f64)
+        match self {
+            Scalars::F64(v) => v[i],
+            Scalars::U8(v) => v[i] as f64,
+            Scalars::I8(v) => v[i] as f64,
+            Scalars::U16(v) => v[i] as f64,
+            Scalars::I16(v) => v[i] as f64,
+            Scalars::U32(v) => v[i] as f64,
+            Scalars::I32(v) => v[i] as f64,
+            Scalars::F32(v) => v[i] as f64,
+        }
     }
 }
 

@@ -16,10 +16,18 @@ struct Brick {
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
 
+// Nearest-neighbour passes fetch texels directly (textureLoad), which skips the sampler
+// machinery; it picks the same texel as a nearest sampler would.
+override NEAREST: bool = false;
+
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
-    let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
-    return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
+    let q = p - brick.tex_lo.xyz + 0.5;
+    if (NEAREST) {
+        let hi = vec3<i32>(brick.tex_size.xyz) - 1;
+        return textureLoad(volume_tex, clamp(vec3<i32>(floor(q)), vec3<i32>(0), hi), 0);
+    }
+    return textureSampleLevel(volume_tex, volume_sampler, q * brick.tex_inv_size.xyz, 0.0);
 }
 
 // Scalars (data units) of every component at index-space point p.
