@@ -16,6 +16,8 @@ override SHADE: bool = false;
 override GRAD_OPACITY: bool = false;
 override SKIP: bool = false;
 override CROP: bool = false;
+// One brick: the ray state starts empty here instead of being cleared and read back.
+override SINGLE_BRICK: bool = false;
 
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
 // Per block of the occupancy grid: 1 when the transfer function gives some block voxel a
@@ -133,7 +135,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pix = gid.y * frame.viewport.x + gid.x;
     let blend = BLEND;
-    var st = state[pix];
+    var st: PixelState;
+    if (!SINGLE_BRICK) {
+        st = state[pix];
+    }
     let ert = frame.misc.y;
     if (blend == BLEND_COMPOSITE && st.color.a >= ert) {
         return;
@@ -152,7 +157,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let b = box_interval(ray, brick.core_lo.xyz, brick.core_hi.xyz);
     let t_lo = max(b.x, seg.x);
     let t_hi = min(b.y, seg.y);
-    if (t_lo >= t_hi) {
+    // (written so that NaN from a degenerate ray also leaves)
+    if (!(t_lo < t_hi)) {
+        if (SINGLE_BRICK) {
+            state[pix] = st;
+        }
         return;
     }
     let dt = frame.misc.x;
@@ -161,7 +170,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         jit = hash01(pix ^ frame.viewport.w);
     }
     var k = max(ceil((t_lo - seg.x) / dt - jit), 0.0);
-    let k_end = ceil((t_hi - seg.x) / dt - jit);
+    // Bounded below 2^24 so that k + 1 is always exact and the loop always ends.
+    let k_end = min(ceil((t_hi - seg.x) / dt - jit), 1.0e7);
     var color = st.color;
     var value = st.value;
     var misc = st.misc;

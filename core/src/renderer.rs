@@ -139,10 +139,11 @@ struct DvrVariant {
     skip: bool,
     crop: bool,
     nearest: bool,
+    single_brick: bool,
 }
 
 impl DvrVariant {
-    fn constants(&self) -> [(&'static str, f64); 8] {
+    fn constants(&self) -> [(&'static str, f64); 9] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         [
             ("BLEND", self.blend as f64),
@@ -153,6 +154,7 @@ impl DvrVariant {
             ("SKIP", b(self.skip)),
             ("CROP", b(self.crop)),
             ("NEAREST", b(self.nearest)),
+            ("SINGLE_BRICK", b(self.single_brick)),
         ]
     }
 }
@@ -893,26 +895,21 @@ impl Renderer {
         let dir = world_to_index.transform_vector3(view.camera.direction());
         let bc = vol.layout.brick_cells as f64;
         let mut order: Vec<usize> = (0..vol.bricks.len()).collect();
+        // Per axis, how many brick steps separate a brick from the camera's brick (perspective:
+        // a ray's successive bricks have non-decreasing steps on every axis and a strictly
+        // larger sum) or how far it lies along the view direction (parallel).
         let key = |e: &BrickExtent| -> [i64; 3] {
             [0, 1, 2].map(|a| {
-                let lo = e.core_lo[a] as f64;
-                let hi = e.core_hi[a] as f64;
-                // distance in brick steps from the camera's slab along this axis
-                let steps = if view.camera.parallel {
-                    // parallel rays: order by the view direction only
+                let cell = e.cell[a] as i64;
+                if view.camera.parallel {
                     if dir[a] >= 0.0 {
-                        lo / bc
+                        cell
                     } else {
-                        -hi / bc
+                        -cell
                     }
-                } else if cam[a] < lo {
-                    (lo - cam[a]) / bc
-                } else if cam[a] > hi {
-                    (cam[a] - hi) / bc
                 } else {
-                    0.0
-                };
-                steps.floor() as i64
+                    (cell - (cam[a] / bc).floor() as i64).abs()
+                }
             })
         };
         order.sort_by_key(|&i| {
@@ -968,6 +965,7 @@ impl Renderer {
             skip,
             crop: u.mode[1] & FLAG_CROP != 0,
             nearest: params.interpolation == Interpolation::Nearest,
+            single_brick: self.volume.as_ref().is_some_and(|v| v.bricks.len() == 1),
         };
         if !self.dvr_variants.contains_key(&variant) {
             let constants = variant.constants();
@@ -1077,7 +1075,9 @@ impl Renderer {
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame"),
         });
-        enc.clear_buffer(&t.state, 0, None);
+        if !variant.single_brick {
+            enc.clear_buffer(&t.state, 0, None);
+        }
         for i in order {
             let b = &vol.bricks[i];
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
