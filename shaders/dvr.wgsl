@@ -6,6 +6,7 @@
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
 #include "lib/shading.wgsl"
+#include "lib/output.wgsl"
 
 // Pipeline constants: each combination is its own pipeline, so the ray loop carries only
 // the code of the mode it runs (core/src/renderer.rs, DvrVariant).
@@ -16,7 +17,8 @@ override SHADE: bool = false;
 override GRAD_OPACITY: bool = false;
 override SKIP: bool = false;
 override CROP: bool = false;
-// One brick: the ray state starts empty here instead of being cleared and read back.
+// One brick: the ray state starts empty here and the pass writes the output pixel itself
+// (no state buffer traffic, no resolve pass).
 override SINGLE_BRICK: bool = false;
 
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
@@ -50,6 +52,22 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
             }
         }
         return vec4<f32>(rgb, a);
+    }
+    if (NCOMP == 1u) {
+        var e = classify(0u, s.x);
+        if (e.a <= 0.0 || frame.weights.x <= 0.0) {
+            return vec4<f32>(0.0);
+        }
+        if (need_grad) {
+            let g = world_gradient(gradient_at(p, s), 0u);
+            if (GRAD_OPACITY) {
+                e.a = e.a * gradient_opacity(0u, length(g));
+            }
+            if (SHADE) {
+                e = vec4<f32>(shade(e.rgb, g, pos, view_dir), e.a);
+            }
+        }
+        return e;
     }
     // Independent components, mixed as VTK does: colour weighted by opacity × weight,
     // opacity the opacity-weighted mean of the components' opacities.
@@ -160,7 +178,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // (written so that NaN from a degenerate ray also leaves)
     if (!(t_lo < t_hi)) {
         if (SINGLE_BRICK) {
-            state[pix] = st;
+            write_pixel(gid.xy, st);
         }
         return;
     }
@@ -226,5 +244,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     st.color = color;
     st.value = value;
     st.misc = misc;
-    state[pix] = st;
+    if (SINGLE_BRICK) {
+        write_pixel(gid.xy, st);
+    } else {
+        state[pix] = st;
+    }
 }

@@ -1,61 +1,14 @@
-// Resolve: turns each pixel's ray state into premultiplied RGBA and a window depth. For the
-// projection modes (maximum, minimum, average, additive) the transfer function is applied
-// here, once, to the value the rays found.
+// Resolve: the last pass over a bricked volume, writing each pixel from the ray state the
+// brick passes accumulated (lib/output.wgsl).
 #include "lib/common.wgsl"
+#include "lib/output.wgsl"
 
 @group(0) @binding(2) var<storage, read> state: array<PixelState>;
-@group(0) @binding(3) var out_color: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(4) var out_depth: texture_storage_2d<r32float, write>;
-
-// Premultiplied colour of a projected value (maximum, minimum): the transfer function
-// applied to the value found, un-corrected opacity; independent components mixed as VTK
-// does (colour and opacity summed, weighted).
-fn classify_value(v: vec4<f32>) -> vec4<f32> {
-    let ncomp = frame.counts.w;
-    if (!has_flag(FLAG_INDEPENDENT)) {
-        let oc = ncomp - 1u;
-        let a = raw_alpha(0u, v[oc]);
-        return vec4<f32>(classify(0u, v.x).rgb * a, a);
-    }
-    var out = vec4<f32>(0.0);
-    for (var c = 0u; c < ncomp; c = c + 1u) {
-        let e = classify(c, v[c]);
-        let a = raw_alpha(c, v[c]) * frame.weights[c];
-        out = out + vec4<f32>(e.rgb * a, a);
-    }
-    return out;
-}
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= frame.viewport.x || gid.y >= frame.viewport.y) {
         return;
     }
-    let st = state[gid.y * frame.viewport.x + gid.x];
-    let blend = frame.mode.x;
-    var color = vec4<f32>(0.0);
-    var depth = 1.0;
-    if (blend == BLEND_COMPOSITE) {
-        color = st.color;
-        if (st.misc.z > 0.0) {
-            depth = st.misc.y;
-        }
-    } else if (st.misc.x > 0.0) {
-        if (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE) {
-            // VTK: a grey level, opaque, from the opacity-weighted normalised scalars
-            var v = st.value;
-            if (blend == BLEND_AVERAGE) {
-                v = v / st.misc.x;
-            }
-            var g = v.x;
-            if (has_flag(FLAG_INDEPENDENT)) {
-                g = dot(v, frame.weights * vec4<f32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(frame.counts.w)));
-            }
-            color = vec4<f32>(vec3<f32>(clamp(g, 0.0, 1.0)), 1.0);
-        } else {
-            color = classify_value(st.value);
-        }
-    }
-    textureStore(out_color, vec2<i32>(gid.xy), clamp(color, vec4<f32>(0.0), vec4<f32>(1.0)));
-    textureStore(out_depth, vec2<i32>(gid.xy), vec4<f32>(depth, 0.0, 0.0, 0.0));
+    write_pixel(gid.xy, state[gid.y * frame.viewport.x + gid.x]);
 }

@@ -170,6 +170,8 @@ mod layout_tests {
     #[test]
     fn flags_match_wgsl() {
         let src = crate::shaders::compose("dvr.wgsl");
+        let table = format!("const TABLE_N: u32 = {}u;", crate::transfer::TABLE_SIZE);
+        assert!(src.contains(&table), "WGSL lacks `{table}`");
         for (name, v) in [
             ("FLAG_SHADE", FLAG_SHADE),
             ("FLAG_JITTER", FLAG_JITTER),

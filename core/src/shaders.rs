@@ -16,6 +16,10 @@ pub const FILES: &[(&str, &str)] = &[
         "lib/shading.wgsl",
         include_str!("../../shaders/lib/shading.wgsl"),
     ),
+    (
+        "lib/output.wgsl",
+        include_str!("../../shaders/lib/output.wgsl"),
+    ),
     ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
 ];

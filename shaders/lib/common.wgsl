@@ -19,6 +19,14 @@ const FLAG_DEPTH_INPUT: u32 = 128u;
 const FLAG_AVERAGE_RANGE: u32 = 1024u;
 
 const MAX_LIGHTS: u32 = 8u;
+// Entries per lookup table (transfer::TABLE_SIZE).
+const TABLE_N: u32 = 1024u;
+
+// Nearest-neighbour interpolation, a pipeline constant: volume texels are fetched directly
+// (textureLoad, the texel a nearest sampler would pick, without the sampler machinery) and
+// the transfer-function tables are read at the nearest entry, as VTK's
+// InterpolationType applies to both.
+override NEAREST: bool = false;
 const MAX_CLIP: u32 = 6u;
 
 struct Light {
@@ -63,7 +71,7 @@ struct Frame {
     clip: array<vec4<f32>, 6>,    // index-space planes: keep dot(xyz, p) + w >= 0
     lights: array<Light, 8>,
     viewport: vec4<u32>,          // width, height, pixel count, seed
-    mode: vec4<u32>,              // blend, flags, crop regions, table size
+    mode: vec4<u32>,              // blend, flags, crop regions, unused
     counts: vec4<u32>,            // clip planes, lights, occupancy block size, components
     occupancy_dims: vec4<u32>,    // blocks per axis
 }
@@ -88,11 +96,13 @@ fn has_flag(f: u32) -> bool {
 // Linear lookup into table `which` (0: colour + corrected alpha, 1: alpha & gradient opacity)
 // of component `c` at normalised coordinate u in [0, 1] (clamped, like VTK's tables).
 fn table_lookup(c: u32, which: u32, u: f32) -> vec4<f32> {
-    let n = frame.mode.w;
-    let x = clamp(u, 0.0, 1.0) * f32(n - 1u);
-    let i0 = u32(floor(x));
-    let i1 = min(i0 + 1u, n - 1u);
-    let base = (2u * c + which) * n;
+    let x = clamp(u, 0.0, 1.0) * f32(TABLE_N - 1u);
+    let base = (2u * c + which) * TABLE_N;
+    if (NEAREST) {
+        return tables[base + u32(x + 0.5)];
+    }
+    let i0 = u32(x);
+    let i1 = min(i0 + 1u, TABLE_N - 1u);
     return mix(tables[base + i0], tables[base + i1], x - f32(i0));
 }
 

@@ -5,6 +5,12 @@
 // lighting a light behind the surface lights its back. Where the gradient vanishes there
 // is no normal and only the ambient term remains.
 
+// Whether any light is positional (a pipeline constant: directional-only scenes, the
+// common case with VTK's headlight, carry no attenuation or spotlight code).
+override POSITIONAL_LIGHTS: bool = true;
+// Number of lights (a pipeline constant, so the light loop unrolls).
+override NUM_LIGHTS: u32 = 1u;
+
 fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec3<f32> {
     let glen = length(grad);
     var ambient = vec3<f32>(0.0);
@@ -16,7 +22,7 @@ fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>)
         n = -grad / glen;
     }
     let v = -view_dir;
-    for (var i = 0u; i < frame.counts.y; i = i + 1u) {
+    for (var i = 0u; i < NUM_LIGHTS; i = i + 1u) {
         let light = frame.lights[i];
         ambient = ambient + light.ambient.rgb;
         if (!has_normal) {
@@ -24,7 +30,7 @@ fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>)
         }
         var l = light.position.xyz;
         var atten = 1.0;
-        if (light.position.w > 0.5) {
+        if (POSITIONAL_LIGHTS && light.position.w > 0.5) {
             let lv = light.position.xyz - pos;
             let d = length(lv);
             l = lv / max(d, 1e-20);

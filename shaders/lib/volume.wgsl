@@ -16,10 +16,6 @@ struct Brick {
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
 
-// Nearest-neighbour passes fetch texels directly (textureLoad), which skips the sampler
-// machinery; it picks the same texel as a nearest sampler would.
-override NEAREST: bool = false;
-
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
     let q = p - brick.tex_lo.xyz + 0.5;
