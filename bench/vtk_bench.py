@@ -16,7 +16,7 @@ then --frames timed frames. Every frame is followed by renWin.WaitForCompletion(
 (glFinish), and the loop is timed with time.perf_counter.
 
 Output: comment lines start with '#'; results are machine-readable lines
-    vtk_<mapper> <mode> ms_per_frame=<mean> min_ms=<min> max_ms=<max> frames=<n> size=<W>x<H> extent=<N>
+    vtk_<mapper> <mode> ms_per_frame=<mean> median_ms=<median> min_ms=<min> max_ms=<max> frames=<n> size=<W>x<H> extent=<N>
 
 Run with Debian's /usr/bin/python3 (VTK 9.2 from ParaView 5.11), offscreen: the caller
 provides an X display (e.g. Xvfb) in $DISPLAY.
@@ -28,6 +28,7 @@ Examples:
 
 import argparse
 import os
+import statistics
 import sys
 import time
 
@@ -202,8 +203,8 @@ def main(argv):
         ms = 1000.0 * total_s / args.frames
         print("# %s: warm-up %d frames %.1f ms (first frames include texture upload / shader build)"
               % (mode, WARMUP_FRAMES, 1000.0 * warmup_s))
-        print("vtk_%s %s ms_per_frame=%.1f min_ms=%.1f max_ms=%.1f frames=%d size=%dx%d extent=%d"
-              % (args.mapper, mode, ms, 1000.0 * min(times), 1000.0 * max(times),
+        print("vtk_%s %s ms_per_frame=%.1f median_ms=%.1f min_ms=%.1f max_ms=%.1f frames=%d size=%dx%d extent=%d"
+              % (args.mapper, mode, ms, 1000.0 * statistics.median(times), 1000.0 * min(times), 1000.0 * max(times),
                  args.frames, width, height, n))
         sys.stdout.flush()
 

@@ -65,6 +65,7 @@ fn nominal_samples(view: &View, bounds: [f64; 6], step: f64) -> f64 {
 
 struct Figures {
     ms_per_frame: f64,
+    median_ms: f64,
     samples_per_s: f64,
 }
 
@@ -91,27 +92,29 @@ fn time_config(
     let pb = indicatif::ProgressBar::new(frames as u64);
     let mut samples = 0.0;
     let mut elapsed = 0.0;
+    let mut times = Vec::with_capacity(frames as usize);
     for _ in 0..frames {
         advance(&mut view);
         let t = Instant::now();
         r.render(&view, params, None)?;
         r.context().wait_idle()?;
-        elapsed += t.elapsed().as_secs_f64();
-        if std::env::var("FERROVOL_BENCH_TRACE").is_ok() {
-            eprintln!("frame {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
-        }
+        let dt = t.elapsed().as_secs_f64();
+        elapsed += dt;
+        times.push(dt);
         samples += nominal_samples(&view, bounds, step);
         pb.inc(1);
     }
     pb.finish_and_clear();
+    times.sort_by(f64::total_cmp);
     Ok(Figures {
         ms_per_frame: 1e3 * elapsed / frames as f64,
+        median_ms: 1e3 * times[times.len() / 2],
         samples_per_s: samples / elapsed,
     })
 }
 
-/// Runs VTK's mapper on the scene; returns (unshaded, shaded) ms/frame.
-fn run_vtk(a: &BenchArgs) -> Result<(f64, f64), CliError> {
+/// Runs VTK's mapper on the scene; returns (mean, median) ms/frame, unshaded then shaded.
+fn run_vtk(a: &BenchArgs) -> Result<[(f64, f64); 2], CliError> {
     let out = std::process::Command::new(&a.vtk_python)
         .args([
             &a.vtk_script,
@@ -135,22 +138,25 @@ fn run_vtk(a: &BenchArgs) -> Result<(f64, f64), CliError> {
             String::from_utf8_lossy(&out.stderr)
         )));
     }
-    let find = |key: &str| -> Result<f64, CliError> {
-        text.lines()
-            .find(|l| l.starts_with(key))
-            .and_then(|l| l.split("ms_per_frame=").nth(1))
-            .and_then(|v| v.split_whitespace().next())
-            .and_then(|v| v.parse().ok())
-            .ok_or_else(|| {
-                CliError::Usage(format!(
-                    "VTK benchmark printed no '{key} ms_per_frame=' line:\n{text}"
-                ))
-            })
+    // (mean, median) ms of a `vtk_gpu <mode> ms_per_frame=… median_ms=…` line
+    let find = |key: &str| -> Result<(f64, f64), CliError> {
+        let line = text.lines().find(|l| l.starts_with(key));
+        let field = |name: &str| {
+            line.and_then(|l| l.split(name).nth(1))
+                .and_then(|v| v.split_whitespace().next())
+                .and_then(|v| v.parse::<f64>().ok())
+        };
+        match (field("ms_per_frame="), field("median_ms=")) {
+            (Some(mean), Some(median)) => Ok((mean, median)),
+            _ => Err(CliError::Usage(format!(
+                "VTK benchmark printed no '{key} ms_per_frame=… median_ms=…' line:\n{text}"
+            ))),
+        }
     };
     for l in text.lines().filter(|l| l.starts_with('#')) {
         println!("{l}");
     }
-    Ok((find("vtk_gpu unshaded")?, find("vtk_gpu shaded")?))
+    Ok([find("vtk_gpu unshaded")?, find("vtk_gpu shaded")?])
 }
 
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
@@ -179,9 +185,6 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     r.set_volume(&vol)?;
     r.set_transfer_function(&tf)?;
     pb.finish_and_clear();
-    if let Ok(s) = std::env::var("FERROVOL_BENCH_SLEEP") {
-        std::thread::sleep(std::time::Duration::from_secs_f64(s.parse().unwrap_or(0.0)));
-    }
     let (w, h) = a.size;
     let view = View::fit(bounds, w, h);
     println!(
@@ -217,8 +220,8 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
                 "skipping=off".to_string()
             };
             println!(
-                "ferrovol {name} ms_per_frame={:.1} samples_per_s={:.3e} {skip_note}",
-                f.ms_per_frame, f.samples_per_s
+                "ferrovol {name} ms_per_frame={:.1} median_ms={:.1} samples_per_s={:.3e} {skip_note}",
+                f.ms_per_frame, f.median_ms, f.samples_per_s
             );
             if let Some(dir) = &a.png_dir {
                 std::fs::create_dir_all(dir)
@@ -226,15 +229,22 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
                 r.read_image()?
                     .save_png(&dir.join(format!("ferrovol-{name}.png")), [0.0; 3])?;
             }
-            ours.push(f.ms_per_frame);
+            ours.push((f.ms_per_frame, f.median_ms));
         }
     }
     if a.vtk {
-        let (vu, vs) = run_vtk(&a)?;
-        println!("vtk_gpu unshaded ms_per_frame={vu:.1}");
-        println!("vtk_gpu shaded ms_per_frame={vs:.1}");
-        println!("ratio unshaded ferrovol/vtk={:.3}", ours[0] / vu);
-        println!("ratio shaded ferrovol/vtk={:.3}", ours[1] / vs);
+        let vtk = run_vtk(&a)?;
+        for (i, name) in ["unshaded", "shaded"].into_iter().enumerate() {
+            let (mean, median) = vtk[i];
+            println!("vtk_gpu {name} ms_per_frame={mean:.1} median_ms={median:.1}");
+        }
+        for (i, name) in ["unshaded", "shaded"].into_iter().enumerate() {
+            println!(
+                "ratio {name} ferrovol/vtk mean={:.3} median={:.3}",
+                ours[i].0 / vtk[i].0,
+                ours[i].1 / vtk[i].1
+            );
+        }
     }
     Ok(())
 }
