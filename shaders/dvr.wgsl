@@ -148,10 +148,12 @@ fn block_exit(r: Ray, p: vec3<f32>) -> f32 {
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= frame.viewport.x || gid.y >= frame.viewport.y) {
+    // The dispatch covers only frame.rect, the pixels the volume's box can project to.
+    let px = gid.xy + frame.rect.xy;
+    if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
         return;
     }
-    let pix = gid.y * frame.viewport.x + gid.x;
+    let pix = px.y * frame.viewport.x + px.x;
     let blend = BLEND;
     var st: PixelState;
     if (!SINGLE_BRICK) {
@@ -161,14 +163,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (blend == BLEND_COMPOSITE && st.color.a >= ert) {
         return;
     }
-    let ray = make_ray(gid.xy);
+    let ray = make_ray(px);
     // The whole ray segment inside the volume, near/far planes, opaque depth and clip planes.
     var seg = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
     seg.x = max(seg.x, 0.0);
     seg.y = min(seg.y, ray.far);
     if (has_flag(FLAG_DEPTH_INPUT)) {
-        let d = textureLoad(depth_in, vec2<i32>(gid.xy), 0).x;
-        seg.y = min(seg.y, depth_to_distance(ray, gid.xy, d));
+        let d = textureLoad(depth_in, vec2<i32>(px), 0).x;
+        seg.y = min(seg.y, depth_to_distance(ray, px, d));
     }
     seg = clip_interval(ray, seg);
     // This brick's part of it.
@@ -178,7 +180,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // (written so that NaN from a degenerate ray also leaves)
     if (!(t_lo < t_hi)) {
         if (SINGLE_BRICK) {
-            write_pixel(gid.xy, st);
+            write_pixel(px, st);
         }
         return;
     }
@@ -245,7 +247,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     st.value = value;
     st.misc = misc;
     if (SINGLE_BRICK) {
-        write_pixel(gid.xy, st);
+        write_pixel(px, st);
     } else {
         state[pix] = st;
     }

@@ -7,8 +7,9 @@
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= frame.viewport.x || gid.y >= frame.viewport.y) {
+    let px = gid.xy + frame.rect.xy;
+    if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
         return;
     }
-    write_pixel(gid.xy, state[gid.y * frame.viewport.x + gid.x]);
+    write_pixel(px, state[px.y * frame.viewport.x + px.x]);
 }

@@ -45,6 +45,7 @@ pub struct FrameUniforms {
     pub mode: [u32; 4],
     pub counts: [u32; 4],
     pub occupancy_dims: [u32; 4],
+    pub rect: [u32; 4],
 }
 
 #[repr(C)]
@@ -148,7 +149,8 @@ mod layout_tests {
                 viewport,
                 mode,
                 counts,
-                occupancy_dims
+                occupancy_dims,
+                rect
             ]
         );
         check!(

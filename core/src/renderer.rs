@@ -125,6 +125,65 @@ struct TableKey {
     step_bits: u64,
 }
 
+/// The pixels the volume's box can cover: the bounding rectangle of its projected corners
+/// widened by a pixel, as [x0, y0, x1, y1) — or the whole image when a corner lies behind
+/// the camera (the camera is inside or beside the volume).
+fn screen_rect(
+    vp: DMat4,
+    index_to_world: DMat4,
+    dims: [u32; 3],
+    width: u32,
+    height: u32,
+) -> [u32; 4] {
+    let full = [0, 0, width, height];
+    let (mut x0, mut y0, mut x1, mut y1) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for c in 0..8u32 {
+        let ijk = DVec3::new(
+            if c & 1 != 0 {
+                (dims[0] - 1) as f64
+            } else {
+                0.0
+            },
+            if c & 2 != 0 {
+                (dims[1] - 1) as f64
+            } else {
+                0.0
+            },
+            if c & 4 != 0 {
+                (dims[2] - 1) as f64
+            } else {
+                0.0
+            },
+        );
+        let clip = vp * index_to_world.transform_point3(ijk).extend(1.0);
+        if clip.w <= 1e-9 || !clip.is_finite() {
+            return full;
+        }
+        let x = (clip.x / clip.w + 1.0) * 0.5 * width as f64;
+        let y = (1.0 - clip.y / clip.w) * 0.5 * height as f64;
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let clamp = |v: f64, hi: u32| v.clamp(0.0, hi as f64) as u32;
+    let r = [
+        clamp(x0.floor() - 1.0, width),
+        clamp(y0.floor() - 1.0, height),
+        clamp(x1.ceil() + 1.0, width),
+        clamp(y1.ceil() + 1.0, height),
+    ];
+    if r[0] >= r[2] || r[1] >= r[3] {
+        return [0, 0, 0, 0];
+    }
+    r
+}
+
 /// Edge of the square compute workgroups (`@workgroup_size` in dvr.wgsl and resolve.wgsl).
 /// 8×8 keeps rays in a workgroup coherent; 16×16 measured slower on lavapipe.
 const WORKGROUP: u32 = 8;
@@ -194,6 +253,27 @@ fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
         ty,
         count: None,
     }
+}
+
+/// A colour attachment that clears its first channel to `value` and the rest to zero.
+fn clear_attachment(
+    view: &wgpu::TextureView,
+    value: f64,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Clear(wgpu::Color {
+                r: value,
+                g: 0.0,
+                b: 0.0,
+                a: 0.0,
+            }),
+            store: wgpu::StoreOp::Store,
+        },
+    })
 }
 
 fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
@@ -714,7 +794,8 @@ impl Renderer {
             };
             let out_usage = wgpu::TextureUsages::STORAGE_BINDING
                 | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING;
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::RENDER_ATTACHMENT;
             Targets {
                 width,
                 height,
@@ -877,12 +958,8 @@ impl Renderer {
         if depth_input {
             flags |= FLAG_DEPTH_INPUT;
         }
-        u.viewport = [
-            view.width,
-            view.height,
-            view.width * view.height,
-            0x9e37_79b9,
-        ];
+        u.viewport = [view.width, view.height, 0, 0x9e37_79b9];
+        u.rect = screen_rect(vp, index_to_world, vol.data_dims, view.width, view.height);
         u.mode[0] = params.blend.code();
         u.mode[1] = flags;
         u.counts = [
@@ -1060,13 +1137,25 @@ impl Renderer {
             layout: &self.resolve_bgl,
             entries: &common,
         });
+        let rect = u.rect;
         let groups = [
-            view.width.div_ceil(WORKGROUP),
-            view.height.div_ceil(WORKGROUP),
+            (rect[2] - rect[0]).div_ceil(WORKGROUP),
+            (rect[3] - rect[1]).div_ceil(WORKGROUP),
         ];
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame"),
         });
+        if rect != [0, 0, view.width, view.height] {
+            // Pixels outside the rectangle get no ray: clear them (transparent, far depth).
+            enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("clear outside the volume"),
+                color_attachments: &[
+                    clear_attachment(&color_view, 0.0),
+                    clear_attachment(&depth_view, 1.0),
+                ],
+                ..Default::default()
+            });
+        }
         if !variant.single_brick {
             enc.clear_buffer(&t.state, 0, None);
         }

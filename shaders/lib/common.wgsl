@@ -70,10 +70,11 @@ struct Frame {
     additive_scale: vec4<f32>,    // per component: sample distance / unit distance
     clip: array<vec4<f32>, 6>,    // index-space planes: keep dot(xyz, p) + w >= 0
     lights: array<Light, 8>,
-    viewport: vec4<u32>,          // width, height, pixel count, seed
+    viewport: vec4<u32>,          // width, height, unused, jitter seed
     mode: vec4<u32>,              // blend, flags, crop regions, unused
     counts: vec4<u32>,            // clip planes, lights, occupancy block size, components
     occupancy_dims: vec4<u32>,    // blocks per axis
+    rect: vec4<u32>,              // pixels the passes cover: x0, y0, x1, y1 (exclusive)
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
