@@ -258,6 +258,69 @@ fn trilinear(v: &VolumeData, p: DVec3) -> f64 {
     lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2])
 }
 
+/// The voxel a nearest-neighbour fetch at index-space point p takes: floor(p + 0.5),
+/// clamped to the grid (shaders/lib/volume.wgsl sample_texel with NEAREST).
+fn nearest_voxel(v: &VolumeData, p: DVec3) -> [i64; 3] {
+    std::array::from_fn(|a| ((p[a] + 0.5).floor() as i64).clamp(0, v.dims[a] as i64 - 1))
+}
+
+/// The value of voxel c, its index clamped to the grid (the shader's `texel`).
+fn voxel(v: &VolumeData, c: [i64; 3]) -> f64 {
+    let [i, j, k] = std::array::from_fn(|a| c[a].clamp(0, v.dims[a] as i64 - 1) as u32);
+    v.value(i, j, k, 0)
+}
+
+/// The scalar the renderer samples at index-space point p.
+fn sample(v: &VolumeData, p: DVec3, interp: Interpolation) -> f64 {
+    match interp {
+        Interpolation::Linear => trilinear(v, p),
+        Interpolation::Nearest => voxel(v, nearest_voxel(v, p)),
+    }
+}
+
+/// Index-space central-difference gradient at p: of the interpolated field one index step
+/// either side (linear), or of the nearest voxel's six neighbours (nearest, as
+/// shaders/lib/volume.wgsl gradient_at: one rounding for all six).
+fn gradient(v: &VolumeData, p: DVec3, interp: Interpolation) -> DVec3 {
+    let e = [DVec3::X, DVec3::Y, DVec3::Z];
+    match interp {
+        Interpolation::Linear => DVec3::from_array(std::array::from_fn(|a| {
+            0.5 * (trilinear(v, p + e[a]) - trilinear(v, p - e[a]))
+        })),
+        Interpolation::Nearest => {
+            let c = nearest_voxel(v, p);
+            DVec3::from_array(std::array::from_fn(|a| {
+                let (mut lo, mut hi) = (c, c);
+                lo[a] -= 1;
+                hi[a] += 1;
+                0.5 * (voxel(v, hi) - voxel(v, lo))
+            }))
+        }
+    }
+}
+
+/// Colour and opacity corrected for a step of `dt` of scalar s. Linear: the piecewise
+/// functions themselves (the renderer's 1024-entry tables, read linearly, stand in for
+/// them to a fraction of a level). Nearest: the table entry the renderer reads, entry
+/// i = round(u·1023) of the table over the component's table range, which holds the
+/// functions at x_i = lo + (hi − lo)·i/1023 (core/src/transfer.rs build_tables,
+/// shaders/lib/common.wgsl table_lookup).
+fn classify(tf: &ComponentTransfer, s: f64, dt: f64, interp: Interpolation) -> ([f64; 3], f64) {
+    let x = match interp {
+        Interpolation::Linear => s,
+        Interpolation::Nearest => {
+            let [lo, hi] = tf.table_range();
+            let last = (transfer::TABLE_SIZE - 1) as f64;
+            let u = ((s - lo) / (hi - lo)).clamp(0.0, 1.0);
+            let i = (u * last + 0.5).floor();
+            lo + (hi - lo) * i / last
+        }
+    };
+    let a0 = eval_pw(&tf.opacity, x)[0].clamp(0.0, 1.0);
+    let a = 1.0 - (1.0 - a0).powf(dt / tf.unit_distance);
+    (eval_pw(&tf.color, x), a)
+}
+
 /// Phong shading as shaders/lib/shading.wgsl, for the lights of `view`'s headlight
 /// (directional, at the camera, white ambient/diffuse/specular, intensity 1).
 fn cpu_shade(
@@ -297,7 +360,8 @@ fn cpu_shade(
 }
 
 /// f64 reference of the composite ray integral: premultiplied RGBA per pixel in [0, 1]
-/// and the window depth of the first sample with any opacity (1 where none).
+/// and the window depth of the first sample with any opacity (1 where none). Samples,
+/// gradients and the transfer function are interpolated as `p.interpolation` says.
 fn cpu_render(
     v: &VolumeData,
     tf: &ComponentTransfer,
@@ -311,6 +375,12 @@ fn cpu_render(
         "the reference knows the headlight only"
     );
     assert_eq!(view.lights[0].space, LightSpace::Headlight);
+    assert_eq!(
+        p.gradient,
+        GradientMethod::Central,
+        "the reference knows central differences only"
+    );
+    let interp = p.interpolation;
     let cam = &view.camera;
     let light_dir = (cam.position - cam.focal_point).normalize();
     let w2i = v.index_to_data().inverse();
@@ -332,20 +402,13 @@ fn cpu_render(
                 }
                 k += 1.0;
                 let pi = io + t * id;
-                let s = trilinear(v, pi);
-                let a0 = eval_pw(&tf.opacity, s)[0].clamp(0.0, 1.0);
-                let a = 1.0 - (1.0 - a0).powf(dt / tf.unit_distance);
+                let s = sample(v, pi, interp);
+                let (mut rgb, a) = classify(tf, s, dt, interp);
                 if a <= 0.0 {
                     continue;
                 }
-                let mut rgb = eval_pw(&tf.color, s);
                 if p.shading.enabled {
-                    let e = [DVec3::X, DVec3::Y, DVec3::Z];
-                    let g = DVec3::new(
-                        0.5 * (trilinear(v, pi + e[0]) - trilinear(v, pi - e[0])),
-                        0.5 * (trilinear(v, pi + e[1]) - trilinear(v, pi - e[1])),
-                        0.5 * (trilinear(v, pi + e[2]) - trilinear(v, pi - e[2])),
-                    );
+                    let g = gradient(v, pi, interp);
                     let gw = grad_to_world.transform_vector3(g);
                     rgb = cpu_shade(rgb, gw, ray.dir, light_dir, &p.shading);
                 }
@@ -1605,4 +1668,318 @@ fn blend_modes_cropping_clipping() {
         right_changed, 0,
         "the kept half changed ({right_changed} px)"
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// 13. Nearest-neighbour interpolation against the f64 reference
+// ---------------------------------------------------------------------------------------
+
+/// Pixels with some channel more than `levels` away from the reference.
+fn pixels_off_by_more(img: &Image, reference: &[[f64; 4]], levels: f64) -> usize {
+    img.rgba
+        .chunks(4)
+        .zip(reference)
+        .filter(|(p, q)| {
+            (0..4).any(|c| (p[c] as f64 - q[c].clamp(0.0, 1.0) * 255.0).abs() > levels)
+        })
+        .count()
+}
+
+#[test]
+fn cpu_reference_nearest() {
+    let mut r = renderer();
+    // small enough that a voxel covers ~2 pixels, so nearest's blocks show
+    let vol = blob_volume(24)
+        .with_spacing([1.0, 0.8, 1.2])
+        .unwrap()
+        .with_origin([-5.0, 3.0, 0.5])
+        .unwrap();
+    let tf = blob_transfer();
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&TransferFunction::single(tf.clone()))
+        .unwrap();
+    let (w, h) = (64u32, 64u32);
+    let npix = (w * h) as usize;
+    for (view_name, az, el) in [("front", 0.0, 0.0), ("oblique", 35.0, -25.0)] {
+        let mut view = View::fit(vol.bounds(), w, h);
+        view.camera.azimuth(az);
+        view.camera.elevation(el);
+        view.camera.orthogonalize_view_up();
+        view.camera.reset_clipping_range(vol.bounds());
+        for shade in [false, true] {
+            let name = format!(
+                "nearest_{view_name}_{}",
+                if shade { "shaded" } else { "unshaded" }
+            );
+            let params = RenderParams {
+                interpolation: Interpolation::Nearest,
+                shading: Shading {
+                    enabled: shade,
+                    ..Shading::default()
+                },
+                ..RenderParams::default()
+            };
+            let dt = r.sample_distance(&params).unwrap();
+            let img = r.render_image(&view, &params).unwrap();
+            let (refc, _) = cpu_render(&vol, &tf, &view, &params, dt);
+            save(&img, &name);
+            save(&reference_image(&refc, w, h), &format!("{name}_cpu"));
+            let (mae, psnr, max) = compare_to_reference(&img, &refc);
+            let big = pixels_off_by_more(&img, &refc, 8.0);
+            // What the test tells apart: the same GPU image against the linear reference,
+            // and the renderer's own linear image against the nearest reference.
+            let linear = RenderParams {
+                interpolation: Interpolation::Linear,
+                ..params.clone()
+            };
+            let (ref_lin, _) = cpu_render(&vol, &tf, &view, &linear, dt);
+            let (mae_lin, psnr_lin, _) = compare_to_reference(&img, &ref_lin);
+            let img_lin = r.render_image(&view, &linear).unwrap();
+            let (mae_gl, psnr_gl, _) = compare_to_reference(&img_lin, &refc);
+            let fp = footprint(&img);
+            println!(
+                "{name}: footprint {fp} px, vs nearest reference: mean abs error {mae:.3}/255, max {max:.1}/255, PSNR {psnr:.1} dB, {big} of {npix} px off by > 8/255 (dt {dt}); vs linear reference: mean {mae_lin:.3}/255, PSNR {psnr_lin:.1} dB; GPU linear image vs nearest reference: mean {mae_gl:.3}/255, PSNR {psnr_gl:.1} dB"
+            );
+            assert!(fp > 400, "{name}: the image is almost empty ({fp} px)");
+            // As for linear interpolation (cpu_reference_composite_shaded): f32 against
+            // f64 and the u8 output cost a fraction of a level on average; the tables are
+            // no approximation here, the reference reads the same entries.
+            assert!(psnr >= 35.0, "{name}: PSNR {psnr:.1} dB");
+            assert!(mae < 1.5, "{name}: mean abs error {mae:.3}/255");
+            // Nearest classification is discontinuous: a sample whose p + 0.5 lies within
+            // f32 rounding of a voxel boundary (or whose scalar lies within rounding of a
+            // half-way point between table entries) takes the neighbouring voxel (entry)
+            // on one side and not the other, and that one sample's colour and opacity
+            // jump. On a smooth volume that moves a pixel by a few levels at most, and
+            // such samples are rare: at most 1% of the pixels may be off by more than 8.
+            assert!(
+                big * 100 < npix,
+                "{name}: {big} of {npix} pixels off by more than 8/255"
+            );
+            // On this smooth blob nearest and linear interpolation differ by only a few
+            // tenths of a level on average, well inside the bounds above: they alone would
+            // pass a renderer that ignored the setting. The reference's own agreement (u8
+            // rounding and little else) is several times tighter, so the nearest reference
+            // must fit at least three times better than the linear one, and the renderer's
+            // linear image must not fit it as well.
+            assert!(
+                3.0 * mae < mae_lin && 3.0 * mae < mae_gl,
+                "{name}: the nearest image is not told from a linear one (mean abs error {mae:.3} vs the nearest reference, {mae_lin:.3} vs the linear one; linear image vs the nearest reference {mae_gl:.3})"
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 14. Rays only over the volume's projected rectangle, the rest cleared
+// ---------------------------------------------------------------------------------------
+
+/// Pixels whose square [x, x+1) × [y, y+1) touches the bounding rectangle of the
+/// projected corners of the volume's box: no pixel outside can have a ray through the box
+/// (its centre is at least half a pixel from the projection). `None` when a corner is
+/// not in front of the camera (the projection is not bounded by the corners).
+fn box_footprint(vol: &VolumeData, view: &View) -> Option<Vec<bool>> {
+    let vp = view.camera.view_projection(view.aspect());
+    let m = vol.index_to_data();
+    let (lo, hi) = index_box(vol);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in box_corners(lo, hi) {
+        let c = vp * m.transform_point3(p).extend(1.0);
+        if c.w <= 0.0 {
+            return None;
+        }
+        let x = (c.x / c.w + 1.0) * 0.5 * view.width as f64;
+        let y = (1.0 - c.y / c.w) * 0.5 * view.height as f64;
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    Some(
+        (0..view.height)
+            .flat_map(|y| (0..view.width).map(move |x| (x as f64, y as f64)))
+            .map(|(x, y)| x + 1.0 > x0 && x < x1 && y + 1.0 > y0 && y < y1)
+            .collect(),
+    )
+}
+
+/// (max abs channel difference, pixels whose depth differs in any bit) of two frames.
+fn frame_diff(a: &Image, b: &Image) -> (u8, usize) {
+    let (_, max) = image_diff(a, b);
+    let depth = a
+        .depth
+        .iter()
+        .zip(&b.depth)
+        .filter(|(x, y)| x.to_bits() != y.to_bits())
+        .count();
+    (max, depth)
+}
+
+#[test]
+fn outside_rectangle_is_cleared() {
+    let mut r = renderer();
+    let vol = blob_volume(24);
+    let tf = TransferFunction::single(blob_transfer());
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&tf).unwrap();
+    let b = vol.bounds();
+    let (w, h) = (96u32, 80u32);
+    let npix = (w * h) as usize;
+    let params = shaded();
+    let mut small = View::fit(b, w, h);
+    small.camera.azimuth(30.0);
+    small.camera.elevation(20.0);
+    small.camera.orthogonalize_view_up();
+    small.camera.reset_clipping_range(b);
+    let mut zoomed = small.clone();
+    zoomed.camera.zoom(4.0);
+    zoomed.camera.reset_clipping_range(b);
+
+    // 1. The zoomed frame: the box covers the whole image (a full-image dispatch) and the
+    // blob's core shows everywhere.
+    let zoom_img = r.render_image(&zoomed, &params).unwrap();
+    save(&zoom_img, "rect_zoomed");
+    let zoom_hits = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let (_, _, t0, t1) = ray_segment(&vol, &pixel_ray(&zoomed, x, y));
+            t0 < t1
+        })
+        .count();
+    let zoom_fp = footprint(&zoom_img);
+
+    // 2. The small frame right after it, on the same renderer and targets.
+    let fp_mask = box_footprint(&vol, &small).expect("the box is in front of the camera");
+    let img = r.render_image(&small, &params).unwrap();
+    save(&img, "rect_small");
+    let inside = fp_mask.iter().filter(|&&m| m).count();
+    let mut outside = 0;
+    let mut stale = 0; // outside pixels the zoomed frame had drawn
+    let mut bad_color = 0;
+    let mut bad_depth = 0;
+    let mut first_bad = None;
+    for (i, &m) in fp_mask.iter().enumerate() {
+        if m {
+            continue;
+        }
+        outside += 1;
+        stale += (zoom_img.rgba[4 * i + 3] > 0) as usize;
+        let c = &img.rgba[4 * i..4 * i + 4];
+        let d = img.depth[i];
+        bad_color += (c != [0u8; 4]) as usize;
+        bad_depth += (d != 1.0) as usize;
+        if (c != [0u8; 4] || d != 1.0) && first_bad.is_none() {
+            first_bad = Some((i as u32 % w, i as u32 / w, [c[0], c[1], c[2], c[3]], d));
+        }
+    }
+    let small_fp = footprint(&img);
+    let small_fp_out = img
+        .rgba
+        .chunks(4)
+        .zip(&fp_mask)
+        .filter(|(p, &m)| p[3] > 0 && !m)
+        .count();
+
+    // 3. The same small view by a renderer that never drew anything else.
+    let mut fresh = Renderer::new(Context::new().unwrap()).unwrap();
+    fresh.set_volume(&vol).unwrap();
+    fresh.set_transfer_function(&tf).unwrap();
+    let fresh_img = fresh.render_image(&small, &params).unwrap();
+    let (max_fresh, depth_fresh) = frame_diff(&img, &fresh_img);
+    println!(
+        "rect: zoomed frame: {zoom_hits} of {npix} px on the box, {zoom_fp} with opacity; small frame: analytic footprint {inside} px, {outside} outside it ({stale} of them drawn by the zoomed frame), {small_fp} px with opacity ({small_fp_out} outside the footprint); outside: {bad_color} px not rgba 0, {bad_depth} px depth not 1 (first {first_bad:?}); vs a fresh renderer: max abs diff {max_fresh}/255, {depth_fresh} depths differ"
+    );
+    assert_eq!(zoom_hits, npix, "the zoomed box must cover the image");
+    assert!(
+        zoom_fp * 10 >= npix * 9,
+        "the zoomed frame must fill the image ({zoom_fp} of {npix} px)"
+    );
+    assert!(inside > 0 && small_fp > 0, "empty footprint");
+    // the test means something only where the zoomed frame left pixels to clear
+    assert!(
+        outside * 4 >= npix && stale * 10 >= outside * 9,
+        "too little outside the footprint: {outside} px, {stale} drawn before"
+    );
+    // Outside the footprint no ray meets the box: the pixels are cleared, never left from
+    // the zoomed frame, and exactly so (clear values, not computed ones).
+    assert_eq!(
+        (bad_color, bad_depth),
+        (0, 0),
+        "pixels outside the footprint not cleared (first: {first_bad:?})"
+    );
+    // Inside, every pixel is written by the rays: nothing of the previous frame remains.
+    assert_eq!(
+        (max_fresh, depth_fresh),
+        (0, 0),
+        "the small frame depends on the frame before it"
+    );
+
+    // 4. The volume entirely off-screen (the camera shifted sideways by three box
+    // widths): an empty rectangle, everything cleared.
+    let mut away = small.clone();
+    let right = away
+        .camera
+        .direction()
+        .cross(away.camera.view_up)
+        .normalize();
+    let shift = right * 3.0 * (b[1] - b[0]);
+    away.camera.position += shift;
+    away.camera.focal_point += shift;
+    away.camera.reset_clipping_range(b);
+    let away_mask = box_footprint(&vol, &away).expect("the box is in front of the camera");
+    r.render_image(&zoomed, &params).unwrap();
+    let away_img = r.render_image(&away, &params).unwrap();
+    let away_inside = away_mask.iter().filter(|&&m| m).count();
+    let away_color = away_img.rgba.iter().filter(|&&c| c != 0).count();
+    let away_depth = away_img.depth.iter().filter(|&&d| d != 1.0).count();
+    println!(
+        "rect: volume off-screen after the zoomed frame: footprint {away_inside} px, {away_color} channels not 0, {away_depth} depths not 1"
+    );
+    assert_eq!(away_inside, 0, "the shifted view still sees the box");
+    assert_eq!(
+        (away_color, away_depth),
+        (0, 0),
+        "an off-screen volume left pixels uncleared"
+    );
+
+    // 5. The camera inside the volume (a corner behind the camera: the full-image path),
+    // right after the small frame, against the fresh renderer and the f64 reference.
+    let mut inside_view = small.clone();
+    inside_view.camera.position = DVec3::new(10.5, 11.0, 12.5);
+    inside_view.camera.focal_point = DVec3::new(2.0, 5.0, 4.0);
+    inside_view.camera.view_angle = 70.0;
+    inside_view.camera.orthogonalize_view_up();
+    inside_view.camera.reset_clipping_range(b);
+    assert!(
+        box_footprint(&vol, &inside_view).is_none(),
+        "the camera must be inside the box"
+    );
+    r.render_image(&small, &params).unwrap();
+    let in_img = r.render_image(&inside_view, &params).unwrap();
+    save(&in_img, "rect_camera_inside");
+    let in_fresh = fresh.render_image(&inside_view, &params).unwrap();
+    let (max_in, depth_in) = frame_diff(&in_img, &in_fresh);
+    let dt = r.sample_distance(&params).unwrap();
+    let (refc, _) = cpu_render(&vol, &blob_transfer(), &inside_view, &params, dt);
+    let (mae, psnr, max) = compare_to_reference(&in_img, &refc);
+    let in_fp = footprint(&in_img);
+    println!(
+        "rect: camera inside: {in_fp} of {npix} px with opacity; vs a fresh renderer: max abs diff {max_in}/255, {depth_in} depths differ; vs the f64 reference: mean abs error {mae:.3}/255, max {max:.1}/255, PSNR {psnr:.1} dB"
+    );
+    // Every ray starts inside the blob's core (value ≈ 0.9 at the camera), so every pixel
+    // has opacity.
+    assert_eq!(in_fp, npix, "pixels without opacity with the camera inside");
+    assert_eq!(
+        (max_in, depth_in),
+        (0, 0),
+        "the frame depends on the one before"
+    );
+    // as cpu_reference_composite_shaded
+    assert!(psnr >= 35.0, "camera inside: PSNR {psnr:.1} dB");
+    assert!(mae < 1.5, "camera inside: mean abs error {mae:.3}/255");
 }
