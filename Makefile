@@ -28,8 +28,11 @@ lint: deps
 test: lint
 	$(CARGO) test --locked --workspace
 
+# The first process after a shader change runs 3-4x slower on lavapipe until Mesa's shader
+# cache holds the pipelines (measured), so a short priming run of both renderers goes first.
 bench: build
-	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --png-dir build/bench
+	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 1 --size 300x300 >/dev/null
+	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 20 --png-dir build/bench
 
 # The README's pictures.
 pictures: build

@@ -22,10 +22,10 @@ const MAX_LIGHTS: u32 = 8u;
 // Entries per lookup table (transfer::TABLE_SIZE).
 const TABLE_N: u32 = 1024u;
 
-// Nearest-neighbour interpolation, a pipeline constant: volume texels are fetched directly
-// (textureLoad, the texel a nearest sampler would pick, without the sampler machinery) and
-// the transfer-function tables are read at the nearest entry, as VTK's
-// InterpolationType applies to both.
+// Nearest-neighbour interpolation, a pipeline constant: the transfer-function tables are
+// read at the nearest entry, as VTK's InterpolationType applies to the tables too (the
+// volume itself is read through the brick's nearest sampler; on lavapipe a sampler fetch
+// measured faster than textureLoad).
 override NEAREST: bool = false;
 const MAX_CLIP: u32 = 6u;
 

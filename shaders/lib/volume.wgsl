@@ -16,29 +16,20 @@ struct Brick {
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
 
-// Raw value of the texel at integer texture coordinate c, clamped to the brick's texture.
-fn texel(c: vec3<i32>) -> vec4<f32> {
-    let hi = vec3<i32>(brick.tex_size.xyz) - 1;
-    return textureLoad(volume_tex, clamp(c, vec3<i32>(0), hi), 0);
-}
-
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
-    let q = p - brick.tex_lo.xyz + 0.5;
-    if (NEAREST) {
-        return texel(vec3<i32>(floor(q)));
-    }
-    return textureSampleLevel(volume_tex, volume_sampler, q * brick.tex_inv_size.xyz, 0.0);
+    let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
+    return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
+}
+
+// Scalars (data units) of every component at texture coordinate tc.
+fn scalars_at(tc: vec3<f32>) -> vec4<f32> {
+    return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0) * frame.scalar_scale + frame.scalar_shift;
 }
 
 // Scalars (data units) of every component at index-space point p.
 fn sample_scalars(p: vec3<f32>) -> vec4<f32> {
     return sample_texel(p) * frame.scalar_scale + frame.scalar_shift;
-}
-
-// Scalars of the texel at integer texture coordinate c.
-fn scalars_at_texel(c: vec3<i32>) -> vec4<f32> {
-    return texel(c) * frame.scalar_scale + frame.scalar_shift;
 }
 
 struct Gradient {
@@ -50,32 +41,20 @@ struct Gradient {
 // Index-space gradient of every component: central differences (6 samples) or forward
 // differences from the centre value s (3 samples).
 fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
+    // neighbours one voxel away, offset directly in texture coordinates
+    let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
+    let dx = vec3<f32>(brick.tex_inv_size.x, 0.0, 0.0);
+    let dy = vec3<f32>(0.0, brick.tex_inv_size.y, 0.0);
+    let dz = vec3<f32>(0.0, 0.0, brick.tex_inv_size.z);
     var g: Gradient;
-    if (NEAREST) {
-        // the six neighbours of the nearest texel, one rounding for all of them
-        let c = vec3<i32>(floor(p - brick.tex_lo.xyz + 0.5));
-        let ex = vec3<i32>(1, 0, 0);
-        let ey = vec3<i32>(0, 1, 0);
-        let ez = vec3<i32>(0, 0, 1);
-        if (has_flag(FLAG_FORWARD_DIFF)) {
-            g.x = scalars_at_texel(c + ex) - s;
-            g.y = scalars_at_texel(c + ey) - s;
-            g.z = scalars_at_texel(c + ez) - s;
-        } else {
-            g.x = 0.5 * (scalars_at_texel(c + ex) - scalars_at_texel(c - ex));
-            g.y = 0.5 * (scalars_at_texel(c + ey) - scalars_at_texel(c - ey));
-            g.z = 0.5 * (scalars_at_texel(c + ez) - scalars_at_texel(c - ez));
-        }
-        return g;
-    }
     if (has_flag(FLAG_FORWARD_DIFF)) {
-        g.x = sample_scalars(p + vec3<f32>(1.0, 0.0, 0.0)) - s;
-        g.y = sample_scalars(p + vec3<f32>(0.0, 1.0, 0.0)) - s;
-        g.z = sample_scalars(p + vec3<f32>(0.0, 0.0, 1.0)) - s;
+        g.x = scalars_at(tc + dx) - s;
+        g.y = scalars_at(tc + dy) - s;
+        g.z = scalars_at(tc + dz) - s;
     } else {
-        g.x = 0.5 * (sample_scalars(p + vec3<f32>(1.0, 0.0, 0.0)) - sample_scalars(p - vec3<f32>(1.0, 0.0, 0.0)));
-        g.y = 0.5 * (sample_scalars(p + vec3<f32>(0.0, 1.0, 0.0)) - sample_scalars(p - vec3<f32>(0.0, 1.0, 0.0)));
-        g.z = 0.5 * (sample_scalars(p + vec3<f32>(0.0, 0.0, 1.0)) - sample_scalars(p - vec3<f32>(0.0, 0.0, 1.0)));
+        g.x = 0.5 * (scalars_at(tc + dx) - scalars_at(tc - dx));
+        g.y = 0.5 * (scalars_at(tc + dy) - scalars_at(tc - dy));
+        g.z = 0.5 * (scalars_at(tc + dz) - scalars_at(tc - dz));
     }
     return g;
 }
