@@ -31,7 +31,7 @@ test: lint
 # The first process after a shader change runs 3-4x slower on lavapipe until Mesa's shader
 # cache holds the pipelines (measured), so a short priming run of both renderers goes first.
 bench: build
-	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 1 --size 300x300 >/dev/null
+	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 2 >/dev/null
 	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 20 --png-dir build/bench
 
 # The README's pictures.
@@ -39,3 +39,5 @@ pictures: build
 	$(FERROVOL) render --demo wavelet --shade --size 640x640 --azimuth 30 --elevation 20 --out docs/img/wavelet-shaded.png
 	$(FERROVOL) render --demo marschner-lobb --shade --size 640x640 --elevation 30 --out docs/img/marschner-lobb.png
 	$(FERROVOL) render --demo wavelet --mode mip --size 640x640 --azimuth 30 --elevation 20 --out docs/img/wavelet-mip.png
+	scripts/fetch-data.sh >/dev/null
+	$(FERROVOL) render build/data/cranium.vti --tf ct-skin-bone --shade --elevation -90 --size 640x640 --out docs/img/cranium-ct.png
