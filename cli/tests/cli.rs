@@ -1,0 +1,71 @@
+//! The `ferrovol` command as a user runs it: exit codes, messages, and a real render.
+
+use std::process::Command;
+
+fn ferrovol(args: &[&str]) -> (i32, String, String) {
+    let xdg = std::env::temp_dir().join("ferrovol-cli-test-xdg");
+    let _ = std::fs::create_dir_all(&xdg);
+    let out = Command::new(env!("CARGO_BIN_EXE_ferrovol"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", &xdg)
+        .output()
+        .expect("the ferrovol binary runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn missing_file_names_the_file_and_fails() {
+    let (code, _, err) = ferrovol(&["render", "/no/such/volume.vti", "--out", "/tmp/never.png"]);
+    println!("exit {code}: {err}");
+    assert_ne!(code, 0);
+    assert!(err.contains("/no/such/volume.vti"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn bad_parameters_fail_with_a_message() {
+    for args in [
+        vec!["render", "--size", "0x10"],
+        vec!["render", "--tf", "no-such-preset"],
+        vec!["render", "--sample-distance", "0"],
+    ] {
+        let (code, _, err) = ferrovol(&args);
+        println!(
+            "{args:?}: exit {code}: {}",
+            err.lines().next().unwrap_or("")
+        );
+        assert_ne!(code, 0, "{args:?}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!err.trim().is_empty());
+    }
+}
+
+#[test]
+fn demo_render_writes_a_picture_of_the_volume() {
+    let out = std::env::temp_dir().join("ferrovol-cli-test-demo.png");
+    let path = out.to_str().expect("utf-8 temp path");
+    let (code, stdout, err) = ferrovol(&[
+        "render",
+        "--demo",
+        "marschner-lobb",
+        "--shade",
+        "--size",
+        "96x80",
+        "--out",
+        path,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains(path), "{stdout}");
+    let img = image::open(&out).expect("a PNG").to_rgb8();
+    assert_eq!(img.dimensions(), (96, 80));
+    // The volume covers the middle of the picture and leaves the black background around it.
+    let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
+    let corner = img.get_pixel(0, 0).0;
+    println!("lit pixels {lit} of {}, corner {corner:?}", 96 * 80);
+    assert!(lit > 96 * 80 / 10, "only {lit} lit pixels");
+    assert_eq!(corner, [0, 0, 0]);
+}
