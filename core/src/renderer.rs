@@ -4,7 +4,7 @@ use crate::camera::Camera;
 use crate::device::Context;
 use crate::error::{Error, Result};
 use crate::gpu::*;
-use crate::light::Light;
+use crate::light::{Light, LightSpace};
 use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, MAX_LIGHTS};
 use crate::transfer::{build_tables, TransferFunction, TABLE_SIZE};
 use crate::upload::{self, BrickExtent, Layout, MinMaxGrid, BLOCK_SIZE};
@@ -924,7 +924,14 @@ impl Renderer {
                     g.spot = [axis.x as f32, axis.y as f32, axis.z as f32, cone];
                 } else {
                     let dir = (pos - focal).try_normalize().unwrap_or(DVec3::Z);
-                    g.position = [dir.x as f32, dir.y as f32, dir.z as f32, 0.0];
+                    // A headlight shines along each ray (w = 2), as VTK's headlight path
+                    // lights every sample from the camera.
+                    let w = if l.space == LightSpace::Headlight {
+                        2.0
+                    } else {
+                        0.0
+                    };
+                    g.position = [dir.x as f32, dir.y as f32, dir.z as f32, w];
                     g.spot = [0.0, 0.0, 0.0, -2.0];
                 }
                 g.diffuse = [
@@ -1062,7 +1069,7 @@ impl Renderer {
             single_brick: self.volume.as_ref().is_some_and(|v| v.bricks.len() == 1),
             positional_lights: u.lights[..u.counts[1] as usize]
                 .iter()
-                .any(|l| l.position[3] > 0.5),
+                .any(|l| l.position[3] == 1.0),
             lights: u.counts[1],
         };
         if !self.dvr_variants.contains_key(&variant) {

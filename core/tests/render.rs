@@ -321,23 +321,18 @@ fn classify(tf: &ComponentTransfer, s: f64, dt: f64, interp: Interpolation) -> (
     (eval_pw(&tf.color, x), a)
 }
 
-/// Phong shading as shaders/lib/shading.wgsl, for the lights of `view`'s headlight
-/// (directional, at the camera, white ambient/diffuse/specular, intensity 1).
-fn cpu_shade(
-    color: [f64; 3],
-    grad: DVec3,
-    view_dir: DVec3,
-    light_dir: DVec3,
-    s: &Shading,
-) -> [f64; 3] {
+/// Phong shading as shaders/lib/shading.wgsl, for `view`'s headlight (at the camera,
+/// lighting each sample along its ray as VTK's headlight path does; white
+/// ambient/diffuse/specular, intensity 1).
+fn cpu_shade(color: [f64; 3], grad: DVec3, view_dir: DVec3, s: &Shading) -> [f64; 3] {
     let glen = grad.length();
     let ambient = 1.0; // Σ lights' ambient colour: the headlight's is white
     let mut diffuse = 0.0;
     let mut specular = 0.0;
     if glen > 0.0 {
         let mut n = -grad / glen;
-        let l = light_dir;
         let v = -view_dir;
+        let l = v;
         let mut ndl = n.dot(l);
         if ndl < 0.0 && s.two_sided {
             n = -n;
@@ -382,7 +377,6 @@ fn cpu_render(
     );
     let interp = p.interpolation;
     let cam = &view.camera;
-    let light_dir = (cam.position - cam.focal_point).normalize();
     let w2i = v.index_to_data().inverse();
     let grad_to_world = w2i.transpose();
     let ert = p.termination_threshold as f64;
@@ -410,7 +404,7 @@ fn cpu_render(
                 if p.shading.enabled {
                     let g = gradient(v, pi, interp);
                     let gw = grad_to_world.transform_vector3(g);
-                    rgb = cpu_shade(rgb, gw, ray.dir, light_dir, &p.shading);
+                    rgb = cpu_shade(rgb, gw, ray.dir, &p.shading);
                 }
                 let w = (1.0 - acc[3]) * a;
                 for c in 0..3 {

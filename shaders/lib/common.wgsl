@@ -31,7 +31,7 @@ const MAX_CLIP: u32 = 6u;
 
 struct Light {
     // xyz: world position (positional) or unit vector toward the light (directional);
-    // w: 1 positional, 0 directional
+    // w: 1 positional, 0 directional, 2 headlight (lights each sample along its ray)
     position: vec4<f32>,
     // xyz: unit spot axis (from the light toward its focal point); w: cos(cone angle),
     // -2 when the light has no cone

@@ -28,9 +28,10 @@ fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>)
         if (!has_normal) {
             continue;
         }
-        var l = light.position.xyz;
+        // w: 0 directional, 1 positional, 2 headlight (from the camera along each ray)
+        var l = select(light.position.xyz, v, light.position.w > 1.5);
         var atten = 1.0;
-        if (POSITIONAL_LIGHTS && light.position.w > 0.5) {
+        if (POSITIONAL_LIGHTS && light.position.w > 0.5 && light.position.w < 1.5) {
             let lv = light.position.xyz - pos;
             let d = length(lv);
             l = lv / max(d, 1e-20);
