@@ -28,18 +28,7 @@ const SUPPORTED_TYPES: &str =
     "MET_UCHAR, MET_CHAR, MET_USHORT, MET_SHORT, MET_UINT, MET_INT, MET_ULONG, MET_LONG, MET_FLOAT and MET_DOUBLE";
 
 fn bad(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::BadHeader {
-        path: path.to_path_buf(),
-        format: FORMAT,
-        message: message.into(),
-    }
-}
-
-fn unsupported(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::Unsupported {
-        path: path.to_path_buf(),
-        message: message.into(),
-    }
+    ReadError::bad_header(path, FORMAT, message)
 }
 
 fn met_type(name: &str) -> Option<ScalarType> {
@@ -150,7 +139,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
 
     if let Some((k, v)) = h.get(&["ObjectType"]) {
         if !v.eq_ignore_ascii_case("Image") {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!("{k} = {v}; only MetaImage Image objects hold volumes"),
             ));
@@ -166,7 +155,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         None => dv.split_ascii_whitespace().count(),
     };
     if !(1..=3).contains(&ndims) {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!(
                 "NDims = {ndims}; ferrovol reads 1- to 3-dimensional images (extract a 3D volume first)"
@@ -215,7 +204,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         None => 1,
     };
     if !(1..=4).contains(&components) {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!("{components} channels per voxel (ElementNumberOfChannels); ferrovol renders 1 to 4"),
         ));
@@ -248,7 +237,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
     let (data_path, data): (PathBuf, &[u8]) = if file_value.eq_ignore_ascii_case("LOCAL") {
         (path.to_path_buf(), bytes.get(h.data_start..).unwrap_or(&[]))
     } else if file_value.eq_ignore_ascii_case("LIST") || file_value.contains('%') {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!("ElementDataFile = {file_value}: data split over several files; merge the slices into one volume (e.g. save it again as .mha)"),
         ));

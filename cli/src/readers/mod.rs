@@ -92,6 +92,25 @@ pub enum ReadError {
     },
 }
 
+impl ReadError {
+    /// A malformed header of `format` in `path`.
+    pub fn bad_header(path: &Path, format: &'static str, message: impl Into<String>) -> ReadError {
+        ReadError::BadHeader {
+            path: path.to_path_buf(),
+            format,
+            message: message.into(),
+        }
+    }
+
+    /// A feature of a valid file that these readers do not implement.
+    pub fn unsupported(path: &Path, message: impl Into<String>) -> ReadError {
+        ReadError::Unsupported {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
 /// Reads a volume file, choosing the reader by the file name's extension
 /// (case-insensitive): `.vti`, `.nii`, `.nii.gz`, `.mha`, `.mhd`, `.nrrd`, `.nhdr`.
 /// The result has passed [`VolumeData::validate`].

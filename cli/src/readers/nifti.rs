@@ -64,18 +64,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
 }
 
 fn bad(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::BadHeader {
-        path: path.to_path_buf(),
-        format: FORMAT,
-        message: message.into(),
-    }
-}
-
-fn unsupported(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::Unsupported {
-        path: path.to_path_buf(),
-        message: message.into(),
-    }
+    ReadError::bad_header(path, FORMAT, message)
 }
 
 /// The header fields the reader uses, widened to NIfTI-2's types.
@@ -227,13 +216,13 @@ fn parse_header(path: &Path, b: &[u8]) -> Result<Header, ReadError> {
     match &magic[..3] {
         b"n+1" | b"n+2" => {}
         b"ni1" | b"ni2" => {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 "this is the header of a separate .hdr/.img NIfTI pair; convert it to a single .nii file (e.g. with nibabel or fslchfiletype NIFTI)",
             ))
         }
         _ => {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!("magic {magic_text:?} is not NIfTI's n+1/n+2 (an Analyze 7.5 file?); convert it to NIfTI"),
             ))
@@ -311,7 +300,7 @@ fn parse_header(path: &Path, b: &[u8]) -> Result<Header, ReadError> {
         d[i] = dim[i] as u64;
     }
     if d[4] > 1 {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!(
                 "a 4D series of {} volumes (dim[4]); extract one volume first (e.g. fslroi in.nii.gz out.nii.gz 0 1)",
@@ -320,7 +309,7 @@ fn parse_header(path: &Path, b: &[u8]) -> Result<Header, ReadError> {
         ));
     }
     if d[6] > 1 || d[7] > 1 {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!("dimensions 6 and 7 are {} and {}; only 3D volumes (with up to 4 components in dim[5]) are supported", d[6], d[7]),
         ));
@@ -328,7 +317,7 @@ fn parse_header(path: &Path, b: &[u8]) -> Result<Header, ReadError> {
     let vector = d[5];
     let components = type_components.saturating_mul(vector);
     if components > 4 {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!(
                 "{components} components per voxel (dim[5] = {vector}); ferrovol renders 1 to 4"

@@ -26,18 +26,7 @@ const SUPPORTED_TYPES: &str =
     "int8, uint8, int16, uint16, int32, uint32, float and double (in any NRRD spelling, e.g. uchar, short, unsigned int)";
 
 fn bad(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::BadHeader {
-        path: path.to_path_buf(),
-        format: FORMAT,
-        message: message.into(),
-    }
-}
-
-fn unsupported(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::Unsupported {
-        path: path.to_path_buf(),
-        message: message.into(),
-    }
+    ReadError::bad_header(path, FORMAT, message)
 }
 
 fn nrrd_type(name: &str) -> Option<ScalarType> {
@@ -191,7 +180,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         )
     })?;
     if !(1..=4).contains(&dimension) {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!("dimension {dimension}; ferrovol reads 1 to 3 spatial axes plus an optional first axis of 1-4 components"),
         ));
@@ -250,7 +239,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         .is_some_and(|d| d.is_none());
     let comp_axis = if dimension == 4 {
         if first_is_domain {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 "a 4D image whose first axis is spatial (a time series?); extract one 3D volume first (e.g. with unu slice)",
             ));
@@ -261,7 +250,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
     };
     let components = if comp_axis { sizes[0] } else { 1 };
     if !(1..=4).contains(&components) {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!("{components} components per voxel on the first axis; ferrovol renders 1 to 4"),
         ));
@@ -286,7 +275,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
                 )
             })?;
             if v.len() > 3 {
-                return Err(unsupported(
+                return Err(ReadError::unsupported(
                     path,
                     format!("a {}-dimensional space (space directions); ferrovol places volumes in 3D space", v.len()),
                 ));
@@ -339,7 +328,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         "ascii" | "text" | "txt" => Encoding::Ascii,
         "hex" => Encoding::Hex,
         "bzip2" | "bz2" | "zstd" => {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!("encoding {enc_text}; re-save with raw or gzip encoding (e.g. unu save -f nrrd -e gzip)"),
             ))
@@ -386,7 +375,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         Some(f) => {
             let first = f.split_ascii_whitespace().next().unwrap_or("");
             if first == "LIST" || f.contains('%') {
-                return Err(unsupported(
+                return Err(ReadError::unsupported(
                     path,
                     format!("data file: {f}: data split over several files; join them into one file (e.g. with unu join, then unu save)"),
                 ));

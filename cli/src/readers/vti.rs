@@ -36,18 +36,7 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
 }
 
 fn bad(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::BadHeader {
-        path: path.to_path_buf(),
-        format: FORMAT,
-        message: message.into(),
-    }
-}
-
-fn unsupported(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::Unsupported {
-        path: path.to_path_buf(),
-        message: message.into(),
-    }
+    ReadError::bad_header(path, FORMAT, message)
 }
 
 /// Maps a VTK XML (or legacy VTK) type name to a scalar type.
@@ -191,7 +180,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VolumeData, ReadError> {
     match h.file_type.as_deref() {
         Some("ImageData") => {}
         Some(other) => {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!(
                     "the file holds VTK {other} data, not ImageData; resample it to an image (e.g. ParaView's Resample To Image) and save as .vti"
@@ -224,7 +213,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VolumeData, ReadError> {
         None | Some("") => false,
         Some("vtkZLibDataCompressor") => true,
         Some(other) => {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!(
                     "compressor {other}; only vtkZLibDataCompressor (zlib) is supported (save the file again with ZLib compression or none)"
@@ -243,7 +232,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VolumeData, ReadError> {
         0 => return Err(bad(path, "<ImageData> has no <Piece> element")),
         1 => {}
         n => {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!("{n} pieces in one file; save the image as a single piece (ParaView: Merge Blocks, then save as .vti)"),
             ))
@@ -252,7 +241,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VolumeData, ReadError> {
     if let Some(Some(piece)) = h.pieces.first() {
         let pe = parse_extent(path, "Piece Extent", piece)?;
         if pe != extent {
-            return Err(unsupported(
+            return Err(ReadError::unsupported(
                 path,
                 format!(
                     "the piece's Extent {pe:?} differs from the WholeExtent {extent:?} (part of a parallel .pvti dataset?); load the .pvti in ParaView and save it as one .vti"
@@ -333,7 +322,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VolumeData, ReadError> {
         })?
     };
     if !(1..=4).contains(&components) {
-        return Err(unsupported(
+        return Err(ReadError::unsupported(
             path,
             format!(
                 "{what} has {components} components; ferrovol renders 1 to 4 (extract the components you need, e.g. with ParaView's Calculator)"
