@@ -536,37 +536,14 @@ impl Renderer {
                     },
                     size,
                 );
+                let v4 = |v: [u32; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+                let tex_size = v4(e.tex_size);
                 let bu = BrickUniforms {
-                    core_lo: [
-                        e.core_lo[0] as f32,
-                        e.core_lo[1] as f32,
-                        e.core_lo[2] as f32,
-                        0.0,
-                    ],
-                    core_hi: [
-                        e.core_hi[0] as f32,
-                        e.core_hi[1] as f32,
-                        e.core_hi[2] as f32,
-                        0.0,
-                    ],
-                    tex_lo: [
-                        e.tex_lo[0] as f32,
-                        e.tex_lo[1] as f32,
-                        e.tex_lo[2] as f32,
-                        0.0,
-                    ],
-                    tex_size: [
-                        e.tex_size[0] as f32,
-                        e.tex_size[1] as f32,
-                        e.tex_size[2] as f32,
-                        0.0,
-                    ],
-                    tex_inv_size: [
-                        1.0 / e.tex_size[0] as f32,
-                        1.0 / e.tex_size[1] as f32,
-                        1.0 / e.tex_size[2] as f32,
-                        0.0,
-                    ],
+                    core_lo: v4(e.core_lo),
+                    core_hi: v4(e.core_hi),
+                    tex_lo: v4(e.tex_lo),
+                    tex_size,
+                    tex_inv_size: [1.0 / tex_size[0], 1.0 / tex_size[1], 1.0 / tex_size[2], 0.0],
                 };
                 let uniform = d.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("brick uniforms"),
