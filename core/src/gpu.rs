@@ -23,8 +23,6 @@ pub struct FrameUniforms {
     pub world_to_index: [f32; 16],
     pub index_to_data: [f32; 16],
     pub gradient_to_world: [f32; 16],
-    pub index_to_world: [f32; 16],
-    pub camera_position: [f32; 4],
     pub dims: [f32; 4],
     pub scalar_scale: [f32; 4],
     pub scalar_shift: [f32; 4],
@@ -54,7 +52,6 @@ pub struct BrickUniforms {
     pub core_lo: [f32; 4],
     pub core_hi: [f32; 4],
     pub tex_lo: [f32; 4],
-    pub tex_size: [f32; 4],
     pub tex_inv_size: [f32; 4],
 }
 
@@ -62,12 +59,9 @@ pub struct BrickUniforms {
 pub const PIXEL_STATE_BYTES: u64 = 48;
 
 // Flag bits (FLAG_* in common.wgsl).
-pub const FLAG_SHADE: u32 = 1;
 pub const FLAG_JITTER: u32 = 2;
 pub const FLAG_FORWARD_DIFF: u32 = 4;
-pub const FLAG_CROP: u32 = 8;
 pub const FLAG_TWO_SIDED: u32 = 16;
-pub const FLAG_GRADIENT_OPACITY: u32 = 32;
 pub const FLAG_INDEPENDENT: u32 = 64;
 pub const FLAG_DEPTH_INPUT: u32 = 128;
 pub const FLAG_AVERAGE_RANGE: u32 = 1024;
@@ -128,8 +122,6 @@ mod layout_tests {
                 world_to_index,
                 index_to_data,
                 gradient_to_world,
-                index_to_world,
-                camera_position,
                 dims,
                 scalar_scale,
                 scalar_shift,
@@ -163,7 +155,7 @@ mod layout_tests {
             m,
             "Brick",
             BrickUniforms,
-            [core_lo, core_hi, tex_lo, tex_size, tex_inv_size]
+            [core_lo, core_hi, tex_lo, tex_inv_size]
         );
         let (_, ps) = wgsl_struct(&m, "PixelState");
         assert_eq!(ps as u64, PIXEL_STATE_BYTES);
@@ -175,12 +167,9 @@ mod layout_tests {
         let table = format!("const TABLE_N: u32 = {}u;", crate::transfer::TABLE_SIZE);
         assert!(src.contains(&table), "WGSL lacks `{table}`");
         for (name, v) in [
-            ("FLAG_SHADE", FLAG_SHADE),
             ("FLAG_JITTER", FLAG_JITTER),
             ("FLAG_FORWARD_DIFF", FLAG_FORWARD_DIFF),
-            ("FLAG_CROP", FLAG_CROP),
             ("FLAG_TWO_SIDED", FLAG_TWO_SIDED),
-            ("FLAG_GRADIENT_OPACITY", FLAG_GRADIENT_OPACITY),
             ("FLAG_INDEPENDENT", FLAG_INDEPENDENT),
             ("FLAG_DEPTH_INPUT", FLAG_DEPTH_INPUT),
             ("FLAG_AVERAGE_RANGE", FLAG_AVERAGE_RANGE),

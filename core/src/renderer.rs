@@ -495,11 +495,10 @@ impl Renderer {
             storage,
             format,
             texel_bytes,
-            channels: if v.components >= 3 { 4 } else { v.components },
+            channels: upload::channels_for(v.components),
             scale,
             shift,
             brick_cells,
-            bricks: extents.clone(),
         };
         let d = &self.ctx.device;
         let mut bricks = Vec::with_capacity(extents.len());
@@ -542,7 +541,6 @@ impl Renderer {
                     core_lo: v4(e.core_lo),
                     core_hi: v4(e.core_hi),
                     tex_lo: v4(e.tex_lo),
-                    tex_size,
                     tex_inv_size: [1.0 / tex_size[0], 1.0 / tex_size[1], 1.0 / tex_size[2], 0.0],
                 };
                 let uniform = d.create_buffer(&wgpu::BufferDescriptor {
@@ -801,7 +799,8 @@ impl Renderer {
         params: &RenderParams,
         step: f64,
         depth_input: bool,
-    ) -> Result<FrameUniforms> {
+        skip: bool,
+    ) -> Result<(FrameUniforms, DvrVariant)> {
         let vol = self
             .volume
             .as_ref()
@@ -823,9 +822,6 @@ impl Renderer {
         u.world_to_index = mat(world_to_index);
         u.index_to_data = mat(vol.index_to_data);
         u.gradient_to_world = mat(world_to_index.transpose());
-        u.index_to_world = mat(index_to_world);
-        let cp = view.camera.position;
-        u.camera_position = [cp.x as f32, cp.y as f32, cp.z as f32, 1.0];
         let dd = vol.data_dims;
         u.dims = [
             dd[0] as f32,
@@ -852,7 +848,6 @@ impl Renderer {
         u.material = [s.ambient, s.diffuse, s.specular, s.specular_power];
         let mut flags = 0;
         if let Some(c) = &params.cropping {
-            flags |= FLAG_CROP;
             u.crop_lo = [
                 c.planes[0] as f32,
                 c.planes[2] as f32,
@@ -922,7 +917,6 @@ impl Renderer {
                 g.attenuation = [l.attenuation[0], l.attenuation[1], l.attenuation[2], 0.0];
                 nl += 1;
             }
-            flags |= FLAG_SHADE;
             if s.two_sided {
                 flags |= FLAG_TWO_SIDED;
             }
@@ -932,9 +926,6 @@ impl Renderer {
         }
         if params.gradient == GradientMethod::Forward {
             flags |= FLAG_FORWARD_DIFF;
-        }
-        if any_go {
-            flags |= FLAG_GRADIENT_OPACITY;
         }
         if tf.independent {
             flags |= FLAG_INDEPENDENT;
@@ -958,7 +949,20 @@ impl Renderer {
             vol.minmax.dims[2],
             0,
         ];
-        Ok(u)
+        let variant = DvrVariant {
+            blend: params.blend.code(),
+            components: vol.components,
+            independent: tf.independent,
+            shade: s.enabled,
+            gradient_opacity: any_go,
+            skip,
+            crop: params.cropping.is_some(),
+            nearest: params.interpolation == Interpolation::Nearest,
+            single_brick: vol.bricks.len() == 1,
+            positional_lights: u.lights[..nl].iter().any(|l| l.position[3] == 1.0),
+            lights: nl as u32,
+        };
+        Ok((u, variant))
     }
 
     /// Bricks in front-to-back order for this camera: along each axis, bricks on the
@@ -1033,22 +1037,7 @@ impl Renderer {
                 )));
             }
         }
-        let u = self.frame_uniforms(view, params, step, depth.is_some())?;
-        let variant = DvrVariant {
-            blend: params.blend.code(),
-            components: u.counts[3],
-            independent: u.mode[1] & FLAG_INDEPENDENT != 0,
-            shade: u.mode[1] & FLAG_SHADE != 0,
-            gradient_opacity: u.mode[1] & FLAG_GRADIENT_OPACITY != 0,
-            skip,
-            crop: u.mode[1] & FLAG_CROP != 0,
-            nearest: params.interpolation == Interpolation::Nearest,
-            single_brick: self.volume.as_ref().is_some_and(|v| v.bricks.len() == 1),
-            positional_lights: u.lights[..u.counts[1] as usize]
-                .iter()
-                .any(|l| l.position[3] == 1.0),
-            lights: u.counts[1],
-        };
+        let (u, variant) = self.frame_uniforms(view, params, step, depth.is_some(), skip)?;
         if !self.dvr_variants.contains_key(&variant) {
             let constants = variant.constants();
             let p = self.ctx.checked("creating a ray-casting pipeline", || {

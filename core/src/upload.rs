@@ -41,7 +41,6 @@ pub struct Layout {
     pub shift: [f32; 4],
     /// Cells per brick along each axis (the brick's core).
     pub brick_cells: u32,
-    pub bricks: Vec<BrickExtent>,
 }
 
 /// One brick: the cells it owns and the points its texture holds.
@@ -57,7 +56,7 @@ pub struct BrickExtent {
     pub tex_size: [u32; 3],
 }
 
-fn channels_for(components: u32) -> u32 {
+pub(crate) fn channels_for(components: u32) -> u32 {
     if components >= 3 {
         4
     } else {

@@ -8,12 +8,9 @@ const BLEND_MINIMUM: u32 = 2u;
 const BLEND_AVERAGE: u32 = 3u;
 const BLEND_ADDITIVE: u32 = 4u;
 
-const FLAG_SHADE: u32 = 1u;
 const FLAG_JITTER: u32 = 2u;
 const FLAG_FORWARD_DIFF: u32 = 4u;
-const FLAG_CROP: u32 = 8u;
 const FLAG_TWO_SIDED: u32 = 16u;
-const FLAG_GRADIENT_OPACITY: u32 = 32u;
 const FLAG_INDEPENDENT: u32 = 64u;
 const FLAG_DEPTH_INPUT: u32 = 128u;
 const FLAG_AVERAGE_RANGE: u32 = 1024u;
@@ -52,8 +49,6 @@ struct Frame {
     world_to_index: mat4x4<f32>,  // world → volume index space (i, j, k)
     index_to_data: mat4x4<f32>,   // index → data coordinates (for cropping)
     gradient_to_world: mat4x4<f32>, // index-space gradient → world gradient (inverse transpose)
-    index_to_world: mat4x4<f32>,
-    camera_position: vec4<f32>,   // world
     dims: vec4<f32>,              // points per axis; w: components
     scalar_scale: vec4<f32>,      // texel value → scalar, per component
     scalar_shift: vec4<f32>,

@@ -5,10 +5,9 @@ struct Brick {
     // index-space box this pass marches through (the brick's own cells)
     core_lo: vec4<f32>,
     core_hi: vec4<f32>,
-    // first point index held by the texture, and the texture's size in points; the texture
-    // extends past the core by an overlap so interpolation and gradients see no seam
+    // first point index held by the texture, and 1 / the texture's size in points; the
+    // texture extends past the core by an overlap so interpolation and gradients see no seam
     tex_lo: vec4<f32>,
-    tex_size: vec4<f32>,
     tex_inv_size: vec4<f32>,
 }
 
