@@ -24,7 +24,8 @@ pub struct DeviceInfo {
     pub timestamps: bool,
 }
 
-/// An adapter, a device and its queue. Cheap to share by reference; `Send + Sync`.
+/// An adapter, a device and its queue. `Send + Sync`; clones share the same device.
+#[derive(Clone)]
 pub struct Context {
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,

@@ -19,6 +19,7 @@ pub mod camera;
 pub mod device;
 pub mod error;
 pub mod gpu;
+pub mod interop;
 pub mod light;
 pub mod params;
 pub mod renderer;
@@ -31,6 +32,7 @@ pub mod volume;
 pub use camera::Camera;
 pub use device::{Context, DeviceInfo};
 pub use error::{Error, Result};
+pub use interop::{DeviceUuids, OutputPath, SharedImage, SharedOutput};
 pub use light::{Light, LightSpace};
 pub use params::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,

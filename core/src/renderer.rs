@@ -4,6 +4,7 @@ use crate::camera::Camera;
 use crate::device::Context;
 use crate::error::{Error, Result};
 use crate::gpu::*;
+use crate::interop::{self, ExportableMemory, OutputPath, SharedOutput};
 use crate::light::{Light, LightSpace};
 use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, MAX_LIGHTS};
 use crate::transfer::{build_tables, TransferFunction, TABLE_SIZE};
@@ -116,6 +117,32 @@ struct Targets {
     color: wgpu::Texture,
     depth: wgpu::Texture,
     depth_in: wgpu::Texture,
+    /// The exportable memory of `color`, `depth` and `depth_in` (owned by those textures)
+    /// when they were allocated for [`OutputPath::Shared`].
+    exported: Option<[ExportableMemory; 3]>,
+    /// [`Renderer::output_generation`] of this allocation.
+    generation: u64,
+}
+
+impl Targets {
+    fn path(&self) -> OutputPath {
+        if self.exported.is_some() {
+            OutputPath::Shared
+        } else {
+            OutputPath::Readback
+        }
+    }
+}
+
+/// Where the ray caster's depth input comes from.
+#[derive(Clone, Copy)]
+enum DepthSource<'a> {
+    /// None: rays run to the far side of the volume.
+    None,
+    /// Uploaded from the CPU with the frame.
+    Cpu(&'a [f32]),
+    /// Already in the shared depth-input image, written by the host.
+    Shared,
 }
 
 /// Everything that decides the tables' contents; tables are rebuilt only when it changes.
@@ -243,6 +270,9 @@ pub struct Renderer {
     tables: Option<(TableKey, wgpu::Buffer)>,
     occupancy: Option<(TableKey, wgpu::Buffer, f64)>,
     targets: Option<Targets>,
+    output_path: OutputPath,
+    /// Counts allocations of the output images.
+    generation: u64,
     stats: Stats,
 }
 
@@ -445,6 +475,8 @@ impl Renderer {
             tables: None,
             occupancy: None,
             targets: None,
+            output_path: OutputPath::Readback,
+            generation: 0,
             stats: Stats::default(),
         })
     }
@@ -739,7 +771,7 @@ impl Renderer {
         if self
             .targets
             .as_ref()
-            .is_some_and(|t| t.width == width && t.height == height)
+            .is_some_and(|t| t.width == width && t.height == height && t.path() == self.output_path)
         {
             return Ok(());
         }
@@ -749,29 +781,73 @@ impl Renderer {
                 "image size {width}x{height}: each side must be 1 to {max}"
             )));
         }
-        let d = &self.ctx.device;
-        let targets = self.ctx.checked("allocating the frame", || {
-            let tex = |label, format, usage| {
-                d.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width,
-                        height,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
+        let shared = self.output_path == OutputPath::Shared;
+        let ctx = &self.ctx;
+        let d = &ctx.device;
+        let tex = |label, format, usage| -> Result<(wgpu::Texture, Option<ExportableMemory>)> {
+            let desc = wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
             };
-            let out_usage = wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::RENDER_ATTACHMENT;
-            Targets {
+            if shared {
+                let (t, m) = interop::create_exportable_texture(ctx, &desc)?;
+                Ok((t, Some(m)))
+            } else {
+                Ok((d.create_texture(&desc), None))
+            }
+        };
+        let out_usage = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let targets = ctx.checked("allocating the frame", || -> Result<Targets> {
+            let (color, color_mem) = tex("color", wgpu::TextureFormat::Rgba8Unorm, out_usage)?;
+            let (depth, depth_mem) = tex("depth", wgpu::TextureFormat::R32Float, out_usage)?;
+            let (depth_in, depth_in_mem) = tex(
+                "depth in",
+                wgpu::TextureFormat::R32Float,
+                wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            )?;
+            let exported = match (color_mem, depth_mem, depth_in_mem) {
+                (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+                _ => None,
+            };
+            if exported.is_some() {
+                // wgpu zero-fills the textures it allocates before their first use; it
+                // leaves imported ones alone, so clear these the same way.
+                let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("clear the shared output"),
+                });
+                let cv = color.create_view(&Default::default());
+                let dv = depth.create_view(&Default::default());
+                enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("clear the shared output"),
+                    color_attachments: &[clear_attachment(&cv, 0.0), clear_attachment(&dv, 0.0)],
+                    ..Default::default()
+                });
+                ctx.queue.write_texture(
+                    depth_in.as_image_copy(),
+                    &vec![0u8; 4 * width as usize * height as usize],
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(4 * width),
+                        rows_per_image: None,
+                    },
+                    depth_in.size(),
+                );
+                ctx.queue.submit([enc.finish()]);
+            }
+            Ok(Targets {
                 width,
                 height,
                 state: d.create_buffer(&wgpu::BufferDescriptor {
@@ -780,15 +856,14 @@ impl Renderer {
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
-                color: tex("color", wgpu::TextureFormat::Rgba8Unorm, out_usage),
-                depth: tex("depth", wgpu::TextureFormat::R32Float, out_usage),
-                depth_in: tex(
-                    "depth in",
-                    wgpu::TextureFormat::R32Float,
-                    wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                ),
-            }
-        })?;
+                color,
+                depth,
+                depth_in,
+                exported,
+                generation: self.generation + 1,
+            })
+        })??;
+        self.generation = targets.generation;
         self.targets = Some(targets);
         Ok(())
     }
@@ -1001,13 +1076,60 @@ impl Renderer {
         order
     }
 
-    /// Renders one frame and returns once it is submitted; read it with [`Renderer::read_image`].
-    /// `depth` (window depth per pixel, rows top to bottom) terminates rays at opaque geometry.
+    /// Renders one frame and returns once it is submitted; read it with [`Renderer::read_image`]
+    /// or, with [`OutputPath::Shared`], wait with [`Renderer::finish`] and sample the shared
+    /// images. `depth` (window depth per pixel, rows top to bottom) terminates rays at opaque
+    /// geometry.
     pub fn render(
         &mut self,
         view: &View,
         params: &RenderParams,
         depth: Option<&[f32]>,
+    ) -> Result<()> {
+        let source = match depth {
+            Some(d) => DepthSource::Cpu(d),
+            None => DepthSource::None,
+        };
+        self.render_from(view, params, source)
+    }
+
+    /// Like [`Renderer::render`] with a depth input, but the depth is what the host wrote into
+    /// the shared depth-input image ([`SharedOutput::depth_in`], window depth, rows top to
+    /// bottom) instead of an upload. Needs [`OutputPath::Shared`] and output images of the
+    /// view's size already allocated ([`Renderer::prepare_output`] or an earlier frame); the
+    /// host must have finished writing (`glFinish`) before this call.
+    pub fn render_with_shared_depth(&mut self, view: &View, params: &RenderParams) -> Result<()> {
+        match &self.targets {
+            Some(t)
+                if t.path() == OutputPath::Shared
+                    && self.output_path == OutputPath::Shared
+                    && t.width == view.width
+                    && t.height == view.height => {}
+            Some(t) if t.path() == OutputPath::Shared && self.output_path == OutputPath::Shared => {
+                return Err(Error::InvalidParameter(format!(
+                    "the shared depth input is {}x{}, the view {}x{}: call \
+                     Renderer::prepare_output({}, {}), import the new images and write the \
+                     depth into the new depth input first",
+                    t.width, t.height, view.width, view.height, view.width, view.height
+                )))
+            }
+            _ => {
+                return Err(Error::InvalidParameter(
+                    "no shared depth input: switch to OutputPath::Shared and call \
+                     Renderer::prepare_output, import SharedOutput::depth_in and write the depth \
+                     into it first"
+                        .into(),
+                ))
+            }
+        }
+        self.render_from(view, params, DepthSource::Shared)
+    }
+
+    fn render_from(
+        &mut self,
+        view: &View,
+        params: &RenderParams,
+        depth: DepthSource<'_>,
     ) -> Result<()> {
         params.validate()?;
         if view.lights.len() > MAX_LIGHTS && params.shading.enabled {
@@ -1026,7 +1148,7 @@ impl Renderer {
             && params.blend == BlendMode::Composite
             && occupied < SKIP_MAX_OCCUPANCY;
         self.ensure_targets(view.width, view.height)?;
-        if let Some(d) = depth {
+        if let DepthSource::Cpu(d) = depth {
             let n = (view.width * view.height) as usize;
             if d.len() != n {
                 return Err(Error::InvalidParameter(format!(
@@ -1037,7 +1159,8 @@ impl Renderer {
                 )));
             }
         }
-        let (u, variant) = self.frame_uniforms(view, params, step, depth.is_some(), skip)?;
+        let depth_input = !matches!(depth, DepthSource::None);
+        let (u, variant) = self.frame_uniforms(view, params, step, depth_input, skip)?;
         if !self.dvr_variants.contains_key(&variant) {
             let constants = variant.constants();
             let p = self.ctx.checked("creating a ray-casting pipeline", || {
@@ -1066,7 +1189,7 @@ impl Renderer {
         let q = &self.ctx.queue;
         let d = &self.ctx.device;
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&u));
-        if let Some(depth) = depth {
+        if let DepthSource::Cpu(depth) = depth {
             q.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &t.depth_in,
@@ -1165,6 +1288,89 @@ impl Renderer {
     /// The output texture (premultiplied RGBA8) of the last frame.
     pub fn output_texture(&self) -> Option<&wgpu::Texture> {
         self.targets.as_ref().map(|t| &t.color)
+    }
+
+    /// Chooses where frames go. [`OutputPath::Shared`] needs a device that can export memory
+    /// ([`Context::external_memory_support`]); without one this returns that error
+    /// ([`Error::Unsupported`], saying why) and the renderer stays on the path it had. The
+    /// output images are reallocated at the next frame or [`Renderer::prepare_output`].
+    pub fn set_output_path(&mut self, path: OutputPath) -> Result<()> {
+        if path == OutputPath::Shared {
+            self.ctx.external_memory_support()?;
+        }
+        self.output_path = path;
+        Ok(())
+    }
+
+    /// [`Renderer::set_output_path`] with [`OutputPath::Shared`] (`true`) or
+    /// [`OutputPath::Readback`] (`false`).
+    pub fn set_output_sharing(&mut self, on: bool) -> Result<()> {
+        self.set_output_path(if on {
+            OutputPath::Shared
+        } else {
+            OutputPath::Readback
+        })
+    }
+
+    /// The path chosen with [`Renderer::set_output_path`] (the default is
+    /// [`OutputPath::Readback`]).
+    pub fn output_path(&self) -> OutputPath {
+        self.output_path
+    }
+
+    /// Allocates the output images for frames of `width × height` on the current path now
+    /// rather than at the next frame, so the host can import them (and write the depth input)
+    /// before rendering. Does nothing when they already fit.
+    pub fn prepare_output(&mut self, width: u32, height: u32) -> Result<()> {
+        self.ensure_targets(width, height)
+    }
+
+    /// Counts allocations of the output images: it changes exactly when they are replaced
+    /// (a new size, a path switch), i.e. when a host must import them again. 0 before the
+    /// first allocation.
+    pub fn output_generation(&self) -> u64 {
+        self.targets.as_ref().map_or(0, |t| t.generation)
+    }
+
+    /// Exports the output images: new file descriptors (the caller owns them) with what
+    /// OpenGL needs to import them; see [`crate::interop`] for the protocol. Needs
+    /// [`OutputPath::Shared`] and images allocated on it (a frame rendered or
+    /// [`Renderer::prepare_output`] called after switching).
+    pub fn shared_output(&self) -> Result<SharedOutput> {
+        if self.output_path != OutputPath::Shared {
+            return Err(Error::Unsupported(
+                "the output is not shared: call Renderer::set_output_path(OutputPath::Shared) \
+                 first (or read frames with Renderer::read_image)"
+                    .into(),
+            ));
+        }
+        let Some((t, [color, depth, depth_in])) = self
+            .targets
+            .as_ref()
+            .and_then(|t| t.exported.as_ref().map(|e| (t, e)))
+        else {
+            return Err(Error::InvalidParameter(
+                "the output images are not allocated in shared memory yet: render a frame or \
+                 call Renderer::prepare_output(width, height) first"
+                    .into(),
+            ));
+        };
+        Ok(SharedOutput {
+            generation: t.generation,
+            width: t.width,
+            height: t.height,
+            color: color.export(&self.ctx, &t.color)?,
+            depth: depth.export(&self.ctx, &t.depth)?,
+            depth_in: depth_in.export(&self.ctx, &t.depth_in)?,
+        })
+    }
+
+    /// Blocks until the GPU has finished every frame submitted so far. With
+    /// [`OutputPath::Shared`] this is the synchronisation with the host: call it after
+    /// [`Renderer::render`] and before the host samples the shared images (no semaphores are
+    /// shared; Mesa's llvmpipe has no `GL_EXT_semaphore_fd`).
+    pub fn finish(&self) -> Result<()> {
+        self.ctx.wait_idle()
     }
 
     /// Waits for the last frame and copies its colour and depth to the CPU.
