@@ -4,7 +4,8 @@
 # (see docs/ARCHITECTURE.md, Machines): never libvtk9-dev / python3-vtk9.
 set -euo pipefail
 PKGS=(mesa-vulkan-drivers libvulkan1 xvfb xauth cmake ninja-build pkg-config
-      paraview paraview-dev python3-paraview python3-numpy zlib1g-dev)
+      paraview paraview-dev python3-paraview python3-numpy zlib1g-dev
+      g++ libegl-dev libgl-dev)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

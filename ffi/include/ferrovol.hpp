@@ -1,0 +1,186 @@
+// ferrovol.hpp: a header-only C++17 RAII wrapper over the C ABI in ferrovol.h.
+// Every handle is owned by exactly one object (movable, not copyable); every failing call
+// throws ferrovol::Error carrying the FvStatus and the library's message.
+// Thread use follows the C types: see ferrovol.h.
+#ifndef FERROVOL_HPP
+#define FERROVOL_HPP
+
+#include "ferrovol.h"
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ferrovol {
+
+/// A failed ferrovol call: the status and fv_last_error()'s message.
+class Error : public std::runtime_error {
+public:
+  Error(FvStatus status, const std::string &message)
+      : std::runtime_error(std::string(fv_status_name(status)) + ": " + message),
+        status_(status) {}
+  FvStatus status() const noexcept { return status_; }
+
+private:
+  FvStatus status_;
+};
+
+/// Throws ferrovol::Error unless `status` is FV_STATUS_OK.
+inline void check(FvStatus status) {
+  if (status != FV_STATUS_OK) {
+    throw Error(status, fv_last_error());
+  }
+}
+
+namespace detail {
+template <typename T, void (*Free)(T *)> struct Deleter {
+  void operator()(T *p) const noexcept { Free(p); }
+};
+template <typename T, void (*Free)(T *)>
+using Handle = std::unique_ptr<T, Deleter<T, Free>>;
+} // namespace detail
+
+/// The library version at run time ("MAJOR.MINOR.PATCH").
+inline std::string version() { return fv_version(); }
+
+/// A GPU device (see FvContext).
+class Context {
+public:
+  Context() {
+    FvContext *c = nullptr;
+    check(fv_context_new(&c));
+    h_.reset(c);
+  }
+  FvAdapterInfo info() const {
+    FvAdapterInfo i{};
+    check(fv_context_info(h_.get(), &i));
+    return i;
+  }
+  FvContext *get() const noexcept { return h_.get(); }
+
+private:
+  detail::Handle<FvContext, fv_context_free> h_;
+};
+
+/// Volume data copied from the caller (see FvVolume).
+class Volume {
+public:
+  Volume(const FvVolumeDesc &desc, const void *data, size_t bytes) {
+    FvVolume *v = nullptr;
+    check(fv_volume_new(&desc, data, bytes, &v));
+    h_.reset(v);
+  }
+  std::array<double, 2> range(uint32_t component = 0) const {
+    double r[2] = {0.0, 0.0};
+    check(fv_volume_range(h_.get(), component, &r));
+    return {r[0], r[1]};
+  }
+  const FvVolume *get() const noexcept { return h_.get(); }
+
+private:
+  detail::Handle<FvVolume, fv_volume_free> h_;
+};
+
+/// Colour, opacity and gradient opacity per component (see FvTransferFunction).
+class TransferFunction {
+public:
+  explicit TransferFunction(uint32_t components = 1, bool independent = true) {
+    FvTransferFunction *t = nullptr;
+    check(fv_transfer_function_new(components, independent, &t));
+    h_.reset(t);
+  }
+  /// Flat (x, r, g, b) quadruples.
+  void set_color(uint32_t component, const std::vector<double> &xrgb) {
+    check(fv_transfer_function_set_color(h_.get(), component, xrgb.data(), xrgb.size() / 4));
+  }
+  /// Flat (x, opacity) pairs.
+  void set_opacity(uint32_t component, const std::vector<double> &xa) {
+    check(fv_transfer_function_set_opacity(h_.get(), component, xa.data(), xa.size() / 2));
+  }
+  /// Flat (|gradient|, opacity) pairs; empty turns gradient opacity off.
+  void set_gradient_opacity(uint32_t component, const std::vector<double> &xa) {
+    check(fv_transfer_function_set_gradient_opacity(h_.get(), component, xa.data(),
+                                                    xa.size() / 2));
+  }
+  void set_unit_distance(uint32_t component, double unit_distance, double weight = 1.0) {
+    check(fv_transfer_function_set_unit_distance(h_.get(), component, unit_distance, weight));
+  }
+  const FvTransferFunction *get() const noexcept { return h_.get(); }
+
+private:
+  detail::Handle<FvTransferFunction, fv_transfer_function_free> h_;
+};
+
+/// A frame read back to the CPU (see FvFrame).
+class Frame {
+public:
+  explicit Frame(FvFrame *f) : h_(f) { fv_frame_size(f, &width_, &height_); }
+  uint32_t width() const noexcept { return width_; }
+  uint32_t height() const noexcept { return height_; }
+  /// Premultiplied RGBA8, rows top to bottom.
+  const uint8_t *rgba() const noexcept { return fv_frame_rgba(h_.get()); }
+  /// Window depth, rows top to bottom.
+  const float *depth() const noexcept { return fv_frame_depth(h_.get()); }
+  void write_png(const std::string &path, std::array<float, 3> background = {0, 0, 0}) const {
+    float bg[3] = {background[0], background[1], background[2]};
+    check(fv_frame_write_png(h_.get(), path.c_str(), &bg));
+  }
+
+private:
+  detail::Handle<FvFrame, fv_frame_free> h_;
+  uint32_t width_ = 0;
+  uint32_t height_ = 0;
+};
+
+/// A renderer (see FvRenderer).
+class Renderer {
+public:
+  explicit Renderer(const Context &ctx) {
+    FvRenderer *r = nullptr;
+    check(fv_renderer_new(ctx.get(), &r));
+    h_.reset(r);
+  }
+  static FvRenderParams default_params() {
+    FvRenderParams p{};
+    check(fv_render_params_default(&p));
+    return p;
+  }
+  void set_volume(const Volume &v) { check(fv_renderer_set_volume(h_.get(), v.get())); }
+  void set_transfer_function(const TransferFunction &tf) {
+    check(fv_renderer_set_transfer_function(h_.get(), tf.get()));
+  }
+  void set_camera(const FvCamera &camera) { check(fv_renderer_set_camera(h_.get(), &camera)); }
+  void set_lights(const std::vector<FvLight> &lights) {
+    check(fv_renderer_set_lights(h_.get(), lights.data(), lights.size()));
+  }
+  void set_params(const FvRenderParams &p) { check(fv_renderer_set_params(h_.get(), &p)); }
+  void set_max_brick_points(uint32_t points) {
+    check(fv_renderer_set_max_brick_points(h_.get(), points));
+  }
+  /// `depth`: width·height window depths of opaque geometry (rows top to bottom), or empty.
+  void render(uint32_t width, uint32_t height, const std::vector<float> &depth = {}) {
+    check(fv_renderer_render(h_.get(), width, height, depth.empty() ? nullptr : depth.data(),
+                             depth.size()));
+  }
+  Frame read_frame() const {
+    FvFrame *f = nullptr;
+    check(fv_renderer_read_frame(h_.get(), &f));
+    return Frame(f);
+  }
+  FvStats stats() const {
+    FvStats s{};
+    check(fv_renderer_stats(h_.get(), &s));
+    return s;
+  }
+  FvRenderer *get() const noexcept { return h_.get(); }
+
+private:
+  detail::Handle<FvRenderer, fv_renderer_free> h_;
+};
+
+} // namespace ferrovol
+
+#endif // FERROVOL_HPP

@@ -1,0 +1,762 @@
+//! ferrovol's C ABI (library `ferrovol`): opaque handles with `_new`/`_free` pairs, an
+//! [`FvStatus`] from every call that can fail with a per-thread message
+//! ([`fv_last_error`]), and no panic crossing the boundary. The header
+//! `include/ferrovol.h` is generated from this crate by cbindgen.
+//!
+//! A frame: fv_context_new → fv_renderer_new → fv_volume_new + fv_renderer_set_volume →
+//! fv_transfer_function_new (+ set_color / set_opacity) + fv_renderer_set_transfer_function
+//! → fv_renderer_set_camera / set_lights / set_params → fv_renderer_render →
+//! fv_renderer_read_frame (CPU) or the shared images (zero copy).
+#![allow(clippy::missing_safety_doc)] // each export documents its pointer rules in the header
+
+mod status;
+mod types;
+
+pub use status::*;
+pub use types::*;
+
+use ferrovol_core::{
+    ComponentTransfer, Context, Image, Piecewise, Renderer, Scalars, TransferFunction,
+    UploadOptions, View, VolumeData,
+};
+use std::ffi::{c_char, c_void, CStr};
+
+/// Major version of this header; equals fv_version_major() of a compatible library.
+pub const FV_VERSION_MAJOR: u32 = 0;
+/// Minor version of this header.
+pub const FV_VERSION_MINOR: u32 = 1;
+/// Patch version of this header.
+pub const FV_VERSION_PATCH: u32 = 0;
+
+/// The library's version as "MAJOR.MINOR.PATCH" (static string, never NULL).
+#[no_mangle]
+pub extern "C" fn fv_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// The library's major version (compare with FV_VERSION_MAJOR: they must agree).
+#[no_mangle]
+pub extern "C" fn fv_version_major() -> u32 {
+    FV_VERSION_MAJOR
+}
+
+fn mut_ref<'a, T>(p: *mut T, what: &str) -> FfiResult<&'a mut T> {
+    // SAFETY: the caller passes a handle from the matching fv_*_new (documented per function);
+    // NULL is checked here.
+    unsafe { p.as_mut() }.ok_or_else(|| FfiError::null(what))
+}
+
+fn const_ref<'a, T>(p: *const T, what: &str) -> FfiResult<&'a T> {
+    // SAFETY: as mut_ref.
+    unsafe { p.as_ref() }.ok_or_else(|| FfiError::null(what))
+}
+
+fn out_ptr<T>(p: *mut *mut T, what: &str) -> FfiResult<&'static mut *mut T> {
+    // SAFETY: the caller passes a writable pointer to a handle slot; NULL is checked.
+    let slot = unsafe { p.as_mut() }.ok_or_else(|| FfiError::null(what))?;
+    *slot = std::ptr::null_mut();
+    Ok(slot)
+}
+
+fn free_handle<T>(p: *mut T) {
+    if !p.is_null() {
+        // SAFETY: p came from Box::into_raw in the matching fv_*_new and is freed once.
+        drop(unsafe { Box::from_raw(p) });
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Context
+
+/// A GPU adapter and device. Create one per process (or per host graphics context) and
+/// share it between renderers. Thread use: may be used from any thread; calls on one
+/// context may run concurrently (the device is internally synchronised).
+pub struct FvContext {
+    ctx: Context,
+}
+
+/// What a context runs on. Strings are NUL-terminated and truncated to fit.
+/// Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvAdapterInfo {
+    pub name: [c_char; 256],
+    /// "Vulkan", "Gl", …
+    pub backend: [c_char; 32],
+    pub driver: [c_char; 256],
+    /// True for a CPU device such as Mesa's lavapipe.
+    pub is_cpu: bool,
+    pub max_texture_dimension_3d: u32,
+    pub max_texture_dimension_2d: u32,
+    pub max_buffer_size: u64,
+}
+
+fn copy_str<const N: usize>(dst: &mut [c_char; N], s: &str) {
+    let bytes = s.as_bytes();
+    let n = bytes.len().min(N - 1);
+    for (d, &b) in dst.iter_mut().zip(&bytes[..n]) {
+        *d = b as c_char;
+    }
+    dst[n] = 0;
+}
+
+/// Opens a GPU device (hardware first, Mesa's lavapipe otherwise; FERROVOL_ADAPTER and
+/// FERROVOL_BACKEND override the choice). `*out` receives the context, NULL on failure.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_new(out: *mut *mut FvContext) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        let ctx = Context::new()?;
+        *slot = Box::into_raw(Box::new(FvContext { ctx }));
+        Ok(())
+    })
+}
+
+/// Releases a context (NULL is ignored). Renderers created from it keep the device alive.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_free(ctx: *mut FvContext) {
+    guard_value((), || free_handle(ctx))
+}
+
+/// Fills `*info` with the adapter's name, backend, driver and limits.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_info(
+    ctx: *const FvContext,
+    info: *mut FvAdapterInfo,
+) -> FvStatus {
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        let out = mut_ref(info, "info")?;
+        let i = &c.ctx.info;
+        copy_str(&mut out.name, &i.name);
+        copy_str(&mut out.backend, &i.backend);
+        copy_str(&mut out.driver, &format!("{} {}", i.driver, i.driver_info));
+        out.is_cpu = i.device_type == "Cpu";
+        out.max_texture_dimension_3d = i.limits.max_texture_dimension_3d;
+        out.max_texture_dimension_2d = i.limits.max_texture_dimension_2d;
+        out.max_buffer_size = i.limits.max_buffer_size;
+        Ok(())
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Volume
+
+/// Volume data on the CPU (a copy of the caller's array), ready to upload to renderers.
+/// Thread use: immutable after creation; may be read from several threads at once.
+pub struct FvVolume {
+    data: VolumeData,
+}
+
+fn scalars_from_bytes(t: FvScalarType, bytes: &[u8]) -> Scalars {
+    fn read<T: Copy, const N: usize>(b: &[u8], f: fn([u8; N]) -> T) -> Vec<T> {
+        b.chunks_exact(N)
+            .map(|c| f(c.try_into().expect("chunk of N")))
+            .collect()
+    }
+    use FvScalarType as T;
+    match t {
+        T::U8 => Scalars::U8(bytes.to_vec()),
+        T::I8 => Scalars::I8(read(bytes, i8::from_ne_bytes)),
+        T::U16 => Scalars::U16(read(bytes, u16::from_ne_bytes)),
+        T::I16 => Scalars::I16(read(bytes, i16::from_ne_bytes)),
+        T::U32 => Scalars::U32(read(bytes, u32::from_ne_bytes)),
+        T::I32 => Scalars::I32(read(bytes, i32::from_ne_bytes)),
+        T::F32 => Scalars::F32(read(bytes, f32::from_ne_bytes)),
+        T::F64 => Scalars::F64(read(bytes, f64::from_ne_bytes)),
+        T::I64 => Scalars::F64(read(bytes, |b| i64::from_ne_bytes(b) as f64)),
+        T::U64 => Scalars::F64(read(bytes, |b| u64::from_ne_bytes(b) as f64)),
+    }
+}
+
+const SCALAR_TYPES: [FvScalarType; 10] = [
+    FvScalarType::U8,
+    FvScalarType::I8,
+    FvScalarType::U16,
+    FvScalarType::I16,
+    FvScalarType::U32,
+    FvScalarType::I32,
+    FvScalarType::F32,
+    FvScalarType::F64,
+    FvScalarType::I64,
+    FvScalarType::U64,
+];
+
+fn scalar_size(t: FvScalarType) -> usize {
+    use FvScalarType as T;
+    match t {
+        T::U8 | T::I8 => 1,
+        T::U16 | T::I16 => 2,
+        T::U32 | T::I32 | T::F32 => 4,
+        T::F64 | T::I64 | T::U64 => 8,
+    }
+}
+
+/// Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
+/// `desc->scalar_type`, components interleaved, x fastest; `data_bytes` is its size in
+/// bytes (checked). Scalars are validated (NaN/Inf refused, spacing > 0, direction
+/// invertible). `*out` receives the volume, NULL on failure.
+#[no_mangle]
+pub unsafe extern "C" fn fv_volume_new(
+    desc: *const FvVolumeDesc,
+    data: *const c_void,
+    data_bytes: usize,
+    out: *mut *mut FvVolume,
+) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        let d = const_ref(desc, "desc")?;
+        if data.is_null() {
+            return Err(FfiError::null("data"));
+        }
+        let t = *SCALAR_TYPES.get(d.scalar_type as usize).ok_or_else(|| {
+            FfiError::new(
+                FvStatus::Unsupported,
+                format!(
+                    "scalar type {} is not an FvScalarType (0 to {})",
+                    d.scalar_type,
+                    SCALAR_TYPES.len() - 1
+                ),
+            )
+        })?;
+        let count = d
+            .dims
+            .iter()
+            .map(|&n| n as u64)
+            .product::<u64>()
+            .checked_mul(d.components as u64)
+            .ok_or_else(|| FfiError::invalid("volume size overflows"))?;
+        let expected = count
+            .checked_mul(scalar_size(t) as u64)
+            .filter(|&b| b <= usize::MAX as u64)
+            .ok_or_else(|| FfiError::invalid("volume size overflows"))?;
+        if expected != data_bytes as u64 {
+            return Err(FfiError::invalid(format!(
+                "data_bytes is {data_bytes} but {}x{}x{} points × {} component(s) of {:?} need {expected}",
+                d.dims[0], d.dims[1], d.dims[2], d.components, t
+            )));
+        }
+        // SAFETY: the caller guarantees `data` points to `data_bytes` readable bytes.
+        let bytes = unsafe { std::slice::from_raw_parts(data.cast::<u8>(), data_bytes) };
+        let m = &d.direction;
+        let direction = [[m[0], m[1], m[2]], [m[3], m[4], m[5]], [m[6], m[7], m[8]]];
+        let v = VolumeData {
+            dims: d.dims,
+            spacing: d.spacing,
+            origin: d.origin,
+            direction,
+            components: d.components,
+            scalars: scalars_from_bytes(t, bytes),
+        };
+        v.validate()?;
+        *slot = Box::into_raw(Box::new(FvVolume { data: v }));
+        Ok(())
+    })
+}
+
+/// Releases a volume (NULL is ignored). Renderers keep what they uploaded.
+#[no_mangle]
+pub unsafe extern "C" fn fv_volume_free(volume: *mut FvVolume) {
+    guard_value((), || free_handle(volume))
+}
+
+/// Minimum and maximum of one component into `range[0..2]`.
+#[no_mangle]
+pub unsafe extern "C" fn fv_volume_range(
+    volume: *const FvVolume,
+    component: u32,
+    range: *mut [f64; 2],
+) -> FvStatus {
+    guard(|| {
+        let v = const_ref(volume, "volume")?;
+        let out = mut_ref(range, "range")?;
+        if component >= v.data.components {
+            return Err(FfiError::invalid(format!(
+                "component {component}: the volume has {}",
+                v.data.components
+            )));
+        }
+        *out = v.data.range(component);
+        Ok(())
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Transfer function
+
+#[derive(Clone, Default)]
+struct PartialComponent {
+    color: Option<Piecewise<3>>,
+    opacity: Option<Piecewise<1>>,
+    gradient_opacity: Option<Piecewise<1>>,
+    unit_distance: Option<f64>,
+    weight: Option<f32>,
+}
+
+/// Colour, scalar opacity and gradient opacity per component (vtkVolumeProperty's
+/// functions). Thread use: one thread at a time.
+pub struct FvTransferFunction {
+    components: Vec<PartialComponent>,
+    independent: bool,
+}
+
+impl FvTransferFunction {
+    fn component(&mut self, c: u32) -> FfiResult<&mut PartialComponent> {
+        let n = self.components.len();
+        self.components.get_mut(c as usize).ok_or_else(|| {
+            FfiError::invalid(format!(
+                "component {c}: this transfer function has {n} (0 to {})",
+                n - 1
+            ))
+        })
+    }
+
+    fn to_core(&self) -> FfiResult<TransferFunction> {
+        let mut components = Vec::with_capacity(self.components.len());
+        for (i, c) in self.components.iter().enumerate() {
+            let (Some(color), Some(opacity)) = (&c.color, &c.opacity) else {
+                return Err(FfiError::invalid(format!(
+                    "component {i} needs both a colour and an opacity function (fv_transfer_function_set_color / _set_opacity)"
+                )));
+            };
+            let mut t = ComponentTransfer::new(color.clone(), opacity.clone());
+            t.gradient_opacity = c.gradient_opacity.clone();
+            t.unit_distance = c.unit_distance.unwrap_or(t.unit_distance);
+            t.weight = c.weight.unwrap_or(t.weight);
+            components.push(t);
+        }
+        Ok(TransferFunction {
+            components,
+            independent: self.independent,
+        })
+    }
+}
+
+fn points<const N: usize>(
+    what: &str,
+    p: *const f64,
+    count: usize,
+) -> FfiResult<Option<Piecewise<N>>> {
+    if count == 0 {
+        return Ok(None);
+    }
+    if p.is_null() {
+        return Err(FfiError::null(what));
+    }
+    // SAFETY: the caller guarantees `count` points of 1 + N doubles.
+    let flat = unsafe { std::slice::from_raw_parts(p, count * (N + 1)) };
+    let pts = flat
+        .chunks_exact(N + 1)
+        .map(|c| (c[0], std::array::from_fn(|i| c[i + 1] as f32)))
+        .collect();
+    Piecewise::new(pts)
+        .map(Some)
+        .map_err(|e| FfiError::invalid(format!("{what}: {e}")))
+}
+
+/// A transfer function for `components` (1–4) components; `independent` is
+/// vtkVolumeProperty::IndependentComponents (with dependent components, give one
+/// component's functions). `*out` receives it, NULL on failure.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_new(
+    components: u32,
+    independent: bool,
+    out: *mut *mut FvTransferFunction,
+) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        if !(1..=4).contains(&components) {
+            return Err(FfiError::invalid(format!(
+                "{components} components: a transfer function has 1 to 4"
+            )));
+        }
+        *slot = Box::into_raw(Box::new(FvTransferFunction {
+            components: vec![PartialComponent::default(); components as usize],
+            independent,
+        }));
+        Ok(())
+    })
+}
+
+/// Releases a transfer function (NULL is ignored).
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_free(tf: *mut FvTransferFunction) {
+    guard_value((), || free_handle(tf))
+}
+
+/// Colour points of one component: `count` quadruples (x, r, g, b), x increasing.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_color(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    xrgb: *const f64,
+    count: usize,
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        let c = t.component(component)?;
+        c.color = points::<3>("colour points", xrgb, count)?;
+        if c.color.is_none() {
+            return Err(FfiError::invalid(
+                "a colour function needs at least one point",
+            ));
+        }
+        Ok(())
+    })
+}
+
+/// Scalar opacity points of one component: `count` pairs (x, opacity), x increasing.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_opacity(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    xa: *const f64,
+    count: usize,
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        let c = t.component(component)?;
+        c.opacity = points::<1>("opacity points", xa, count)?;
+        if c.opacity.is_none() {
+            return Err(FfiError::invalid(
+                "an opacity function needs at least one point",
+            ));
+        }
+        Ok(())
+    })
+}
+
+/// Gradient-magnitude opacity points of one component: `count` pairs (|∇s| in scalar units
+/// per world unit, opacity multiplier); count = 0 turns gradient opacity off.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_gradient_opacity(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    xa: *const f64,
+    count: usize,
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        t.component(component)?.gradient_opacity =
+            points::<1>("gradient opacity points", xa, count)?;
+        Ok(())
+    })
+}
+
+/// ScalarOpacityUnitDistance (> 0) and the component weight (≥ 0) of one component.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_unit_distance(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    unit_distance: f64,
+    weight: f64,
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        if !(unit_distance.is_finite() && unit_distance > 0.0) {
+            return Err(FfiError::invalid(format!(
+                "scalar opacity unit distance {unit_distance} must be positive"
+            )));
+        }
+        if !(weight.is_finite() && weight >= 0.0) {
+            return Err(FfiError::invalid(format!(
+                "component weight {weight} must be finite and non-negative"
+            )));
+        }
+        let c = t.component(component)?;
+        c.unit_distance = Some(unit_distance);
+        c.weight = Some(weight as f32);
+        Ok(())
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Renderer
+
+/// A renderer: the uploaded volume, transfer tables, pipelines and the frame it draws.
+/// Camera, lights and parameters persist between frames. Thread use: one thread at a
+/// time (it may move between threads).
+pub struct FvRenderer {
+    r: Renderer,
+    view: View,
+    params: ferrovol_core::RenderParams,
+    upload: UploadOptions,
+}
+
+/// A renderer on `ctx` (which may be freed afterwards). `*out` receives it.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_new(
+    ctx: *const FvContext,
+    out: *mut *mut FvRenderer,
+) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        let c = const_ref(ctx, "ctx")?;
+        let r = Renderer::new(c.ctx.clone())?;
+        *slot = Box::into_raw(Box::new(FvRenderer {
+            r,
+            view: View::fit([-1.0, 1.0, -1.0, 1.0, -1.0, 1.0], 1, 1),
+            params: Default::default(),
+            upload: UploadOptions::default(),
+        }));
+        Ok(())
+    })
+}
+
+/// Releases a renderer and its GPU resources (NULL is ignored).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_free(renderer: *mut FvRenderer) {
+    guard_value((), || free_handle(renderer))
+}
+
+/// Largest brick edge in points for later volume uploads (0 = the device limit). Volumes
+/// beyond it are split into bricks and still rendered whole.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_max_brick_points(
+    renderer: *mut FvRenderer,
+    points: u32,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        if points == 1 || points == 2 {
+            return Err(FfiError::invalid(format!(
+                "max brick points {points}: a brick needs at least 3 points per edge"
+            )));
+        }
+        r.upload.max_brick_points = (points > 0).then_some(points);
+        Ok(())
+    })
+}
+
+/// Uploads a volume (replacing the previous one). Call again only when the data changed:
+/// camera and parameter changes never re-upload.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_volume(
+    renderer: *mut FvRenderer,
+    volume: *const FvVolume,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        let v = const_ref(volume, "volume")?;
+        r.r.set_volume_with(&v.data, r.upload)?;
+        Ok(())
+    })
+}
+
+/// Sets the transfer function; only its tables are re-uploaded.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_transfer_function(
+    renderer: *mut FvRenderer,
+    tf: *const FvTransferFunction,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        let t = const_ref(tf, "tf")?.to_core()?;
+        r.r.set_transfer_function(&t)?;
+        Ok(())
+    })
+}
+
+/// Sets the camera for the following frames.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_camera(
+    renderer: *mut FvRenderer,
+    camera: *const FvCamera,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        r.view.camera = const_ref(camera, "camera")?.to_core()?;
+        Ok(())
+    })
+}
+
+/// Sets the lights (`count` may be 0: shading then has ambient light only; at most
+/// FV_MAX_LIGHTS with shading on).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_lights(
+    renderer: *mut FvRenderer,
+    lights: *const FvLight,
+    count: usize,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        if count > FV_MAX_LIGHTS {
+            return Err(FfiError::invalid(format!(
+                "{count} lights: at most {FV_MAX_LIGHTS}"
+            )));
+        }
+        let ls = if count == 0 {
+            &[][..]
+        } else {
+            if lights.is_null() {
+                return Err(FfiError::null("lights"));
+            }
+            // SAFETY: the caller guarantees `count` lights at `lights`.
+            unsafe { std::slice::from_raw_parts(lights, count) }
+        };
+        r.view.lights = ls
+            .iter()
+            .enumerate()
+            .map(|(i, l)| l.to_core(i))
+            .collect::<FfiResult<_>>()?;
+        Ok(())
+    })
+}
+
+/// Fills `*params` with the defaults (VTK's: composite, linear, automatic sample
+/// distance, no shading, early termination at 1 − 1/255).
+#[no_mangle]
+pub unsafe extern "C" fn fv_render_params_default(params: *mut FvRenderParams) -> FvStatus {
+    guard(|| {
+        *mut_ref(params, "params")? = FvRenderParams::defaults();
+        Ok(())
+    })
+}
+
+/// Sets the render parameters (validated: out-of-range values are refused and the previous
+/// parameters kept).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_params(
+    renderer: *mut FvRenderer,
+    params: *const FvRenderParams,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        r.params = const_ref(params, "params")?.to_core()?;
+        Ok(())
+    })
+}
+
+/// Renders a `width × height` frame. `depth` (NULL for none) holds `depth_count` =
+/// width·height window depths (0 near … 1 far, rows top to bottom) of opaque geometry
+/// that stops rays. Returns once the work is submitted; read the result with
+/// fv_renderer_read_frame or the shared images.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_render(
+    renderer: *mut FvRenderer,
+    width: u32,
+    height: u32,
+    depth: *const f32,
+    depth_count: usize,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        r.view.width = width;
+        r.view.height = height;
+        let depth = if depth.is_null() {
+            None
+        } else {
+            // SAFETY: the caller guarantees `depth_count` floats at `depth`.
+            Some(unsafe { std::slice::from_raw_parts(depth, depth_count) })
+        };
+        r.r.render(&r.view, &r.params, depth)?;
+        Ok(())
+    })
+}
+
+/// Counters of what was uploaded and rendered so far.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_stats(
+    renderer: *const FvRenderer,
+    stats: *mut FvStats,
+) -> FvStatus {
+    guard(|| {
+        let r = const_ref(renderer, "renderer")?;
+        let s = r.r.stats();
+        *mut_ref(stats, "stats")? = FvStats {
+            volume_uploads: s.volume_uploads,
+            table_uploads: s.table_uploads,
+            frames: s.frames,
+            bricks: r.r.brick_count() as u32,
+        };
+        Ok(())
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Frame
+
+/// A rendered frame copied to the CPU: premultiplied RGBA8 and window depth, rows top to
+/// bottom. Thread use: immutable; may be read from several threads at once.
+pub struct FvFrame {
+    image: Image,
+}
+
+/// Waits for the last frame and copies it to the CPU. `*out` receives the frame.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_read_frame(
+    renderer: *const FvRenderer,
+    out: *mut *mut FvFrame,
+) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        let r = const_ref(renderer, "renderer")?;
+        let image = r.r.read_image()?;
+        *slot = Box::into_raw(Box::new(FvFrame { image }));
+        Ok(())
+    })
+}
+
+/// Releases a frame (NULL is ignored).
+#[no_mangle]
+pub unsafe extern "C" fn fv_frame_free(frame: *mut FvFrame) {
+    guard_value((), || free_handle(frame))
+}
+
+/// Width and height of a frame (0 × 0 for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn fv_frame_size(frame: *const FvFrame, width: *mut u32, height: *mut u32) {
+    guard_value((), || {
+        // SAFETY: NULL-checked; the caller passes a frame handle and writable u32s.
+        let f = unsafe { frame.as_ref() };
+        let (w, h) = f.map_or((0, 0), |f| (f.image.width, f.image.height));
+        if let Some(p) = unsafe { width.as_mut() } {
+            *p = w;
+        }
+        if let Some(p) = unsafe { height.as_mut() } {
+            *p = h;
+        }
+    })
+}
+
+/// Premultiplied RGBA8 pixels, width·height·4 bytes, rows top to bottom; valid until the
+/// frame is freed (NULL for a NULL frame).
+#[no_mangle]
+pub unsafe extern "C" fn fv_frame_rgba(frame: *const FvFrame) -> *const u8 {
+    guard_value(std::ptr::null(), || {
+        // SAFETY: NULL-checked frame handle.
+        unsafe { frame.as_ref() }.map_or(std::ptr::null(), |f| f.image.rgba.as_ptr())
+    })
+}
+
+/// Window depth per pixel (1 where the volume is transparent), width·height floats, rows top
+/// to bottom; valid until the frame is freed (NULL for a NULL frame).
+#[no_mangle]
+pub unsafe extern "C" fn fv_frame_depth(frame: *const FvFrame) -> *const f32 {
+    guard_value(std::ptr::null(), || {
+        // SAFETY: NULL-checked frame handle.
+        unsafe { frame.as_ref() }.map_or(std::ptr::null(), |f| f.image.depth.as_ptr())
+    })
+}
+
+/// Writes the frame over an opaque `background` (RGB in [0, 1]) as a PNG at `path` (UTF-8).
+#[no_mangle]
+pub unsafe extern "C" fn fv_frame_write_png(
+    frame: *const FvFrame,
+    path: *const c_char,
+    background: *const [f32; 3],
+) -> FvStatus {
+    guard(|| {
+        let f = const_ref(frame, "frame")?;
+        if path.is_null() {
+            return Err(FfiError::null("path"));
+        }
+        // SAFETY: the caller passes a NUL-terminated string.
+        let p = unsafe { CStr::from_ptr(path) }
+            .to_str()
+            .map_err(|_| FfiError::invalid("path is not UTF-8"))?;
+        let bg = const_ref(background, "background")?;
+        f.image.save_png(p.as_ref(), *bg)?;
+        Ok(())
+    })
+}

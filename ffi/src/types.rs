@@ -1,0 +1,415 @@
+//! Plain-data structs and enums crossing the C ABI, and their conversion into core types.
+//! Enum-valued fields travel as `uint32_t` so that a value outside the enum is an
+//! FV_STATUS_INVALID_ARGUMENT, not undefined behaviour.
+
+use crate::status::{FfiError, FfiResult};
+use ferrovol_core::{
+    BlendMode, Camera, ClipPlane, Cropping, GradientMethod, Interpolation, Light, LightSpace,
+    RenderParams, Shading,
+};
+use glam::{DMat4, DVec3};
+
+/// Scalar types of volume data (VTK's VTK_UNSIGNED_CHAR … VTK_DOUBLE). 64-bit integers
+/// are converted to double on upload (exact up to 2^53).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvScalarType {
+    U8 = 0,
+    I8 = 1,
+    U16 = 2,
+    I16 = 3,
+    U32 = 4,
+    I32 = 5,
+    F32 = 6,
+    F64 = 7,
+    I64 = 8,
+    U64 = 9,
+}
+
+/// How samples along a ray combine (vtkVolumeMapper's blend modes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvBlendMode {
+    Composite = 0,
+    Maximum = 1,
+    Minimum = 2,
+    Average = 3,
+    Additive = 4,
+}
+
+/// Volume interpolation (vtkVolumeProperty::InterpolationType).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvInterpolation {
+    Nearest = 0,
+    Linear = 1,
+}
+
+/// Gradient estimator for shading and gradient opacity.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvGradientMethod {
+    /// Central differences (6 extra samples).
+    Central = 0,
+    /// Forward differences (3 extra samples).
+    Forward = 1,
+}
+
+/// Where a light is defined (vtkLight's light types).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvLightSpace {
+    /// At the camera, shining at the focal point; position and focal point ignored.
+    Headlight = 0,
+    /// In camera coordinates (camera at the origin looking down −z, unit distance).
+    Camera = 1,
+    /// In world coordinates.
+    World = 2,
+}
+
+/// A volume's geometry and scalar layout. Point (i, j, k) sits at
+/// origin + direction · (spacing ⊙ (i, j, k)), as vtkImageData places it.
+/// Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvVolumeDesc {
+    /// Points along x, y, z (each ≥ 1).
+    pub dims: [u32; 3],
+    /// Components per point, 1–4, interleaved.
+    pub components: u32,
+    /// One of FvScalarType.
+    pub scalar_type: u32,
+    pub spacing: [f64; 3],
+    pub origin: [f64; 3],
+    /// Row-major 3×3 direction matrix (vtkImageData::GetDirectionMatrix).
+    pub direction: [f64; 9],
+}
+
+/// A VTK camera. Matrices are column-major (OpenGL order: element (row r, column c) at
+/// index 4·c + r). Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvCamera {
+    pub position: [f64; 3],
+    pub focal_point: [f64; 3],
+    pub view_up: [f64; 3],
+    /// Vertical view angle in degrees (perspective).
+    pub view_angle: f64,
+    pub parallel: bool,
+    /// Half the viewport height in world units (parallel projection).
+    pub parallel_scale: f64,
+    /// Near and far clipping distances from the camera.
+    pub clipping_range: [f64; 2],
+    /// Use view_matrix and projection_matrix instead of the fields above (e.g. VTK's
+    /// vtkCamera::GetCompositeProjectionTransformMatrix split into its two parts).
+    pub use_matrices: bool,
+    /// World → view.
+    pub view_matrix: [f64; 16],
+    /// View → clip (OpenGL clip space, depth −1…1).
+    pub projection_matrix: [f64; 16],
+}
+
+/// A light (vtkLight). Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvLight {
+    /// One of FvLightSpace.
+    pub space: u32,
+    pub positional: bool,
+    pub position: [f64; 3],
+    pub focal_point: [f64; 3],
+    pub ambient: [f32; 3],
+    pub diffuse: [f32; 3],
+    pub specular: [f32; 3],
+    pub intensity: f32,
+    /// Constant, linear, quadratic (positional lights).
+    pub attenuation: [f32; 3],
+    /// Spotlight half-angle in degrees; ≥ 180 means no cone.
+    pub cone_angle: f32,
+    pub exponent: f32,
+}
+
+/// A clipping plane: points with dot(normal, p − origin) ≥ 0 are kept (VTK's convention).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FvPlane {
+    pub origin: [f64; 3],
+    pub normal: [f64; 3],
+}
+
+/// Maximum number of clipping planes in FvRenderParams.
+pub const FV_MAX_CLIP_PLANES: usize = 6;
+/// Maximum number of lights with shading on.
+pub const FV_MAX_LIGHTS: usize = 8;
+
+/// Everything about a frame that is neither the volume, the transfer function, the camera
+/// nor the lights. Fill with fv_render_params_default() and change what you need.
+/// Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvRenderParams {
+    /// One of FvBlendMode.
+    pub blend_mode: u32,
+    /// One of FvInterpolation.
+    pub interpolation: u32,
+    /// World distance between samples; 0 = the smallest voxel spacing (VTK's automatic choice).
+    pub sample_distance: f64,
+    /// Offset each ray's first sample by a per-pixel fraction of a step (hides wood grain).
+    pub jitter: bool,
+    /// Early ray termination opacity, (0, 1]; VTK's is 1 − 1/255.
+    pub termination_threshold: f32,
+    /// One of FvGradientMethod.
+    pub gradient_method: u32,
+    pub shade: bool,
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub specular_power: f32,
+    pub two_sided_lighting: bool,
+    pub cropping: bool,
+    /// xmin, xmax, ymin, ymax, zmin, zmax in data coordinates.
+    pub cropping_planes: [f64; 6],
+    /// vtkVolumeMapper::CroppingRegionFlags (27 bits).
+    pub cropping_regions: u32,
+    pub clip_plane_count: u32,
+    pub clip_planes: [FvPlane; FV_MAX_CLIP_PLANES],
+    /// Average blend mode: ignore samples outside average_range (AverageIPScalarRange).
+    pub average_range_enabled: bool,
+    pub average_range: [f64; 2],
+    /// Skip blocks the transfer function makes fully transparent (composite mode).
+    pub empty_space_skipping: bool,
+    /// Depth output: first sample where accumulated opacity exceeds this, [0, 1).
+    pub depth_threshold: f32,
+    /// The vtkVolume's matrix (data → world), column-major.
+    pub volume_matrix: [f64; 16],
+}
+
+/// Counters that show what the renderer re-uploaded. Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FvStats {
+    pub volume_uploads: u32,
+    pub table_uploads: u32,
+    pub frames: u32,
+    /// Bricks the volume was split into (1 when it fits in one texture).
+    pub bricks: u32,
+}
+
+fn enum_value<T: Copy>(what: &str, v: u32, table: &[T]) -> FfiResult<T> {
+    table.get(v as usize).copied().ok_or_else(|| {
+        FfiError::invalid(format!(
+            "{what} {v} is out of range (0 to {})",
+            table.len() - 1
+        ))
+    })
+}
+
+pub fn column_major(m: &[f64; 16]) -> DMat4 {
+    DMat4::from_cols_array(m)
+}
+
+impl FvRenderParams {
+    pub fn defaults() -> Self {
+        let d = RenderParams::default();
+        FvRenderParams {
+            blend_mode: FvBlendMode::Composite as u32,
+            interpolation: FvInterpolation::Linear as u32,
+            sample_distance: 0.0,
+            jitter: d.jitter,
+            termination_threshold: d.termination_threshold,
+            gradient_method: FvGradientMethod::Central as u32,
+            shade: d.shading.enabled,
+            ambient: d.shading.ambient,
+            diffuse: d.shading.diffuse,
+            specular: d.shading.specular,
+            specular_power: d.shading.specular_power,
+            two_sided_lighting: d.shading.two_sided,
+            cropping: false,
+            cropping_planes: [0.0; 6],
+            cropping_regions: Cropping::SUBVOLUME,
+            clip_plane_count: 0,
+            clip_planes: [FvPlane::default(); FV_MAX_CLIP_PLANES],
+            average_range_enabled: false,
+            average_range: [0.0, 0.0],
+            empty_space_skipping: d.empty_space_skipping,
+            depth_threshold: d.depth_threshold,
+            volume_matrix: DMat4::IDENTITY.to_cols_array(),
+        }
+    }
+
+    pub fn to_core(&self) -> FfiResult<RenderParams> {
+        use BlendMode as B;
+        let blend = enum_value(
+            "blend_mode",
+            self.blend_mode,
+            &[
+                B::Composite,
+                B::Maximum,
+                B::Minimum,
+                B::Average,
+                B::Additive,
+            ],
+        )?;
+        let interpolation = enum_value(
+            "interpolation",
+            self.interpolation,
+            &[Interpolation::Nearest, Interpolation::Linear],
+        )?;
+        let gradient = enum_value(
+            "gradient_method",
+            self.gradient_method,
+            &[GradientMethod::Central, GradientMethod::Forward],
+        )?;
+        if !(self.sample_distance.is_finite() && self.sample_distance >= 0.0) {
+            return Err(FfiError::invalid(format!(
+                "sample_distance {} must be 0 (automatic) or positive",
+                self.sample_distance
+            )));
+        }
+        let n = self.clip_plane_count as usize;
+        if n > FV_MAX_CLIP_PLANES {
+            return Err(FfiError::invalid(format!(
+                "clip_plane_count {n}: at most {FV_MAX_CLIP_PLANES} clipping planes"
+            )));
+        }
+        let p = RenderParams {
+            blend,
+            interpolation,
+            sample_distance: (self.sample_distance > 0.0).then_some(self.sample_distance),
+            jitter: self.jitter,
+            termination_threshold: self.termination_threshold,
+            gradient,
+            shading: Shading {
+                enabled: self.shade,
+                ambient: self.ambient,
+                diffuse: self.diffuse,
+                specular: self.specular,
+                specular_power: self.specular_power,
+                two_sided: self.two_sided_lighting,
+            },
+            cropping: self.cropping.then_some(Cropping {
+                planes: self.cropping_planes,
+                regions: self.cropping_regions,
+            }),
+            clip_planes: self.clip_planes[..n]
+                .iter()
+                .map(|p| ClipPlane {
+                    origin: DVec3::from_array(p.origin),
+                    normal: DVec3::from_array(p.normal),
+                })
+                .collect(),
+            average_range: self.average_range_enabled.then_some(self.average_range),
+            empty_space_skipping: self.empty_space_skipping,
+            depth_threshold: self.depth_threshold,
+            volume_matrix: column_major(&self.volume_matrix),
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+fn finite3(what: &str, v: [f64; 3]) -> FfiResult<DVec3> {
+    let d = DVec3::from_array(v);
+    if d.is_finite() {
+        Ok(d)
+    } else {
+        Err(FfiError::invalid(format!("{what} {v:?} is not finite")))
+    }
+}
+
+impl FvCamera {
+    pub fn to_core(&self) -> FfiResult<Camera> {
+        let position = finite3("camera position", self.position)?;
+        let focal_point = finite3("camera focal point", self.focal_point)?;
+        let view_up = finite3("camera view up", self.view_up)?;
+        let raw = if self.use_matrices {
+            let v = column_major(&self.view_matrix);
+            let p = column_major(&self.projection_matrix);
+            for (name, m) in [("view", v), ("projection", p)] {
+                if !m.is_finite() || m.determinant().abs() < 1e-300 {
+                    return Err(FfiError::invalid(format!(
+                        "camera {name} matrix is singular or not finite"
+                    )));
+                }
+            }
+            Some((v, p))
+        } else {
+            if (position - focal_point).length() <= 0.0 {
+                return Err(FfiError::invalid(
+                    "camera position equals its focal point: no view direction",
+                ));
+            }
+            if view_up.cross(focal_point - position).length() <= 0.0 {
+                return Err(FfiError::invalid(
+                    "camera view up is zero or parallel to the view direction",
+                ));
+            }
+            let angle_ok = self.view_angle > 0.0 && self.view_angle < 180.0;
+            if !self.parallel && !angle_ok {
+                return Err(FfiError::invalid(format!(
+                    "camera view angle {} must be in (0, 180) degrees",
+                    self.view_angle
+                )));
+            }
+            if self.parallel && !(self.parallel_scale.is_finite() && self.parallel_scale > 0.0) {
+                return Err(FfiError::invalid(format!(
+                    "camera parallel scale {} must be positive",
+                    self.parallel_scale
+                )));
+            }
+            let [near, far] = self.clipping_range;
+            if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
+                return Err(FfiError::invalid(format!(
+                    "camera clipping range [{near}, {far}] needs 0 < near < far"
+                )));
+            }
+            None
+        };
+        Ok(Camera {
+            position,
+            focal_point,
+            view_up,
+            view_angle: self.view_angle,
+            parallel: self.parallel,
+            parallel_scale: self.parallel_scale,
+            clipping_range: self.clipping_range,
+            raw,
+        })
+    }
+}
+
+impl FvLight {
+    pub fn to_core(&self, index: usize) -> FfiResult<Light> {
+        let space = enum_value(
+            &format!("light {index} space"),
+            self.space,
+            &[LightSpace::Headlight, LightSpace::Camera, LightSpace::World],
+        )?;
+        let colours = [self.ambient, self.diffuse, self.specular];
+        let scalars = [self.intensity, self.cone_angle, self.exponent];
+        if colours
+            .iter()
+            .flatten()
+            .chain(&scalars)
+            .chain(&self.attenuation)
+            .any(|v| !v.is_finite())
+        {
+            return Err(FfiError::invalid(format!(
+                "light {index} has a non-finite colour, intensity, attenuation or cone"
+            )));
+        }
+        Ok(Light {
+            space,
+            positional: self.positional,
+            position: finite3(&format!("light {index} position"), self.position)?,
+            focal_point: finite3(&format!("light {index} focal point"), self.focal_point)?,
+            ambient: self.ambient,
+            diffuse: self.diffuse,
+            specular: self.specular,
+            intensity: self.intensity,
+            attenuation: self.attenuation,
+            cone_angle: self.cone_angle,
+            exponent: self.exponent,
+        })
+    }
+}

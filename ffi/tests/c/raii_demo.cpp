@@ -1,0 +1,76 @@
+// Drives the C++ RAII wrapper (ferrovol.hpp): renders a small sphere volume, then checks that
+// a bad call throws ferrovol::Error with the right status and a message.
+// Built with -std=c++17 -Wall -Wextra -Werror -pedantic by ffi/tests/c_program.rs.
+#include "ferrovol.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+int main(int argc, char **argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s OUT.png\n", argv[0]);
+    return 2;
+  }
+  try {
+    ferrovol::Context ctx;
+    ferrovol::Renderer renderer(ctx);
+    const uint32_t n = 32;
+    std::vector<uint8_t> data(n * n * n);
+    for (uint32_t k = 0; k < n; ++k)
+      for (uint32_t j = 0; j < n; ++j)
+        for (uint32_t i = 0; i < n; ++i) {
+          double x = i - 15.5, y = j - 15.5, z = k - 15.5;
+          double r = std::sqrt(x * x + y * y + z * z);
+          data[(k * n + j) * n + i] = static_cast<uint8_t>(r < 14 ? 255 - 16 * r : 0);
+        }
+    FvVolumeDesc desc{};
+    desc.dims[0] = desc.dims[1] = desc.dims[2] = n;
+    desc.components = 1;
+    desc.scalar_type = FV_SCALAR_TYPE_U8;
+    desc.spacing[0] = desc.spacing[1] = desc.spacing[2] = 1.0;
+    desc.direction[0] = desc.direction[4] = desc.direction[8] = 1.0;
+    ferrovol::Volume volume(desc, data.data(), data.size());
+    renderer.set_volume(volume);
+    ferrovol::TransferFunction tf;
+    tf.set_color(0, {0, 1, 0.5, 0.2, 255, 1, 1, 0.9});
+    tf.set_opacity(0, {0, 0, 255, 0.2});
+    renderer.set_transfer_function(tf);
+    FvCamera cam{};
+    cam.focal_point[0] = cam.focal_point[1] = cam.focal_point[2] = 15.5;
+    cam.position[0] = cam.position[1] = 15.5;
+    cam.position[2] = 15.5 + 100;
+    cam.view_up[1] = 1;
+    cam.view_angle = 30;
+    cam.parallel_scale = 1;
+    cam.clipping_range[0] = 50;
+    cam.clipping_range[1] = 150;
+    renderer.set_camera(cam);
+    renderer.set_params(ferrovol::Renderer::default_params());
+    renderer.render(200, 150);
+    ferrovol::Frame frame = renderer.read_frame();
+    const uint8_t *centre = frame.rgba() + 4 * (75 * 200 + 100);
+    std::printf("frame %ux%u, centre alpha %u\n", frame.width(), frame.height(), centre[3]);
+    frame.write_png(argv[1]);
+    if (centre[3] < 128) {
+      std::fprintf(stderr, "the sphere is missing from the centre of the frame\n");
+      return 1;
+    }
+    try {
+      FvRenderParams bad = ferrovol::Renderer::default_params();
+      bad.blend_mode = 42;
+      renderer.set_params(bad);
+      std::fprintf(stderr, "an invalid blend mode was accepted\n");
+      return 1;
+    } catch (const ferrovol::Error &e) {
+      std::printf("invalid blend mode refused: %s\n", e.what());
+      if (e.status() != FV_STATUS_INVALID_ARGUMENT) {
+        return 1;
+      }
+    }
+  } catch (const ferrovol::Error &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
