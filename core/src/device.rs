@@ -33,12 +33,16 @@ pub struct Context {
     pub info: DeviceInfo,
 }
 
-fn backends_from_env() -> Result<wgpu::Backends> {
+/// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and
+/// OpenGL only when none of them has an adapter, because initialising wgpu's GL backend
+/// (EGL) releases whatever GL context the calling thread had current, which breaks a host
+/// such as VTK that creates ferrovol inside its own GL rendering.
+fn backends_from_env() -> Result<Vec<wgpu::Backends>> {
     match std::env::var("FERROVOL_BACKEND") {
-        Err(_) => Ok(wgpu::Backends::VULKAN
-            | wgpu::Backends::GL
-            | wgpu::Backends::METAL
-            | wgpu::Backends::DX12),
+        Err(_) => Ok(vec![
+            wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12,
+            wgpu::Backends::GL,
+        ]),
         Ok(s) => {
             let mut b = wgpu::Backends::empty();
             for part in s.split(',').map(|p| p.trim().to_ascii_lowercase()) {
@@ -54,7 +58,7 @@ fn backends_from_env() -> Result<wgpu::Backends> {
                     }
                 };
             }
-            Ok(b)
+            Ok(vec![b])
         }
     }
 }
@@ -76,16 +80,23 @@ impl Context {
     }
 
     async fn new_async() -> Result<Context> {
-        let backends = backends_from_env()?;
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
-        let mut adapters = instance.enumerate_adapters(backends).await;
         let wanted = std::env::var("FERROVOL_ADAPTER")
             .ok()
             .map(|s| s.to_lowercase());
-        if let Some(w) = &wanted {
-            adapters.retain(|a| a.get_info().name.to_lowercase().contains(w.as_str()));
+        let sets = backends_from_env()?;
+        let mut adapters = Vec::new();
+        let mut backends = wgpu::Backends::empty();
+        for set in sets {
+            backends |= set;
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+            desc.backends = set;
+            adapters = wgpu::Instance::new(desc).enumerate_adapters(set).await;
+            if let Some(w) = &wanted {
+                adapters.retain(|a| a.get_info().name.to_lowercase().contains(w.as_str()));
+            }
+            if !adapters.is_empty() {
+                break;
+            }
         }
         // Hardware first; among equals prefer Vulkan (the path shared with GL interop).
         adapters.sort_by_key(|a| {

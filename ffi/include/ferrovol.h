@@ -152,6 +152,39 @@ typedef enum FvScalarType {
 } FvScalarType;
 
 /**
+ * Where a renderer's frames go (fv_renderer_set_output_path).
+ */
+typedef enum FvOutputPath {
+  /**
+   * Frames stay in GPU memory private to ferrovol; read them with fv_renderer_read_frame.
+   */
+  FV_OUTPUT_PATH_READBACK = 0,
+  /**
+   * Frames are drawn into memory exported to the host's graphics API (zero copy).
+   */
+  FV_OUTPUT_PATH_SHARED = 1,
+} FvOutputPath;
+
+/**
+ * The images of the shared output path (fv_renderer_shared_image).
+ */
+typedef enum FvTarget {
+  /**
+   * Premultiplied RGBA8 colour (GL_RGBA8).
+   */
+  FV_TARGET_COLOR = 0,
+  /**
+   * Window depth of the volume, 1 where transparent (GL_R32F).
+   */
+  FV_TARGET_DEPTH = 1,
+  /**
+   * Window depth of the host's opaque geometry, written by the host (GL_R32F), read by
+   * fv_renderer_render_with_shared_depth.
+   */
+  FV_TARGET_DEPTH_INPUT = 2,
+} FvTarget;
+
+/**
  * A GPU adapter and device. Create one per process (or per host graphics context) and
  * share it between renderers. Thread use: may be used from any thread; calls on one
  * context may run concurrently (the device is internally synchronised).
@@ -366,6 +399,37 @@ typedef struct FvRenderParams {
 } FvRenderParams;
 
 /**
+ * One exported image, for glCreateMemoryObjectsEXT + glImportMemoryFdEXT(size,
+ * GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd) + glTexStorageMem2DEXT(GL_TEXTURE_2D, 1,
+ * gl_internal_format, width, height, memory, 0) with GL_TEXTURE_TILING_EXT =
+ * GL_OPTIMAL_TILING_EXT and GL_DEDICATED_MEMORY_OBJECT_EXT = GL_TRUE when `dedicated`.
+ * Rows are top to bottom (row 0 is the top of the frame). Thread use: plain data.
+ */
+typedef struct FvSharedImage {
+  /**
+   * A new file descriptor owned by the caller: glImportMemoryFdEXT takes it over on
+   * success; otherwise close() it.
+   */
+  int32_t fd;
+  /**
+   * Allocation size in bytes (pass it to glImportMemoryFdEXT).
+   */
+  uint64_t size;
+  uint32_t width;
+  uint32_t height;
+  /**
+   * GL_RGBA8 (0x8058) or GL_R32F (0x822E).
+   */
+  uint32_t gl_internal_format;
+  bool dedicated;
+  /**
+   * Changes whenever the images are reallocated (new size, path switched): the host
+   * then deletes its imported textures and memory objects and imports again.
+   */
+  uint64_t generation;
+} FvSharedImage;
+
+/**
  * Counters that show what the renderer re-uploaded. Thread use: plain data.
  */
 typedef struct FvStats {
@@ -407,6 +471,21 @@ void fv_context_free(struct FvContext *ctx);
  * Fills `*info` with the adapter's name, backend, driver and limits.
  */
 enum FvStatus fv_context_info(const struct FvContext *ctx, struct FvAdapterInfo *info);
+
+/**
+ * The Vulkan device and driver UUIDs of the context (16 bytes each), to compare with
+ * OpenGL's GL_DEVICE_UUID_EXT and GL_DRIVER_UUID_EXT before importing shared images.
+ * FV_STATUS_UNSUPPORTED where the device cannot tell (not Vulkan).
+ */
+enum FvStatus fv_context_uuids(const struct FvContext *ctx,
+                               uint8_t (*device_uuid)[16],
+                               uint8_t (*driver_uuid)[16]);
+
+/**
+ * Whether renderers on this context can use FV_OUTPUT_PATH_SHARED (false with the reason
+ * in fv_last_error() when not).
+ */
+bool fv_context_can_share(const struct FvContext *ctx);
 
 /**
  * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
@@ -543,6 +622,50 @@ enum FvStatus fv_renderer_render(struct FvRenderer *renderer,
                                  uint32_t height,
                                  const float *depth,
                                  size_t depth_count);
+
+/**
+ * Chooses where frames go (an FvOutputPath). FV_OUTPUT_PATH_SHARED is refused with
+ * FV_STATUS_UNSUPPORTED and the reason (backend, missing Vulkan extension) where the
+ * device cannot export memory; the path is then unchanged.
+ */
+enum FvStatus fv_renderer_set_output_path(struct FvRenderer *renderer, uint32_t path);
+
+/**
+ * The active output path (an FvOutputPath) into `*path`.
+ */
+enum FvStatus fv_renderer_output_path(const struct FvRenderer *renderer, uint32_t *path);
+
+/**
+ * Allocates the frame images for `width × height` now (a render does it too), so a host
+ * can import the shared images, and fill the depth input, before the first frame.
+ */
+enum FvStatus fv_renderer_prepare_targets(struct FvRenderer *renderer,
+                                          uint32_t width,
+                                          uint32_t height);
+
+/**
+ * Exports one image of the shared output path (an FvTarget) into `*image`, with a new file
+ * descriptor the caller owns. FV_STATUS_INVALID_ARGUMENT unless the path is
+ * FV_OUTPUT_PATH_SHARED and the images exist (after fv_renderer_prepare_targets or a
+ * render).
+ */
+enum FvStatus fv_renderer_shared_image(const struct FvRenderer *renderer,
+                                       uint32_t target,
+                                       struct FvSharedImage *image);
+
+/**
+ * Renders like fv_renderer_render, with the opaque depth taken from the shared
+ * FV_TARGET_DEPTH_INPUT image the host wrote (it must glFinish before this call).
+ */
+enum FvStatus fv_renderer_render_with_shared_depth(struct FvRenderer *renderer,
+                                                   uint32_t width,
+                                                   uint32_t height);
+
+/**
+ * Waits until the last frame is finished on the GPU: after it, the host may sample the
+ * shared images. This CPU wait is the synchronisation of the shared path (no semaphores).
+ */
+enum FvStatus fv_renderer_finish(const struct FvRenderer *renderer);
 
 /**
  * Counters of what was uploaded and rendered so far.

@@ -16,7 +16,7 @@ pub use status::*;
 pub use types::*;
 
 use ferrovol_core::{
-    ComponentTransfer, Context, Image, Piecewise, Renderer, Scalars, TransferFunction,
+    ComponentTransfer, Context, Image, OutputPath, Piecewise, Renderer, Scalars, TransferFunction,
     UploadOptions, View, VolumeData,
 };
 use std::ffi::{c_char, c_void, CStr};
@@ -137,6 +137,40 @@ pub unsafe extern "C" fn fv_context_info(
         out.max_buffer_size = i.limits.max_buffer_size;
         Ok(())
     })
+}
+
+/// The Vulkan device and driver UUIDs of the context (16 bytes each), to compare with
+/// OpenGL's GL_DEVICE_UUID_EXT and GL_DRIVER_UUID_EXT before importing shared images.
+/// FV_STATUS_UNSUPPORTED where the device cannot tell (not Vulkan).
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_uuids(
+    ctx: *const FvContext,
+    device_uuid: *mut [u8; 16],
+    driver_uuid: *mut [u8; 16],
+) -> FvStatus {
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        let dev = mut_ref(device_uuid, "device_uuid")?;
+        let drv = mut_ref(driver_uuid, "driver_uuid")?;
+        let u = c.ctx.device_uuids()?;
+        *dev = u.device;
+        *drv = u.driver;
+        Ok(())
+    })
+}
+
+/// Whether renderers on this context can use FV_OUTPUT_PATH_SHARED (false with the reason
+/// in fv_last_error() when not).
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_can_share(ctx: *const FvContext) -> bool {
+    let mut can = false;
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        c.ctx.external_memory_support()?;
+        can = true;
+        Ok(())
+    });
+    can
 }
 
 // ---------------------------------------------------------------------------------------
@@ -650,6 +684,131 @@ pub unsafe extern "C" fn fv_renderer_render(
             Some(unsafe { std::slice::from_raw_parts(depth, depth_count) })
         };
         r.r.render(&r.view, &r.params, depth)?;
+        Ok(())
+    })
+}
+
+/// Chooses where frames go (an FvOutputPath). FV_OUTPUT_PATH_SHARED is refused with
+/// FV_STATUS_UNSUPPORTED and the reason (backend, missing Vulkan extension) where the
+/// device cannot export memory; the path is then unchanged.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_output_path(
+    renderer: *mut FvRenderer,
+    path: u32,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        let p = match path {
+            0 => OutputPath::Readback,
+            1 => OutputPath::Shared,
+            _ => {
+                return Err(FfiError::invalid(format!(
+                    "output path {path} is not an FvOutputPath (0 readback, 1 shared)"
+                )))
+            }
+        };
+        r.r.set_output_path(p)?;
+        Ok(())
+    })
+}
+
+/// The active output path (an FvOutputPath) into `*path`.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_output_path(
+    renderer: *const FvRenderer,
+    path: *mut u32,
+) -> FvStatus {
+    guard(|| {
+        let r = const_ref(renderer, "renderer")?;
+        *mut_ref(path, "path")? = match r.r.output_path() {
+            OutputPath::Readback => FvOutputPath::Readback as u32,
+            OutputPath::Shared => FvOutputPath::Shared as u32,
+        };
+        Ok(())
+    })
+}
+
+/// Allocates the frame images for `width × height` now (a render does it too), so a host
+/// can import the shared images, and fill the depth input, before the first frame.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_prepare_targets(
+    renderer: *mut FvRenderer,
+    width: u32,
+    height: u32,
+) -> FvStatus {
+    guard(|| {
+        mut_ref(renderer, "renderer")?
+            .r
+            .prepare_output(width, height)?;
+        Ok(())
+    })
+}
+
+/// Exports one image of the shared output path (an FvTarget) into `*image`, with a new file
+/// descriptor the caller owns. FV_STATUS_INVALID_ARGUMENT unless the path is
+/// FV_OUTPUT_PATH_SHARED and the images exist (after fv_renderer_prepare_targets or a
+/// render).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_shared_image(
+    renderer: *const FvRenderer,
+    target: u32,
+    image: *mut FvSharedImage,
+) -> FvStatus {
+    guard(|| {
+        let r = const_ref(renderer, "renderer")?;
+        let out = mut_ref(image, "image")?;
+        if target > FvTarget::DepthInput as u32 {
+            return Err(FfiError::invalid(format!(
+                "target {target} is not an FvTarget (0 colour, 1 depth, 2 depth input)"
+            )));
+        }
+        if r.r.output_path() != OutputPath::Shared {
+            return Err(FfiError::invalid(
+                "the output is not shared: call fv_renderer_set_output_path(renderer, FV_OUTPUT_PATH_SHARED) first, or read frames with fv_renderer_read_frame",
+            ));
+        }
+        let shared = r.r.shared_output()?;
+        let img = match target {
+            0 => shared.color,
+            1 => shared.depth,
+            _ => shared.depth_in,
+        };
+        *out = FvSharedImage {
+            fd: std::os::fd::IntoRawFd::into_raw_fd(img.fd),
+            size: img.size,
+            width: img.width,
+            height: img.height,
+            gl_internal_format: img.gl_internal_format,
+            dedicated: img.dedicated,
+            generation: shared.generation,
+        };
+        Ok(())
+    })
+}
+
+/// Renders like fv_renderer_render, with the opaque depth taken from the shared
+/// FV_TARGET_DEPTH_INPUT image the host wrote (it must glFinish before this call).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_render_with_shared_depth(
+    renderer: *mut FvRenderer,
+    width: u32,
+    height: u32,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        r.view.width = width;
+        r.view.height = height;
+        r.r.render_with_shared_depth(&r.view, &r.params)?;
+        Ok(())
+    })
+}
+
+/// Waits until the last frame is finished on the GPU: after it, the host may sample the
+/// shared images. This CPU wait is the synchronisation of the shared path (no semaphores).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_finish(renderer: *const FvRenderer) -> FvStatus {
+    guard(|| {
+        const_ref(renderer, "renderer")?.r.finish()?;
         Ok(())
     })
 }

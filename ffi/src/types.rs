@@ -9,6 +9,52 @@ use ferrovol_core::{
 };
 use glam::{DMat4, DVec3};
 
+/// Where a renderer's frames go (fv_renderer_set_output_path).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvOutputPath {
+    /// Frames stay in GPU memory private to ferrovol; read them with fv_renderer_read_frame.
+    Readback = 0,
+    /// Frames are drawn into memory exported to the host's graphics API (zero copy).
+    Shared = 1,
+}
+
+/// The images of the shared output path (fv_renderer_shared_image).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvTarget {
+    /// Premultiplied RGBA8 colour (GL_RGBA8).
+    Color = 0,
+    /// Window depth of the volume, 1 where transparent (GL_R32F).
+    Depth = 1,
+    /// Window depth of the host's opaque geometry, written by the host (GL_R32F), read by
+    /// fv_renderer_render_with_shared_depth.
+    DepthInput = 2,
+}
+
+/// One exported image, for glCreateMemoryObjectsEXT + glImportMemoryFdEXT(size,
+/// GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd) + glTexStorageMem2DEXT(GL_TEXTURE_2D, 1,
+/// gl_internal_format, width, height, memory, 0) with GL_TEXTURE_TILING_EXT =
+/// GL_OPTIMAL_TILING_EXT and GL_DEDICATED_MEMORY_OBJECT_EXT = GL_TRUE when `dedicated`.
+/// Rows are top to bottom (row 0 is the top of the frame). Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvSharedImage {
+    /// A new file descriptor owned by the caller: glImportMemoryFdEXT takes it over on
+    /// success; otherwise close() it.
+    pub fd: i32,
+    /// Allocation size in bytes (pass it to glImportMemoryFdEXT).
+    pub size: u64,
+    pub width: u32,
+    pub height: u32,
+    /// GL_RGBA8 (0x8058) or GL_R32F (0x822E).
+    pub gl_internal_format: u32,
+    pub dedicated: bool,
+    /// Changes whenever the images are reallocated (new size, path switched): the host
+    /// then deletes its imported textures and memory objects and imports again.
+    pub generation: u64,
+}
+
 /// Scalar types of volume data (VTK's VTK_UNSIGNED_CHAR … VTK_DOUBLE). 64-bit integers
 /// are converted to double on upload (exact up to 2^53).
 #[repr(C)]

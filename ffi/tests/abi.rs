@@ -432,6 +432,38 @@ fn renderer_errors() {
         );
         assert_eq!(set_lights(r, null(), 0), FvStatus::Ok);
 
+        let set_path =
+            lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_output_path");
+        lib.expect(
+            "output path 5",
+            set_path(r, 5),
+            FvStatus::InvalidArgument,
+            "output path 5",
+        );
+        let shared = lib
+            .f::<unsafe extern "C" fn(H, u32, *mut ferrovol::FvSharedImage) -> FvStatus>(
+                "fv_renderer_shared_image",
+            );
+        let mut img: ferrovol::FvSharedImage = std::mem::zeroed();
+        lib.expect(
+            "shared image while reading back",
+            shared(r, 0, &mut img),
+            FvStatus::InvalidArgument,
+            "shared",
+        );
+        lib.expect(
+            "target 9",
+            shared(r, 9, &mut img),
+            FvStatus::InvalidArgument,
+            "target 9",
+        );
+        lib.expect(
+            "NULL image",
+            shared(r, 0, null_mut()),
+            FvStatus::NullArgument,
+            "image is NULL",
+        );
+
         // A valid frame still renders after all those refusals.
         p.shade = true;
         assert_eq!(set_params(r, &p), FvStatus::Ok);
