@@ -835,9 +835,12 @@ impl Renderer {
                     color_attachments: &[clear_attachment(&cv, 0.0), clear_attachment(&dv, 0.0)],
                     ..Default::default()
                 });
+                // The depth input starts at the far plane: nothing occludes until the host
+                // writes its depth.
+                let far: Vec<f32> = vec![1.0; width as usize * height as usize];
                 ctx.queue.write_texture(
                     depth_in.as_image_copy(),
-                    &vec![0u8; 4 * width as usize * height as usize],
+                    bytemuck::cast_slice(&far),
                     wgpu::TexelCopyBufferLayout {
                         offset: 0,
                         bytes_per_row: Some(4 * width),
@@ -846,6 +849,9 @@ impl Renderer {
                     depth_in.size(),
                 );
                 ctx.queue.submit([enc.finish()]);
+                // Wait: the host may write the depth input through its own API right after
+                // this returns, and a clear landing later would wipe it.
+                ctx.wait_idle()?;
             }
             Ok(Targets {
                 width,
