@@ -5,7 +5,13 @@
 set -euo pipefail
 PKGS=(mesa-vulkan-drivers libvulkan1 xvfb xauth cmake ninja-build pkg-config
       paraview paraview-dev python3-paraview python3-numpy zlib1g-dev
-      g++ libegl-dev libgl-dev)
+      g++ libegl-dev libgl-dev
+      libopenmpi-dev libglew-dev)
+# libopenmpi-dev, libglew-dev: ParaView's VTK CMake package needs MPI's and GLEW's headers
+# to build a VTK module against it (vtk_plugin/, paraview/).
+PKGS+=(libdouble-conversion-dev)
+# libdouble-conversion-dev: find_package(ParaView COMPONENTS RemotingViews ...) (paraview/)
+# pulls in VTK::IOCore, whose CMake package requires double-conversion's headers.
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,249 @@
+"""Shared pieces of the vtkFerroVolumeMapper tests: scenes, image capture, SSIM/PSNR and
+the images written for people to look at (FERROVOL_TEST_OUTPUT, default
+build/vtk/test-images).
+
+Run the suites with Debian's /usr/bin/python3 (VTK 9.2), after `. build/env.sh`, with an X
+display:  scripts/with-xvfb.sh /usr/bin/python3 -m unittest -v test_vtk_reference
+"""
+import os
+import sys
+
+import numpy as np
+import vtk
+from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+
+import ferrovol
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+OUTPUT = os.environ.get("FERROVOL_TEST_OUTPUT", os.path.join(ROOT, "build", "vtk", "test-images"))
+DATA = os.environ.get("FERROVOL_DATA_DIR", os.path.join(ROOT, "build", "data"))
+os.makedirs(OUTPUT, exist_ok=True)
+
+# VTK's TestGPURayCastMapperBenchmark transfer function for the wavelet.
+WAVELET_COLOR = [(37.3531, 0.2, 0.29, 1.0), (157.091, 0.87, 0.87, 0.87),
+                 (276.829, 0.7, 0.015, 0.15)]
+WAVELET_OPACITY = [(37.3531, 0.0), (276.829, 1.0)]
+
+
+def log(*args):
+    print(*args, file=sys.stderr, flush=True)
+
+
+def wavelet(n=31, maximum=None):
+    """vtkRTAnalyticSource with WholeExtent -n..n+1 per axis (float32 point scalars 'RTData')."""
+    src = vtk.vtkRTAnalyticSource()
+    src.SetWholeExtent(-n, n + 1, -n, n + 1, -n, n + 1)
+    if maximum is not None:
+        src.SetMaximum(maximum)
+    src.Update()
+    return src
+
+
+def image_from_array(arr, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), name="scalars",
+                     cells=False, vtk_type=None):
+    """vtkImageData from a numpy array indexed [z, y, x] or [z, y, x, component]."""
+    a = np.asarray(arr)
+    comps = a.shape[3] if a.ndim == 4 else 1
+    nz, ny, nx = a.shape[:3]
+    img = vtk.vtkImageData()
+    img.SetDimensions(nx + 1, ny + 1, nz + 1) if cells else img.SetDimensions(nx, ny, nz)
+    img.SetSpacing(*spacing)
+    img.SetOrigin(*origin)
+    flat = np.ascontiguousarray(a.reshape(-1, comps) if comps > 1 else a.reshape(-1))
+    data = numpy_to_vtk(flat, deep=True, array_type=vtk_type)
+    data.SetName(name)
+    if cells:
+        img.GetCellData().SetScalars(data)
+    else:
+        img.GetPointData().SetScalars(data)
+    return img
+
+
+def tf_property(color=WAVELET_COLOR, opacity=WAVELET_OPACITY, interpolation="nearest"):
+    ctf = vtk.vtkColorTransferFunction()
+    for x, r, g, b in color:
+        ctf.AddRGBPoint(x, r, g, b)
+    otf = vtk.vtkPiecewiseFunction()
+    for x, a in opacity:
+        otf.AddPoint(x, a)
+    prop = vtk.vtkVolumeProperty()
+    prop.SetColor(ctf)
+    prop.SetScalarOpacity(otf)
+    if interpolation == "linear":
+        prop.SetInterpolationTypeToLinear()
+    return prop
+
+
+_DISPLAY_OWNER = []
+
+
+def new_window():
+    """An offscreen vtkRenderWindow. All test windows share one X display connection: on
+    these machines Xvfb resets a new connection now and then (~2% of XOpenDisplay calls under
+    load), and VTK aborts when that happens, so a process opens only one."""
+    if not _DISPLAY_OWNER:
+        owner = vtk.vtkRenderWindow()
+        owner.SetOffScreenRendering(1)
+        owner.SetSize(4, 4)
+        owner.Render()
+        _DISPLAY_OWNER.append(owner)
+    w = vtk.vtkRenderWindow()
+    w.SetDisplayId(_DISPLAY_OWNER[0].GetGenericDisplayId())
+    w.SetOffScreenRendering(1)
+    return w
+
+
+class Errors:
+    """Collects the ErrorEvents (and WarningEvents) of a VTK object."""
+
+    def __init__(self, obj):
+        self.messages = []
+        self.warnings = []
+
+        @vtk.calldata_type(vtk.VTK_STRING)
+        def on_error(_obj, _event, message):
+            self.messages.append(message)
+
+        @vtk.calldata_type(vtk.VTK_STRING)
+        def on_warning(_obj, _event, message):
+            self.warnings.append(message)
+
+        self._cb = (on_error, on_warning)
+        obj.AddObserver("ErrorEvent", on_error)
+        obj.AddObserver("WarningEvent", on_warning)
+
+    def last(self):
+        return self.messages[-1] if self.messages else ""
+
+
+class Scene:
+    """A renderer and an offscreen window holding one volume (and optional actors)."""
+
+    def __init__(self, mapper, data, prop, size=(160, 160), background=(0.0, 0.0, 0.0),
+                 camera=None, actors=()):
+        self.mapper = mapper
+        path = os.environ.get("FERROVOL_OUTPUT_PATH")  # readback / shared: force one path
+        if path and mapper.IsA("vtkFerroVolumeMapper"):
+            getattr(mapper, "SetOutputPathTo" + path.capitalize())()
+        if data is not None:
+            if isinstance(data, vtk.vtkAlgorithm):
+                mapper.SetInputConnection(data.GetOutputPort())
+            else:
+                mapper.SetInputData(data)
+        self.volume = vtk.vtkVolume()
+        self.volume.SetMapper(mapper)
+        self.volume.SetProperty(prop)
+        self.renderer = vtk.vtkRenderer()
+        self.renderer.SetBackground(*background)
+        self.renderer.AddVolume(self.volume)
+        for a in actors:
+            self.renderer.AddActor(a)
+        self.window = new_window()
+        self.window.SetSize(*size)
+        self.window.AddRenderer(self.renderer)
+        self.renderer.ResetCamera()
+        if camera:
+            camera(self.renderer.GetActiveCamera())
+            self.renderer.ResetCameraClippingRange()
+
+    def render(self):
+        """Renders once and returns the window as float RGB, rows top to bottom."""
+        self.window.Render()
+        return grab(self.window, rerender=False)
+
+
+def grab(window, rerender=False):
+    w2i = vtk.vtkWindowToImageFilter()
+    w2i.SetInput(window)
+    w2i.ReadFrontBufferOff()
+    if not rerender:
+        w2i.ShouldRerenderOff()
+    w2i.Update()
+    img = w2i.GetOutput()
+    nx, ny, _ = img.GetDimensions()
+    a = vtk_to_numpy(img.GetPointData().GetScalars()).reshape(ny, nx, -1)[::-1, :, :3]
+    return a.astype(np.float64)
+
+
+def render_pair(data, prop_factory, size=(160, 160), camera=None, configure=None,
+                actors_factory=None, background=(0.0, 0.0, 0.0)):
+    """The same scene rendered by vtkFerroVolumeMapper and vtkGPUVolumeRayCastMapper."""
+    images = []
+    mappers = []
+    for mapper in (ferrovol.vtkFerroVolumeMapper(), vtk.vtkGPUVolumeRayCastMapper()):
+        if configure:
+            configure(mapper)
+        actors = actors_factory() if actors_factory else ()
+        scene = Scene(mapper, data, prop_factory(), size=size, camera=camera, actors=actors,
+                      background=background)
+        images.append(scene.render())
+        mappers.append(mapper)
+    return images[0], images[1], mappers[0]
+
+
+# ---------------------------------------------------------------------------------------
+# Image comparison
+
+def _gauss_blur(x, sigma=1.5, radius=5):
+    k = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
+    k /= k.sum()
+    p = np.pad(x, radius, mode="reflect")
+    h, w = x.shape
+    rows = sum(k[i] * p[:, i:i + w] for i in range(2 * radius + 1))
+    return sum(k[i] * rows[i:i + h, :] for i in range(2 * radius + 1))
+
+
+def luminance(img):
+    return img[..., 0] * 0.299 + img[..., 1] * 0.587 + img[..., 2] * 0.114
+
+
+def ssim(a, b):
+    """Mean SSIM (Wang et al. 2004: 11x11 Gaussian window, sigma 1.5) of the luminance of two
+    8-bit RGB images."""
+    x, y = luminance(a), luminance(b)
+    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
+    mx, my = _gauss_blur(x), _gauss_blur(y)
+    sxx = _gauss_blur(x * x) - mx * mx
+    syy = _gauss_blur(y * y) - my * my
+    sxy = _gauss_blur(x * y) - mx * my
+    s = ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
+    return float(s.mean())
+
+
+def psnr(a, b):
+    mse = float(np.mean((a - b) ** 2))
+    return float("inf") if mse == 0 else 10.0 * np.log10(255.0 ** 2 / mse)
+
+
+def coverage(img, background=(0.0, 0.0, 0.0), tol=8.0):
+    """Fraction of pixels that differ from the background colour."""
+    bg = np.array(background) * 255.0
+    return float((np.abs(img - bg).max(axis=2) > tol).mean())
+
+
+def save(name, *images):
+    """Writes the images side by side (and their difference, when two) as a PNG."""
+    imgs = list(images)
+    if len(imgs) == 2:
+        imgs.append(np.clip(np.abs(imgs[0] - imgs[1]) * 4.0, 0, 255))
+    row = np.concatenate(imgs, axis=1)
+    row = np.ascontiguousarray(row[::-1]).astype(np.uint8)
+    img = vtk.vtkImageData()
+    img.SetDimensions(row.shape[1], row.shape[0], 1)
+    img.GetPointData().SetScalars(numpy_to_vtk(row.reshape(-1, 3), deep=True))
+    w = vtk.vtkPNGWriter()
+    path = os.path.join(OUTPUT, name + ".png")
+    w.SetFileName(path)
+    w.SetInputData(img)
+    w.Write()
+    return path
+
+
+def compare(name, ours, theirs):
+    """SSIM and PSNR of ferrovol's image against VTK's; prints them and saves the images."""
+    s, p = ssim(ours, theirs), psnr(ours, theirs)
+    path = save(name, ours, theirs)
+    log("  %-28s SSIM %.4f  PSNR %5.1f dB  (%s: ferrovol | VTK | 4x difference)"
+        % (name, s, p, os.path.basename(path)))
+    return s, p

@@ -1,0 +1,148 @@
+"""The two ways frames reach OpenGL give the same pixels: shared memory (zero copy, Vulkan
+memory imported with GL_EXT_memory_object_fd) and CPU readback. Also with opaque geometry
+(depth in), a reduced image sample distance, window resizes (images re-imported), several
+viewports, and single-sampled windows (no multisample resolve of the depth)."""
+import unittest
+
+import numpy as np
+import vtk
+
+import ferrovol
+import fvtest
+from fvtest import Errors, Scene, save, tf_property, wavelet
+
+
+def view(cam):
+    cam.Azimuth(30.0)
+    cam.Elevation(20.0)
+    cam.OrthogonalizeViewUp()
+
+
+def sphere():
+    s = vtk.vtkSphereSource()
+    s.SetCenter(8, -8, 18)
+    s.SetRadius(9)
+    s.SetThetaResolution(32)
+    s.SetPhiResolution(32)
+    m = vtk.vtkPolyDataMapper()
+    m.SetInputConnection(s.GetOutputPort())
+    a = vtk.vtkActor()
+    a.SetMapper(m)
+    a.GetProperty().SetColor(0.9, 0.8, 0.2)
+    return a
+
+
+def shared_available():
+    m = ferrovol.vtkFerroVolumeMapper()
+    m.SetOutputPathToShared()
+    scene = Scene(m, wavelet(4), tf_property(), size=(16, 16))
+    scene.render()
+    return m.GetOutputPathName() == "shared", m.GetOutputPathReason()
+
+
+SHARED, WHY = shared_available()
+
+
+@unittest.skipUnless(SHARED, "no shared output path here: " + WHY)
+class OutputPaths(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.src = wavelet(23)
+        fvtest.log("  shared output: " + WHY)
+
+    def both(self, name, configure=None, size=(140, 120), multisamples=None, resize=None,
+             actors=True):
+        images = {}
+        for path in ("Readback", "Shared"):
+            m = ferrovol.vtkFerroVolumeMapper()
+            getattr(m, "SetOutputPathTo" + path)()
+            errors = Errors(m)
+            if configure:
+                configure(m)
+            scene = Scene(m, self.src, tf_property(), size=size, camera=view,
+                          actors=[sphere()] if actors else ())
+            if multisamples is not None:
+                scene.window.SetMultiSamples(multisamples)
+            scene.renderer.ResetCameraClippingRange()
+            img = scene.render()
+            if resize:
+                scene.window.SetSize(*resize)
+                img = scene.render()
+            self.assertEqual(m.GetOutputPathName(), path.lower())
+            self.assertEqual(errors.messages, [])
+            self.assertEqual(errors.warnings, [])
+            images[path] = img
+        d = np.abs(images["Readback"] - images["Shared"])
+        save("paths-" + name, images["Readback"], images["Shared"])
+        fvtest.log("  %-28s readback vs shared: max |diff| %.0f, %d px differ"
+                   % (name, d.max(), int((d.max(axis=2) > 0).sum())))
+        self.assertLessEqual(d.max(), 1.0)
+        return images
+
+    def test_plain(self):
+        self.both("plain", actors=False)
+
+    def test_opaque_geometry(self):
+        self.both("sphere")
+
+    def test_single_sampled_window(self):
+        self.both("sphere-no-msaa", multisamples=0)
+
+    def test_image_sample_distance(self):
+        for isd in (2.0, 3.0):
+            def configure(m, isd=isd):
+                m.AutoAdjustSampleDistancesOff()
+                m.SetImageSampleDistance(isd)
+            self.both("sphere-isd-%g" % isd, configure)
+
+    def test_resize(self):
+        self.both("sphere-resized", resize=(90, 160))
+
+    def test_viewports(self):
+        images = {}
+        for path in ("Readback", "Shared"):
+            win = fvtest.new_window()
+            win.SetSize(200, 100)
+            keep = []
+            for x0 in (0.0, 0.5):
+                m = ferrovol.vtkFerroVolumeMapper()
+                getattr(m, "SetOutputPathTo" + path)()
+                m.SetInputConnection(self.src.GetOutputPort())
+                vol = vtk.vtkVolume()
+                vol.SetMapper(m)
+                vol.SetProperty(tf_property())
+                ren = vtk.vtkRenderer()
+                ren.SetViewport(x0, 0, x0 + 0.5, 1)
+                ren.AddVolume(vol)
+                ren.AddActor(sphere())
+                win.AddRenderer(ren)
+                ren.ResetCamera()
+                view(ren.GetActiveCamera())
+                ren.GetActiveCamera().Azimuth(90 * x0)
+                ren.ResetCameraClippingRange()
+                keep.append((m, vol, ren))
+            win.Render()
+            images[path] = fvtest.grab(win)
+            self.assertEqual(keep[1][0].GetOutputPathName(), path.lower())
+        d = np.abs(images["Readback"] - images["Shared"])
+        save("paths-viewports", images["Readback"], images["Shared"])
+        fvtest.log("  %-28s readback vs shared: max |diff| %.0f" % ("two viewports", d.max()))
+        self.assertLessEqual(d.max(), 1.0)
+
+    def test_switching_paths(self):
+        m = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(m, self.src, tf_property(), size=(80, 80), camera=view)
+        names = []
+        for path in ("Shared", "Readback", "Automatic", "Shared"):
+            getattr(m, "SetOutputPathTo" + path)()
+            scene.render()
+            names.append(m.GetOutputPathName())
+        fvtest.log("  switching: %s; automatic chose %s (%s)"
+                   % (names, names[2], m.GetOutputPathReason()))
+        self.assertEqual(names[:2], ["shared", "readback"])
+        self.assertEqual(names[3], "shared")
+        self.assertEqual(m.GetVolumeUploadCount(), 1)  # the path is not the volume
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

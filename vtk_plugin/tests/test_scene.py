@@ -1,0 +1,343 @@
+"""vtkFerroVolumeMapper inside VTK scenes: opaque geometry, vtkWindowToImageFilter, several
+viewports, window resizes, camera inside the volume, upload counters, releasing graphics
+resources. Images go to build/vtk/test-images (scene-*.png)."""
+import unittest
+
+import numpy as np
+import vtk
+
+import ferrovol
+import fvtest
+from fvtest import Errors, Scene, coverage, grab, save, ssim, tf_property, wavelet
+
+
+def view(cam):
+    cam.Azimuth(30.0)
+    cam.Elevation(20.0)
+    cam.OrthogonalizeViewUp()
+
+
+def sphere_actor(center, radius, color=(0.1, 1.0, 0.1)):
+    s = vtk.vtkSphereSource()
+    s.SetCenter(*center)
+    s.SetRadius(radius)
+    s.SetThetaResolution(32)
+    s.SetPhiResolution(32)
+    m = vtk.vtkPolyDataMapper()
+    m.SetInputConnection(s.GetOutputPort())
+    a = vtk.vtkActor()
+    a.SetMapper(m)
+    a.GetProperty().SetColor(*color)
+    a.GetProperty().SetAmbient(1.0)
+    a.GetProperty().SetDiffuse(0.0)
+    a.GetProperty().SetSpecular(0.0)
+    return a
+
+
+class SceneTests(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.src = wavelet(23)
+
+    def opaque_property(self):
+        # nearly opaque: nothing behind the volume's front shows
+        return tf_property(opacity=[(37.3531, 0.0), (120.0, 1.0)])
+
+    def test_sphere_in_front_and_behind(self):
+        results = {}
+        for where, z in (("front", 40.0), ("behind", -40.0)):
+            mapper = ferrovol.vtkFerroVolumeMapper()
+
+            def camera(cam):
+                cam.SetPosition(0, 0, 150)
+                cam.SetFocalPoint(0, 0, 0)
+                cam.SetViewUp(0, 1, 0)
+            scene = Scene(mapper, self.src, self.opaque_property(), size=(120, 120),
+                          camera=camera, actors=[sphere_actor((0, 0, z), 6.0)])
+            scene.renderer.ResetCameraClippingRange()
+            results[where] = scene.render()
+        save("scene-sphere-front-behind", results["front"], results["behind"])
+        front = results["front"][60, 60]
+        behind = results["behind"][60, 60]
+        fvtest.log("  sphere: centre pixel in front %s, behind %s" % (front, behind))
+        self.assertTrue(front[1] > 240 and front[0] < 40 and front[2] < 40, front)
+        self.assertFalse(behind[1] > 200 and behind[0] < 60, behind)
+        # the sphere's silhouette in front: a green disc of radius ~6 world units
+        green = (results["front"][..., 1] > 200) & (results["front"][..., 0] < 60)
+        self.assertGreater(green.sum(), 100)
+        self.assertEqual(((results["behind"][..., 1] > 200) &
+                          (results["behind"][..., 0] < 60)).sum(), 0)
+
+    def test_sphere_cutting_the_volume(self):
+        # a sphere half inside a translucent volume: where it is, rays stop at it (the volume
+        # in front of it still tints it); elsewhere the image is unchanged
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(mapper, self.src, tf_property(), size=(140, 140), camera=view)
+        without = scene.render()
+        scene.renderer.AddActor(sphere_actor((24, 0, 0), 10.0))
+        scene.renderer.ResetCameraClippingRange()
+        with_sphere = scene.render()
+        save("scene-sphere-cutting", with_sphere, without)
+        changed = np.abs(with_sphere - without).max(axis=2) > 3
+        green = (with_sphere[..., 1] > 200) & (with_sphere[..., 0] < 60)
+        fvtest.log("  sphere cutting the volume: %d px changed, %d px plain sphere green"
+                   % (changed.sum(), green.sum()))
+        self.assertGreater(green.sum(), 50)
+        # every changed pixel lies within the sphere's silhouette (a disc round its
+        # projection), not over the rest of the volume
+        ys, xs = np.nonzero(changed)
+        gy, gx = np.nonzero(green)
+        cy, cx = gy.mean(), gx.mean()
+        self.assertLess(np.sqrt((ys - cy) ** 2 + (xs - cx) ** 2).max(), 30)
+
+    def test_volume_writes_depth(self):
+        # the composited volume leaves its depth (first visible sample) in VTK's depth
+        # buffer, so passes after it composite against it
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(mapper, self.src, self.opaque_property(), size=(100, 100), camera=view)
+        scene.renderer.GetActiveCamera().SetClippingRange(50.0, 300.0)
+        scene.render()
+        self.assertEqual(scene.window.GetZbufferDataAtPoint(1, 1), 1.0)  # nothing there
+        # where the volume is, its depth unprojects onto the face of its box it enters by
+        bounds = self.src.GetOutput().GetBounds()
+        worst = 0.0
+        for x, y in ((50, 50), (40, 60), (60, 45), (45, 35)):
+            d = scene.window.GetZbufferDataAtPoint(x, y)
+            self.assertLess(d, 1.0)
+            scene.renderer.SetDisplayPoint(x + 0.5, y + 0.5, d)  # pixel centres
+            scene.renderer.DisplayToWorld()
+            w = scene.renderer.GetWorldPoint()
+            p = [w[i] / w[3] for i in range(3)]
+            off = min(abs(p[i] - bounds[2 * i + k]) for i in range(3) for k in range(2))
+            worst = max(worst, off)
+        fvtest.log("  depth written by the volume: unprojected points lie %.4f world units "
+                   "from the box's faces at most" % worst)
+        self.assertLess(worst, 0.05)
+
+    def test_window_to_image_filter(self):
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(mapper, self.src, tf_property(), size=(100, 80), camera=view)
+        # the filter renders the window itself (ShouldRerender on, its default)
+        img = grab(scene.window, rerender=True)
+        self.assertEqual(img.shape, (80, 100, 3))
+        self.assertTrue(mapper.GetLastRenderDrew())
+        self.assertGreater(coverage(img), 0.2)
+        again = grab(scene.window, rerender=True)
+        self.assertLessEqual(np.abs(img - again).max(), 1.0)
+        # and after an explicit Render without re-rendering
+        self.assertLessEqual(np.abs(scene.render() - img).max(), 1.0)
+        # magnification (tiles): a 2x capture renders 4 tiles
+        w2i = vtk.vtkWindowToImageFilter()
+        w2i.SetInput(scene.window)
+        w2i.SetScale(2)
+        w2i.ReadFrontBufferOff()
+        w2i.Update()
+        nx, ny, _ = w2i.GetOutput().GetDimensions()
+        from vtk.util.numpy_support import vtk_to_numpy
+        big = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars()).reshape(ny, nx, -1)
+        big = big[::-1, :, :3].astype(np.float64)
+        small = big.reshape(80, 2, 100, 2, 3).mean(axis=(1, 3))
+        s = ssim(small, img)
+        save("scene-window-to-image-tiles", img, small)
+        fvtest.log("  vtkWindowToImageFilter scale 2 (tiled), downsampled vs 1x: SSIM %.3f" % s)
+        self.assertEqual((nx, ny), (200, 160))
+        self.assertGreater(s, 0.9)
+
+    def test_two_viewports(self):
+        win = fvtest.new_window()
+        win.SetSize(240, 120)
+        mappers = []
+        for i, (x0, x1) in enumerate(((0.0, 0.5), (0.5, 1.0))):
+            mapper = ferrovol.vtkFerroVolumeMapper()
+            mapper.SetInputConnection(self.src.GetOutputPort())
+            if i == 1:
+                mapper.SetBlendModeToMaximumIntensity()
+            vol = vtk.vtkVolume()
+            vol.SetMapper(mapper)
+            vol.SetProperty(tf_property())
+            ren = vtk.vtkRenderer()
+            ren.SetViewport(x0, 0.0, x1, 1.0)
+            ren.SetBackground(0.0, 0.0, 0.2 * i)
+            ren.AddVolume(vol)
+            win.AddRenderer(ren)
+            ren.ResetCamera()
+            view(ren.GetActiveCamera())
+            mappers.append((mapper, vol, ren))
+        win.Render()
+        both = grab(win)
+        singles = []
+        for i, blend in enumerate(("Composite", "MaximumIntensity")):
+            m = ferrovol.vtkFerroVolumeMapper()
+            getattr(m, "SetBlendModeTo" + blend)()
+            singles.append(Scene(m, self.src, tf_property(), size=(120, 120), camera=view,
+                                 background=(0.0, 0.0, 0.2 * i)).render())
+        save("scene-two-viewports", both, np.concatenate(singles, axis=1))
+        for i in range(2):
+            half = both[:, 120 * i:120 * (i + 1)]
+            s = ssim(half, singles[i])
+            fvtest.log("  viewport %d vs the same scene in its own window: SSIM %.4f, "
+                       "max |diff| %.0f" % (i, s, np.abs(half - singles[i]).max()))
+            self.assertGreater(s, 0.995)
+            self.assertEqual(tuple(mappers[i][0].GetLastRenderSize()), (120, 120))
+
+    def test_one_mapper_in_two_renderers(self):
+        # the same vtkVolume in two viewports with different cameras
+        win = fvtest.new_window()
+        win.SetSize(200, 100)
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        mapper.SetInputConnection(self.src.GetOutputPort())
+        vol = vtk.vtkVolume()
+        vol.SetMapper(mapper)
+        vol.SetProperty(tf_property())
+        for i, x0 in enumerate((0.0, 0.5)):
+            ren = vtk.vtkRenderer()
+            ren.SetViewport(x0, 0, x0 + 0.5, 1)
+            ren.AddVolume(vol)
+            win.AddRenderer(ren)
+            ren.ResetCamera()
+            ren.GetActiveCamera().Azimuth(60 * i)
+        win.Render()
+        img = grab(win)
+        self.assertGreater(coverage(img[:, :100]), 0.2)
+        self.assertGreater(coverage(img[:, 100:]), 0.2)
+        self.assertGreater(np.abs(img[:, :100] - img[:, 100:]).mean(), 2.0)
+        self.assertEqual(mapper.GetVolumeUploadCount(), 1)
+
+    def test_window_resize(self):
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(mapper, self.src, tf_property(), size=(120, 120), camera=view)
+        a = scene.render()
+        scene.window.SetSize(200, 100)
+        b = scene.render()
+        scene.window.SetSize(90, 150)
+        c = scene.render()
+        self.assertEqual(b.shape, (100, 200, 3))
+        self.assertEqual(tuple(mapper.GetLastRenderSize()), (90, 150))
+        for img in (a, b, c):
+            self.assertGreater(coverage(img), 0.1)
+        # the aspect ratio follows the window, as VTK's own mapper's does
+        ref = Scene(vtk.vtkGPUVolumeRayCastMapper(), self.src, tf_property(), size=(120, 120),
+                    camera=view)
+        ref.render()
+        ref.window.SetSize(200, 100)
+        vb = ref.render()
+        save("scene-resize-200x100", b, vb)
+        s = ssim(b, vb)
+        fvtest.log("  resized to 200x100: SSIM to vtkGPUVolumeRayCastMapper %.3f" % s)
+        self.assertGreater(s, 0.95)
+        self.assertEqual((mapper.GetVolumeUploadCount(), mapper.GetTableUploadCount()), (1, 1))
+
+    def test_upload_counters(self):
+        src = wavelet(15)
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        prop = tf_property()
+        scene = Scene(mapper, src, prop, size=(80, 80), camera=view)
+        self.assertEqual(mapper.GetVolumeUploadCount(), -1)
+        scene.render()
+        counts = [(mapper.GetVolumeUploadCount(), mapper.GetTableUploadCount())]
+        cam = scene.renderer.GetActiveCamera()
+        for _ in range(3):
+            cam.Azimuth(25)
+            cam.Elevation(5)
+            cam.OrthogonalizeViewUp()
+            cam.Zoom(1.05)
+            scene.render()
+        scene.volume.SetPosition(3, 0, 0)  # the volume matrix is a per-frame parameter too
+        mapper.SetBlendModeToMaximumIntensity()
+        mapper.SetBlendModeToComposite()
+        scene.render()
+        counts.append((mapper.GetVolumeUploadCount(), mapper.GetTableUploadCount()))
+        prop.GetScalarOpacity().AddPoint(200.0, 0.3)  # a function of the property
+        scene.render()
+        counts.append((mapper.GetVolumeUploadCount(), mapper.GetTableUploadCount()))
+        prop.ShadeOn()  # a property change that needs no new tables still re-samples them
+        scene.render()
+        counts.append((mapper.GetVolumeUploadCount(), mapper.GetTableUploadCount()))
+        src.SetMaximum(200.0)  # the input changes
+        scene.render()
+        counts.append((mapper.GetVolumeUploadCount(), mapper.GetTableUploadCount()))
+        frames = mapper.GetFrameCount()
+        fvtest.log("  uploads (volume, tables): first frame %s, after camera/matrix/blend "
+                   "changes %s, opacity point %s, shading %s, new input %s; %d frames"
+                   % (tuple(counts[0]), counts[1], counts[2], counts[3], counts[4], frames))
+        self.assertEqual(counts[0], (1, 1))
+        self.assertEqual(counts[1], (1, 1))
+        self.assertEqual(counts[2], (1, 2))
+        self.assertEqual(counts[3][0], 1)
+        self.assertEqual(counts[4][0], 2)
+        self.assertEqual(frames, 8)
+
+    def test_camera_inside_volume(self):
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        errors = Errors(mapper)
+
+        def inside(cam):
+            cam.SetPosition(0, 0, 5)
+            cam.SetFocalPoint(0, 0, -10)
+            cam.SetViewUp(0, 1, 0)
+            cam.SetClippingRange(0.1, 100)
+        scene = Scene(mapper, self.src, tf_property(opacity=[(37.35, 0), (276.8, 0.3)]),
+                      size=(100, 100), camera=inside)
+        img = scene.render()
+        vtk_img = Scene(vtk.vtkGPUVolumeRayCastMapper(), self.src,
+                        tf_property(opacity=[(37.35, 0), (276.8, 0.3)]), size=(100, 100),
+                        camera=inside).render()
+        s = ssim(img, vtk_img)
+        save("scene-camera-inside", img, vtk_img)
+        fvtest.log("  camera inside the volume: coverage %.2f, SSIM to VTK %.3f"
+                   % (coverage(img), s))
+        self.assertEqual(errors.messages, [])
+        self.assertGreater(coverage(img), 0.95)  # the whole view is inside the volume
+        self.assertGreater(s, 0.9)
+
+    def test_background_and_translucency(self):
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(mapper, self.src, tf_property(opacity=[(37.35, 0), (276.8, 0.1)]),
+                      size=(100, 100), camera=view, background=(0.2, 0.4, 0.6))
+        img = scene.render()
+        corner = img[2, 2]
+        self.assertTrue(np.allclose(corner, [51, 102, 153], atol=1), corner)
+        # a translucent volume lets the background through: not the plain TF colour
+        centre = img[50, 50]
+        self.assertGreater(centre[2], 60)
+
+    def test_release_graphics_resources(self):
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        scene = Scene(mapper, self.src, tf_property(), size=(80, 80), camera=view)
+        a = scene.render()
+        self.assertIn(mapper.GetOutputPathName(), ("shared", "readback"))
+        mapper.ReleaseGraphicsResources(scene.window)
+        self.assertEqual(mapper.GetVolumeUploadCount(), -1)
+        self.assertEqual(mapper.GetOutputPathName(), "none")
+        b = scene.render()
+        self.assertEqual(mapper.GetVolumeUploadCount(), 1)
+        self.assertLessEqual(np.abs(a - b).max(), 0.0)
+        # removing the volume from the renderer releases nothing but stops drawing
+        scene.renderer.RemoveVolume(scene.volume)
+        c = scene.render()
+        self.assertEqual(coverage(c), 0.0)
+        # the window going away (Finalize) with the mapper alive, then a new window
+        scene.window.Finalize()
+        scene2 = Scene(mapper, self.src, tf_property(), size=(80, 80), camera=view)
+        d = scene2.render()
+        self.assertLessEqual(np.abs(a - d).max(), 0.0)
+
+    def test_print_self_and_defaults(self):
+        m = ferrovol.vtkFerroVolumeMapper()
+        self.assertTrue(m.IsA("vtkVolumeMapper"))
+        self.assertEqual(m.GetAutoAdjustSampleDistances(), 1)
+        self.assertEqual(m.GetSampleDistance(), 1.0)
+        self.assertEqual(m.GetImageSampleDistance(), 1.0)
+        self.assertEqual(m.GetUseJittering(), 0)
+        m.SetImageSampleDistance(1000.0)
+        self.assertEqual(m.GetImageSampleDistance(), 100.0)  # clamped as VTK's
+        text = str(m)
+        for key in ("AutoAdjustSampleDistances", "SampleDistance", "ImageSampleDistance",
+                    "UseJittering", "OutputPath", "ferrovol"):
+            self.assertIn(key, text)
+        self.assertRegex(ferrovol.vtkFerroVolumeMapper.GetFerrovolVersion(), r"^\d+\.\d+\.\d+")
+        fvtest.log("  adapter: %s" % ferrovol.vtkFerroVolumeMapper.GetAdapterDescription())
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
