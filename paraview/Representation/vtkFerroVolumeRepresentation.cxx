@@ -1,0 +1,295 @@
+#include "vtkFerroVolumeRepresentation.h"
+
+#include "vtkCellData.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFerroVolumeMapper.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkObjectFactory.h"
+#include "vtkPVLODVolume.h"
+#include "vtkPVView.h"
+#include "vtkPointData.h"
+#include "vtkScalarsToColors.h"
+#include "vtkTrivialProducer.h"
+#include "vtkVolumeMapper.h"
+#include "vtkVolumeProperty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+vtkStandardNewMacro(vtkFerroVolumeRepresentation);
+
+//------------------------------------------------------------------------------------------
+vtkFerroVolumeRepresentation::vtkFerroVolumeRepresentation()
+{
+  // The superclass made a vtkMultiBlockVolumeMapper; nothing has used it yet.
+  this->VolumeMapper = vtkSmartPointer<vtkFerroVolumeMapper>::New();
+}
+
+//------------------------------------------------------------------------------------------
+vtkFerroVolumeRepresentation::~vtkFerroVolumeRepresentation() = default;
+
+//------------------------------------------------------------------------------------------
+vtkFerroVolumeMapper* vtkFerroVolumeRepresentation::GetFerroVolumeMapper()
+{
+  return vtkFerroVolumeMapper::SafeDownCast(this->VolumeMapper);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetFerrovolBlendMode(int mode)
+{
+  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ADDITIVE_BLEND)
+  {
+    vtkErrorMacro(<< "FerrovolBlendMode " << mode
+                  << " is not one of composite (0), maximum (1), minimum (2), average (3) or "
+                     "additive (4); keeping "
+                  << this->FerrovolBlendMode << ".");
+    return;
+  }
+  this->FerrovolBlendMode = mode;
+  this->VolumeMapper->SetBlendMode(mode);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetBlendMode(int mode)
+{
+  this->SharedBlendMode = mode;
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetAutoAdjustSampleDistances(int value)
+{
+  this->GetFerroVolumeMapper()->SetAutoAdjustSampleDistances(value != 0);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetSampleDistance(double value)
+{
+  if (!(value > 0.0))
+  {
+    vtkErrorMacro(<< "SampleDistance must be positive (got " << value << ").");
+    return;
+  }
+  this->GetFerroVolumeMapper()->SetSampleDistance(static_cast<float>(value));
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetImageSampleDistance(double value)
+{
+  this->GetFerroVolumeMapper()->SetImageSampleDistance(static_cast<float>(value));
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetUseJittering(int value)
+{
+  this->GetFerroVolumeMapper()->SetUseJittering(value != 0);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetEmptySpaceSkipping(int value)
+{
+  this->GetFerroVolumeMapper()->SetEmptySpaceSkipping(value != 0);
+}
+
+//------------------------------------------------------------------------------------------
+const char* vtkFerroVolumeRepresentation::GetFerrovolVersion()
+{
+  return vtkFerroVolumeMapper::GetFerrovolVersion();
+}
+
+//------------------------------------------------------------------------------------------
+const char* vtkFerroVolumeRepresentation::GetFerrovolAdapter()
+{
+  const char* adapter = vtkFerroVolumeMapper::GetAdapterDescription();
+  this->Adapter = adapter ? adapter : "";
+  return this->Adapter.c_str();
+}
+
+//------------------------------------------------------------------------------------------
+const char* vtkFerroVolumeRepresentation::GetFerrovolOutputPath()
+{
+  const char* path = this->GetFerroVolumeMapper()->GetOutputPathName();
+  this->OutputPath = path ? path : "";
+  return this->OutputPath.c_str();
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::GetFerrovolLastRenderDrew()
+{
+  return this->GetFerroVolumeMapper()->GetLastRenderDrew() ? 1 : 0;
+}
+
+//------------------------------------------------------------------------------------------
+int* vtkFerroVolumeRepresentation::GetFerrovolLastRenderSize()
+{
+  this->GetFerroVolumeMapper()->GetLastRenderSize(this->LastRenderSize);
+  return this->LastRenderSize;
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::GetFerrovolVolumeUploadCount()
+{
+  return this->GetFerroVolumeMapper()->GetVolumeUploadCount();
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::GetFerrovolTableUploadCount()
+{
+  return this->GetFerroVolumeMapper()->GetTableUploadCount();
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  const int result = this->Superclass::RequestData(request, inputVector, outputVector);
+
+  // Without input (a client or render server in client/server mode) only the outline shows.
+  const bool hasInput = inputVector[0]->GetNumberOfInformationObjects() == 1;
+  const bool wasImage = this->InputIsImageData;
+  this->InputIsImageData = !hasInput || vtkImageData::SafeDownCast(this->Cache) != nullptr;
+  if (!this->InputIsImageData && wasImage)
+  {
+    vtkWarningMacro(<< "\"Ferrovol Volume\" renders vtkImageData only; this input is "
+                    << (this->Cache ? this->Cache->GetClassName() : "empty")
+                    << ". Use the \"Volume\" representation, or resample the data to an image "
+                       "(Resample To Image) first.");
+  }
+  return result;
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::ProcessViewRequest(
+  vtkInformationRequestKey* request_type, vtkInformation* inInfo, vtkInformation* outInfo)
+{
+  if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
+  {
+    return 0;
+  }
+  if (request_type == vtkPVView::REQUEST_RENDER())
+  {
+    this->ApplyVectorMode();
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::ApplyVectorMode()
+{
+  auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
+  vtkVolumeProperty* prop = this->Property;
+  vtkColorTransferFunction* ctf = prop ? prop->GetRGBTransferFunction(0) : nullptr;
+  if (!image || !ctf || !prop->GetIndependentComponents())
+  {
+    return;
+  }
+  const int mode = ctf->GetVectorMode();
+  if (mode != vtkScalarsToColors::MAGNITUDE && mode != vtkScalarsToColors::COMPONENT)
+  {
+    return;
+  }
+  int cellFlag = 0;
+  vtkDataArray* array = vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
+    this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
+    this->VolumeMapper->GetArrayName(), cellFlag);
+  const int comps = array ? array->GetNumberOfComponents() : 0;
+  if (comps < 2)
+  {
+    return;
+  }
+  const int component = std::max(0, std::min(ctf->GetVectorComponent(), comps - 1));
+
+  std::ostringstream key;
+  key << image << ':' << image->GetMTime() << ':' << array << ':' << array->GetMTime() << ':'
+      << mode << ':' << component << ':' << cellFlag;
+  const std::string name = std::string(array->GetName() ? array->GetName() : "scalars") +
+    (mode == vtkScalarsToColors::MAGNITUDE ? "_ferrovol_magnitude"
+                                           : "_ferrovol_" + std::to_string(component));
+  if (key.str() != this->VectorModeKey || !this->VectorModeImage)
+  {
+    // The same grid with one array: the chosen component (its own type), or the magnitude
+    // (double for double input, float otherwise), as vtkSmartVolumeMapper makes them.
+    vtkSmartPointer<vtkDataArray> out;
+    const vtkIdType n = array->GetNumberOfTuples();
+    if (mode == vtkScalarsToColors::COMPONENT)
+    {
+      out.TakeReference(array->NewInstance());
+      out->SetNumberOfComponents(1);
+      out->SetNumberOfTuples(n);
+      out->CopyComponent(0, array, component);
+    }
+    else
+    {
+      if (array->GetDataType() == VTK_DOUBLE)
+      {
+        out = vtkSmartPointer<vtkDoubleArray>::New();
+      }
+      else
+      {
+        out = vtkSmartPointer<vtkFloatArray>::New();
+      }
+      out->SetNumberOfComponents(1);
+      out->SetNumberOfTuples(n);
+      for (vtkIdType i = 0; i < n; ++i)
+      {
+        double sum = 0.0;
+        for (int c = 0; c < comps; ++c)
+        {
+          const double v = array->GetComponent(i, c);
+          sum += v * v;
+        }
+        out->SetComponent(i, 0, std::sqrt(sum));
+      }
+    }
+    out->SetName(name.c_str());
+    auto derived = vtkSmartPointer<vtkImageData>::New();
+    derived->CopyStructure(image);
+    if (cellFlag)
+    {
+      derived->GetCellData()->SetScalars(out);
+    }
+    else
+    {
+      derived->GetPointData()->SetScalars(out);
+    }
+    this->VectorModeImage = derived;
+    if (!this->VectorModeProducer)
+    {
+      this->VectorModeProducer = vtkSmartPointer<vtkTrivialProducer>::New();
+    }
+    this->VectorModeProducer->SetOutput(derived);
+    this->VectorModeKey = key.str();
+  }
+  this->VolumeMapper->SetInputConnection(this->VectorModeProducer->GetOutputPort());
+  this->VolumeMapper->SelectScalarArray(name.c_str());
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::UpdateMapperParameters()
+{
+  this->Superclass::UpdateMapperParameters();
+
+  // The shared "BlendMode" went nowhere (see SetBlendMode); the Ferrovol one decides.
+  this->VolumeMapper->SetBlendMode(this->FerrovolBlendMode);
+
+  if (!this->InputIsImageData)
+  {
+    this->Actor->SetVisibility(false);
+  }
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FerrovolBlendMode: " << this->FerrovolBlendMode << "\n";
+  os << indent << "SharedBlendMode (ignored): " << this->SharedBlendMode << "\n";
+  os << indent << "InputIsImageData: " << this->InputIsImageData << "\n";
+  os << indent << "FerroVolumeMapper:\n";
+  this->VolumeMapper->PrintSelf(os, indent.GetNextIndent());
+}

@@ -1,0 +1,150 @@
+/**
+ * @class   vtkFerroVolumeRepresentation
+ * @brief   ParaView's image volume representation drawn by ferrovol.
+ *
+ * vtkImageVolumeRepresentation with its vtkMultiBlockVolumeMapper swapped for a
+ * vtkFerroVolumeMapper (the pattern of ParaView's NVIDIA IndeX plugin). Everything the
+ * superclass does stays: the colour and opacity transfer functions, Shade and the lighting
+ * coefficients, ScalarOpacityUnitDistance, InterpolationType, cropping, the array selection,
+ * ghost-cell cropping, the outline on ranks without data and, under MPI, ordered compositing
+ * of the ranks' translucent images from the bounds of each rank's piece
+ * (vtkPVRenderView::USE_BOUNDS_FOR_REDISTRIBUTION; see paraview/README.md).
+ *
+ * The server-manager XML (FerrovolRepresentation.xml) adds it to UniformGridRepresentation
+ * as "Ferrovol Volume" and shares the standard volume properties with "Volume". ferrovol's
+ * own settings come as separate properties ("Ferrovol" group):
+ *
+ * - FerrovolBlendMode: vtkVolumeMapper::BlendModes composite, maximum, minimum, average and
+ *   additive. The shared "BlendMode" property (Composite / Isosurface / Slice, for ParaView's
+ *   own mapper) is ignored here: see SetBlendMode();
+ * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
+ *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering, and
+ *   EmptySpaceSkipping.
+ *
+ * Inputs: vtkImageData only (what vtkFerroVolumeMapper renders). Rectilinear grids and
+ * composite datasets, which "Volume" accepts, are not drawn; a warning says so.
+ *
+ * Multi-component arrays with independent components (MapScalars on, MultiComponentsMapping
+ * off): the colour map's vector mode decides, as vtkSmartVolumeMapper's VectorMode does for
+ * "Volume": the mapper gets one component, or the magnitude, as a single-component array
+ * (computed here once per input and mode, not per frame).
+ */
+
+#ifndef vtkFerroVolumeRepresentation_h
+#define vtkFerroVolumeRepresentation_h
+
+#include "vtkFerroVolumeRepresentationModule.h" // For export macro
+#include "vtkImageVolumeRepresentation.h"
+
+#include "vtkSmartPointer.h" // for ivar
+
+#include <string> // for ivar
+
+class vtkFerroVolumeMapper;
+class vtkImageData;
+class vtkTrivialProducer;
+
+class VTKFERROVOLUMEREPRESENTATION_EXPORT vtkFerroVolumeRepresentation
+  : public vtkImageVolumeRepresentation
+{
+public:
+  static vtkFerroVolumeRepresentation* New();
+  vtkTypeMacro(vtkFerroVolumeRepresentation, vtkImageVolumeRepresentation);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * ferrovol's blend mode, a vtkVolumeMapper::BlendModes value: COMPOSITE_BLEND (0, the
+   * default), MAXIMUM_INTENSITY_BLEND (1), MINIMUM_INTENSITY_BLEND (2),
+   * AVERAGE_INTENSITY_BLEND (3) or ADDITIVE_BLEND (4).
+   */
+  void SetFerrovolBlendMode(int mode);
+  vtkGetMacro(FerrovolBlendMode, int);
+  ///@}
+
+  /**
+   * Hides vtkImageVolumeRepresentation::SetBlendMode, the target of the "BlendMode" property
+   * this representation shares with "Volume" (Composite / Isosurface / Slice). The value is
+   * kept for PrintSelf but not passed to the mapper: FerrovolBlendMode decides.
+   */
+  void SetBlendMode(int mode);
+
+  ///@{
+  /**
+   * Forwarded to vtkFerroVolumeMapper (same meaning as vtkGPUVolumeRayCastMapper's).
+   */
+  void SetAutoAdjustSampleDistances(int value);
+  void SetSampleDistance(double value);
+  void SetImageSampleDistance(double value);
+  void SetUseJittering(int value);
+  void SetEmptySpaceSkipping(int value);
+  ///@}
+
+  /**
+   * The mapper this representation renders with.
+   */
+  vtkFerroVolumeMapper* GetFerroVolumeMapper();
+
+  ///@{
+  /**
+   * What the mapper reports, for information-only properties: the ferrovol library's
+   * version, its GPU adapter ("" when none opened), how frames reach OpenGL ("none" before
+   * the first frame), whether the last render drew the volume (0/1), the size in pixels of
+   * the last frame ferrovol rendered, and how many volume and transfer-table uploads the
+   * mapper made (-1 before the first frame).
+   */
+  const char* GetFerrovolVersion();
+  const char* GetFerrovolAdapter();
+  const char* GetFerrovolOutputPath();
+  int GetFerrovolLastRenderDrew();
+  int* GetFerrovolLastRenderSize() VTK_SIZEHINT(2);
+  int GetFerrovolVolumeUploadCount();
+  int GetFerrovolTableUploadCount();
+  ///@}
+
+protected:
+  vtkFerroVolumeRepresentation();
+  ~vtkFerroVolumeRepresentation() override;
+
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+
+  /**
+   * The superclass's work; on REQUEST_RENDER, then gives the mapper the single-component
+   * image the colour map's vector mode asks for (see ApplyVectorMode()).
+   */
+  int ProcessViewRequest(vtkInformationRequestKey* request_type, vtkInformation* inInfo,
+    vtkInformation* outInfo) override;
+
+  /**
+   * For a multi-component array with independent components and a colour map in MAGNITUDE
+   * or COMPONENT vector mode: points the mapper at a copy of the image's structure holding
+   * only that magnitude or component (cached until the input, array, mode or component
+   * changes). Otherwise leaves the mapper on the view's data.
+   */
+  void ApplyVectorMode();
+
+  /**
+   * The superclass's work (array selection, scalar mode, cropping planes, independent
+   * components), then ferrovol's settings; hides the volume when the input is not image data.
+   */
+  void UpdateMapperParameters() override;
+
+  int FerrovolBlendMode = 0;
+  int SharedBlendMode = 0;
+  bool InputIsImageData = true;
+  std::string Adapter;
+  std::string OutputPath;
+  int LastRenderSize[2] = { 0, 0 };
+
+  // ApplyVectorMode()'s single-component image, its producer and what it was made from.
+  vtkSmartPointer<vtkImageData> VectorModeImage;
+  vtkSmartPointer<vtkTrivialProducer> VectorModeProducer;
+  std::string VectorModeKey;
+
+private:
+  vtkFerroVolumeRepresentation(const vtkFerroVolumeRepresentation&) = delete;
+  void operator=(const vtkFerroVolumeRepresentation&) = delete;
+};
+
+#endif

@@ -1,0 +1,271 @@
+"""Shared pieces of the Ferrovol ParaView tests (run by pvbatch / pvpython, see Makefile).
+
+- load_plugin(): the plugin by name (PV_PLUGIN_PATH, build/paraview/env.sh) or by path
+  (FERROVOL_PV_PLUGIN);
+- render helpers with a fixed camera and transfer functions, saving PNGs under OUT_DIR
+  (build/paraview-test), read back as numpy arrays;
+- ssim()/psnr(): the measures the tests print and assert. SSIM is Wang et al. 2004 (Gaussian
+  window sigma 1.5, K1 0.01, K2 0.03) averaged over R, G and B; it is reported over the whole frame and
+  over the volume's screen box (pixels that differ from the background in either image),
+  the thresholds apply to the box, so an empty background cannot inflate them.
+"""
+import os
+import sys
+import time
+
+import numpy as np
+
+from paraview.simple import (  # noqa: F401  (re-exported for the tests)
+    ColorBy, CreateRenderView, Delete, GetColorTransferFunction, GetOpacityTransferFunction,
+    LoadDistributedPlugin, LoadPlugin, Render, SaveScreenshot, Show, servermanager)
+
+OUT_DIR = os.environ.get("FERROVOL_PV_TEST_OUT", os.path.join(os.getcwd(), "build", "paraview-test"))
+BACKGROUND = (0.1, 0.1, 0.15)
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def rank():
+    pm = servermanager.vtkProcessModule.GetProcessModule()
+    return pm.GetPartitionId() if pm else 0
+
+
+def nranks():
+    pm = servermanager.vtkProcessModule.GetProcessModule()
+    return pm.GetNumberOfLocalPartitions() if pm else 1
+
+
+def print_in_rank_order(msg):
+    """Every rank prints msg, rank 0 first (one line each, not interleaved)."""
+    from vtkmodules.vtkParallelCore import vtkMultiProcessController
+    ctrl = vtkMultiProcessController.GetGlobalController()
+    n = ctrl.GetNumberOfProcesses() if ctrl else 1
+    for r in range(n):
+        if ctrl and n > 1:
+            ctrl.Barrier()
+        if r == rank():
+            print(msg, flush=True)
+
+
+def log(*args):
+    if rank() == 0:
+        print(*args, flush=True)
+
+
+def plugin_loaded(name="Ferrovol"):
+    info = servermanager.vtkSMProxyManager.GetProxyManager().GetPluginManager().GetLocalInformation()
+    return any(info.GetPluginName(i) == name and info.GetPluginLoaded(i)
+               for i in range(info.GetNumberOfPlugins()))
+
+
+def load_plugin(ns=None):
+    """Loads the Ferrovol plugin: from FERROVOL_PV_PLUGIN (a path) if set, else by name with
+    LoadDistributedPlugin (PV_PLUGIN_PATH, build/env.sh). ParaView already loaded it at
+    start-up when it is in PV_PLUGIN_PATH; loading it again makes ParaView 5.11 log a
+    misleading "Plugin load failed: No plugin loaded yet." (and succeed), so that is skipped.
+    Returns how it was loaded."""
+    path = os.environ.get("FERROVOL_PV_PLUGIN")
+    if path:
+        LoadPlugin(path, remote=False, ns=ns)
+        return path
+    if plugin_loaded():
+        return "PV_PLUGIN_PATH (at start-up)"
+    LoadDistributedPlugin("Ferrovol", remote=False, ns=ns)
+    return "LoadDistributedPlugin"
+
+
+def make_view(size=(400, 400)):
+    # paraview.simple.Render() resets the camera on the session's first render: the tests
+    # set their cameras themselves.
+    import paraview.simple
+    paraview.simple._funcs_internals.first_render = False
+    view = CreateRenderView()
+    view.ViewSize = list(size)
+    view.OrientationAxesVisibility = 0
+    view.Background = list(BACKGROUND)
+    # ParaView 5.11 keeps a palette-driven background unless told otherwise.
+    if view.GetProperty("UseColorPaletteForBackground") is not None:
+        view.UseColorPaletteForBackground = 0
+    # Full-resolution still renders only (no LOD, no interactive subsampling).
+    view.LODThreshold = 1e20
+    return view
+
+
+def set_camera(view, bounds, azimuth=30.0, elevation=20.0, direction=None, zoom=1.0):
+    """Looks at the centre of bounds from a fixed direction (azimuth/elevation about +y, or an
+    explicit unit direction from the focal point to the camera)."""
+    c = [(bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2, (bounds[4] + bounds[5]) / 2]
+    diag = np.linalg.norm([bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]])
+    if direction is None:
+        a, e = np.radians(azimuth), np.radians(elevation)
+        direction = [np.sin(a) * np.cos(e), np.sin(e), np.cos(a) * np.cos(e)]
+    d = np.asarray(direction, float)
+    d /= np.linalg.norm(d)
+    dist = 1.9 * diag / zoom
+    view.CameraFocalPoint = c
+    view.CameraPosition = list(np.asarray(c) + dist * d)
+    up = [0, 1, 0] if abs(d[1]) < 0.9 else [0, 0, 1]
+    view.CameraViewUp = up
+    view.CameraViewAngle = 30
+    view.CameraParallelProjection = 0
+    view.CenterOfRotation = c
+
+
+def color_by(display, array, rgb_points=None, opacity_points=None, association="POINTS"):
+    ColorBy(display, (association, array))
+    lut = GetColorTransferFunction(array)
+    pwf = GetOpacityTransferFunction(array)
+    if rgb_points is not None:
+        lut.RGBPoints = list(rgb_points)
+    if opacity_points is not None:
+        pwf.Points = list(opacity_points)
+    lut.ScalarRangeInitialized = 1
+    pwf.ScalarRangeInitialized = 1
+    lut.AutomaticRescaleRangeMode = "Never"
+    pwf.AllowDuplicateScalars = 1
+    return lut, pwf
+
+
+def screenshot(view, name, size=None, transparent=False):
+    """Renders view into OUT_DIR/name.png and returns it as an HxWx3 (or x4) uint8 array."""
+    os.makedirs(OUT_DIR, exist_ok=True)
+    path = os.path.join(OUT_DIR, name + ".png")
+    kw = {"ImageResolution": list(size or view.ViewSize)}
+    if transparent:
+        kw["TransparentBackground"] = 1
+    t0 = time.time()
+    SaveScreenshot(path, view, **kw)
+    dt = time.time() - t0
+    img = read_png(path) if rank() == 0 else None
+    return img, path, dt
+
+
+def read_png(path):
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    r = vtkPNGReader()
+    r.SetFileName(path)
+    r.Update()
+    im = r.GetOutput()
+    w, h, _ = im.GetDimensions()
+    arr = vtk_to_numpy(im.GetPointData().GetScalars())
+    comps = arr.shape[1] if arr.ndim == 2 else 1
+    return arr.reshape(h, w, comps)[::-1].copy()  # top row first
+
+
+def write_png(path, img):
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    img = np.ascontiguousarray(img[::-1])
+    h, w, c = img.shape
+    data = vtkImageData()
+    data.SetDimensions(w, h, 1)
+    arr = numpy_to_vtk(img.reshape(h * w, c), deep=1)
+    data.GetPointData().SetScalars(arr)
+    wr = vtkPNGWriter()
+    wr.SetFileName(path)
+    wr.SetInputData(data)
+    wr.Write()
+
+
+def _blur(x, sigma=1.5, radius=5):
+    t = np.arange(-radius, radius + 1)
+    k = np.exp(-0.5 * (t / sigma) ** 2)
+    k /= k.sum()
+    x = np.pad(x, radius, mode="reflect")
+    x = np.apply_along_axis(lambda r: np.convolve(r, k, mode="valid"), 1, x)
+    x = np.apply_along_axis(lambda c: np.convolve(c, k, mode="valid"), 0, x)
+    return x
+
+
+def _ssim_channel(x, y):
+    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
+    mx, my = _blur(x), _blur(y)
+    sxx = _blur(x * x) - mx * mx
+    syy = _blur(y * y) - my * my
+    sxy = _blur(x * y) - mx * my
+    s = ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
+    return float(s.mean())
+
+
+def ssim(a, b):
+    """Mean SSIM of two uint8 RGB(A) images: the mean of the R, G and B channels' SSIM (so a
+    change of hue counts, which luminance alone would hide)."""
+    a = a[..., :3].astype(np.float64)
+    b = b[..., :3].astype(np.float64)
+    return float(np.mean([_ssim_channel(a[..., c], b[..., c]) for c in range(3)]))
+
+
+def psnr(a, b):
+    d = a[..., :3].astype(np.float64) - b[..., :3].astype(np.float64)
+    mse = float((d * d).mean())
+    return float("inf") if mse == 0 else 10 * np.log10(255.0 ** 2 / mse)
+
+
+def volume_box(*imgs, background=BACKGROUND, tol=3, pad=4):
+    """Rows and columns (slices) covering every pixel that differs from the background in any
+    of imgs."""
+    bg = np.round(np.asarray(background) * 255)
+    mask = np.zeros(imgs[0].shape[:2], bool)
+    for im in imgs:
+        mask |= np.abs(im[..., :3].astype(int) - bg).max(axis=2) > tol
+    if not mask.any():
+        return None
+    rows, cols = np.where(mask.any(axis=1))[0], np.where(mask.any(axis=0))[0]
+    h, w = mask.shape
+    return (slice(max(rows[0] - pad, 0), min(rows[-1] + pad + 1, h)),
+            slice(max(cols[0] - pad, 0), min(cols[-1] + pad + 1, w)))
+
+
+def coverage(img, background=BACKGROUND, tol=3):
+    bg = np.round(np.asarray(background) * 255)
+    return float((np.abs(img[..., :3].astype(int) - bg).max(axis=2) > tol).mean())
+
+
+def compare(name, a, b, min_ssim=None, min_psnr=None, failures=None, expect_fail=False):
+    """Prints SSIM (frame and volume box) and PSNR of a against b, writes a diff image, and
+    records a failure when the box SSIM or PSNR is under its threshold (or, with
+    expect_fail, when neither is)."""
+    box = volume_box(a, b)
+    s_full, p = ssim(a, b), psnr(a, b)
+    s_box = ssim(a[box], b[box]) if box else s_full
+    p_box = psnr(a[box], b[box]) if box else p
+    diff = np.clip(np.abs(a[..., :3].astype(int) - b[..., :3].astype(int)) * 4, 0, 255)
+    write_png(os.path.join(OUT_DIR, name + "-diff.png"), diff.astype(np.uint8))
+    ok = True
+    why = []
+    if min_ssim is not None and s_box < min_ssim:
+        ok = False
+        why.append("SSIM %.4f < %.3f" % (s_box, min_ssim))
+    if min_psnr is not None and p_box < min_psnr:
+        ok = False
+        why.append("PSNR %.2f dB < %.1f dB" % (p_box, min_psnr))
+    if expect_fail:
+        verdict = ("fails as it must: " + "; ".join(why)) if not ok else "FAIL: passed"
+        ok = not ok
+        why = why or ["passed thresholds it must fail"]
+    else:
+        verdict = "ok" if ok else "FAIL: " + "; ".join(why)
+    print("  %-34s SSIM %.4f (box %.4f)  PSNR %.2f dB (box %.2f dB)  %s" % (
+        name, s_full, s_box, p, p_box, verdict), flush=True)
+    if not ok and failures is not None:
+        failures.append("%s: %s" % (name, "; ".join(why)))
+    return s_box, p_box
+
+
+def finish(failures, what):
+    if rank() != 0:
+        return
+    if failures:
+        print("FAIL %s:\n  %s\n  images: %s" % (what, "\n  ".join(failures), OUT_DIR), flush=True)
+        sys.stdout.flush()
+        os._exit(1)
+    print("PASS %s" % what, flush=True)
+
+
+def ferrovol_info(display):
+    display.UpdatePropertyInformation()
+    return {p: display.GetProperty(p).GetData() for p in (
+        "FerrovolVersion", "FerrovolAdapter", "FerrovolOutputPath",
+        "FerrovolLastRenderDrew", "FerrovolLastRenderSize", "FerrovolVolumeUploadCount",
+        "FerrovolTableUploadCount")}

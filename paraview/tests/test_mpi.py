@@ -1,0 +1,180 @@
+"""(f) "Ferrovol Volume" on a distributed Wavelet under MPI, against the serial image.
+
+Two steps (make paraview-test runs both):
+
+  pvbatch test_mpi.py serial
+      renders the whole Wavelet serially from four cameras (the references), and shows that
+      ordering matters: the Wavelet cut at z = 0 into the two halves that two ranks hold,
+      each half rendered alone, composited back to front in numpy in the right and in the
+      wrong order, against the whole;
+  mpiexec -n N pvbatch --symmetric test_mpi.py distributed
+      each rank holds one piece of the Wavelet (ParaView's extent translator cuts it along z
+      for N = 2), draws only that piece with ferrovol, and IceT composites the ranks' RGBA
+      images in the order vtkPVRenderView computes from the pieces' bounds; rank 0 compares
+      the result with the serial references (SSIM >= 0.98 required).
+
+Why it works (ParaView 5.11): vtkImageVolumeRepresentation reports NEED_ORDERED_COMPOSITING
+and USE_BOUNDS_FOR_REDISTRIBUTION. The data is not moved: every rank's local bounds are
+all-gathered into one box per rank (vtkPVRenderViewDataDeliveryManager), and for each
+frame vtkOrderedCompositingHelper sorts the boxes back to front from the camera position
+(vtkBlockSortHelper); IceT then blends the ranks' premultiplied images in that order
+instead of z-compositing them. This is right when the pieces do not overlap in space (the
+representation crops ghost cells away for that reason), whatever the camera: the cameras
+"front" and "back" below look along the cut, so one piece lies entirely behind the other
+and the order must flip between them.
+"""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fvtest as T  # noqa: E402
+from paraview.simple import Wavelet, ExtractSubset, Show, Hide, Render  # noqa: E402
+
+MODE = sys.argv[1] if len(sys.argv) > 1 else "distributed"
+SIZE = (300, 300)
+EXTENT = [-10, 10, -10, 10, -10, 10]
+# The whole Wavelet's bounds (spacing 1, origin 0), written out: under --symmetric a rank's
+# data information may describe only its own piece.
+BOUNDS = [float(e) for e in EXTENT]
+RGB = [37.35, 0.23, 0.30, 0.75, 157.1, 0.87, 0.87, 0.87, 276.8, 0.71, 0.02, 0.15]
+OPACITY = [37.35, 0.0, 0.5, 0.0, 276.8, 0.9, 0.5, 0.0]
+# Camera directions (focal point -> camera). front/back look along z, the axis the pieces
+# are cut along: the pieces overlap completely on screen, one in front of the other.
+CAMERAS = {
+    "oblique": [0.5, 0.34, 0.8],
+    "front": [0.15, 0.1, 1.0],
+    "back": [-0.15, 0.1, -1.0],
+    "side": [1.0, 0.2, 0.1],
+}
+# The distributed image against the serial one: SSIM >= 0.98 (the issue's requirement) and
+# PSNR >= 35 dB on the volume's box. Measured: see the output; the pieces start their rays
+# at their own faces, so samples near the cut sit elsewhere than in the serial frame.
+MIN_SSIM, MIN_PSNR = 0.98, 35.0
+
+T.load_plugin(globals())
+
+
+def setup(view, source, rep="Ferrovol Volume"):
+    disp = Show(source, view)
+    T.color_by(disp, "RTData", rgb_points=RGB, opacity_points=OPACITY)
+    disp.ScalarOpacityUnitDistance = 2.0
+    disp.Representation = rep
+    return disp
+
+
+def ref_path(cam):
+    return os.path.join(T.OUT_DIR, "mpi-serial-%s.png" % cam)
+
+
+def serial():
+    view = T.make_view(SIZE)
+    src = Wavelet()
+    src.WholeExtent = EXTENT
+    setup(view, src)
+    bounds = BOUNDS
+    for cam, d in CAMERAS.items():
+        T.set_camera(view, bounds, direction=d)
+        Render(view)
+        img, path, _ = T.screenshot(view, "mpi-serial-%s" % cam)
+        T.log("  serial reference %-8s %s" % (cam, path))
+    Hide(src, view)
+
+    # Ordering matters: render the halves z <= 0 and z >= 0 (what two ranks hold) alone,
+    # over black and over white (colour over black = premultiplied colour, the difference
+    # gives alpha), and composite them back to front in both orders.
+    failures = []
+    halves = []
+    for voi in ([-10, 10, -10, 10, -10, 0], [-10, 10, -10, 10, 0, 10]):
+        sub = ExtractSubset(Input=src)
+        sub.VOI = voi
+        halves.append((sub, setup(view, sub)))
+        Hide(sub, view)
+    for cam in ("front", "back"):
+        T.set_camera(view, bounds, direction=CAMERAS[cam])
+        layers = []
+        for sub, _ in halves:
+            Show(sub, view)
+            rgba = []
+            for bg in ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)):
+                view.Background = list(bg)
+                Render(view)
+                img, _, _ = T.screenshot(view, "mpi-half")
+                rgba.append(img[..., :3].astype(float) / 255)
+            Hide(sub, view)
+            black, white = rgba
+            alpha = np.clip(1 - (white - black).mean(axis=2, keepdims=True), 0, 1)
+            layers.append((black, alpha))
+        view.Background = list(T.BACKGROUND)
+        bg = np.asarray(T.BACKGROUND)
+        ref = T.read_png(ref_path(cam))
+        # the camera is on the +z side for "front": the z >= 0 half (layers[1]) is nearer.
+        near, far = (layers[1], layers[0]) if cam == "front" else (layers[0], layers[1])
+
+        def over(a, b):
+            return a[0] + (1 - a[1]) * b[0], a[1] + (1 - a[1]) * b[1]
+
+        for label, (top, bottom) in (("right order", (near, far)), ("wrong order", (far, near))):
+            c, a = over(top, bottom)
+            img = np.clip(np.round((c + (1 - a) * bg) * 255), 0, 255).astype(np.uint8)
+            T.write_png(os.path.join(T.OUT_DIR, "mpi-halves-%s-%s.png" % (
+                cam, label.replace(" ", "-"))), img)
+            if label == "right order":
+                T.compare("halves %s, %s" % (cam, label), img, ref, MIN_SSIM, MIN_PSNR, failures)
+            else:
+                T.compare("halves %s, %s" % (cam, label), img, ref, MIN_SSIM, MIN_PSNR, failures,
+                          expect_fail=True)
+    T.finish(failures, "serial references; the order of translucent pieces matters")
+
+
+def distributed():
+    failures = []
+    if T.nranks() < 2:
+        failures.append("run me with mpiexec -n 2 (or more) pvbatch --symmetric")
+        T.finish(failures, "distributed")
+        return
+    for cam in CAMERAS:
+        if T.rank() == 0 and not os.path.exists(ref_path(cam)):
+            failures.append("no serial reference %s: run 'pvbatch test_mpi.py serial' first"
+                            % ref_path(cam))
+    view = T.make_view(SIZE)
+    src = Wavelet()
+    src.WholeExtent = EXTENT
+    disp = setup(view, src)
+    bounds = BOUNDS
+    Render(view)
+    local = src.GetClientSideObject().GetOutputDataObject(0)
+    ext = local.GetExtent()
+    info = T.ferrovol_info(disp)
+    # every rank says what it holds and whether ferrovol drew it
+    T.print_in_rank_order(
+        "  rank %d/%d: piece extent %s (%d points), ferrovol drew: %d, volume uploads: %d"
+        % (T.rank(), T.nranks(), list(ext), local.GetNumberOfPoints(),
+           info["FerrovolLastRenderDrew"], info["FerrovolVolumeUploadCount"]))
+    total = 21 ** 3
+    if local.GetNumberOfPoints() >= total:
+        failures.append("rank %d holds the whole Wavelet: the data is not distributed" % T.rank())
+    if info["FerrovolLastRenderDrew"] != 1:
+        failures.append("rank %d: ferrovol did not draw its piece" % T.rank())
+    for cam, d in CAMERAS.items():
+        T.set_camera(view, bounds, direction=d)
+        Render(view)
+        img, _, dt = T.screenshot(view, "mpi-n%d-%s" % (T.nranks(), cam))
+        if T.rank() == 0 and os.path.exists(ref_path(cam)):
+            ref = T.read_png(ref_path(cam))
+            T.compare("mpi -n %d %s vs serial" % (T.nranks(), cam), img, ref, MIN_SSIM, MIN_PSNR,
+                      failures)
+    # Rank-local failures are printed by their ranks; rank 0 decides the exit status.
+    if failures and T.rank() != 0:
+        print("FAIL rank %d: %s" % (T.rank(), "; ".join(failures)), flush=True)
+        os._exit(1)
+    T.finish(failures, "distributed: mpiexec -n %d matches serial" % T.nranks())
+
+
+if MODE == "serial":
+    T.log("MPI test, serial part: references and the ordering control (%dx%d)" % SIZE)
+    serial()
+else:
+    T.log("MPI test, %d ranks (%dx%d)" % (T.nranks(), SIZE[0], SIZE[1]))
+    distributed()
