@@ -2,13 +2,20 @@
 #   make demo   render the built-in demo volume to build/demo.png
 #   make test   format, lint and run every test (installs what is missing first)
 #   make bench  VTK's GPU ray cast benchmark scene, ferrovol vs vtkGPUVolumeRayCastMapper
-#   make build  release build of the `ferrovol` command
+#   make build  release build of the `ferrovol` command and the VTK module (make vtk)
+#   make vtk    vtkFerroVolumeMapper (C++ + Python package `ferrovol`) in build/vtk;
+#               writes build/env.sh: `. build/env.sh; /usr/bin/python3 -c "import vtk, ferrovol"`
+#   make vtk-test  the VTK module's tests (CTest: C++ and Python) under Xvfb
+#   make paraview  the ParaView plugin (representation "Ferrovol Volume") in build/paraview;
+#               `. build/env.sh && pvpython` then has it loaded (PV_PLUGIN_PATH)
+#   make paraview-test  the plugin's pvbatch tests, serial and `mpiexec -n 2`, under Xvfb
+#   make paraview-regression  the same with 4 MPI ranks
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
-.PHONY: deps build demo test lint bench pictures
+.PHONY: deps build demo test lint bench pictures vtk vtk-test paraview paraview-test paraview-regression
 
 deps:
 	@bash scripts/install-deps.sh
@@ -16,6 +23,50 @@ deps:
 
 build: deps
 	$(CARGO) build --release --locked -p ferrovol-cli
+	$(MAKE) vtk
+
+# The VTK module links the C ABI library (target/release/libferrovol.so); VTK 9.2 is
+# ParaView's (docs/ARCHITECTURE.md, Machines). 2 cores: ninja -j2.
+VTK_BUILD := build/vtk
+vtk: deps
+	$(CARGO) build --release --locked -p ferrovol-ffi
+	cmake -G Ninja -S vtk_plugin -B $(VTK_BUILD) -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+	ninja -C $(VTK_BUILD) -j2
+	cp $(VTK_BUILD)/env.sh build/env.sh
+	$(PV_ENV_HOOK)
+	@echo "VTK module built: . build/env.sh && /usr/bin/python3 -c 'import vtk, ferrovol'"
+
+# C++ and Python tests of vtkFerroVolumeMapper in a private Xvfb (images and measured
+# figures land in build/vtk/test-images; ~30 s on 2 cores).
+vtk-test: vtk
+	@scripts/fetch-data.sh >/dev/null || echo "vtk-test: no build/data/cranium.vti; the examples render a synthetic volume"
+	env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(VTK_BUILD) --output-on-failure -j1
+
+# The ParaView plugin builds vtkFerroVolumeMapper from vtk_plugin/FerroVolume itself (it
+# does not need build/vtk) and writes build/paraview/env.sh (PV_PLUGIN_PATH); build/env.sh
+# (written by `make vtk`, or created here) sources it.
+PV_BUILD := build/paraview
+# The line of build/env.sh that sources build/paraview/env.sh (if it exists); `make vtk`
+# rewrites build/env.sh, so both targets add it.
+define PV_ENV_HOOK
+@touch build/env.sh
+@grep -qF '$(PV_BUILD)/env.sh' build/env.sh || \
+  echo 'if [ -f "$(CURDIR)/$(PV_BUILD)/env.sh" ]; then . "$(CURDIR)/$(PV_BUILD)/env.sh"; fi' >> build/env.sh
+endef
+paraview: deps
+	$(CARGO) build --release --locked -p ferrovol-ffi
+	cmake -G Ninja -S paraview -B $(PV_BUILD) -Wno-deprecated >/dev/null
+	ninja -C $(PV_BUILD) -j2
+	$(PV_ENV_HOOK)
+	@echo "ParaView plugin built: . build/env.sh && pvpython   (\"Ferrovol Volume\" is loaded)"
+
+# pvbatch/pvpython/paraview tests in a private Xvfb (1920x1080 screen); build/data/cranium.vti
+# is used when scripts/fetch-data.sh has made it (the cranium test says SKIP otherwise).
+paraview-test: paraview
+	env -u DISPLAY scripts/with-xvfb.sh paraview/tests/run-all.sh 2
+
+paraview-regression: paraview
+	env -u DISPLAY scripts/with-xvfb.sh paraview/tests/run-all.sh 4
 
 demo: build
 	$(FERROVOL) render --demo wavelet --shade --size 640x640 --azimuth 30 --elevation 20 --out build/demo.png
@@ -27,6 +78,8 @@ lint: deps
 
 test: lint
 	$(CARGO) test --locked --workspace
+	$(MAKE) vtk-test
+	$(MAKE) paraview-test
 
 # The first process after a shader change runs 3-4x slower on lavapipe until Mesa's shader
 # cache holds the pipelines (measured), so a short priming run of both renderers goes first.

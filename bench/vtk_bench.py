@@ -59,9 +59,13 @@ def parse_args(argv):
     )
     p.add_argument("--frames", type=positive_int, default=20,
                    help="timed frames per mode, after %d warm-up frames (default 20)" % WARMUP_FRAMES)
-    p.add_argument("--mapper", choices=["gpu", "fixed"], default="gpu",
-                   help="vtkGPUVolumeRayCastMapper (gpu, default) or "
-                        "vtkFixedPointVolumeRayCastMapper (fixed, CPU)")
+    p.add_argument("--mapper", choices=["gpu", "fixed", "ferrovol"], default="gpu",
+                   help="vtkGPUVolumeRayCastMapper (gpu, default), "
+                        "vtkFixedPointVolumeRayCastMapper (fixed, CPU) or ferrovol's "
+                        "vtkFerroVolumeMapper (ferrovol: needs `. build/env.sh`)")
+    p.add_argument("--output-path", choices=["automatic", "shared", "readback"],
+                   default="automatic",
+                   help="vtkFerroVolumeMapper only: zero-copy shared texture or CPU readback")
     p.add_argument("--size", type=parse_size, default=(900, 900), metavar="WxH",
                    help="window size (default 900x900)")
     p.add_argument("--extent", type=positive_int, default=127, metavar="N",
@@ -116,6 +120,11 @@ def main(argv):
     # Mapper.
     if args.mapper == "gpu":
         mapper = vtk.vtkGPUVolumeRayCastMapper()
+    elif args.mapper == "ferrovol":
+        import ferrovol
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        {"automatic": mapper.SetOutputPathToAutomatic, "shared": mapper.SetOutputPathToShared,
+         "readback": mapper.SetOutputPathToReadback}[args.output_path]()
     else:
         mapper = vtk.vtkFixedPointVolumeRayCastMapper()
     mapper.SetInputConnection(source.GetOutputPort())
@@ -203,8 +212,13 @@ def main(argv):
         ms = 1000.0 * total_s / args.frames
         print("# %s: warm-up %d frames %.1f ms (first frames include texture upload / shader build)"
               % (mode, WARMUP_FRAMES, 1000.0 * warmup_s))
+        name = args.mapper
+        if args.mapper == "ferrovol":
+            name = "ferrovol_" + mapper.GetOutputPathName().lower()
+            print("# ferrovol output path: %s (%s)"
+                  % (mapper.GetOutputPathName(), mapper.GetOutputPathReason()))
         print("vtk_%s %s ms_per_frame=%.1f median_ms=%.1f min_ms=%.1f max_ms=%.1f frames=%d size=%dx%d extent=%d"
-              % (args.mapper, mode, ms, 1000.0 * statistics.median(times), 1000.0 * min(times), 1000.0 * max(times),
+              % (name, mode, ms, 1000.0 * statistics.median(times), 1000.0 * min(times), 1000.0 * max(times),
                  args.frames, width, height, n))
         sys.stdout.flush()
 
