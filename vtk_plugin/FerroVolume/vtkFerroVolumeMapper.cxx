@@ -440,6 +440,9 @@ struct FrameRequest
   vtkOpenGLRenderWindow* Window;
   int ViewportX, ViewportY, ViewportW, ViewportH;
   int RenderW, RenderH;
+  // Whether opaque geometry may be in VTK's depth buffer; without any, the buffer holds only
+  // its clear value and the frame is rendered without a depth input (no copy pass).
+  bool UseDepth;
 };
 
 // How ferrovol's frames reach OpenGL. Each path takes VTK's opaque depth for the viewport,
@@ -481,15 +484,16 @@ public:
     // pixels ferrovol renders (rows top to bottom), picking texels as OpenGL's nearest
     // filtering does (the shared path samples the same depth on the GPU).
     std::string depthError;
-    const bool haveDepth = this->Depth.Read(req.Window, req.ViewportX, req.ViewportY,
-      req.ViewportW, req.ViewportH, this->WindowDepth, depthError);
-    if (!haveDepth)
+    const int rw = req.RenderW, rh = req.RenderH, vw = req.ViewportW, vh = req.ViewportH;
+    const bool haveDepth = req.UseDepth &&
+      this->Depth.Read(req.Window, req.ViewportX, req.ViewportY, req.ViewportW, req.ViewportH,
+        this->WindowDepth, depthError);
+    if (req.UseDepth && !haveDepth)
     {
       warning = "the volume ignores opaque geometry in this frame: " + depthError;
     }
-    const int rw = req.RenderW, rh = req.RenderH, vw = req.ViewportW, vh = req.ViewportH;
-    this->DepthInput.resize(static_cast<size_t>(rw) * rh);
-    for (int y = 0; y < rh; ++y)
+    this->DepthInput.resize(haveDepth ? static_cast<size_t>(rw) * rh : 0);
+    for (int y = 0; haveDepth && y < rh; ++y)
     {
       const float* src =
         this->WindowDepth.data() + static_cast<size_t>(vh - 1 - SourcePixel(y, rh, vh)) * vw;
@@ -507,8 +511,8 @@ public:
       }
     }
 
-    FvStatus st = fv_renderer_render(
-      renderer, rw, rh, this->DepthInput.data(), this->DepthInput.size());
+    FvStatus st = fv_renderer_render(renderer, rw, rh,
+      haveDepth ? this->DepthInput.data() : nullptr, this->DepthInput.size());
     if (st != FV_STATUS_OK)
     {
       error = FvError("render the frame", st);
@@ -749,14 +753,21 @@ public:
     {
       return false;
     }
-    if (!this->WriteDepthInput(req, error))
+    if (!req.UseDepth)
     {
-      warning = "the volume ignores opaque geometry in this frame: " + error;
-      error.clear();
-      this->ClearDepthInput(req);
+      st = fv_renderer_render(renderer, req.RenderW, req.RenderH, nullptr, 0);
     }
-    glFinish(); // ferrovol reads the depth input next
-    st = fv_renderer_render_with_shared_depth(renderer, req.RenderW, req.RenderH);
+    else
+    {
+      if (!this->WriteDepthInput(req, error))
+      {
+        warning = "the volume ignores opaque geometry in this frame: " + error;
+        error.clear();
+        this->ClearDepthInput(req);
+      }
+      glFinish(); // ferrovol reads the depth input next
+      st = fv_renderer_render_with_shared_depth(renderer, req.RenderW, req.RenderH);
+    }
     if (st != FV_STATUS_OK)
     {
       error = FvError("render the frame", st);
@@ -1752,6 +1763,78 @@ bool BuildTransferFunction(vtkFerroVolumeMapper* self, vtkVolumeProperty* prop, 
 } // namespace
 
 //------------------------------------------------------------------------------------------
+namespace
+{
+// Whether the renderer has visible props other than volumes that draw opaque geometry
+// before the volume pass. Without any, VTK's depth buffer holds only its clear value: the
+// frame then needs no depth input, which saves a full-viewport copy (about 6 ms of a 900x900
+// frame on llvmpipe, measured).
+bool HasOpaqueGeometry(vtkRenderer* ren, vtkVolume* self)
+{
+  vtkPropCollection* props = ren->GetViewProps();
+  vtkCollectionSimpleIterator it;
+  props->InitTraversal(it);
+  while (vtkProp* p = props->GetNextProp(it))
+  {
+    if (p != self && p->GetVisibility() && !vtkVolume::SafeDownCast(p) && p->HasOpaqueGeometry())
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The viewport pixels (x, y, w, h relative to the viewport) the volume's world bounding box,
+// grown by `pad` world units on every side, can cover (a volume one point thick renders as a
+// slab one spacing thick, beyond VTK's flat bounds); the whole viewport when a corner is
+// behind the camera. Outside them ferrovol's
+// frame is empty, so the compositing pass is scissored to them (it is a full-viewport
+// fragment pass otherwise: ~8 ms of a 900x900 frame on llvmpipe, measured).
+void ProjectedRect(vtkRenderer* ren, vtkVolume* vol, double pad, int vw, int vh, int rect[4])
+{
+  rect[0] = 0;
+  rect[1] = 0;
+  rect[2] = vw;
+  rect[3] = vh;
+  double b[6];
+  vol->GetBounds(b);
+  for (int k = 0; k < 3; ++k)
+  {
+    b[2 * k] -= pad;
+    b[2 * k + 1] += pad;
+  }
+  vtkMatrix4x4* m = ren->GetActiveCamera()->GetCompositeProjectionTransformMatrix(
+    static_cast<double>(vw) / vh, -1, 1);
+  double lo[2] = { 1e300, 1e300 }, hi[2] = { -1e300, -1e300 };
+  for (int i = 0; i < 8; ++i)
+  {
+    const double p[4] = { b[i & 1], b[2 + ((i >> 1) & 1)], b[4 + ((i >> 2) & 1)], 1.0 };
+    double c[4];
+    m->MultiplyPoint(p, c);
+    if (!(c[3] > 1e-12))
+    {
+      return;
+    }
+    for (int k = 0; k < 2; ++k)
+    {
+      lo[k] = std::min(lo[k], c[k] / c[3]);
+      hi[k] = std::max(hi[k], c[k] / c[3]);
+    }
+  }
+  const int size[2] = { vw, vh };
+  int r[4];
+  for (int k = 0; k < 2; ++k)
+  {
+    // NDC to pixels, one pixel of margin for rounding.
+    const double a = std::floor((lo[k] + 1.0) * 0.5 * size[k]) - 1.0;
+    const double z = std::ceil((hi[k] + 1.0) * 0.5 * size[k]) + 1.0;
+    r[k] = static_cast<int>(std::max(0.0, std::min(a, static_cast<double>(size[k]))));
+    r[k + 2] = static_cast<int>(std::max(0.0, std::min(z, static_cast<double>(size[k])))) - r[k];
+  }
+  std::copy(r, r + 4, rect);
+}
+}
+
 void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   this->LastRenderDrew = 0;
@@ -2164,6 +2247,7 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   req.ViewportH = vh;
   req.RenderW = std::max(1, static_cast<int>(vw / isd));
   req.RenderH = std::max(1, static_cast<int>(vh / isd));
+  req.UseDepth = HasOpaqueGeometry(ren, vol);
   if (!in->Output || in->OutputPreference != this->OutputPath || in->OutputWindow != win)
   {
     if (in->Output)
@@ -2250,8 +2334,22 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   vtkOpenGLState::ScopedglDepthFunc depthFuncSaver(ostate);
   vtkOpenGLState::ScopedglViewport viewportSaver(ostate);
   vtkOpenGLState::ScopedglEnableDisable cullSaver(ostate, GL_CULL_FACE);
+  vtkOpenGLState::ScopedglEnableDisable scissorSaver(ostate, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglScissor scissorBoxSaver(ostate);
   ostate->vtkglDisable(GL_CULL_FACE);
   ostate->vtkglViewport(vx, vy, vw, vh);
+  int rect[4];
+  const double* spacing = image->GetSpacing();
+  const double pad = matrixScale *
+    std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
+  ProjectedRect(ren, vol, pad, vw, vh, rect);
+  if (rect[2] < 1 || rect[3] < 1)
+  {
+    this->LastRenderDrew = 1; // the volume is entirely off screen: nothing to composite
+    return;
+  }
+  ostate->vtkglEnable(GL_SCISSOR_TEST);
+  ostate->vtkglScissor(vx + rect[0], vy + rect[1], rect[2], rect[3]);
   ostate->vtkglEnable(GL_BLEND);
   ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   // Rays already stopped at the opaque geometry: the volume's depth is written as is.
