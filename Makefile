@@ -76,7 +76,10 @@ lint: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
 
+# The C ABI tests load and link target/debug/libferrovol.so, which `cargo test` alone does
+# not build (it links tests against the rlib).
 test: lint
+	$(CARGO) build --locked -p ferrovol-ffi
 	$(CARGO) test --locked --workspace
 	$(MAKE) vtk-test
 	$(MAKE) paraview-test

@@ -21,7 +21,14 @@ impl Lib {
             .unwrap()
             .join("libferrovol.so");
         // SAFETY: loading our own library, whose initialisers are Rust's (none run code).
-        Lib(unsafe { Library::new(&path) }.unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+        // (`cargo test` builds only the rlib: `cargo build -p ferrovol-ffi` makes the cdylib,
+        // and `make test` runs it first.)
+        Lib(unsafe { Library::new(&path) }.unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}; build it with `cargo build -p ferrovol-ffi` (make test does)",
+                path.display()
+            )
+        }))
     }
     fn f<T>(&self, name: &str) -> Symbol<'_, T> {
         // SAFETY: each call site names the C signature of the symbol it looks up.

@@ -18,7 +18,8 @@ fn build(source: &str, compiler: &str, std: &str, extra: &[&str]) -> PathBuf {
     let lib = lib_dir();
     assert!(
         lib.join("libferrovol.so").exists(),
-        "{} missing: build the ffi crate first",
+        "{} missing: build it with `cargo build -p ferrovol-ffi` (make test does; `cargo test` \
+         builds only the rlib)",
         lib.join("libferrovol.so").display()
     );
     let tmp = std::env::temp_dir().join(format!("ferrovol-ffi-{}", std::process::id()));
