@@ -15,28 +15,8 @@ struct Brick {
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
 
-// With nearest interpolation (the NEAREST pipeline constant) volume reads load the texel
-// directly: the values a nearest sampler returns (clamped to the edge like it), without the
-// sampler's coordinate and filtering work, which measured ~10% of an unshaded frame on
-// lavapipe. Texel (i, j, k) holds point tex_lo + (i, j, k).
-fn texel_of(p: vec3<f32>) -> vec3<i32> {
-    return vec3<i32>(floor(p - brick.tex_lo.xyz + 0.5));
-}
-
-fn load_texel(ijk: vec3<i32>) -> vec4<f32> {
-    let hi = vec3<i32>(textureDimensions(volume_tex)) - 1;
-    return textureLoad(volume_tex, clamp(ijk, vec3<i32>(0), hi), 0);
-}
-
-fn load_scalars(ijk: vec3<i32>) -> vec4<f32> {
-    return load_texel(ijk) * frame.scalar_scale + frame.scalar_shift;
-}
-
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
-    if (NEAREST) {
-        return load_texel(texel_of(p));
-    }
     let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
     return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
 }
@@ -60,28 +40,12 @@ struct Gradient {
 // Index-space gradient of every component: central differences (6 samples) or forward
 // differences from the centre value s (3 samples).
 fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
-    var g: Gradient;
-    if (NEAREST) {
-        let c = texel_of(p);
-        let ex = vec3<i32>(1, 0, 0);
-        let ey = vec3<i32>(0, 1, 0);
-        let ez = vec3<i32>(0, 0, 1);
-        if (has_flag(FLAG_FORWARD_DIFF)) {
-            g.x = load_scalars(c + ex) - s;
-            g.y = load_scalars(c + ey) - s;
-            g.z = load_scalars(c + ez) - s;
-        } else {
-            g.x = 0.5 * (load_scalars(c + ex) - load_scalars(c - ex));
-            g.y = 0.5 * (load_scalars(c + ey) - load_scalars(c - ey));
-            g.z = 0.5 * (load_scalars(c + ez) - load_scalars(c - ez));
-        }
-        return g;
-    }
     // neighbours one voxel away, offset directly in texture coordinates
     let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
     let dx = vec3<f32>(brick.tex_inv_size.x, 0.0, 0.0);
     let dy = vec3<f32>(0.0, brick.tex_inv_size.y, 0.0);
     let dz = vec3<f32>(0.0, 0.0, brick.tex_inv_size.z);
+    var g: Gradient;
     if (has_flag(FLAG_FORWARD_DIFF)) {
         g.x = scalars_at(tc + dx) - s;
         g.y = scalars_at(tc + dy) - s;
