@@ -2,6 +2,7 @@
 #   make demo   render the built-in demo volume to build/demo.png
 #   make test   format, lint and run every test (installs what is missing first)
 #   make bench  VTK's GPU ray cast benchmark scene, ferrovol vs vtkGPUVolumeRayCastMapper
+#   make bench-vtk  the same scene in a VTK window: vtkFerroVolumeMapper vs vtkGPUVolumeRayCastMapper
 #   make build  release build of the `ferrovol` command and the VTK module (make vtk)
 #   make vtk    vtkFerroVolumeMapper (C++ + Python package `ferrovol`) in build/vtk;
 #               writes build/env.sh: `. build/env.sh; /usr/bin/python3 -c "import vtk, ferrovol"`
@@ -10,12 +11,17 @@
 #               `. build/env.sh && pvpython` then has it loaded (PV_PLUGIN_PATH)
 #   make paraview-test  the plugin's pvbatch tests, serial and `mpiexec -n 2`, under Xvfb
 #   make paraview-regression  the same with 4 MPI ranks
+#   make regression  ferrovol against VTK's own volume rendering, scene by scene
+#               (tests/regression/); report: build/regression/index.html; then the
+#               ParaView tests with 4 MPI ranks
+#   make regression-quick  the subset of it that `make test` runs
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
-.PHONY: deps build demo test lint bench pictures vtk vtk-test paraview paraview-test paraview-regression
+.PHONY: deps build demo test lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
+        regression regression-quick
 
 deps:
 	@bash scripts/install-deps.sh
@@ -83,12 +89,36 @@ test: lint
 	$(CARGO) test --locked --workspace
 	$(MAKE) vtk-test
 	$(MAKE) paraview-test
+	$(MAKE) regression-quick
+
+# The regression suite (tests/regression/README.md): every scene of tests/regression/scenes.py
+# rendered by vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper and
+# vtkFerroVolumeMapper in a private Xvfb; SSIM, PSNR, FLIP and footprint colour difference
+# against tests/regression/thresholds.toml; report in build/regression/index.html. The whole
+# matrix takes ~70 s on 2 cores, the quick subset ~35 s. Scenes whose data is missing are
+# reported as skipped (scripts/fetch-data.sh makes it).
+REGRESSION = . build/env.sh && env -u DISPLAY scripts/with-xvfb.sh \
+  vtk_plugin/tests/retry-on-x-failure.sh /usr/bin/python3 tests/regression/run.py
+regression: vtk
+	@scripts/fetch-data.sh >/dev/null
+	$(REGRESSION)
+	$(MAKE) paraview-regression
+
+regression-quick: vtk
+	@scripts/fetch-data.sh >/dev/null || echo "regression-quick: data missing, those scenes are skipped"
+	$(REGRESSION) --quick
 
 # The first process after a shader change runs 3-4x slower on lavapipe until Mesa's shader
 # cache holds the pipelines (measured), so a short priming run of both renderers goes first.
 bench: build
 	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 2 >/dev/null
 	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 20 --png-dir build/bench
+
+# vtkFerroVolumeMapper (zero-copy shared path and readback path) against
+# vtkGPUVolumeRayCastMapper in a VTK window, the same benchmark scene, alternating rounds.
+bench-vtk: vtk
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 1 >/dev/null
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5
 
 # The README's pictures.
 pictures: build

@@ -14,4 +14,15 @@ fi
 [ -f build/data/cranium.vti ] || python3 scripts/convert_inv3.py \
   /usr/share/doc/invesalius-examples/examples/Cranium.inv3 build/data/cranium.vti
 [ -f build/data/colin27.nii.gz ] || cp /usr/share/mricron/templates/ch2.nii.gz build/data/colin27.nii.gz
+# mayavi2's heart.vti (a small float32 CT volume): taken out of the .deb, not installed.
+if [ ! -f build/data/heart.vti ]; then
+  tmp=$(mktemp -d)
+  if ! (cd "$tmp" && apt-get download mayavi2 >/dev/null 2>&1); then
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
+    $SUDO apt-get update -qq && (cd "$tmp" && apt-get download mayavi2 >/dev/null 2>&1)
+  fi
+  dpkg-deb --fsys-tarfile "$tmp"/mayavi2_*.deb | tar -x -C "$tmp" --wildcards '*/examples/mayavi/data/heart.vti'
+  cp "$tmp"/usr/share/doc/mayavi2/examples/mayavi/data/heart.vti build/data/heart.vti
+  rm -rf "$tmp"
+fi
 ls -la build/data

@@ -10,6 +10,9 @@ PKGS=(mesa-vulkan-drivers libvulkan1 xvfb xauth cmake ninja-build pkg-config
 # libopenmpi-dev, libglew-dev: ParaView's VTK CMake package needs MPI's and GLEW's headers
 # to build a VTK module against it (vtk_plugin/, paraview/).
 PKGS+=(libdouble-conversion-dev)
+PKGS+=(python3-scipy)
+# python3-scipy: image filtering for the FLIP metric of the regression suite
+# (tests/regression/flip.py).
 # libdouble-conversion-dev: find_package(ParaView COMPONENTS RemotingViews ...) (paraview/)
 # pulls in VTK::IOCore, whose CMake package requires double-conversion's headers.
 missing=()

@@ -3,9 +3,11 @@ same settings, SSIM and PSNR printed for each, images saved (ferrovol | VTK | 4x
 
 Thresholds: each sits a margin below what was measured on lavapipe/llvmpipe (the numbers in
 the comments), so that a real change in what the mapper hands ferrovol fails while driver
-noise does not. Differences that remain are the renderers' own: VTK steps rays from the
-volume's bounding box faces through its proxy geometry, ferrovol from the ray's box entry,
-so sample positions (and wood-grain patterns) differ by a fraction of a step.
+noise does not. Differences that remain are the renderers' own: both march rays on a lattice
+anchored at the box entry, but VTK 9.2 takes its first sample one step inside the box
+(g_rayOrigin += g_dirStep) where ferrovol samples the entry face, so ferrovol has one extra
+sample per ray, which weighs less the finer the step (tests/regression/SAMPLING.md has the
+whole comparison).
 """
 import os
 import unittest
