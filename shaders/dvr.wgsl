@@ -1,7 +1,10 @@
 // Direct volume rendering: marches each pixel's ray through one brick and carries the
 // ray's state (colour, running max/min/sum, depth) to the next brick in visibility order.
-// Samples sit on one lattice per ray, t_k = t_entry + (k + jitter)·Δ, whatever the
-// bricking, so a bricked volume gives the same samples as an unbricked one.
+// Samples sit on one lattice per ray, whatever the bricking, so a bricked volume gives the
+// same samples as an unbricked one. The lattice is VTK 9.2's (tests/regression/SAMPLING.md):
+// t_k = t_entry + (k + 1)·Δ (k + jitter with jittering), the first sample taken even past
+// the exit, a sample on the exit face kept, and up to one step past opaque depth and
+// clipping planes.
 #include "lib/common.wgsl"
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
@@ -165,14 +168,37 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let ray = make_ray(px);
     // The whole ray segment inside the volume, near/far planes, opaque depth and clip planes.
-    var seg = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
-    seg.x = max(seg.x, 0.0);
-    seg.y = min(seg.y, ray.far);
+    let dt = frame.misc.x;
+    let box = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    var seg = vec2<f32>(max(box.x, 0.0), min(box.y, ray.far));
+    // VTK 9.2: the ray ends at the opaque depth or a clipping plane, but its loop tests that
+    // end only after stepping, so it samples up to one step past it (never past the box).
+    var term = ray.far;
     if (has_flag(FLAG_DEPTH_INPUT)) {
         let d = textureLoad(depth_in, vec2<i32>(px), 0).x;
-        seg.y = min(seg.y, depth_to_distance(ray, px, d));
+        term = min(term, depth_to_distance(ray, px, d));
     }
-    seg = clip_interval(ray, seg);
+    let cl = clip_interval(ray, vec2<f32>(seg.x, term));
+    var first_forced = false;
+    var jit = 1.0; // VTK: g_rayOrigin += g_dirStep (no jitter): the first sample one step in
+    if (has_flag(FLAG_JITTER)) {
+        jit = hash01(pix ^ frame.viewport.w);
+    }
+    if (!(max(seg.x, cl.x) < min(seg.y, cl.y))) {
+        seg = vec2<f32>(1.0, 0.0);
+    } else {
+        seg.x = cl.x;
+        seg.y = min(seg.y, cl.y + dt);
+        if (frame.counts.x > 0u) {
+            // VTK discards a clipped ray whose first sample lies outside the box
+            if (seg.x + jit * dt > box.y) {
+                seg = vec2<f32>(1.0, 0.0);
+            }
+        } else if (seg.x + jit * dt >= seg.y) {
+            // VTK always takes its first sample (clamped to the edge) even past the exit
+            first_forced = true;
+        }
+    }
     // This brick's part of it.
     let b = box_interval(ray, brick.core_lo.xyz, brick.core_hi.xyz);
     let t_lo = max(b.x, seg.x);
@@ -184,14 +210,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         return;
     }
-    let dt = frame.misc.x;
-    var jit = 0.0;
-    if (has_flag(FLAG_JITTER)) {
-        jit = hash01(pix ^ frame.viewport.w);
-    }
     var k = max(ceil((t_lo - seg.x) / dt - jit), 0.0);
     // Bounded below 2^24 so that k + 1 is always exact and the loop always ends.
-    let k_end = min(ceil((t_hi - seg.x) / dt - jit), 1.0e7);
+    // Samples before t_hi; where this brick holds the segment's end, a sample exactly on it
+    // too (VTK keeps a sample on the exit face). Brick boundaries stay half-open, so a sample
+    // on one is taken once.
+    let k_last = (t_hi - seg.x) / dt - jit;
+    var k_end = min(select(ceil(k_last), floor(k_last) + 1.0, t_hi >= seg.y), 1.0e7);
+    if (first_forced && t_lo == seg.x) {
+        k_end = max(k_end, 1.0);
+    }
     var color = st.color;
     var value = st.value;
     var misc = st.misc;

@@ -388,10 +388,13 @@ fn cpu_render(
             let (io, id, t0, t1) = ray_segment(v, &ray);
             let mut acc = [0.0f64; 4];
             let mut d = 1.0;
-            let mut k = 0.0;
+            // VTK 9.2's lattice: the first sample one step inside (taken even when that is
+            // past the exit, clamped to the edge), then every step up to and including the
+            // exit.
+            let mut k = 1.0;
             loop {
                 let t = t0 + k * dt;
-                if t0 >= t1 || t >= t1 {
+                if t0 >= t1 || (t > t1 && k > 1.0) {
                     break;
                 }
                 k += 1.0;

@@ -382,9 +382,9 @@ OUTLINE_NOTE = ("Outline: VTK rasterises its proxy box into the 8x multisampled 
                 "composite covers a pixel fully or not at all, and VTK also takes one sample "
                 "on rays that graze an edge by less than a step.")
 
-SAMPLING_NOTE = ("Sample placement: VTK's first sample is one step inside the box "
-                 "(g_rayOrigin += g_dirStep), ferrovol's is on the entry face; see the "
-                 "sampling analysis in the report header.")
+SAMPLING_NOTE = ("Sample placement: ferrovol samples on VTK 9.2's lattice (first sample one "
+                 "step inside the box, the exit-face sample kept), adopted after this suite "
+                 "found the difference; what remains is listed in SAMPLING.md.")
 
 SCENES = [
     # --- wavelet 128^3: blend modes
