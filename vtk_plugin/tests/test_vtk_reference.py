@@ -275,10 +275,11 @@ class VtkReference(unittest.TestCase):
         cells.DeepCopy(point.GetPointData().GetScalars())
         cells.SetName("cells")
         img.GetCellData().SetScalars(cells)
-        # measured SSIM 0.954, PSNR 29.3 dB: the difference is the rim, VTK stretches cell
-        # data to the point bounds, ferrovol renders the grid of cell centres (half a voxel
-        # smaller on each side)
-        self.check("ref-cell-data", 0.93, 27.0, data=img,
+        # measured SSIM 0.924, PSNR 26.6 dB (0.954 / 29.3 dB before ferrovol took VTK's
+        # first-sample rule, which weighs the rim more): the difference is the rim, VTK
+        # stretches cell data to the point bounds, ferrovol renders the grid of cell centres
+        # (half a voxel smaller on each side)
+        self.check("ref-cell-data", 0.91, 25.5, data=img,
                    prop=lambda: tf_property(interpolation="linear"))
 
     def test_independent_components(self):
