@@ -6,8 +6,9 @@ mod readers;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
-    synth, BlendMode, Context, GradientMethod, Interpolation, RenderParams, Renderer,
-    UploadOptions, View, VolumeData,
+    synth, AmbientOcclusion, BlendMode, Context, Environment, GradientMethod, Interpolation,
+    IsoParams, IsoValue, RenderParams, Renderer, Shininess, SpecularMode, UploadOptions, View,
+    VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -23,7 +24,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a volume (or a built-in one) to a PNG.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Time VTK's GPU ray cast benchmark scene (wavelet 256³, 900×900), shaded and unshaded.
     Bench(bench::BenchArgs),
     /// Print the GPU adapter, backend and limits ferrovol would use.
@@ -44,6 +45,17 @@ enum Mode {
     Minip,
     Average,
     Additive,
+    /// Isosurfaces (--iso): first hit with bisection, deferred shading with environment
+    /// lighting and ambient occlusion.
+    Iso,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
+enum SpecularArg {
+    /// Random vectors in a cone blended with the reflection vector (simple, noisy).
+    Cone,
+    /// Importance sampling of the Phong lobe with mip filtering.
+    Importance,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -107,9 +119,237 @@ struct RenderArgs {
     /// Split the volume into bricks of at most this many points per edge.
     #[arg(long)]
     brick: Option<u32>,
+    /// Render this many frames and print the mean time per frame (the first, which builds
+    /// pipelines and maps, is not counted).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    repeat: u32,
+    #[command(flatten)]
+    iso: IsoArgs,
     /// Output PNG.
     #[arg(long, short, default_value = "ferrovol.png")]
     out: PathBuf,
+}
+
+/// Isosurface options (--mode iso).
+#[derive(clap::Args)]
+struct IsoArgs {
+    /// An isosurface, VALUE[:OPACITY[:R,G,B]] (opacity in (0, 1], default 1; colour
+    /// components in [0, 1]); repeat for nested surfaces, e.g. --iso 300 --iso -300:0.3.
+    /// Default: the middle of the data range.
+    #[arg(long = "iso", value_parser = parse_iso, allow_hyphen_values = true)]
+    values: Vec<(f64, Option<f32>, Option<[f32; 3]>)>,
+    /// Environment: an equirectangular .hdr/.exr/.png/.jpg image, or `sky` for the built-in
+    /// procedural sky (the default).
+    #[arg(long)]
+    env: Option<String>,
+    /// Environment from six square cube faces: +X,-X,+Y,-Y,+Z,-Z image paths, comma-separated.
+    #[arg(long, conflicts_with = "env")]
+    env_cube: Option<String>,
+    /// The world axis that is up in the environment: x, y, z, -x, -y or -z.
+    #[arg(long, default_value = "y", value_parser = parse_axis, allow_hyphen_values = true)]
+    env_up: [f64; 3],
+    /// Turn the environment about its up axis, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    env_azimuth: f64,
+    /// Multiply the environment's radiance.
+    #[arg(long, default_value_t = 1.0)]
+    env_intensity: f32,
+    /// Weight of environment lighting on the surfaces (0: the headlight only; 1 with
+    /// --no-lights).
+    #[arg(long, default_value_t = 0.6)]
+    env_light: f32,
+    /// Show the environment behind the surfaces.
+    #[arg(long)]
+    env_background: bool,
+    /// Specular environment sampling.
+    #[arg(long, value_enum, default_value = "importance")]
+    specular: SpecularArg,
+    /// Environment samples on the specular lobe per shaded point.
+    #[arg(long, default_value_t = 16)]
+    specular_samples: u32,
+    /// Specular exponent: S (constant) or LO:HI (from LO at weak to HI at strong gradients).
+    #[arg(long, default_value = "8:64", value_parser = parse_shininess, allow_hyphen_values = true)]
+    shininess: (f32, Option<f32>),
+    /// Gradient magnitudes G0:G1 (scalar units per world unit) the LO:HI exponents span
+    /// (default: 0 to a quarter of the data range per voxel).
+    #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
+    shininess_range: Option<[f64; 2]>,
+    /// Schlick Fresnel weighting of specular light with this reflectance at normal incidence.
+    #[arg(long)]
+    fresnel: Option<f32>,
+    /// Ambient occlusion with this many directions per hit.
+    #[arg(long)]
+    ao: Option<u32>,
+    /// Steps per ambient-occlusion ray.
+    #[arg(long, default_value_t = 8)]
+    ao_steps: u32,
+    /// Ambient-occlusion ray length, world units (default: 8 voxels).
+    #[arg(long)]
+    ao_radius: Option<f64>,
+    /// Bisection steps refining each crossing.
+    #[arg(long, default_value_t = 8)]
+    bisection: u32,
+    /// Surface layers kept per pixel (translucent surfaces).
+    #[arg(long, default_value_t = 4)]
+    layers: u32,
+    /// No headlight: environment lighting only.
+    #[arg(long)]
+    no_lights: bool,
+}
+
+/// Default colours of the isosurfaces, in order: bone, skin, then distinct hues.
+const ISO_COLORS: [[f32; 3]; 8] = [
+    [0.95, 0.92, 0.84],
+    [0.92, 0.68, 0.56],
+    [0.55, 0.72, 0.95],
+    [0.6, 0.88, 0.6],
+    [0.95, 0.82, 0.4],
+    [0.78, 0.6, 0.92],
+    [0.92, 0.5, 0.5],
+    [0.55, 0.9, 0.9],
+];
+
+type IsoSpec = (f64, Option<f32>, Option<[f32; 3]>);
+
+fn parse_iso(s: &str) -> Result<IsoSpec, String> {
+    let mut parts = s.splitn(3, ':');
+    let v = parts.next().unwrap_or("").trim();
+    let value: f64 = v
+        .parse()
+        .ok()
+        .filter(|x: &f64| x.is_finite())
+        .ok_or_else(|| {
+            format!("iso-value '{v}' in '{s}' is not a finite number (VALUE[:OPACITY[:R,G,B]])")
+        })?;
+    let opacity = match parts.next() {
+        None => None,
+        Some(o) => Some(
+            o.trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|a| *a > 0.0 && *a <= 1.0)
+                .ok_or_else(|| format!("opacity '{o}' in '{s}' must be a number in (0, 1]"))?,
+        ),
+    };
+    let color = match parts.next() {
+        None => None,
+        Some(c) => Some(parse_rgb(c).map_err(|e| format!("in '{s}': {e}"))?),
+    };
+    Ok((value, opacity, color))
+}
+
+fn parse_axis(s: &str) -> Result<[f64; 3], String> {
+    Ok(match s.trim().to_ascii_lowercase().as_str() {
+        "x" | "+x" => [1.0, 0.0, 0.0],
+        "y" | "+y" => [0.0, 1.0, 0.0],
+        "z" | "+z" => [0.0, 0.0, 1.0],
+        "-x" => [-1.0, 0.0, 0.0],
+        "-y" => [0.0, -1.0, 0.0],
+        "-z" => [0.0, 0.0, -1.0],
+        _ => return Err(format!("axis '{s}' must be x, y, z, -x, -y or -z")),
+    })
+}
+
+fn parse_shininess(s: &str) -> Result<(f32, Option<f32>), String> {
+    let num = |p: &str| {
+        p.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite() && *v >= 0.0)
+            .ok_or_else(|| format!("shininess '{p}' must be a non-negative number"))
+    };
+    match s.split_once(':') {
+        None => Ok((num(s)?, None)),
+        Some((a, b)) => Ok((num(a)?, Some(num(b)?))),
+    }
+}
+
+fn parse_range(s: &str) -> Result<[f64; 2], String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("range '{s}' must look like LOW:HIGH"))?;
+    let num = |p: &str| {
+        p.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{p}' in range '{s}' is not a finite number"))
+    };
+    let (lo, hi) = (num(a)?, num(b)?);
+    if lo >= hi {
+        return Err(format!("range '{s}': LOW must be below HIGH"));
+    }
+    Ok([lo, hi])
+}
+
+/// The isosurface parameters and environment the flags describe.
+fn iso_setup(a: &IsoArgs, vol: &VolumeData) -> Result<(IsoParams, Environment), CliError> {
+    let specs: Vec<IsoSpec> = if a.values.is_empty() {
+        let [lo, hi] = vol.range(0);
+        let mid = 0.5 * (lo + hi);
+        eprintln!("ferrovol: no --iso given; using the middle of the data range, {mid}");
+        vec![(mid, None, None)]
+    } else {
+        a.values.clone()
+    };
+    if specs.len() > ferrovol_core::iso::MAX_ISO_VALUES {
+        return Err(CliError::Usage(format!(
+            "{} --iso values: at most {}",
+            specs.len(),
+            ferrovol_core::iso::MAX_ISO_VALUES
+        )));
+    }
+    let values = specs
+        .iter()
+        .enumerate()
+        .map(|(i, &(v, o, c))| IsoValue::new(v, c.unwrap_or(ISO_COLORS[i]), o.unwrap_or(1.0)))
+        .collect();
+    let shininess = match a.shininess {
+        (s, None) => Shininess::Constant(s),
+        (lo, Some(hi)) => Shininess::GradientMagnitude {
+            range: a.shininess_range,
+            exponents: [lo, hi],
+        },
+    };
+    let iso = IsoParams {
+        values,
+        bisection_steps: a.bisection,
+        max_layers: a.layers,
+        specular: match a.specular {
+            SpecularArg::Cone => SpecularMode::Cone,
+            SpecularArg::Importance => SpecularMode::Importance,
+        },
+        specular_samples: a.specular_samples,
+        shininess,
+        fresnel: a.fresnel,
+        ambient_occlusion: a.ao.map(|n| AmbientOcclusion {
+            samples: n,
+            steps: a.ao_steps,
+            radius: a.ao_radius,
+        }),
+        environment_light: a.env_light,
+        background: a.env_background,
+    };
+    iso.validate()?;
+    let mut env = match (&a.env, &a.env_cube) {
+        (Some(e), _) if e != "sky" => Environment::load(std::path::Path::new(e))?,
+        (_, Some(list)) => {
+            let paths: Vec<&std::path::Path> = list.split(',').map(std::path::Path::new).collect();
+            let six: &[&std::path::Path; 6] = paths.as_slice().try_into().map_err(|_| {
+                CliError::Usage(format!(
+                    "--env-cube needs six comma-separated images (+X,-X,+Y,-Y,+Z,-Z), got {}",
+                    paths.len()
+                ))
+            })?;
+            Environment::load_cube(six)?
+        }
+        _ => Environment::default(),
+    };
+    env.up = glam::DVec3::from_array(a.env_up);
+    env.azimuth = a.env_azimuth;
+    env.intensity = a.env_intensity;
+    env.validate()?;
+    Ok((iso, env))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -193,6 +433,11 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         ),
     };
     let tf = presets::transfer_function(a.tf.as_deref().unwrap_or(default_tf), &vol)?;
+    let iso = if a.mode == Mode::Iso {
+        Some(iso_setup(&a.iso, &vol)?)
+    } else {
+        None
+    };
     pb.set_message("starting the GPU");
     let mut r = Renderer::new(Context::new()?)?;
     pb.set_message("uploading");
@@ -204,6 +449,11 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         },
     )?;
     r.set_transfer_function(&tf)?;
+    if let Some((p, env)) = &iso {
+        pb.set_message("filtering the environment");
+        r.set_isosurface(p)?;
+        r.set_environment(env)?;
+    }
     let (w, h) = a.size;
     let mut view = View::fit(vol.bounds(), w, h);
     view.camera.parallel = a.parallel;
@@ -219,6 +469,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             Mode::Minip => BlendMode::Minimum,
             Mode::Average => BlendMode::Average,
             Mode::Additive => BlendMode::Additive,
+            Mode::Iso => BlendMode::Isosurface,
         },
         interpolation: if a.interpolation == InterpArg::Nearest {
             Interpolation::Nearest
@@ -236,8 +487,21 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         ..Default::default()
     };
     params.shading.enabled = a.shade;
+    if a.iso.no_lights {
+        view.lights.clear();
+    }
     pb.set_message("rendering");
-    let img = r.render_image(&view, &params)?;
+    let mut img = r.render_image(&view, &params)?;
+    let mut timing = None;
+    if a.repeat > 1 {
+        let t0 = std::time::Instant::now();
+        for _ in 1..a.repeat {
+            r.render(&view, &params, None)?;
+            r.finish()?;
+        }
+        timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);
+        img = r.read_image()?;
+    }
     img.save_png(&a.out, a.background)?;
     pb.finish_and_clear();
     let src = a.input.as_ref().map_or_else(
@@ -254,13 +518,20 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         r.context().info.name,
         a.out.display()
     );
+    if let Some(ms) = timing {
+        println!(
+            "ferrovol: {:.1} ms/frame (mean of {} frames after the first)",
+            ms,
+            a.repeat - 1
+        );
+    }
     Ok(())
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(a) => render(a),
+        Command::Render(a) => render(*a),
         Command::Bench(a) => bench::run(a),
         Command::Info => Context::new()
             .map(|c| println!("{}", c.info))

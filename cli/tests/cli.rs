@@ -69,3 +69,74 @@ fn demo_render_writes_a_picture_of_the_volume() {
     assert!(lit > 96 * 80 / 10, "only {lit} lit pixels");
     assert_eq!(corner, [0, 0, 0]);
 }
+
+#[test]
+fn iso_flags_reject_bad_values_with_a_message() {
+    for (args, words) in [
+        (vec!["--iso", "abc"], "not a finite number"),
+        (vec!["--iso", "0.5:0"], "(0, 1]"),
+        (vec!["--iso", "0.5:1.5"], "(0, 1]"),
+        (vec!["--iso", "0.5:1:2,0,0"], "[0, 1]"),
+        (
+            vec!["--iso", "0.5", "--env", "/no/such/sky.hdr"],
+            "/no/such/sky.hdr",
+        ),
+        (
+            vec!["--iso", "0.5", "--env", "sky.txt"],
+            "unsupported file type",
+        ),
+        (vec!["--iso", "0.5", "--env-cube", "a.png,b.png"], "six"),
+        (vec!["--iso", "0.5", "--env-up", "w"], "x, y, z"),
+        (
+            vec!["--iso", "0.5", "--specular-samples", "0"],
+            "specular samples",
+        ),
+        (vec!["--iso", "0.5", "--ao", "0"], "ambient-occlusion"),
+        (vec!["--iso", "0.5", "--layers", "9"], "layers"),
+        (vec!["--iso", "0.5", "--shininess", "-1"], "non-negative"),
+        (vec!["--iso", "0.5", "--fresnel", "2"], "Fresnel"),
+    ] {
+        let mut all = vec!["render", "--demo", "marschner-lobb", "--mode", "iso"];
+        all.extend(&args);
+        all.extend(["--size", "16x16", "--out", "/tmp/ferrovol-cli-never.png"]);
+        let (code, _, err) = ferrovol(&all);
+        println!(
+            "{args:?}: exit {code}: {}",
+            err.lines().next().unwrap_or("")
+        );
+        assert_ne!(code, 0, "{args:?}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(err.contains(words), "{args:?}: '{err}' lacks '{words}'");
+    }
+}
+
+#[test]
+fn iso_render_of_nested_surfaces_with_ao() {
+    let out = std::env::temp_dir().join("ferrovol-cli-test-iso.png");
+    let path = out.to_str().expect("utf-8 temp path");
+    let (code, stdout, err) = ferrovol(&[
+        "render",
+        "--demo",
+        "marschner-lobb",
+        "--mode",
+        "iso",
+        "--iso",
+        "0.7",
+        "--iso",
+        "0.3:0.4:1,0.6,0.5",
+        "--ao",
+        "8",
+        "--env-background",
+        "--size",
+        "64x64",
+        "--out",
+        path,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains(path), "{stdout}");
+    let img = image::open(&out).expect("a PNG").to_rgb8();
+    // the environment fills the background: no black pixel is left
+    let black = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
+    println!("black pixels: {black}");
+    assert_eq!(black, 0);
+}

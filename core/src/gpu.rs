@@ -66,6 +66,43 @@ pub const FLAG_INDEPENDENT: u32 = 64;
 pub const FLAG_DEPTH_INPUT: u32 = 128;
 pub const FLAG_AVERAGE_RANGE: u32 = 1024;
 
+/// The isosurface uniforms (`Iso` in shaders/lib/iso.wgsl), read by the first-hit and
+/// deferred passes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct IsoUniforms {
+    pub env_rotation: [f32; 16],
+    pub values: [[f32; 4]; 2],
+    pub colors: [[f32; 4]; 8],
+    pub shininess: [f32; 4],
+    pub ao: [f32; 4],
+    pub env: [f32; 4],
+    pub counts: [u32; 4],
+    pub options: [u32; 4],
+    pub shade_rect: [u32; 4],
+}
+
+/// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct EnvUniforms {
+    pub zenith: [f32; 4],
+    pub horizon: [f32; 4],
+    pub ground: [f32; 4],
+    pub sun: [f32; 4],
+    pub sun_color: [f32; 4],
+    pub scale: [f32; 4],
+    pub params: [u32; 4],
+}
+
+// Isosurface constants (lib/iso.wgsl, environment.wgsl).
+pub const ISO_MAX_VALUES: usize = 8;
+pub const SPECULAR_CONE: u32 = 0;
+pub const SPECULAR_IMPORTANCE: u32 = 1;
+pub const ISO_FLAG_BACKGROUND: u32 = 1;
+pub const ENV_SKY: u32 = 0;
+pub const ENV_EQUIRECT: u32 = 1;
+
 pub fn mat(m: glam::DMat4) -> [f32; 16] {
     m.as_mat4().to_cols_array()
 }
@@ -159,6 +196,103 @@ mod layout_tests {
         );
         let (_, ps) = wgsl_struct(&m, "PixelState");
         assert_eq!(ps as u64, PIXEL_STATE_BYTES);
+    }
+
+    #[test]
+    fn iso_uniforms_match_wgsl() {
+        for pass in ["firsthit.wgsl", "deferred.wgsl"] {
+            let m = module(pass);
+            check!(
+                m,
+                "Iso",
+                IsoUniforms,
+                [
+                    env_rotation,
+                    values,
+                    colors,
+                    shininess,
+                    ao,
+                    env,
+                    counts,
+                    options,
+                    shade_rect
+                ]
+            );
+            check!(
+                m,
+                "Frame",
+                FrameUniforms,
+                [
+                    inv_view_proj,
+                    view_proj,
+                    world_to_index,
+                    index_to_data,
+                    gradient_to_world,
+                    dims,
+                    scalar_scale,
+                    scalar_shift,
+                    tf_lo,
+                    tf_inv_width,
+                    go_lo,
+                    go_inv_width,
+                    weights,
+                    material,
+                    crop_lo,
+                    crop_hi,
+                    misc,
+                    average_range,
+                    additive_scale,
+                    clip,
+                    lights,
+                    viewport,
+                    mode,
+                    counts,
+                    occupancy_dims,
+                    rect
+                ]
+            );
+            let (_, ps) = wgsl_struct(&m, "PixelState");
+            assert_eq!(ps as u64, PIXEL_STATE_BYTES);
+        }
+        let m = module("environment.wgsl");
+        check!(
+            m,
+            "EnvBuild",
+            EnvUniforms,
+            [zenith, horizon, ground, sun, sun_color, scale, params]
+        );
+    }
+
+    #[test]
+    fn iso_constants_match_wgsl() {
+        let iso = crate::shaders::compose("deferred.wgsl");
+        let env = crate::shaders::compose("environment.wgsl");
+        for (src, name, v) in [
+            (&iso, "MAX_ISO", ISO_MAX_VALUES as u32),
+            (&iso, "SPECULAR_CONE", SPECULAR_CONE),
+            (&iso, "SPECULAR_IMPORTANCE", SPECULAR_IMPORTANCE),
+            (&iso, "ISO_FLAG_BACKGROUND", ISO_FLAG_BACKGROUND),
+            (&env, "ENV_SKY", ENV_SKY),
+            (&env, "ENV_EQUIRECT", ENV_EQUIRECT),
+        ] {
+            let decl = format!("const {name}: u32 = {v}u;");
+            assert!(src.contains(&decl), "WGSL lacks `{decl}`");
+        }
+    }
+
+    /// Every WGSL file is part of some pass, so the naga test above validates all of them.
+    #[test]
+    fn every_file_is_part_of_a_pass() {
+        let used: Vec<String> = crate::shaders::PASSES
+            .iter()
+            .flat_map(|p| crate::shaders::files_of(p))
+            .collect();
+        for (path, _) in crate::shaders::FILES {
+            assert!(
+                used.iter().any(|u| u == path),
+                "{path} is listed in shaders::FILES but no pass includes it"
+            );
+        }
     }
 
     #[test]

@@ -17,9 +17,11 @@
 
 pub mod camera;
 pub mod device;
+pub mod environment;
 pub mod error;
 pub mod gpu;
 pub mod interop;
+pub mod iso;
 pub mod light;
 pub mod params;
 pub mod renderer;
@@ -31,8 +33,10 @@ pub mod volume;
 
 pub use camera::Camera;
 pub use device::{Context, DeviceInfo};
+pub use environment::{CubeImage, Environment, EnvironmentSource, Sky};
 pub use error::{Error, Result};
 pub use interop::{DeviceUuids, OutputPath, SharedImage, SharedOutput};
+pub use iso::{AmbientOcclusion, GBuffer, Hit, IsoParams, IsoValue, Shininess, SpecularMode};
 pub use light::{Light, LightSpace};
 pub use params::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,

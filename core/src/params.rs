@@ -17,6 +17,10 @@ pub enum BlendMode {
     Average,
     /// Sum of opacity-weighted scalars along the ray.
     Additive,
+    /// Isosurfaces: first hit with bisection, deferred shading with environment lighting
+    /// and ambient occlusion; the iso-values and their shading come from
+    /// [`crate::Renderer::set_isosurface`] (crate::iso), not the transfer function.
+    Isosurface,
 }
 
 impl BlendMode {
@@ -27,6 +31,7 @@ impl BlendMode {
             BlendMode::Minimum => 2,
             BlendMode::Average => 3,
             BlendMode::Additive => 4,
+            BlendMode::Isosurface => 5,
         }
     }
 }

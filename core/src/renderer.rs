@@ -93,30 +93,30 @@ impl Image {
     }
 }
 
-struct GpuBrick {
+pub(crate) struct GpuBrick {
     extent: BrickExtent,
     _texture: wgpu::Texture,
     _uniform: wgpu::Buffer,
-    bind_linear: wgpu::BindGroup,
+    pub(crate) bind_linear: wgpu::BindGroup,
     bind_nearest: wgpu::BindGroup,
 }
 
-struct GpuVolume {
+pub(crate) struct GpuVolume {
     data_dims: [u32; 3],
-    components: u32,
+    pub(crate) components: u32,
     index_to_data: DMat4,
     layout: Layout,
-    bricks: Vec<GpuBrick>,
-    minmax: MinMaxGrid,
+    pub(crate) bricks: Vec<GpuBrick>,
+    pub(crate) minmax: MinMaxGrid,
 }
 
-struct Targets {
+pub(crate) struct Targets {
     width: u32,
     height: u32,
-    state: wgpu::Buffer,
-    color: wgpu::Texture,
-    depth: wgpu::Texture,
-    depth_in: wgpu::Texture,
+    pub(crate) state: wgpu::Buffer,
+    pub(crate) color: wgpu::Texture,
+    pub(crate) depth: wgpu::Texture,
+    pub(crate) depth_in: wgpu::Texture,
     /// The exportable memory of `color`, `depth` and `depth_in` (owned by those textures)
     /// when they were allocated for [`OutputPath::Shared`].
     exported: Option<[ExportableMemory; 3]>,
@@ -136,7 +136,7 @@ impl Targets {
 
 /// Where the ray caster's depth input comes from.
 #[derive(Clone, Copy)]
-enum DepthSource<'a> {
+pub(crate) enum DepthSource<'a> {
     /// None: rays run to the far side of the volume.
     None,
     /// Uploaded from the CPU with the frame.
@@ -213,14 +213,14 @@ fn screen_rect(
 
 /// Edge of the square compute workgroups (`@workgroup_size` in dvr.wgsl and resolve.wgsl).
 /// 8×8 keeps rays in a workgroup coherent; 16×16 measured slower on lavapipe.
-const WORKGROUP: u32 = 8;
+pub(crate) const WORKGROUP: u32 = 8;
 
 /// Empty-space skipping is used only when fewer blocks than this fraction are occupied.
-const SKIP_MAX_OCCUPANCY: f64 = 0.9;
+pub(crate) const SKIP_MAX_OCCUPANCY: f64 = 0.9;
 
 /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct DvrVariant {
+pub(crate) struct DvrVariant {
     blend: u32,
     components: u32,
     independent: bool,
@@ -254,26 +254,29 @@ impl DvrVariant {
 }
 
 pub struct Renderer {
-    ctx: Context,
+    pub(crate) ctx: Context,
     dvr_module: wgpu::ShaderModule,
     dvr_layout: wgpu::PipelineLayout,
     dvr_variants: std::collections::HashMap<DvrVariant, wgpu::ComputePipeline>,
     resolve: wgpu::ComputePipeline,
     dvr_bgl: wgpu::BindGroupLayout,
-    brick_bgl: wgpu::BindGroupLayout,
+    pub(crate) brick_bgl: wgpu::BindGroupLayout,
     resolve_bgl: wgpu::BindGroupLayout,
     linear: wgpu::Sampler,
-    nearest: wgpu::Sampler,
-    frame_buf: wgpu::Buffer,
-    volume: Option<GpuVolume>,
+    pub(crate) nearest: wgpu::Sampler,
+    pub(crate) frame_buf: wgpu::Buffer,
+    pub(crate) volume: Option<GpuVolume>,
     tf: Option<TransferFunction>,
     tables: Option<(TableKey, wgpu::Buffer)>,
     occupancy: Option<(TableKey, wgpu::Buffer, f64)>,
-    targets: Option<Targets>,
+    pub(crate) targets: Option<Targets>,
     output_path: OutputPath,
     /// Counts allocations of the output images.
     generation: u64,
-    stats: Stats,
+    pub(crate) stats: Stats,
+    /// The isosurface passes (crate::iso), created on first use.
+    pub(crate) iso: Option<Box<crate::iso::IsoGpu>>,
+    pub(crate) iso_params: Option<crate::iso::IsoParams>,
 }
 
 fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -286,7 +289,7 @@ fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// A colour attachment that clears its first channel to `value` and the rest to zero.
-fn clear_attachment(
+pub(crate) fn clear_attachment(
     view: &wgpu::TextureView,
     value: f64,
 ) -> Option<wgpu::RenderPassColorAttachment<'_>> {
@@ -478,6 +481,8 @@ impl Renderer {
             output_path: OutputPath::Readback,
             generation: 0,
             stats: Stats::default(),
+            iso: None,
+            iso_params: None,
         })
     }
 
@@ -767,7 +772,7 @@ impl Renderer {
         self.occupancy.as_ref().map(|o| o.2)
     }
 
-    fn ensure_targets(&mut self, width: u32, height: u32) -> Result<()> {
+    pub(crate) fn ensure_targets(&mut self, width: u32, height: u32) -> Result<()> {
         if self
             .targets
             .as_ref()
@@ -859,7 +864,10 @@ impl Renderer {
                 state: d.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("ray state"),
                     size: PIXEL_STATE_BYTES * width as u64 * height as u64,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    // (COPY_SRC: Renderer::read_gbuffer reads the isosurface layer counts)
+                    usage: wgpu::BufferUsages::STORAGE
+                        | wgpu::BufferUsages::COPY_DST
+                        | wgpu::BufferUsages::COPY_SRC,
                     mapped_at_creation: false,
                 }),
                 color,
@@ -874,7 +882,7 @@ impl Renderer {
         Ok(())
     }
 
-    fn frame_uniforms(
+    pub(crate) fn frame_uniforms(
         &self,
         view: &View,
         params: &RenderParams,
@@ -886,10 +894,20 @@ impl Renderer {
             .volume
             .as_ref()
             .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
-        let tf = self
-            .tf
-            .as_ref()
-            .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
+        // Isosurfaces need no transfer function: a placeholder fills its uniforms.
+        let placeholder;
+        let tf = match self.tf.as_ref() {
+            Some(tf) => tf,
+            None if params.blend == BlendMode::Isosurface => {
+                placeholder = TransferFunction::ramp([0.0, 1.0], 1.0);
+                &placeholder
+            }
+            None => {
+                return Err(Error::InvalidParameter(
+                    "no transfer function has been set".into(),
+                ))
+            }
+        };
         let aspect = view.aspect();
         let vp = view.camera.view_projection(aspect);
         if !vp.is_finite() || vp.determinant().abs() < 1e-300 {
@@ -1049,7 +1067,7 @@ impl Renderer {
     /// Bricks in front-to-back order for this camera: along each axis, bricks on the
     /// camera's side of a brick boundary come first. For a grid of boxes this order is a
     /// valid visibility order for perspective and parallel projection alike.
-    fn brick_order(&self, view: &View, params: &RenderParams) -> Vec<usize> {
+    pub(crate) fn brick_order(&self, view: &View, params: &RenderParams) -> Vec<usize> {
         let Some(vol) = self.volume.as_ref() else {
             return vec![];
         };
@@ -1137,6 +1155,9 @@ impl Renderer {
         params: &RenderParams,
         depth: DepthSource<'_>,
     ) -> Result<()> {
+        if params.blend == BlendMode::Isosurface {
+            return self.render_isosurface(view, params, depth);
+        }
         params.validate()?;
         if view.lights.len() > MAX_LIGHTS && params.shading.enabled {
             return Err(Error::InvalidParameter(format!(

@@ -20,12 +20,37 @@ pub const FILES: &[(&str, &str)] = &[
         "lib/output.wgsl",
         include_str!("../../shaders/lib/output.wgsl"),
     ),
+    (
+        "lib/march.wgsl",
+        include_str!("../../shaders/lib/march.wgsl"),
+    ),
+    (
+        "lib/envmap.wgsl",
+        include_str!("../../shaders/lib/envmap.wgsl"),
+    ),
+    ("lib/iso.wgsl", include_str!("../../shaders/lib/iso.wgsl")),
+    (
+        "lib/surface.wgsl",
+        include_str!("../../shaders/lib/surface.wgsl"),
+    ),
     ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
+    ("firsthit.wgsl", include_str!("../../shaders/firsthit.wgsl")),
+    ("deferred.wgsl", include_str!("../../shaders/deferred.wgsl")),
+    (
+        "environment.wgsl",
+        include_str!("../../shaders/environment.wgsl"),
+    ),
 ];
 
 /// The passes (entry files, not library pieces).
-pub const PASSES: &[&str] = &["dvr.wgsl", "resolve.wgsl"];
+pub const PASSES: &[&str] = &[
+    "dvr.wgsl",
+    "resolve.wgsl",
+    "firsthit.wgsl",
+    "deferred.wgsl",
+    "environment.wgsl",
+];
 
 fn source(path: &str) -> Option<&'static str> {
     FILES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s)
@@ -37,6 +62,13 @@ pub fn compose(path: &str) -> String {
     let mut seen = Vec::new();
     expand(path, &mut out, &mut seen);
     out
+}
+
+/// The files a pass is composed of: itself and everything it includes, directly or not.
+pub fn files_of(path: &str) -> Vec<String> {
+    let mut seen = Vec::new();
+    expand(path, &mut String::new(), &mut seen);
+    seen
 }
 
 fn expand(path: &str, out: &mut String, seen: &mut Vec<String>) {

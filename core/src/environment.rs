@@ -1,0 +1,989 @@
+//! Environment maps for image-based lighting of isosurfaces.
+//!
+//! An [`Environment`] is the radiance arriving from every direction: a procedural sky (the
+//! default), an equirectangular image (HDR `.hdr`/`.exr` or LDR `.png`/`.jpg`, through the
+//! `image` crate) or six cube faces. [`crate::Renderer::set_environment`] turns it, once,
+//! into GPU maps (shaders/environment.wgsl):
+//!
+//! - the **environment cube** (`rgba16float`, full mip chain by 2×2 box filtering), which
+//!   specular lighting samples on the Phong lobe and the background shows;
+//! - the **irradiance cube** (32² per face): the π-normalised irradiance
+//!   `E(n)/π = (1/π)∫ L(ω) max(n·ω, 0) dω` per normal direction, by Monte Carlo filtering of
+//!   the environment cube with cosine-weighted Hammersley directions, each read from the mip
+//!   level its pdf calls for. A constant environment `L = c` gives `c`, so a white Lambertian
+//!   surface under it reflects exactly `c`.
+//!
+//! Directions: the environment's own frame has +Y up; [`Environment::up`] says which world
+//! direction that is and [`Environment::azimuth`] turns the environment about it. Values are
+//! taken as linear radiance as they come: LDR images are not sRGB-decoded (the renderer's
+//! output is not encoded either).
+
+use crate::error::{Error, Result};
+use crate::gpu::{EnvUniforms, ENV_EQUIRECT, ENV_SKY};
+use glam::{DMat3, DQuat, DVec3};
+use std::path::Path;
+use wgpu::util::DeviceExt;
+
+/// Texels per edge of the irradiance cube's faces (irradiance is smooth).
+pub const IRRADIANCE_SIZE: u32 = 32;
+/// Largest cube face edge (texels).
+pub const MAX_CUBE_SIZE: u32 = 2048;
+/// Most cosine-weighted directions per irradiance texel.
+pub const MAX_IRRADIANCE_SAMPLES: u32 = 65536;
+
+/// A procedural sky in the environment's frame (+Y up): the sky colour runs from `horizon`
+/// to `zenith` (with √elevation), `ground` fills the lower hemisphere behind a hard horizon,
+/// and a sun disk with a soft halo sits in `sun_direction`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sky {
+    pub zenith: [f32; 3],
+    pub horizon: [f32; 3],
+    pub ground: [f32; 3],
+    /// Toward the sun (need not be unit length).
+    pub sun_direction: DVec3,
+    /// Radiance added inside the sun's disk; zero for no sun.
+    pub sun_color: [f32; 3],
+    /// Angular radius of the disk, degrees.
+    pub sun_radius_deg: f32,
+    /// A halo `sun_color · sun_halo · cos^256` around the sun (0: none).
+    pub sun_halo: f32,
+}
+
+impl Default for Sky {
+    /// A clear day: pale blue zenith, white horizon, grey-brown ground and a warm sun 40°
+    /// up whose disk gives about as much irradiance as the sky (so surfaces show a light
+    /// direction as well as soft sky light).
+    fn default() -> Self {
+        Sky {
+            zenith: [0.32, 0.45, 0.7],
+            horizon: [0.8, 0.82, 0.85],
+            ground: [0.28, 0.26, 0.24],
+            sun_direction: DVec3::new(0.45, 0.64, 0.62),
+            sun_color: [200.0, 185.0, 160.0],
+            sun_radius_deg: 2.0,
+            sun_halo: 0.02,
+        }
+    }
+}
+
+impl Sky {
+    /// The same radiance `c` from every direction.
+    pub fn constant(c: [f32; 3]) -> Sky {
+        Sky {
+            zenith: c,
+            horizon: c,
+            ground: c,
+            sun_color: [0.0; 3],
+            sun_halo: 0.0,
+            ..Sky::default()
+        }
+    }
+
+    /// `above` over the whole upper hemisphere, `below` under it, no sun.
+    pub fn hemisphere(above: [f32; 3], below: [f32; 3]) -> Sky {
+        Sky {
+            zenith: above,
+            horizon: above,
+            ground: below,
+            sun_color: [0.0; 3],
+            sun_halo: 0.0,
+            ..Sky::default()
+        }
+    }
+
+    /// The sky's radiance in environment direction `d` (unit), as the GPU evaluates it
+    /// (`sky` in shaders/environment.wgsl).
+    pub fn radiance(&self, d: DVec3) -> [f64; 3] {
+        let mut c = [0.0; 3];
+        for (i, v) in c.iter_mut().enumerate() {
+            *v = if d.y >= 0.0 {
+                let f = d.y.sqrt();
+                self.horizon[i] as f64 * (1.0 - f) + self.zenith[i] as f64 * f
+            } else {
+                self.ground[i] as f64
+            };
+        }
+        let sun = self.sun_direction.normalize_or(DVec3::Y);
+        let cs = d.dot(sun);
+        let disk = (self.sun_radius_deg as f64).to_radians().cos();
+        for (i, v) in c.iter_mut().enumerate() {
+            let s = self.sun_color[i] as f64;
+            if cs >= disk {
+                *v += s;
+            }
+            *v += s * self.sun_halo as f64 * cs.max(0.0).powi(256);
+        }
+        c
+    }
+}
+
+/// Where an environment's radiance comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvironmentSource {
+    Sky(Sky),
+    /// Equirectangular (latitude–longitude) image, `width = 2 · height`, rows top (+Y) to
+    /// bottom (−Y); the centre column looks along −Z and longitude grows toward +X (the
+    /// left quarter looks along −X). Linear RGB radiance.
+    Equirect {
+        width: u32,
+        height: u32,
+        texels: Vec<[f32; 3]>,
+    },
+    /// Six square faces of `size × size` texels, in the order +X, −X, +Y, −Y, +Z, −Z, rows
+    /// top to bottom, oriented as Vulkan/OpenGL cube maps ([`cube_direction`]).
+    Cube {
+        size: u32,
+        faces: Vec<Vec<[f32; 3]>>,
+    },
+}
+
+/// The light arriving from every direction, with its placement in the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Environment {
+    pub source: EnvironmentSource,
+    /// Radiance multiplier.
+    pub intensity: f32,
+    /// The world direction that is up (+Y) in the environment.
+    pub up: DVec3,
+    /// Rotation of the environment about `up`, degrees.
+    pub azimuth: f64,
+    /// Edge of the environment cube's faces in texels. `None`: 256 for a sky, a quarter of
+    /// an equirectangular image's width (a power of two, 16 to 1024), a cube's own size.
+    /// Cube sources keep their size.
+    pub resolution: Option<u32>,
+    /// Cosine-weighted directions per texel of the irradiance cube (default 2048: the
+    /// default sky's small bright sun is then within 2% everywhere; 160 ms on lavapipe).
+    pub irradiance_samples: u32,
+}
+
+impl Default for Environment {
+    /// The procedural sky ([`Sky::default`]).
+    fn default() -> Self {
+        Environment::sky(Sky::default())
+    }
+}
+
+fn finite_rgb(what: &str, c: [f32; 3]) -> Result<()> {
+    if c.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter(format!(
+            "{what} {c:?}: radiance must be finite and non-negative"
+        )))
+    }
+}
+
+/// Allowed file extensions of environment images.
+const IMAGE_EXTENSIONS: &[&str] = &["hdr", "exr", "png", "jpg", "jpeg"];
+
+fn read_image(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
+    let shown = path.display();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    if !IMAGE_EXTENSIONS.contains(&ext.as_str()) {
+        return Err(Error::InvalidParameter(format!(
+            "environment map '{shown}': unsupported file type '{ext}'; give an .hdr, .exr, \
+             .png or .jpg image"
+        )));
+    }
+    let reader = image::ImageReader::open(path).map_err(|e| {
+        Error::InvalidParameter(format!(
+            "environment map '{shown}' cannot be opened: {e}; check the path"
+        ))
+    })?;
+    let img = reader
+        .with_guessed_format()
+        .map_err(|e| Error::InvalidParameter(format!("environment map '{shown}': {e}")))?
+        .decode()
+        .map_err(|e| {
+            Error::InvalidParameter(format!(
+                "environment map '{shown}' is not a readable image: {e}"
+            ))
+        })?;
+    let rgb = img.into_rgb32f();
+    let (w, h) = rgb.dimensions();
+    let texels: Vec<[f32; 3]> = rgb
+        .pixels()
+        .map(|p| p.0.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 }))
+        .collect();
+    Ok((w, h, texels))
+}
+
+impl Environment {
+    fn with_source(source: EnvironmentSource) -> Environment {
+        Environment {
+            source,
+            intensity: 1.0,
+            up: DVec3::Y,
+            azimuth: 0.0,
+            resolution: None,
+            irradiance_samples: 2048,
+        }
+    }
+
+    pub fn sky(sky: Sky) -> Environment {
+        Environment::with_source(EnvironmentSource::Sky(sky))
+    }
+
+    /// Radiance `c` from every direction.
+    pub fn constant(c: [f32; 3]) -> Environment {
+        Environment::sky(Sky::constant(c))
+    }
+
+    /// `above` over the upper hemisphere, `below` under it.
+    pub fn hemisphere(above: [f32; 3], below: [f32; 3]) -> Environment {
+        Environment::sky(Sky::hemisphere(above, below))
+    }
+
+    /// An equirectangular image already in memory ([`EnvironmentSource::Equirect`]).
+    pub fn from_equirect(width: u32, height: u32, texels: Vec<[f32; 3]>) -> Result<Environment> {
+        let e = Environment::with_source(EnvironmentSource::Equirect {
+            width,
+            height,
+            texels,
+        });
+        e.validate()?;
+        Ok(e)
+    }
+
+    /// Six cube faces already in memory ([`EnvironmentSource::Cube`]).
+    pub fn from_cube(size: u32, faces: Vec<Vec<[f32; 3]>>) -> Result<Environment> {
+        let e = Environment::with_source(EnvironmentSource::Cube { size, faces });
+        e.validate()?;
+        Ok(e)
+    }
+
+    /// Reads an equirectangular environment map: `.hdr` (Radiance RGBE), `.exr` (OpenEXR)
+    /// or `.png`/`.jpg`, twice as wide as high.
+    pub fn load(path: &Path) -> Result<Environment> {
+        let (w, h, texels) = read_image(path)?;
+        if w != 2 * h {
+            return Err(Error::InvalidParameter(format!(
+                "environment map '{}' is {w}x{h}: an equirectangular map must be exactly twice \
+                 as wide as high (for six cube faces use Environment::load_cube)",
+                path.display()
+            )));
+        }
+        Environment::from_equirect(w, h, texels)
+    }
+
+    /// Reads six square cube faces of one size, in the order +X, −X, +Y, −Y, +Z, −Z.
+    pub fn load_cube(paths: &[&Path; 6]) -> Result<Environment> {
+        let mut faces = Vec::with_capacity(6);
+        let mut size = 0;
+        for (i, p) in paths.iter().enumerate() {
+            let (w, h, texels) = read_image(p)?;
+            if w != h || (i > 0 && w != size) {
+                return Err(Error::InvalidParameter(format!(
+                    "cube face {} '{}' is {w}x{h}: the six faces must be square and of one size{}",
+                    FACE_NAMES[i],
+                    p.display(),
+                    if i > 0 {
+                        format!(" ({size}x{size} like the first)")
+                    } else {
+                        String::new()
+                    }
+                )));
+            }
+            size = w;
+            faces.push(texels);
+        }
+        Environment::from_cube(size, faces)
+    }
+
+    /// Checks the source and settings; every constructor calls it, the renderer again.
+    pub fn validate(&self) -> Result<()> {
+        match &self.source {
+            EnvironmentSource::Sky(s) => {
+                finite_rgb("sky zenith", s.zenith)?;
+                finite_rgb("sky horizon", s.horizon)?;
+                finite_rgb("sky ground", s.ground)?;
+                finite_rgb("sun colour", s.sun_color)?;
+                let sun_ok = s.sun_radius_deg.is_finite()
+                    && (0.0..=90.0).contains(&s.sun_radius_deg)
+                    && s.sun_halo.is_finite()
+                    && s.sun_halo >= 0.0
+                    && s.sun_direction.is_finite()
+                    && s.sun_direction.length() >= 1e-12;
+                if !sun_ok {
+                    return Err(Error::InvalidParameter(format!(
+                        "sun: direction {:?} must be finite and non-zero, radius {}° in [0, 90], \
+                         halo {} non-negative",
+                        s.sun_direction, s.sun_radius_deg, s.sun_halo
+                    )));
+                }
+            }
+            EnvironmentSource::Equirect {
+                width,
+                height,
+                texels,
+            } => {
+                if *width == 0 || *height == 0 || *width != 2 * *height {
+                    return Err(Error::InvalidParameter(format!(
+                        "equirectangular map {width}x{height}: it must be non-empty and exactly \
+                         twice as wide as high"
+                    )));
+                }
+                if texels.len() != (*width as usize) * (*height as usize) {
+                    return Err(Error::InvalidParameter(format!(
+                        "equirectangular map {width}x{height} needs {} texels, got {}",
+                        (*width as usize) * (*height as usize),
+                        texels.len()
+                    )));
+                }
+            }
+            EnvironmentSource::Cube { size, faces } => {
+                if *size == 0 || *size > MAX_CUBE_SIZE || faces.len() != 6 {
+                    return Err(Error::InvalidParameter(format!(
+                        "cube map: {} faces of {size}x{size}; give six faces of 1 to \
+                         {MAX_CUBE_SIZE} texels square",
+                        faces.len()
+                    )));
+                }
+                let n = (*size as usize) * (*size as usize);
+                if let Some(i) = faces.iter().position(|f| f.len() != n) {
+                    return Err(Error::InvalidParameter(format!(
+                        "cube face {} has {} texels; {size}x{size} = {n} expected",
+                        FACE_NAMES[i],
+                        faces[i].len()
+                    )));
+                }
+            }
+        }
+        if !(self.intensity.is_finite() && self.intensity >= 0.0) {
+            return Err(Error::InvalidParameter(format!(
+                "environment intensity {} must be finite and non-negative",
+                self.intensity
+            )));
+        }
+        if !self.up.is_finite() || self.up.length() < 1e-12 || !self.azimuth.is_finite() {
+            return Err(Error::InvalidParameter(format!(
+                "environment up {:?} must be a finite non-zero vector and azimuth {} finite",
+                self.up, self.azimuth
+            )));
+        }
+        if let Some(r) = self.resolution {
+            if !(4..=MAX_CUBE_SIZE).contains(&r) {
+                return Err(Error::InvalidParameter(format!(
+                    "environment resolution {r}: give 4 to {MAX_CUBE_SIZE} texels per cube face \
+                     edge"
+                )));
+            }
+        }
+        if !(1..=MAX_IRRADIANCE_SAMPLES).contains(&self.irradiance_samples) {
+            return Err(Error::InvalidParameter(format!(
+                "{} irradiance samples: give 1 to {MAX_IRRADIANCE_SAMPLES}",
+                self.irradiance_samples
+            )));
+        }
+        Ok(())
+    }
+
+    /// World direction → environment direction (+Y = [`Environment::up`]).
+    pub fn rotation(&self) -> DMat3 {
+        let up = self.up.normalize_or(DVec3::Y);
+        DMat3::from_rotation_y(-self.azimuth.to_radians())
+            * DMat3::from_quat(DQuat::from_rotation_arc(up, DVec3::Y))
+    }
+
+    /// Edge of the environment cube's faces for this source.
+    pub fn cube_size(&self) -> u32 {
+        match &self.source {
+            EnvironmentSource::Cube { size, .. } => *size,
+            EnvironmentSource::Equirect { width, .. } => self
+                .resolution
+                .unwrap_or_else(|| (width / 4).max(1).next_power_of_two().clamp(16, 1024)),
+            EnvironmentSource::Sky(_) => self.resolution.unwrap_or(256),
+        }
+    }
+}
+
+/// Cube face names in layer order.
+pub const FACE_NAMES: [&str; 6] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
+
+/// Unit direction through the point (s, t) ∈ [0, 1]² of cube face `face` (layer order +X,
+/// −X, +Y, −Y, +Z, −Z; s to the right, t down the face image), Vulkan's cube-map convention
+/// (`cube_direction` in shaders/lib/envmap.wgsl).
+pub fn cube_direction(face: usize, s: f64, t: f64) -> DVec3 {
+    let sc = 2.0 * s - 1.0;
+    let tc = 2.0 * t - 1.0;
+    let d = match face {
+        0 => DVec3::new(1.0, -tc, -sc),
+        1 => DVec3::new(-1.0, -tc, sc),
+        2 => DVec3::new(sc, 1.0, tc),
+        3 => DVec3::new(sc, -1.0, -tc),
+        4 => DVec3::new(sc, -tc, 1.0),
+        _ => DVec3::new(-sc, -tc, -1.0),
+    };
+    d.normalize()
+}
+
+/// The face and (s, t) ∈ [0, 1]² a direction falls on (the inverse of [`cube_direction`]).
+pub fn cube_face_coords(d: DVec3) -> (usize, f64, f64) {
+    let a = d.abs();
+    let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
+        if d.x > 0.0 {
+            (0, -d.z, -d.y, a.x)
+        } else {
+            (1, d.z, -d.y, a.x)
+        }
+    } else if a.y >= a.z {
+        if d.y > 0.0 {
+            (2, d.x, d.z, a.y)
+        } else {
+            (3, d.x, -d.z, a.y)
+        }
+    } else if d.z > 0.0 {
+        (4, d.x, -d.y, a.z)
+    } else {
+        (5, -d.x, -d.y, a.z)
+    };
+    (face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0))
+}
+
+/// A cube map read back from the GPU: six faces of `size²` RGBA texels (layer order +X, −X,
+/// +Y, −Y, +Z, −Z, rows top to bottom), in the environment's frame.
+#[derive(Clone, Debug)]
+pub struct CubeImage {
+    pub size: u32,
+    pub faces: Vec<Vec<[f32; 4]>>,
+}
+
+impl CubeImage {
+    /// Unit direction through the centre of texel (x, y) of `face`.
+    pub fn texel_direction(&self, face: usize, x: u32, y: u32) -> DVec3 {
+        let n = self.size as f64;
+        cube_direction(face, (x as f64 + 0.5) / n, (y as f64 + 0.5) / n)
+    }
+
+    /// The texel a direction falls in (nearest, no filtering).
+    pub fn lookup(&self, d: DVec3) -> [f32; 4] {
+        let (face, s, t) = cube_face_coords(d);
+        let n = self.size;
+        let x = ((s * n as f64) as u32).min(n - 1);
+        let y = ((t * n as f64) as u32).min(n - 1);
+        self.faces[face][(y * n + x) as usize]
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// GPU side
+// ---------------------------------------------------------------------------------------
+
+/// The environment passes (shaders/environment.wgsl): created on first use.
+pub(crate) struct EnvPipelines {
+    build_bgl: wgpu::BindGroupLayout,
+    downsample_bgl: wgpu::BindGroupLayout,
+    irradiance_bgl: wgpu::BindGroupLayout,
+    build: wgpu::ComputePipeline,
+    downsample: wgpu::ComputePipeline,
+    irradiance: wgpu::ComputePipeline,
+    equirect_sampler: wgpu::Sampler,
+    pub(crate) cube_sampler: wgpu::Sampler,
+}
+
+/// The maps of one environment on the GPU.
+pub(crate) struct GpuEnvironment {
+    pub(crate) cube: wgpu::Texture,
+    pub(crate) cube_view: wgpu::TextureView,
+    pub(crate) irradiance: wgpu::Texture,
+    pub(crate) irradiance_view: wgpu::TextureView,
+    pub(crate) size: u32,
+    pub(crate) mips: u32,
+    /// World → environment directions.
+    pub(crate) rotation: DMat3,
+}
+
+const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+fn layout_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
+fn uniform_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    layout_entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
+}
+
+fn storage_array_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    layout_entry(
+        binding,
+        wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: ENV_FORMAT,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+        },
+    )
+}
+
+fn texture_layout(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
+    layout_entry(
+        binding,
+        wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: dim,
+            multisampled: false,
+        },
+    )
+}
+
+fn sampler_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    layout_entry(
+        binding,
+        wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+    )
+}
+
+impl EnvPipelines {
+    pub(crate) fn new(ctx: &crate::Context) -> Result<EnvPipelines> {
+        let d = &ctx.device;
+        let module = crate::iso::shader_module(ctx, "environment.wgsl")?;
+        let bgl = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        use wgpu::TextureViewDimension as V;
+        let build_bgl = bgl(
+            "environment build",
+            &[
+                uniform_layout(0),
+                texture_layout(1, V::D2),
+                sampler_layout(2),
+                storage_array_layout(3),
+            ],
+        );
+        let downsample_bgl = bgl(
+            "environment downsample",
+            &[
+                uniform_layout(0),
+                storage_array_layout(3),
+                texture_layout(4, V::D2Array),
+            ],
+        );
+        let irradiance_bgl = bgl(
+            "environment irradiance",
+            &[
+                uniform_layout(0),
+                storage_array_layout(3),
+                texture_layout(5, V::Cube),
+                sampler_layout(6),
+            ],
+        );
+        let pipeline = |entry: &str, layout: &wgpu::BindGroupLayout| {
+            let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry),
+                bind_group_layouts: &[Some(layout)],
+                immediate_size: 0,
+            });
+            ctx.checked(
+                &format!("creating the environment {entry} pipeline"),
+                || {
+                    d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some(entry),
+                        layout: Some(&pl),
+                        module: &module,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    })
+                },
+            )
+        };
+        let build = pipeline("build", &build_bgl)?;
+        let downsample = pipeline("downsample", &downsample_bgl)?;
+        let irradiance = pipeline("irradiance", &irradiance_bgl)?;
+        let equirect_sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("equirect"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let cube_sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment cube"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Ok(EnvPipelines {
+            build_bgl,
+            downsample_bgl,
+            irradiance_bgl,
+            build,
+            downsample,
+            irradiance,
+            equirect_sampler,
+            cube_sampler,
+        })
+    }
+}
+
+fn to_half(c: [f32; 3], scale: f32) -> [half::f16; 4] {
+    // rgba16float's largest finite value; brighter texels are clamped, not made infinite
+    let h = |v: f32| half::f16::from_f32((v * scale).clamp(0.0, 65504.0));
+    [h(c[0]), h(c[1]), h(c[2]), half::f16::ONE]
+}
+
+fn cube_texture(ctx: &crate::Context, label: &str, size: u32, mips: u32) -> wgpu::Texture {
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 6,
+        },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: ENV_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+fn level_view(
+    tex: &wgpu::Texture,
+    level: u32,
+    dim: wgpu::TextureViewDimension,
+) -> wgpu::TextureView {
+    tex.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(dim),
+        base_mip_level: level,
+        mip_level_count: Some(1),
+        ..Default::default()
+    })
+}
+
+impl GpuEnvironment {
+    /// Builds the environment cube, its mip chain and the irradiance cube, and waits for them.
+    pub(crate) fn build(
+        ctx: &crate::Context,
+        p: &EnvPipelines,
+        env: &Environment,
+    ) -> Result<GpuEnvironment> {
+        env.validate()?;
+        let d = &ctx.device;
+        let q = &ctx.queue;
+        let size = env.cube_size();
+        let mips = 32 - size.leading_zeros();
+        let max2d = ctx.info.limits.max_texture_dimension_2d;
+        if size > max2d {
+            return Err(Error::Unsupported(format!(
+                "an environment cube of {size}² per face exceeds this device's texture limit \
+                 {max2d}; set Environment::resolution lower"
+            )));
+        }
+        let mut u = EnvUniforms {
+            scale: [env.intensity, 0.0, 0.0, 0.0],
+            ..Default::default()
+        };
+        let (cube, irradiance) = ctx.checked("building the environment maps", || {
+            let cube = cube_texture(ctx, "environment cube", size, mips);
+            let irradiance = cube_texture(ctx, "irradiance cube", IRRADIANCE_SIZE, 1);
+            (cube, irradiance)
+        })?;
+        let uniform = |u: &EnvUniforms| {
+            let b = d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("environment uniforms"),
+                size: std::mem::size_of::<EnvUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            q.write_buffer(&b, 0, bytemuck::bytes_of(u));
+            b
+        };
+        let groups = |n: u32| n.div_ceil(8);
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("environment"),
+        });
+        // Level 0 from the source.
+        let mut keep = Vec::new();
+        match &env.source {
+            EnvironmentSource::Cube { size, faces } => {
+                for (f, texels) in faces.iter().enumerate() {
+                    let data: Vec<[half::f16; 4]> =
+                        texels.iter().map(|&c| to_half(c, env.intensity)).collect();
+                    q.write_texture(
+                        wgpu::TexelCopyTextureInfo {
+                            texture: &cube,
+                            mip_level: 0,
+                            origin: wgpu::Origin3d {
+                                x: 0,
+                                y: 0,
+                                z: f as u32,
+                            },
+                            aspect: wgpu::TextureAspect::All,
+                        },
+                        bytemuck::cast_slice(&data),
+                        wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: Some(8 * size),
+                            rows_per_image: Some(*size),
+                        },
+                        wgpu::Extent3d {
+                            width: *size,
+                            height: *size,
+                            depth_or_array_layers: 1,
+                        },
+                    );
+                }
+            }
+            src => {
+                let (source, width, height, texels): (u32, u32, u32, Vec<[half::f16; 4]>) =
+                    match src {
+                        EnvironmentSource::Sky(s) => {
+                            let sun = s.sun_direction.normalize();
+                            let v4 = |c: [f32; 3], w: f32| [c[0], c[1], c[2], w];
+                            u.zenith = v4(s.zenith, 0.0);
+                            u.horizon = v4(s.horizon, 0.0);
+                            u.ground = v4(s.ground, 0.0);
+                            u.sun = [
+                                sun.x as f32,
+                                sun.y as f32,
+                                sun.z as f32,
+                                (s.sun_radius_deg as f64).to_radians().cos() as f32,
+                            ];
+                            u.sun_color = v4(s.sun_color, s.sun_halo);
+                            (ENV_SKY, 1, 1, vec![[half::f16::ZERO; 4]])
+                        }
+                        EnvironmentSource::Equirect {
+                            width,
+                            height,
+                            texels,
+                        } => {
+                            if *width > max2d {
+                                return Err(Error::Unsupported(format!(
+                                    "an equirectangular map {width} texels wide exceeds this \
+                                     device's texture limit {max2d}; scale it down"
+                                )));
+                            }
+                            let data = texels.iter().map(|&c| to_half(c, 1.0)).collect();
+                            (ENV_EQUIRECT, *width, *height, data)
+                        }
+                        EnvironmentSource::Cube { .. } => unreachable!("handled above"),
+                    };
+                let src_tex = d.create_texture_with_data(
+                    q,
+                    &wgpu::TextureDescriptor {
+                        label: Some("equirectangular source"),
+                        size: wgpu::Extent3d {
+                            width,
+                            height,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: ENV_FORMAT,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    },
+                    wgpu::util::TextureDataOrder::LayerMajor,
+                    bytemuck::cast_slice(&texels),
+                );
+                u.params = [source, size, 0, 0];
+                let ub = uniform(&u);
+                let src_view = src_tex.create_view(&Default::default());
+                let dst = level_view(&cube, 0, wgpu::TextureViewDimension::D2Array);
+                let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("environment build"),
+                    layout: &p.build_bgl,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: ub.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&src_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::Sampler(&p.equirect_sampler),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::TextureView(&dst),
+                        },
+                    ],
+                });
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&p.build);
+                pass.set_bind_group(0, &bg, &[]);
+                pass.dispatch_workgroups(groups(size), groups(size), 6);
+                drop(pass);
+                keep.push(src_tex);
+            }
+        }
+        // The mip chain, 2×2 box filtered.
+        for level in 1..mips {
+            let s = (size >> level).max(1);
+            u.params = [0, s, 0, 0];
+            let ub = uniform(&u);
+            let src = level_view(&cube, level - 1, wgpu::TextureViewDimension::D2Array);
+            let dst = level_view(&cube, level, wgpu::TextureViewDimension::D2Array);
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("environment downsample"),
+                layout: &p.downsample_bgl,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: ub.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&dst),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: wgpu::BindingResource::TextureView(&src),
+                    },
+                ],
+            });
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&p.downsample);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(groups(s), groups(s), 6);
+        }
+        // The irradiance cube.
+        let cube_view = cube.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::Cube),
+            ..Default::default()
+        });
+        u.scale[1] = texel_solid_angle(size) as f32;
+        u.scale[2] = (mips - 1) as f32;
+        u.params = [0, IRRADIANCE_SIZE, env.irradiance_samples, 0];
+        let ub = uniform(&u);
+        let dst = level_view(&irradiance, 0, wgpu::TextureViewDimension::D2Array);
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("environment irradiance"),
+            layout: &p.irradiance_bgl,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: ub.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&dst),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&cube_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::Sampler(&p.cube_sampler),
+                },
+            ],
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&p.irradiance);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(groups(IRRADIANCE_SIZE), groups(IRRADIANCE_SIZE), 6);
+        }
+        ctx.checked("computing the environment maps", || {
+            q.submit([enc.finish()]);
+        })?;
+        ctx.wait_idle()?;
+        drop(keep);
+        let irradiance_view = irradiance.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::Cube),
+            ..Default::default()
+        });
+        Ok(GpuEnvironment {
+            cube,
+            cube_view,
+            irradiance,
+            irradiance_view,
+            size,
+            mips,
+            rotation: env.rotation(),
+        })
+    }
+}
+
+/// Solid angle of one texel of a cube with `size²` texels per face, averaged over the cube.
+pub(crate) fn texel_solid_angle(size: u32) -> f64 {
+    4.0 * std::f64::consts::PI / (6.0 * size as f64 * size as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_coords_invert_cube_direction() {
+        for face in 0..6 {
+            for &(s, t) in &[(0.5, 0.5), (0.1, 0.8), (0.9, 0.2), (0.3, 0.35)] {
+                let d = cube_direction(face, s, t);
+                let (f2, s2, t2) = cube_face_coords(d);
+                assert_eq!(f2, face, "face of {d:?}");
+                assert!((s - s2).abs() < 1e-12 && (t - t2).abs() < 1e-12);
+            }
+        }
+        // face centres along the axes, in layer order
+        let axes = [
+            DVec3::X,
+            DVec3::NEG_X,
+            DVec3::Y,
+            DVec3::NEG_Y,
+            DVec3::Z,
+            DVec3::NEG_Z,
+        ];
+        for (f, a) in axes.iter().enumerate() {
+            assert!((cube_direction(f, 0.5, 0.5) - *a).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn rotation_puts_up_on_y() {
+        let mut e = Environment::default();
+        for up in [DVec3::Z, DVec3::NEG_Z, DVec3::X, DVec3::new(1.0, 2.0, 3.0)] {
+            e.up = up;
+            e.azimuth = 30.0;
+            let r = e.rotation();
+            assert!((r * up.normalize() - DVec3::Y).length() < 1e-12, "{up:?}");
+        }
+    }
+
+    #[test]
+    fn bad_environments_are_errors() {
+        assert!(Environment::from_equirect(3, 2, vec![[0.0; 3]; 6]).is_err());
+        assert!(Environment::from_equirect(4, 2, vec![[0.0; 3]; 7]).is_err());
+        assert!(Environment::from_cube(2, vec![vec![[0.0; 3]; 4]; 5]).is_err());
+        let mut e = Environment::constant([1.0; 3]);
+        e.intensity = f32::NAN;
+        assert!(e.validate().is_err());
+        let mut e = Environment::constant([-1.0, 0.0, 0.0]);
+        assert!(e.validate().is_err());
+        e = Environment::default();
+        e.up = DVec3::ZERO;
+        assert!(e.validate().is_err());
+    }
+}

@@ -1,0 +1,144 @@
+// Deferred shading of the G-buffer firsthit.wgsl wrote. Per pixel, its surface layers front
+// to back, each
+//   - lit by the scene's lights (Blinn–Phong, lib/surface.wgsl), ambient scaled by AO;
+//   - lit by the environment: diffuse from the irradiance cube at the normal, specular from
+//     the environment cube on the Phong lobe cos^s around the reflection vector (the simple
+//     cone scheme or importance sampling with pdf-based mip filtering), both scaled by AO;
+//   - specular weighted by Schlick's Fresnel term when enabled; the exponent s from the
+//     gradient magnitude (or constant);
+// and composited with its iso-value's opacity; then the environment behind, if asked for.
+#include "lib/common.wgsl"
+#include "lib/ray.wgsl"
+#include "lib/surface.wgsl"
+#include "lib/envmap.wgsl"
+#include "lib/iso.wgsl"
+
+@group(0) @binding(2) var<storage, read> state: array<PixelState>;
+@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(8) var g_position: texture_2d_array<f32>;
+@group(0) @binding(9) var g_normal: texture_2d_array<f32>;
+@group(0) @binding(10) var g_extra: texture_2d_array<f32>;
+@group(0) @binding(11) var env_cube: texture_cube<f32>;
+@group(0) @binding(12) var irradiance_cube: texture_cube<f32>;
+@group(0) @binding(13) var env_sampler: sampler;
+// Random unit vectors, uniform over the sphere (the cone scheme's precomputed directions).
+@group(0) @binding(14) var<storage, read> lobe_dirs: array<vec4<f32>>;
+
+fn env_direction(d: vec3<f32>) -> vec3<f32> {
+    return (iso.env_rotation * vec4<f32>(d, 0.0)).xyz;
+}
+
+fn env_radiance(d: vec3<f32>, lod: f32) -> vec3<f32> {
+    return textureSampleLevel(env_cube, env_sampler, d, lod).rgb;
+}
+
+// The specular exponent of a surface with gradient magnitude m.
+fn shininess(m: f32) -> f32 {
+    let u = clamp((m - iso.shininess.x) * iso.shininess.y, 0.0, 1.0);
+    return mix(iso.shininess.z, iso.shininess.w, u);
+}
+
+// The environment seen through the normalised Phong lobe cos^s around the unit
+// environment-space reflection vector r: ∫ L(ω) cos^s(ω, r) dω / ∫ cos^s(ω, r) dω over the
+// hemisphere around r (a constant environment gives the constant).
+fn specular_environment(r: vec3<f32>, s: f32) -> vec3<f32> {
+    let count = iso.options.y;
+    var sum = vec3<f32>(0.0);
+    if (iso.options.z == SPECULAR_CONE) {
+        // The simple scheme: random unit vectors p turned into r's hemisphere, blended with r
+        // (d = α·r + (1 − α)·p, normalised) and weighted by the lobe. α makes the blend's
+        // widest direction (p ⟂ r) the angle where the lobe has fallen to 1%.
+        let cos_max = pow(0.01, 1.0 / max(s, 1e-3));
+        let tan_max = sqrt(max(1.0 - cos_max * cos_max, 0.0)) / max(cos_max, 1e-4);
+        let a = 1.0 / (1.0 + tan_max);
+        var wsum = 0.0;
+        let nd = arrayLength(&lobe_dirs);
+        for (var i = 0u; i < count; i = i + 1u) {
+            var p = lobe_dirs[i % nd].xyz;
+            if (dot(r, p) < 0.0) {
+                p = -p;
+            }
+            let d = normalize(a * r + (1.0 - a) * p);
+            let w = pow(max(dot(d, r), 0.0), s);
+            sum = sum + w * env_radiance(d, 0.0);
+            wsum = wsum + w;
+        }
+        if (wsum <= 0.0) {
+            return env_radiance(r, 0.0);
+        }
+        return sum / wsum;
+    }
+    // Importance sampling: Hammersley directions distributed as the lobe, each read from
+    // the mip level whose texels cover the solid angle its pdf gives it.
+    let b = basis_around(r);
+    for (var i = 0u; i < count; i = i + 1u) {
+        let l = phong_lobe(hammersley(i, count), s);
+        let pdf = (s + 1.0) / (2.0 * PI) * pow(l.z, s);
+        sum = sum + env_radiance(b * l, filtered_lod(pdf, count, iso.env.z, iso.env.w));
+    }
+    return sum / f32(count);
+}
+
+// Shaded colour (not premultiplied) of one surface layer.
+fn shade_surface(color: vec3<f32>, pos: vec3<f32>, n: vec3<f32>, gmag: f32, ao: f32, v: vec3<f32>) -> vec3<f32> {
+    let s = shininess(gmag);
+    var fresnel = 1.0;
+    if (iso.env.y >= 0.0) {
+        let f0 = iso.env.y;
+        fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
+    }
+    let m = frame.material;
+    let lights = blinn_phong(n, pos, v, s);
+    var rgb = color * (m.x * ao * lights.ambient + m.y * lights.diffuse) + m.z * fresnel * lights.specular;
+    let w = iso.env.x;
+    if (w > 0.0) {
+        let irr = textureSampleLevel(irradiance_cube, env_sampler, env_direction(n), 0.0).rgb;
+        var spec = vec3<f32>(0.0);
+        if (m.z > 0.0) {
+            let r = env_direction(2.0 * dot(n, v) * n - v);
+            spec = specular_environment(normalize(r), s);
+        }
+        rgb = rgb + w * ao * (m.y * color * irr + m.z * fresnel * spec);
+    }
+    return clamp(rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let r = iso.shade_rect;
+    let px = gid.xy + r.xy;
+    if (px.x >= r.z || px.y >= r.w) {
+        return;
+    }
+    let fr = frame.rect;
+    var layers = 0u;
+    if (px.x >= fr.x && px.x < fr.z && px.y >= fr.y && px.y < fr.w) {
+        layers = min(u32(state[px.y * frame.viewport.x + px.x].color.x), iso.counts.z);
+    }
+    let ray = make_ray(px);
+    let v = -ray.dir;
+    let c = vec2<i32>(px);
+    var color = vec4<f32>(0.0);
+    var depth = 1.0;
+    var depth_set = false;
+    for (var l = 0u; l < layers; l = l + 1u) {
+        let gp = textureLoad(g_position, c, i32(l), 0);
+        let gn = textureLoad(g_normal, c, i32(l), 0);
+        let ge = textureLoad(g_extra, c, i32(l), 0);
+        let surface = iso.colors[min(u32(gp.w), MAX_ISO - 1u)];
+        let rgb = shade_surface(surface.rgb, gp.xyz, gn.xyz, gn.w, ge.y, v);
+        let w = (1.0 - color.a) * surface.a;
+        color = vec4<f32>(color.rgb + w * rgb, color.a + w);
+        if (!depth_set && color.a > frame.misc.z) {
+            depth = ge.x;
+            depth_set = true;
+        }
+    }
+    if ((iso.options.w & ISO_FLAG_BACKGROUND) != 0u) {
+        let bg = env_radiance(env_direction(ray.dir), 0.0);
+        color = vec4<f32>(color.rgb + (1.0 - color.a) * bg, 1.0);
+    }
+    textureStore(out_color, c, clamp(color, vec4<f32>(0.0), vec4<f32>(1.0)));
+    textureStore(out_depth, c, vec4<f32>(depth, 0.0, 0.0, 0.0));
+}

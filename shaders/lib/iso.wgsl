@@ -1,0 +1,27 @@
+// The isosurface uniforms shared by the first-hit pass (firsthit.wgsl) and deferred shading
+// (deferred.wgsl). Mirrored in core/src/gpu.rs (IsoUniforms); a unit test checks the layouts.
+
+const MAX_ISO: u32 = 8u;
+const SPECULAR_CONE: u32 = 0u;
+const SPECULAR_IMPORTANCE: u32 = 1u;
+// The environment fills the pixels the surfaces leave uncovered.
+const ISO_FLAG_BACKGROUND: u32 = 1u;
+
+struct Iso {
+    env_rotation: mat4x4<f32>,    // world direction → environment direction (+Y up)
+    values: array<vec4<f32>, 2>,  // the iso-values, four per vec4
+    colors: array<vec4<f32>, 8>,  // per iso-value: rgb, opacity
+    shininess: vec4<f32>,         // |∇| at the low end, 1 / |∇| range, exponent low, exponent high
+    ao: vec4<f32>,                // x: occlusion ray length (world units)
+    env: vec4<f32>,               // x: environment light weight; y: Schlick F0 (< 0: no
+                                  // Fresnel); z: solid angle of a level-0 cube texel; w: last mip
+    counts: vec4<u32>,            // iso-values, bisection steps, max layers, AO directions
+    options: vec4<u32>,           // AO steps, specular samples, specular mode, flags
+    shade_rect: vec4<u32>,        // pixels the deferred pass covers: x0, y0, x1, y1
+}
+
+@group(0) @binding(7) var<uniform> iso: Iso;
+
+fn iso_value(i: u32) -> f32 {
+    return iso.values[i / 4u][i % 4u];
+}

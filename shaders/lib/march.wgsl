@@ -1,0 +1,45 @@
+// Marching a ray through the volume, shared by the ray-casting passes (dvr, firsthit): the
+// ray's segment inside the volume (near/far planes, the host's opaque depth, clipping
+// planes), VTK's cropping regions and the occupancy grid for empty-space skipping.
+
+// Per block of the occupancy grid: 1 when the block may hold something the pass looks for
+// (dvr: some voxel with non-zero opacity; firsthit: some iso-value within the block's
+// range), 0 when the pass can skip it.
+@group(0) @binding(3) var<storage, read> occupancy: array<u32>;
+// The host's opaque depth (window depth per pixel), read when FLAG_DEPTH_INPUT is set.
+@group(0) @binding(4) var depth_in: texture_2d<f32>;
+
+// The part of the ray inside the volume, in front of the far plane and the host's opaque
+// geometry and on the kept side of every clipping plane.
+fn ray_segment(ray: Ray, px: vec2<u32>) -> vec2<f32> {
+    var seg = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    seg.x = max(seg.x, 0.0);
+    seg.y = min(seg.y, ray.far);
+    if (has_flag(FLAG_DEPTH_INPUT)) {
+        let d = textureLoad(depth_in, vec2<i32>(px), 0).x;
+        seg.y = min(seg.y, depth_to_distance(ray, px, d));
+    }
+    return clip_interval(ray, seg);
+}
+
+fn in_crop(p: vec3<f32>) -> bool {
+    let d = (frame.index_to_data * vec4<f32>(p, 1.0)).xyz;
+    let r = select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_lo.xyz)
+          + select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_hi.xyz);
+    let bit = r.x + 3u * r.y + 9u * r.z;
+    return ((frame.mode.z >> bit) & 1u) != 0u;
+}
+
+fn block_occupied(p: vec3<f32>) -> bool {
+    let bs = f32(frame.counts.z);
+    let b = min(vec3<u32>(max(floor(p / bs), vec3<f32>(0.0))), frame.occupancy_dims.xyz - 1u);
+    let d = frame.occupancy_dims;
+    return occupancy[(b.z * d.y + b.y) * d.x + b.x] != 0u;
+}
+
+// Distance at which the ray leaves the occupancy block holding p.
+fn block_exit(r: Ray, p: vec3<f32>) -> f32 {
+    let bs = f32(frame.counts.z);
+    let lo = floor(p / bs) * bs;
+    return box_interval(r, lo, lo + bs).y;
+}
