@@ -9,15 +9,17 @@
 //! fv_renderer_read_frame (CPU) or the shared images (zero copy).
 #![allow(clippy::missing_safety_doc)] // each export documents its pointer rules in the header
 
+mod iso;
 mod status;
 mod types;
 
+pub use iso::*;
 pub use status::*;
 pub use types::*;
 
 use ferrovol_core::{
-    ComponentTransfer, Context, Image, OutputPath, Piecewise, Renderer, Scalars, TransferFunction,
-    UploadOptions, View, VolumeData,
+    ComponentTransfer, Context, Environment, Image, OutputPath, Piecewise, Renderer, Scalars,
+    TransferFunction, UploadOptions, View, VolumeData,
 };
 use std::ffi::{c_char, c_void, CStr};
 
@@ -657,6 +659,70 @@ pub unsafe extern "C" fn fv_renderer_set_params(
     guard(|| {
         let r = mut_ref(renderer, "renderer")?;
         r.params = const_ref(params, "params")?.to_core()?;
+        Ok(())
+    })
+}
+
+/// Fills `*params` with the isosurface defaults (no iso-values yet: set `value_count` and
+/// `values`; 8 bisection steps, 4 layers, 16 importance-sampled specular samples,
+/// shininess 8 to 64 by gradient magnitude, no Fresnel, no ambient occlusion, environment
+/// weight 0.6, no background).
+#[no_mangle]
+pub unsafe extern "C" fn fv_iso_params_default(params: *mut FvIsoParams) -> FvStatus {
+    guard(|| {
+        *mut_ref(params, "params")? = FvIsoParams::defaults();
+        Ok(())
+    })
+}
+
+/// Sets the isosurfaces and their shading for frames with FV_BLEND_MODE_ISOSURFACE
+/// (validated: out-of-range values are refused and the previous settings kept).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_isosurface(
+    renderer: *mut FvRenderer,
+    params: *const FvIsoParams,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        let p = const_ref(params, "params")?.to_core()?;
+        r.r.set_isosurface(&p)?;
+        Ok(())
+    })
+}
+
+/// Sets the environment that lights isosurfaces and builds its maps now (an irradiance
+/// cube and a mip-filtered environment cube; ~0.2 s on a CPU device). `path` (UTF-8) is an
+/// equirectangular .hdr, .exr, .png or .jpg image twice as wide as high, or NULL for the
+/// built-in procedural sky. `up` (3 doubles, or NULL for +Y) is the world direction that
+/// is up in the environment; `azimuth_degrees` turns it about that axis; `intensity`
+/// multiplies its radiance. Without a call, the first isosurface frame uses the sky.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_environment(
+    renderer: *mut FvRenderer,
+    path: *const c_char,
+    intensity: f32,
+    up: *const f64,
+    azimuth_degrees: f64,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        let mut env = if path.is_null() {
+            Environment::default()
+        } else {
+            // SAFETY: the caller passes a NUL-terminated string.
+            let p = unsafe { CStr::from_ptr(path) }
+                .to_str()
+                .map_err(|_| FfiError::invalid("environment path is not UTF-8"))?;
+            Environment::load(p.as_ref())?
+        };
+        if !up.is_null() {
+            // SAFETY: the caller passes 3 doubles at `up`.
+            let u = unsafe { std::slice::from_raw_parts(up, 3) };
+            env.up = glam::DVec3::new(u[0], u[1], u[2]);
+        }
+        env.intensity = intensity;
+        env.azimuth = azimuth_degrees;
+        r.r.set_environment(&env)?;
         Ok(())
     })
 }

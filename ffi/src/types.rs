@@ -81,6 +81,9 @@ pub enum FvBlendMode {
     Minimum = 2,
     Average = 3,
     Additive = 4,
+    /// Isosurfaces (fv_renderer_set_isosurface): first hit with bisection, deferred
+    /// shading with environment light and ambient occlusion.
+    Isosurface = 5,
 }
 
 /// Volume interpolation (vtkVolumeProperty::InterpolationType).
@@ -294,6 +297,7 @@ impl FvRenderParams {
                 B::Minimum,
                 B::Average,
                 B::Additive,
+                B::Isosurface,
             ],
         )?;
         let interpolation = enum_value(

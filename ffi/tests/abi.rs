@@ -525,3 +525,149 @@ fn last_error_is_per_thread_and_status_names_are_static() {
         .unwrap();
     assert_eq!(other, "", "another thread must not see this thread's error");
 }
+
+type SetIso = unsafe extern "C" fn(H, *const ferrovol::FvIsoParams) -> FvStatus;
+type SetEnv = unsafe extern "C" fn(H, *const c_char, f32, *const f64, f64) -> FvStatus;
+
+/// The isosurface mode through the C ABI: every refusal names its problem, then a sphere
+/// renders opaque at the centre and empty in the corner.
+#[test]
+fn isosurface_errors_and_a_frame() {
+    let lib = Lib::open();
+    let mut ctx: H = null_mut();
+    let mut r: H = null_mut();
+    let n = 16usize;
+    // Distance from the volume's centre: the iso-value 5 is a sphere of radius 5 voxels.
+    let data: Vec<f32> = (0..n * n * n)
+        .map(|i| {
+            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
+            let c = (n - 1) as f32 / 2.0;
+            ((x as f32 - c).powi(2) + (y as f32 - c).powi(2) + (z as f32 - c).powi(2)).sqrt()
+        })
+        .collect();
+    let set_iso = lib.f::<SetIso>("fv_renderer_set_isosurface");
+    let set_env = lib.f::<SetEnv>("fv_renderer_set_environment");
+    let set_params = lib.f::<SetParams>("fv_renderer_set_params");
+    let render = lib.f::<Render>("fv_renderer_render");
+    // SAFETY: arguments follow the header; invalid ones are the test.
+    unsafe {
+        assert_eq!(lib.f::<NewCtx>("fv_context_new")(&mut ctx), FvStatus::Ok);
+        assert_eq!(
+            lib.f::<NewRenderer>("fv_renderer_new")(ctx, &mut r),
+            FvStatus::Ok
+        );
+        let d = desc([16, 16, 16], 1, ferrovol::FvScalarType::F32 as u32);
+        let mut v: H = null_mut();
+        assert_eq!(
+            lib.f::<NewVolume>("fv_volume_new")(&d, data.as_ptr().cast(), 4 * n * n * n, &mut v),
+            FvStatus::Ok,
+            "{}",
+            lib.last_error()
+        );
+        assert_eq!(lib.f::<SetH>("fv_renderer_set_volume")(r, v), FvStatus::Ok);
+        let mut cam: FvCamera = std::mem::zeroed();
+        cam.position = [7.5, 7.5, 60.0];
+        cam.focal_point = [7.5, 7.5, 7.5];
+        cam.view_up = [0.0, 1.0, 0.0];
+        cam.view_angle = 30.0;
+        cam.clipping_range = [1.0, 200.0];
+        assert_eq!(
+            lib.f::<SetCamera>("fv_renderer_set_camera")(r, &cam),
+            FvStatus::Ok
+        );
+        let mut p = FvRenderParams::defaults();
+        p.blend_mode = ferrovol::FvBlendMode::Isosurface as u32;
+        assert_eq!(set_params(r, &p), FvStatus::Ok);
+        lib.expect(
+            "no iso-values",
+            render(r, 32, 32, null(), 0),
+            FvStatus::InvalidArgument,
+            "iso-values",
+        );
+
+        let mut iso: ferrovol::FvIsoParams = std::mem::zeroed();
+        let defaults = lib.f::<unsafe extern "C" fn(*mut ferrovol::FvIsoParams) -> FvStatus>(
+            "fv_iso_params_default",
+        );
+        lib.expect(
+            "NULL iso defaults",
+            defaults(null_mut()),
+            FvStatus::NullArgument,
+            "params is NULL",
+        );
+        assert_eq!(defaults(&mut iso), FvStatus::Ok);
+        assert_eq!(iso.bisection_steps, 8);
+        lib.expect(
+            "0 values",
+            set_iso(r, &iso),
+            FvStatus::InvalidArgument,
+            "value_count 0",
+        );
+        iso.value_count = 1;
+        iso.values[0] = ferrovol::FvIsoValue {
+            value: 5.0,
+            color: [0.9, 0.8, 0.7],
+            opacity: 1.0,
+        };
+        let cases: [(&str, fn(&mut ferrovol::FvIsoParams), &str); 7] = [
+            ("9 values", |i| i.value_count = 9, "value_count 9"),
+            ("opacity 0", |i| i.values[0].opacity = 0.0, "opacity 0"),
+            ("colour 2", |i| i.values[0].color[0] = 2.0, "colour"),
+            ("mode 7", |i| i.specular_mode = 7, "specular_mode 7"),
+            ("0 samples", |i| i.specular_samples = 0, "0 specular samples"),
+            ("AO radius", |i| i.ao_radius = -1.0, "ao_radius -1"),
+            ("40 bisections", |i| i.bisection_steps = 40, "40 bisection steps"),
+        ];
+        for (what, edit, needle) in cases {
+            let mut bad = iso;
+            edit(&mut bad);
+            lib.expect(what, set_iso(r, &bad), FvStatus::InvalidArgument, needle);
+        }
+        lib.expect(
+            "NULL renderer",
+            set_iso(null_mut(), &iso),
+            FvStatus::NullArgument,
+            "renderer",
+        );
+        lib.expect(
+            "missing map",
+            set_env(r, c"/nonexistent/sky.hdr".as_ptr(), 1.0, null(), 0.0),
+            FvStatus::InvalidArgument,
+            "cannot be opened",
+        );
+        lib.expect(
+            "text map",
+            set_env(r, c"/etc/hostname.txt".as_ptr(), 1.0, null(), 0.0),
+            FvStatus::InvalidArgument,
+            "unsupported file type",
+        );
+        let up = [0.0, 0.0, 1.0];
+        assert_eq!(
+            set_env(r, null(), 1.0, up.as_ptr(), 30.0),
+            FvStatus::Ok,
+            "{}",
+            lib.last_error()
+        );
+        iso.ao_samples = 8;
+        assert_eq!(set_iso(r, &iso), FvStatus::Ok, "{}", lib.last_error());
+        assert_eq!(
+            render(r, 32, 32, null(), 0),
+            FvStatus::Ok,
+            "{}",
+            lib.last_error()
+        );
+        let mut frame: H = null_mut();
+        let read = lib.f::<unsafe extern "C" fn(H, *mut H) -> FvStatus>("fv_renderer_read_frame");
+        assert_eq!(read(r, &mut frame), FvStatus::Ok);
+        let rgba = lib.f::<unsafe extern "C" fn(H) -> *const u8>("fv_frame_rgba")(frame);
+        let px = |x: usize, y: usize| std::slice::from_raw_parts(rgba.add(4 * (y * 32 + x)), 4);
+        println!("sphere centre {:?}, corner {:?}", px(16, 16), px(0, 0));
+        assert_eq!(px(16, 16)[3], 255, "the opaque sphere covers the centre");
+        assert!(px(16, 16)[0] > 100, "and it is lit");
+        assert_eq!(px(0, 0), [0, 0, 0, 0], "the corner misses it");
+        lib.f::<Free>("fv_frame_free")(frame);
+        lib.f::<Free>("fv_volume_free")(v);
+        lib.f::<Free>("fv_renderer_free")(r);
+        lib.f::<Free>("fv_context_free")(ctx);
+    }
+}

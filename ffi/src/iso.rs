@@ -1,0 +1,159 @@
+//! The isosurface render mode through the C ABI: iso-values, deferred shading and
+//! ambient-occlusion settings ([`FvIsoParams`]) and the environment map.
+
+use crate::status::{FfiError, FfiResult};
+use ferrovol_core::iso::MAX_ISO_VALUES;
+use ferrovol_core::{AmbientOcclusion, IsoParams, IsoValue, Shininess, SpecularMode};
+
+/// Most iso-values in one FvIsoParams.
+pub const FV_MAX_ISO_VALUES: usize = 8;
+const _: () = assert!(FV_MAX_ISO_VALUES == MAX_ISO_VALUES);
+
+/// How the environment's specular light is sampled on the Phong lobe.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvSpecularMode {
+    /// Random unit vectors in a cone blended with the reflection vector (simple, noisy).
+    Cone = 0,
+    /// Importance sampling of the lobe, each sample from the mip level its pdf calls for.
+    Importance = 1,
+}
+
+/// One isosurface: where the first component equals `value`, drawn in `color` (RGB in
+/// [0, 1]) with `opacity` in (0, 1]. Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FvIsoValue {
+    pub value: f64,
+    pub color: [f32; 3],
+    pub opacity: f32,
+}
+
+/// Isosurfaces and their shading for frames with FV_BLEND_MODE_ISOSURFACE. Fill with
+/// fv_iso_params_default() and change what you need. The material's ambient, diffuse and
+/// specular weights come from FvRenderParams (lighting is always on in this mode).
+/// Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvIsoParams {
+    /// 1 to FV_MAX_ISO_VALUES entries of `values` are used.
+    pub value_count: u32,
+    pub values: [FvIsoValue; FV_MAX_ISO_VALUES],
+    /// Halvings of each crossing interval (0 to 32; default 8: hits within 2·10⁻⁵ voxel).
+    pub bisection_steps: u32,
+    /// Translucent surface layers kept per pixel (1 to 8).
+    pub max_layers: u32,
+    /// One of FvSpecularMode.
+    pub specular_mode: u32,
+    /// Environment samples on the specular lobe per shaded point (1 to 1024).
+    pub specular_samples: u32,
+    /// Specular exponent at weak and at strong gradient magnitude (equal values: a constant
+    /// exponent).
+    pub shininess: [f32; 2],
+    /// Gradient magnitudes (scalar units per world unit) that `shininess` spans; [0, 0]:
+    /// 0 to a quarter of the data range per smallest voxel spacing.
+    pub shininess_range: [f64; 2],
+    /// Schlick Fresnel reflectance at normal incidence in [0, 1]; negative: no Fresnel term.
+    pub fresnel: f32,
+    /// Ambient-occlusion directions per hit (0: no ambient occlusion; at most 1024).
+    pub ao_samples: u32,
+    /// Steps along each ambient-occlusion ray (1 to 256).
+    pub ao_steps: u32,
+    /// Ambient-occlusion ray length in world units; 0: 8 smallest voxel spacings.
+    pub ao_radius: f64,
+    /// Weight of the environment's light (0: the lights only).
+    pub environment_light: f32,
+    /// Show the environment behind the surfaces (the frame becomes opaque).
+    pub background: bool,
+}
+
+impl FvIsoParams {
+    pub fn defaults() -> Self {
+        let d = IsoParams::default();
+        let (shininess, shininess_range) = match d.shininess {
+            Shininess::Constant(s) => ([s, s], [0.0, 0.0]),
+            Shininess::GradientMagnitude { range, exponents } => {
+                (exponents, range.unwrap_or([0.0, 0.0]))
+            }
+        };
+        let ao = AmbientOcclusion::default();
+        FvIsoParams {
+            value_count: 0,
+            values: [FvIsoValue::default(); FV_MAX_ISO_VALUES],
+            bisection_steps: d.bisection_steps,
+            max_layers: d.max_layers,
+            specular_mode: match d.specular {
+                SpecularMode::Cone => FvSpecularMode::Cone as u32,
+                SpecularMode::Importance => FvSpecularMode::Importance as u32,
+            },
+            specular_samples: d.specular_samples,
+            shininess,
+            shininess_range,
+            fresnel: d.fresnel.unwrap_or(-1.0),
+            ao_samples: 0,
+            ao_steps: ao.steps,
+            ao_radius: 0.0,
+            environment_light: d.environment_light,
+            background: d.background,
+        }
+    }
+
+    pub fn to_core(&self) -> FfiResult<IsoParams> {
+        let n = self.value_count as usize;
+        if n == 0 || n > FV_MAX_ISO_VALUES {
+            return Err(FfiError::invalid(format!(
+                "value_count {n}: give 1 to {FV_MAX_ISO_VALUES} iso-values"
+            )));
+        }
+        let specular = match self.specular_mode {
+            0 => SpecularMode::Cone,
+            1 => SpecularMode::Importance,
+            m => {
+                return Err(FfiError::invalid(format!(
+                    "specular_mode {m} is not an FvSpecularMode (0 cone, 1 importance)"
+                )))
+            }
+        };
+        let [s0, s1] = self.shininess;
+        let shininess = if s0 == s1 {
+            Shininess::Constant(s0)
+        } else {
+            Shininess::GradientMagnitude {
+                range: (self.shininess_range != [0.0, 0.0]).then_some(self.shininess_range),
+                exponents: self.shininess,
+            }
+        };
+        if !(self.ao_radius.is_finite() && self.ao_radius >= 0.0) {
+            return Err(FfiError::invalid(format!(
+                "ao_radius {} must be 0 (automatic) or positive",
+                self.ao_radius
+            )));
+        }
+        if self.fresnel.is_nan() {
+            return Err(FfiError::invalid(
+                "fresnel is NaN: give a reflectance in [0, 1] or a negative value for none",
+            ));
+        }
+        let p = IsoParams {
+            values: self.values[..n]
+                .iter()
+                .map(|v| IsoValue::new(v.value, v.color, v.opacity))
+                .collect(),
+            bisection_steps: self.bisection_steps,
+            max_layers: self.max_layers,
+            specular,
+            specular_samples: self.specular_samples,
+            shininess,
+            fresnel: (self.fresnel >= 0.0).then_some(self.fresnel),
+            ambient_occlusion: (self.ao_samples > 0).then_some(AmbientOcclusion {
+                samples: self.ao_samples,
+                steps: self.ao_steps,
+                radius: (self.ao_radius > 0.0).then_some(self.ao_radius),
+            }),
+            environment_light: self.environment_light,
+            background: self.background,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
