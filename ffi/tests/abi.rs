@@ -614,9 +614,17 @@ fn isosurface_errors_and_a_frame() {
             ("opacity 0", |i| i.values[0].opacity = 0.0, "opacity 0"),
             ("colour 2", |i| i.values[0].color[0] = 2.0, "colour"),
             ("mode 7", |i| i.specular_mode = 7, "specular_mode 7"),
-            ("0 samples", |i| i.specular_samples = 0, "0 specular samples"),
+            (
+                "0 samples",
+                |i| i.specular_samples = 0,
+                "0 specular samples",
+            ),
             ("AO radius", |i| i.ao_radius = -1.0, "ao_radius -1"),
-            ("40 bisections", |i| i.bisection_steps = 40, "40 bisection steps"),
+            (
+                "40 bisections",
+                |i| i.bisection_steps = 40,
+                "40 bisection steps",
+            ),
         ];
         for (what, edit, needle) in cases {
             let mut bad = iso;
