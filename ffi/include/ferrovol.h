@@ -195,6 +195,20 @@ typedef enum FvTarget {
 } FvTarget;
 
 /**
+ * How the environment's specular light is sampled on the Phong lobe.
+ */
+typedef enum FvSpecularMode {
+  /**
+   * Random unit vectors in a cone blended with the reflection vector (simple, noisy).
+   */
+  FV_SPECULAR_MODE_CONE = 0,
+  /**
+   * Importance sampling of the lobe, each sample from the mip level its pdf calls for.
+   */
+  FV_SPECULAR_MODE_IMPORTANCE = 1,
+} FvSpecularMode;
+
+/**
  * A GPU adapter and device. Create one per process (or per host graphics context) and
  * share it between renderers. Thread use: may be used from any thread; calls on one
  * context may run concurrently (the device is internally synchronised).

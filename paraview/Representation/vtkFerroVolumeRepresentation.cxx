@@ -43,11 +43,11 @@ vtkFerroVolumeMapper* vtkFerroVolumeRepresentation::GetFerroVolumeMapper()
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::SetFerrovolBlendMode(int mode)
 {
-  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ADDITIVE_BLEND)
+  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ISOSURFACE_BLEND)
   {
     vtkErrorMacro(<< "FerrovolBlendMode " << mode
-                  << " is not one of composite (0), maximum (1), minimum (2), average (3) or "
-                     "additive (4); keeping "
+                  << " is not one of composite (0), maximum (1), minimum (2), average (3), "
+                     "additive (4) or isosurface (5); keeping "
                   << this->FerrovolBlendMode << ".");
     return;
   }
@@ -94,6 +94,58 @@ void vtkFerroVolumeRepresentation::SetUseJittering(int value)
 void vtkFerroVolumeRepresentation::SetEmptySpaceSkipping(int value)
 {
   this->GetFerroVolumeMapper()->SetEmptySpaceSkipping(value != 0);
+}
+
+//------------------------------------------------------------------------------------------
+// Isosurface settings: straight to the mapper, which clamps and documents them.
+void vtkFerroVolumeRepresentation::SetEnvironmentLighting(double value)
+{
+  this->GetFerroVolumeMapper()->SetEnvironmentLighting(value);
+}
+
+void vtkFerroVolumeRepresentation::SetEnvironmentMap(const char* path)
+{
+  this->GetFerroVolumeMapper()->SetEnvironmentMap(path);
+}
+
+void vtkFerroVolumeRepresentation::SetEnvironmentBackground(int value)
+{
+  this->GetFerroVolumeMapper()->SetEnvironmentBackground(value != 0);
+}
+
+void vtkFerroVolumeRepresentation::SetSpecularSampling(int mode)
+{
+  this->GetFerroVolumeMapper()->SetSpecularSampling(mode);
+}
+
+void vtkFerroVolumeRepresentation::SetSpecularSamples(int samples)
+{
+  this->GetFerroVolumeMapper()->SetSpecularSamples(samples);
+}
+
+void vtkFerroVolumeRepresentation::SetAmbientOcclusionSamples(int samples)
+{
+  this->GetFerroVolumeMapper()->SetAmbientOcclusionSamples(samples);
+}
+
+void vtkFerroVolumeRepresentation::SetAmbientOcclusionRadius(double radius)
+{
+  this->GetFerroVolumeMapper()->SetAmbientOcclusionRadius(radius);
+}
+
+void vtkFerroVolumeRepresentation::SetShininessFromGradient(int value)
+{
+  this->GetFerroVolumeMapper()->SetShininessFromGradient(value != 0);
+}
+
+void vtkFerroVolumeRepresentation::SetShininessRange(double weak, double strong)
+{
+  this->GetFerroVolumeMapper()->SetShininessRange(weak, strong);
+}
+
+void vtkFerroVolumeRepresentation::SetFresnel(double reflectance)
+{
+  this->GetFerroVolumeMapper()->SetFresnel(reflectance);
 }
 
 //------------------------------------------------------------------------------------------

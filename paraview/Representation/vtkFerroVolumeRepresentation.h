@@ -14,9 +14,12 @@
  * as "Ferrovol Volume" and shares the standard volume properties with "Volume". ferrovol's
  * own settings come as separate properties ("Ferrovol" group):
  *
- * - FerrovolBlendMode: vtkVolumeMapper::BlendModes composite, maximum, minimum, average and
- *   additive. The shared "BlendMode" property (Composite / Isosurface / Slice, for ParaView's
- *   own mapper) is ignored here: see SetBlendMode();
+ * - FerrovolBlendMode: vtkVolumeMapper::BlendModes composite, maximum, minimum, average,
+ *   additive and isosurface (the iso-values are the shared "IsosurfaceValues"). The shared
+ *   "BlendMode" property (Composite / Isosurface / Slice, for ParaView's own mapper) is
+ *   ignored here: see SetBlendMode();
+ * - the isosurface shading of vtkFerroVolumeMapper: environment lighting and map,
+ *   background, specular sampling, ambient occlusion, shininess from the gradient, Fresnel;
  * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
  *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering, and
  *   EmptySpaceSkipping.
@@ -56,7 +59,7 @@ public:
   /**
    * ferrovol's blend mode, a vtkVolumeMapper::BlendModes value: COMPOSITE_BLEND (0, the
    * default), MAXIMUM_INTENSITY_BLEND (1), MINIMUM_INTENSITY_BLEND (2),
-   * AVERAGE_INTENSITY_BLEND (3) or ADDITIVE_BLEND (4).
+   * AVERAGE_INTENSITY_BLEND (3), ADDITIVE_BLEND (4) or ISOSURFACE_BLEND (5).
    */
   void SetFerrovolBlendMode(int mode);
   vtkGetMacro(FerrovolBlendMode, int);
@@ -78,6 +81,23 @@ public:
   void SetImageSampleDistance(double value);
   void SetUseJittering(int value);
   void SetEmptySpaceSkipping(int value);
+  ///@}
+
+  ///@{
+  /**
+   * Forwarded to vtkFerroVolumeMapper's isosurface settings (see its documentation);
+   * SetShininessRange sets the exponents at weak and strong gradients.
+   */
+  void SetEnvironmentLighting(double value);
+  void SetEnvironmentMap(const char* path);
+  void SetEnvironmentBackground(int value);
+  void SetSpecularSampling(int mode);
+  void SetSpecularSamples(int samples);
+  void SetAmbientOcclusionSamples(int samples);
+  void SetAmbientOcclusionRadius(double radius);
+  void SetShininessFromGradient(int value);
+  void SetShininessRange(double weak, double strong);
+  void SetFresnel(double reflectance);
   ///@}
 
   /**

@@ -171,8 +171,16 @@ def measure(img, ref):
            "footprint": float(d[fp].mean()) if fp.any() else 0.0,
            "dlum": float((fvtest.luminance(img) - fvtest.luminance(ref))[fp].mean())
            if fp.any() else 0.0,
-           "coverage": float(fp.mean())}
+           "coverage": float(fp.mean()),
+           "silhouette": fvtest.ssim(silhouette(img), silhouette(ref))}
     return out, fmap
+
+
+def silhouette(img):
+    """The image's coverage mask (pixels that differ from the black background by more than
+    8 levels) as a black and white image: SSIM of two of them compares outlines alone."""
+    mask = np.abs(img).max(axis=2) > 8.0
+    return np.repeat(mask[..., None] * 255.0, 3, axis=2)
 
 
 def save_png(name, img):
@@ -198,6 +206,8 @@ def check(scene, t, m):
         bad.append("PSNR %.2f < %.2f dB" % (m["psnr"], t["psnr"]))
     if m["flip"] > t["flip"]:
         bad.append("FLIP %.4f > %.4f" % (m["flip"], t["flip"]))
+    if "silhouette" in t and m["silhouette"] < t["silhouette"]:
+        bad.append("silhouette SSIM %.4f < %.4f" % (m["silhouette"], t["silhouette"]))
     if m["footprint"] > t["footprint"]:
         bad.append("footprint diff %.2f > %.2f" % (m["footprint"], t["footprint"]))
     return bad
@@ -286,7 +296,7 @@ def fmt(m, k):
         return "–"
     v = m[k]
     return {"ssim": "%.4f", "psnr": "%.2f", "flip": "%.4f", "footprint": "%.2f",
-            "dlum": "%+.2f"}[k] % v
+            "dlum": "%+.2f", "silhouette": "%.4f"}[k] % v
 
 
 def print_row(r):
@@ -296,6 +306,8 @@ def print_row(r):
     if m:
         line += " SSIM %s  PSNR %6s dB  FLIP %s  dRGB %5s" % (
             fmt(m, "ssim"), fmt(m, "psnr"), fmt(m, "flip"), fmt(m, "footprint"))
+    if m and "isosurface" in r["blends"]:
+        line += "  silhouette SSIM %s" % fmt(m, "silhouette")
     if f:
         line += "   | fixed-point: SSIM %s PSNR %s" % (fmt(f, "ssim"), fmt(f, "psnr"))
     log(line)

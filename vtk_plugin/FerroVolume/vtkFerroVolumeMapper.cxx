@@ -15,6 +15,7 @@
 #include "vtkCamera.h"
 #include "vtkCellData.h"
 #include "vtkColorTransferFunction.h"
+#include "vtkContourValues.h"
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkLight.h"
@@ -1126,6 +1127,10 @@ public:
   bool HaveTables = false;
   TableKey Tables;
 
+  // The environment last given to the renderer (isosurface blend mode).
+  bool HaveEnvironment = false;
+  std::string EnvironmentKey;
+
   std::unique_ptr<FrameOutput> Output;
   int OutputPreference = -1;
   // weak: a window destroyed behind our back reads as null, and its GL names are forgotten
@@ -1144,6 +1149,7 @@ public:
     this->Renderer = nullptr;
     this->HaveVolume = false;
     this->HaveTables = false;
+    this->HaveEnvironment = false;
     this->Volume = VolumeKey();
     this->Tables = TableKey();
   }
@@ -1162,6 +1168,22 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , UseJittering(0)
   , EmptySpaceSkipping(1)
   , OutputPath(OUTPUT_PATH_AUTOMATIC)
+  , EnvironmentLighting(0.0)
+  , EnvironmentMap(nullptr)
+  , EnvironmentUp{ 0.0, 1.0, 0.0 }
+  , EnvironmentAzimuth(0.0)
+  , EnvironmentIntensity(1.0)
+  , EnvironmentBackground(0)
+  , SpecularSampling(SPECULAR_IMPORTANCE)
+  , SpecularSamples(16)
+  , AmbientOcclusionSamples(0)
+  , AmbientOcclusionSteps(8)
+  , AmbientOcclusionRadius(0.0)
+  , ShininessFromGradient(0)
+  , ShininessRange{ 8.0, 64.0 }
+  , ShininessGradientRange{ 0.0, 0.0 }
+  , Fresnel(-1.0)
+  , IsosurfaceLayers(4)
   , LastRenderDrew(0)
   , LastRenderSize{ 0, 0 }
   , Internals(new vtkInternals)
@@ -1177,6 +1199,7 @@ vtkFerroVolumeMapper::~vtkFerroVolumeMapper()
     this->Internals->Output->ReleaseGraphicsResources(nullptr);
   }
   delete this->Internals;
+  this->SetEnvironmentMap(nullptr);
 }
 
 //------------------------------------------------------------------------------------------
@@ -1765,6 +1788,160 @@ bool BuildTransferFunction(vtkFerroVolumeMapper* self, vtkVolumeProperty* prop, 
 //------------------------------------------------------------------------------------------
 namespace
 {
+enum class IsoSetup
+{
+  Failed,
+  NothingVisible,
+  Ready
+};
+
+// What the mapper remembers about the environment between frames.
+struct IsoEnvironment
+{
+  bool& Have;
+  std::string& Key;
+  std::set<std::string>& Warned;
+};
+
+// Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
+// environment when it changed. The surfaces' colours and opacities are the property's
+// colour and scalar opacity functions at the iso-values (first component), as
+// vtkGPUVolumeRayCastMapper's; Shade off draws flat colours (ambient 1, no diffuse or
+// specular light, no environment light).
+IsoSetup SetUpIsosurfaces(vtkFerroVolumeMapper* self, FvRenderer* r, vtkVolumeProperty* prop,
+  IsoEnvironment env, FvRenderParams& params, std::string& error)
+{
+  vtkContourValues* contours = prop->GetIsoSurfaceValues();
+  const int n = contours ? contours->GetNumberOfContours() : 0;
+  if (n < 1)
+  {
+    error = "the isosurface blend mode needs iso-values: set them with "
+            "volumeProperty->GetIsoSurfaceValues()->SetValue(0, value)";
+    return IsoSetup::Failed;
+  }
+  if (n > FV_MAX_ISO_VALUES && env.Warned.insert("iso-count").second)
+  {
+    vtkWarningWithObjectMacro(self, << n << " iso-values: ferrovol draws the first "
+                                    << FV_MAX_ISO_VALUES);
+  }
+  FvIsoParams iso;
+  fv_iso_params_default(&iso);
+  // (Get{Gray,RGB}TransferFunction create a default function, and switch the property to
+  // it, when it has none: ask for the one the property uses.)
+  const bool grayColor = prop->GetColorChannels(0) == 1;
+  vtkColorTransferFunction* rgb = grayColor ? nullptr : prop->GetRGBTransferFunction(0);
+  vtkPiecewiseFunction* gray = grayColor ? prop->GetGrayTransferFunction(0) : nullptr;
+  vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(0);
+  uint32_t count = 0;
+  for (int i = 0; i < std::min(n, static_cast<int>(FV_MAX_ISO_VALUES)); ++i)
+  {
+    const double v = contours->GetValue(i);
+    const double a = std::min(1.0, opacity->GetValue(v));
+    if (!(a > 0.0))
+    {
+      if (env.Warned.insert("iso-transparent-" + std::to_string(v)).second)
+      {
+        vtkWarningWithObjectMacro(self, << "iso-value " << v
+                                        << " has opacity 0 in the scalar opacity function: "
+                                           "it is not drawn");
+      }
+      continue;
+    }
+    FvIsoValue& iv = iso.values[count++];
+    iv.value = v;
+    double c[3];
+    if (grayColor)
+    {
+      c[0] = c[1] = c[2] = gray->GetValue(v);
+    }
+    else
+    {
+      rgb->GetColor(v, c);
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      iv.color[k] = static_cast<float>(std::min(1.0, std::max(0.0, c[k])));
+    }
+    iv.opacity = static_cast<float>(a);
+  }
+  if (count == 0)
+  {
+    return IsoSetup::NothingVisible;
+  }
+  iso.value_count = count;
+  iso.max_layers = static_cast<uint32_t>(self->GetIsosurfaceLayers());
+  iso.specular_mode = self->GetSpecularSampling() == vtkFerroVolumeMapper::SPECULAR_CONE
+    ? FV_SPECULAR_MODE_CONE
+    : FV_SPECULAR_MODE_IMPORTANCE;
+  iso.specular_samples = static_cast<uint32_t>(self->GetSpecularSamples());
+  if (self->GetShininessFromGradient())
+  {
+    const double* e = self->GetShininessRange();
+    const double* g = self->GetShininessGradientRange();
+    iso.shininess[0] = static_cast<float>(e[0]);
+    iso.shininess[1] = static_cast<float>(e[1]);
+    iso.shininess_range[0] = g[0];
+    iso.shininess_range[1] = g[1];
+  }
+  else
+  {
+    iso.shininess[0] = iso.shininess[1] = params.specular_power;
+  }
+  iso.fresnel = static_cast<float>(self->GetFresnel());
+  iso.ao_samples = static_cast<uint32_t>(self->GetAmbientOcclusionSamples());
+  iso.ao_steps = static_cast<uint32_t>(self->GetAmbientOcclusionSteps());
+  iso.ao_radius = self->GetAmbientOcclusionRadius();
+  iso.background = self->GetEnvironmentBackground() != 0;
+  iso.environment_light = params.shade ? static_cast<float>(self->GetEnvironmentLighting()) : 0.0f;
+  if (!params.shade)
+  {
+    params.ambient = 1.0f;
+    params.diffuse = 0.0f;
+    params.specular = 0.0f;
+  }
+
+  // The environment: built again only when the map or its placement changed.
+  if (iso.environment_light > 0.0f || iso.background)
+  {
+    const char* file = self->GetEnvironmentMap();
+    const bool sky = !file || !*file;
+    const double* up = self->GetEnvironmentUp();
+    std::ostringstream key;
+    key << (sky ? "" : file) << '|' << up[0] << ',' << up[1] << ',' << up[2] << '|'
+        << self->GetEnvironmentAzimuth() << '|' << self->GetEnvironmentIntensity();
+    if (!env.Have || env.Key != key.str())
+    {
+      env.Have = true;
+      env.Key = key.str();
+      const FvStatus st = fv_renderer_set_environment(r, sky ? nullptr : file,
+        static_cast<float>(self->GetEnvironmentIntensity()), up, self->GetEnvironmentAzimuth());
+      if (st != FV_STATUS_OK)
+      {
+        // Said once per setting; the surfaces go on without environment light.
+        vtkErrorWithObjectMacro(self, << FvError("use the environment map", st)
+                                      << " (the surfaces are drawn without environment light)");
+        env.Key = "failed:" + key.str();
+      }
+    }
+    if (env.Key.rfind("failed:", 0) == 0)
+    {
+      iso.environment_light = 0.0f;
+      iso.background = false;
+    }
+  }
+  const FvStatus st = fv_renderer_set_isosurface(r, &iso);
+  if (st != FV_STATUS_OK)
+  {
+    error = FvError("use the isosurface settings", st);
+    return IsoSetup::Failed;
+  }
+  return IsoSetup::Ready;
+}
+}
+
+//------------------------------------------------------------------------------------------
+namespace
+{
 // Whether the renderer has visible props other than volumes that draw opaque geometry
 // before the volume pass. Without any, VTK's depth buffer holds only its clear value: the
 // frame then needs no depth input, which saves a full-viewport copy (about 6 ms of a 900x900
@@ -1877,15 +2054,13 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       blend = FV_BLEND_MODE_ADDITIVE;
       break;
     case vtkVolumeMapper::ISOSURFACE_BLEND:
-      Fail(this,
-        "the isosurface blend mode is not yet supported by vtkFerroVolumeMapper: nothing is "
-        "drawn (use composite with a sharp opacity step, or vtkGPUVolumeRayCastMapper)");
-      return;
+      blend = FV_BLEND_MODE_ISOSURFACE;
+      break;
     default:
       Fail(this,
         "blend mode " + std::to_string(this->BlendMode) +
-          " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average and "
-          "additive are): nothing is drawn");
+          " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
+          "additive and isosurface are): nothing is drawn");
       return;
   }
 
@@ -2068,7 +2243,8 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     params.sample_distance = this->SampleDistance;
   }
   params.jitter = this->UseJittering != 0;
-  params.shade = prop->GetShade(0) != 0 && blend == FV_BLEND_MODE_COMPOSITE;
+  const bool isosurface = blend == FV_BLEND_MODE_ISOSURFACE;
+  params.shade = prop->GetShade(0) != 0 && (blend == FV_BLEND_MODE_COMPOSITE || isosurface);
   params.ambient = static_cast<float>(prop->GetAmbient(0));
   params.diffuse = static_cast<float>(prop->GetDiffuse(0));
   params.specular = static_cast<float>(prop->GetSpecular(0));
@@ -2105,6 +2281,20 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   params.average_range[1] = this->AverageIPScalarRange[1];
   params.empty_space_skipping = this->EmptySpaceSkipping != 0;
   ToColumnMajor(volumeMatrix, params.volume_matrix);
+  if (isosurface)
+  {
+    IsoEnvironment env{ in->HaveEnvironment, in->EnvironmentKey, in->Warned };
+    switch (SetUpIsosurfaces(this, r, prop, env, params, error))
+    {
+      case IsoSetup::Failed:
+        Fail(this, error);
+        return;
+      case IsoSetup::NothingVisible:
+        return; // every iso-value is transparent (SetUpIsosurfaces warned once)
+      case IsoSetup::Ready:
+        break;
+    }
+  }
   FvStatus st = fv_renderer_set_params(r, &params);
   if (st != FV_STATUS_OK)
   {
@@ -2155,7 +2345,19 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   // ---- lights (VTK's default lighting: one headlight of intensity 1, whose ambient term is
   // the material's ambient times the sample colour)
   std::vector<FvLight> lights;
-  if (params.shade)
+  if (isosurface && !params.shade)
+  {
+    // Flat isosurfaces (Shade off), as vtkGPUVolumeRayCastMapper draws them: the surface
+    // colour alone, through one purely ambient light (SetUpIsosurfaces set the material).
+    FvLight l;
+    std::memset(&l, 0, sizeof(l));
+    l.space = FV_LIGHT_SPACE_HEADLIGHT;
+    l.ambient[0] = l.ambient[1] = l.ambient[2] = 1.0f;
+    l.intensity = 1.0f;
+    l.attenuation[0] = 1.0f;
+    lights.push_back(l);
+  }
+  else if (params.shade)
   {
     vtkLightCollection* lc = ren->GetLights();
     vtkCollectionSimpleIterator it;
@@ -2381,6 +2583,27 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "UseJittering: " << this->UseJittering << "\n";
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
+  os << indent << "EnvironmentLighting: " << this->EnvironmentLighting << "\n";
+  os << indent << "EnvironmentMap: "
+     << (this->EnvironmentMap && *this->EnvironmentMap ? this->EnvironmentMap : "(sky)") << "\n";
+  os << indent << "EnvironmentUp: " << this->EnvironmentUp[0] << " " << this->EnvironmentUp[1]
+     << " " << this->EnvironmentUp[2] << "\n";
+  os << indent << "EnvironmentAzimuth: " << this->EnvironmentAzimuth << "\n";
+  os << indent << "EnvironmentIntensity: " << this->EnvironmentIntensity << "\n";
+  os << indent << "EnvironmentBackground: " << this->EnvironmentBackground << "\n";
+  os << indent << "SpecularSampling: "
+     << (this->SpecularSampling == SPECULAR_CONE ? "cone" : "importance") << "\n";
+  os << indent << "SpecularSamples: " << this->SpecularSamples << "\n";
+  os << indent << "AmbientOcclusionSamples: " << this->AmbientOcclusionSamples << "\n";
+  os << indent << "AmbientOcclusionSteps: " << this->AmbientOcclusionSteps << "\n";
+  os << indent << "AmbientOcclusionRadius: " << this->AmbientOcclusionRadius << "\n";
+  os << indent << "ShininessFromGradient: " << this->ShininessFromGradient << "\n";
+  os << indent << "ShininessRange: " << this->ShininessRange[0] << " "
+     << this->ShininessRange[1] << "\n";
+  os << indent << "ShininessGradientRange: " << this->ShininessGradientRange[0] << " "
+     << this->ShininessGradientRange[1] << "\n";
+  os << indent << "Fresnel: " << this->Fresnel << "\n";
+  os << indent << "IsosurfaceLayers: " << this->IsosurfaceLayers << "\n";
   os << indent << "LastRenderDrew: " << this->LastRenderDrew << "\n";
   os << indent << "LastRenderSize: " << this->LastRenderSize[0] << " x "
      << this->LastRenderSize[1] << "\n";

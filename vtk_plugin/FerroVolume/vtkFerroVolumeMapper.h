@@ -13,9 +13,17 @@
  *   units: the x axis is converted to ferrovol's), unit distance, component weights,
  *   IndependentComponents, Shade/Ambient/Diffuse/Specular/SpecularPower, interpolation;
  *   the tables span each component's data range as vtkGPUVolumeRayCastMapper's do;
- * - vtkVolumeMapper: composite, maximum, minimum, average (AverageIPScalarRange) and
- *   additive blend modes (isosurface and slice are refused with an error), cropping with
+ * - vtkVolumeMapper: composite, maximum, minimum, average (AverageIPScalarRange),
+ *   additive and isosurface blend modes (slice is refused with an error), cropping with
  *   region flags, clipping planes (world coordinates);
+ * - isosurfaces (ISOSURFACE_BLEND): the property's iso-values (GetIsoSurfaceValues), each
+ *   coloured by the colour function and made translucent by the scalar opacity function at
+ *   its value, as vtkGPUVolumeRayCastMapper; each crossing is refined by interval
+ *   bisection (vtkGPUVolumeRayCastMapper shades the sample after it), lit by the
+ *   renderer's lights when the property's Shade is on (flat colours otherwise), and
+ *   optionally by an environment map (diffuse irradiance and a specular lobe), with
+ *   ambient occlusion and a shininess that follows the gradient magnitude; see the
+ *   Environment*, Specular*, AmbientOcclusion*, Shininess* and Fresnel settings;
  * - vtkGPUVolumeRayCastMapper's sampling settings with the same meaning:
  *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering;
  * - the renderer's lights (headlight, light kit, scene lights; at most 8 switched on);
@@ -95,6 +103,121 @@ public:
   vtkSetClampMacro(EmptySpaceSkipping, vtkTypeBool, 0, 1);
   vtkGetMacro(EmptySpaceSkipping, vtkTypeBool);
   vtkBooleanMacro(EmptySpaceSkipping, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode: how much of the environment's light falls on the surfaces,
+   * diffuse (irradiance) and specular (the Phong lobe sampled on the environment map),
+   * added to the renderer's lights. 0 (the default) lights the surfaces as
+   * vtkGPUVolumeRayCastMapper does, with the renderer's lights only.
+   */
+  vtkSetClampMacro(EnvironmentLighting, double, 0.0, 100.0);
+  vtkGetMacro(EnvironmentLighting, double);
+  ///@}
+
+  ///@{
+  /**
+   * The environment map: an equirectangular (latitude-longitude) image twice as wide as
+   * high, .hdr, .exr, .png or .jpg; nullptr or "" (the default) for ferrovol's built-in
+   * procedural sky. A file that cannot be used is reported with vtkErrorMacro and the
+   * surfaces are drawn without environment light.
+   */
+  vtkSetStringMacro(EnvironmentMap);
+  vtkGetStringMacro(EnvironmentMap);
+  ///@}
+
+  ///@{
+  /**
+   * The world direction that is up in the environment map (default 0, 1, 0), its rotation
+   * about that axis in degrees (default 0) and a radiance multiplier (default 1).
+   */
+  vtkSetVector3Macro(EnvironmentUp, double);
+  vtkGetVector3Macro(EnvironmentUp, double);
+  vtkSetMacro(EnvironmentAzimuth, double);
+  vtkGetMacro(EnvironmentAzimuth, double);
+  vtkSetClampMacro(EnvironmentIntensity, double, 0.0, 1.0e6);
+  vtkGetMacro(EnvironmentIntensity, double);
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode: show the environment behind the surfaces (default off; the
+   * volume's pixels then become opaque).
+   */
+  vtkSetClampMacro(EnvironmentBackground, vtkTypeBool, 0, 1);
+  vtkGetMacro(EnvironmentBackground, vtkTypeBool);
+  vtkBooleanMacro(EnvironmentBackground, vtkTypeBool);
+  ///@}
+
+  enum SpecularSamplingModes
+  {
+    SPECULAR_CONE = 0,
+    SPECULAR_IMPORTANCE = 1
+  };
+
+  ///@{
+  /**
+   * How the specular environment light is sampled: SPECULAR_IMPORTANCE (the default)
+   * draws directions distributed as the Phong lobe and reads each from the mip level its
+   * probability calls for (smooth at few samples); SPECULAR_CONE blends random vectors in
+   * a cone with the reflection vector (the simple scheme; noisy). SpecularSamples
+   * directions per shaded point (1 to 1024, default 16).
+   */
+  vtkSetClampMacro(SpecularSampling, int, SPECULAR_CONE, SPECULAR_IMPORTANCE);
+  vtkGetMacro(SpecularSampling, int);
+  vtkSetClampMacro(SpecularSamples, int, 1, 1024);
+  vtkGetMacro(SpecularSamples, int);
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode: ambient occlusion with this many directions per surface point
+   * (0, the default: off; at most 1024), each a short ray of AmbientOcclusionSteps samples
+   * (1 to 256, default 8) over AmbientOcclusionRadius world units (0, the default: 8 voxel
+   * spacings). The fraction of open directions scales ambient and environment light.
+   */
+  vtkSetClampMacro(AmbientOcclusionSamples, int, 0, 1024);
+  vtkGetMacro(AmbientOcclusionSamples, int);
+  vtkSetClampMacro(AmbientOcclusionSteps, int, 1, 256);
+  vtkGetMacro(AmbientOcclusionSteps, int);
+  vtkSetClampMacro(AmbientOcclusionRadius, double, 0.0, 1.0e30);
+  vtkGetMacro(AmbientOcclusionRadius, double);
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode: when on, the specular exponent follows the gradient magnitude
+   * at each surface point, from ShininessRange[0] at ShininessGradientRange[0] to
+   * ShininessRange[1] at ShininessGradientRange[1] (gradient magnitude in scalar units per
+   * world unit; [0, 0], the default: 0 to a quarter of the data range per voxel), so
+   * sharp boundaries look glossier. Off (the default): the property's SpecularPower.
+   */
+  vtkSetClampMacro(ShininessFromGradient, vtkTypeBool, 0, 1);
+  vtkGetMacro(ShininessFromGradient, vtkTypeBool);
+  vtkBooleanMacro(ShininessFromGradient, vtkTypeBool);
+  vtkSetVector2Macro(ShininessRange, double);
+  vtkGetVector2Macro(ShininessRange, double);
+  vtkSetVector2Macro(ShininessGradientRange, double);
+  vtkGetVector2Macro(ShininessGradientRange, double);
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode: Schlick's Fresnel weighting of specular light with this
+   * reflectance at normal incidence, in [0, 1] (e.g. 0.04); negative (the default): none.
+   */
+  vtkSetClampMacro(Fresnel, double, -1.0, 1.0);
+  vtkGetMacro(Fresnel, double);
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode: surfaces kept per pixel when they are translucent (1 to 8,
+   * default 4); marching also ends where the accumulated opacity is nearly 1.
+   */
+  vtkSetClampMacro(IsosurfaceLayers, int, 1, 8);
+  vtkGetMacro(IsosurfaceLayers, int);
   ///@}
 
   enum OutputPaths
@@ -185,6 +308,22 @@ protected:
   vtkTypeBool UseJittering;
   vtkTypeBool EmptySpaceSkipping;
   int OutputPath;
+  double EnvironmentLighting;
+  char* EnvironmentMap;
+  double EnvironmentUp[3];
+  double EnvironmentAzimuth;
+  double EnvironmentIntensity;
+  vtkTypeBool EnvironmentBackground;
+  int SpecularSampling;
+  int SpecularSamples;
+  int AmbientOcclusionSamples;
+  int AmbientOcclusionSteps;
+  double AmbientOcclusionRadius;
+  vtkTypeBool ShininessFromGradient;
+  double ShininessRange[2];
+  double ShininessGradientRange[2];
+  double Fresnel;
+  int IsosurfaceLayers;
   vtkTypeBool LastRenderDrew;
   int LastRenderSize[2];
 
