@@ -1801,6 +1801,8 @@ struct IsoEnvironment
   bool& Have;
   std::string& Key;
   std::set<std::string>& Warned;
+  // Out: the frame shows the environment behind the surfaces (it covers the viewport).
+  bool& Background;
 };
 
 // Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
@@ -1929,6 +1931,7 @@ IsoSetup SetUpIsosurfaces(vtkFerroVolumeMapper* self, FvRenderer* r, vtkVolumePr
       iso.background = false;
     }
   }
+  env.Background = iso.background;
   const FvStatus st = fv_renderer_set_isosurface(r, &iso);
   if (st != FV_STATUS_OK)
   {
@@ -2281,9 +2284,10 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   params.average_range[1] = this->AverageIPScalarRange[1];
   params.empty_space_skipping = this->EmptySpaceSkipping != 0;
   ToColumnMajor(volumeMatrix, params.volume_matrix);
+  bool fullViewport = false;
   if (isosurface)
   {
-    IsoEnvironment env{ in->HaveEnvironment, in->EnvironmentKey, in->Warned };
+    IsoEnvironment env{ in->HaveEnvironment, in->EnvironmentKey, in->Warned, fullViewport };
     switch (SetUpIsosurfaces(this, r, prop, env, params, error))
     {
       case IsoSetup::Failed:
@@ -2545,6 +2549,12 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   const double pad = matrixScale *
     std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
   ProjectedRect(ren, vol, pad, vw, vh, rect);
+  if (fullViewport)
+  {
+    rect[0] = rect[1] = 0;
+    rect[2] = vw;
+    rect[3] = vh;
+  }
   if (rect[2] < 1 || rect[3] < 1)
   {
     this->LastRenderDrew = 1; // the volume is entirely off screen: nothing to composite
