@@ -127,3 +127,5 @@ pictures: build
 	$(FERROVOL) render --demo wavelet --mode mip --size 640x640 --azimuth 30 --elevation 20 --out docs/img/wavelet-mip.png
 	scripts/fetch-data.sh >/dev/null
 	$(FERROVOL) render build/data/cranium.vti --tf ct-skin-bone --shade --elevation -90 --size 640x640 --out docs/img/cranium-ct.png
+	$(FERROVOL) render build/data/cranium.vti --mode iso --iso 400 --iso=-500:0.25 --ao 16 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 640x640 --out docs/img/cranium-iso.png
+	$(FERROVOL) render build/data/colin27.nii.gz --mode iso --iso 60:0.35:0.92,0.72,0.62 --iso 115:1:0.9,0.88,0.82 --ao 16 --elevation 90 --view-up z --env-up z --zoom 1.2 --size 640x640 --out docs/img/mri-iso.png

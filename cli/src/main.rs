@@ -94,6 +94,15 @@ struct RenderArgs {
     /// Camera rotation up/down, degrees (vtkCamera::Elevation).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     elevation: f64,
+    /// The world axis that is up on screen after azimuth and elevation (x, y, z, -x, -y or
+    /// -z; vtkCamera::SetViewUp + OrthogonalizeViewUp), e.g. z for medical volumes seen
+    /// from the front with --elevation -90.
+    #[arg(long, value_parser = parse_axis, allow_hyphen_values = true)]
+    view_up: Option<[f64; 3]>,
+    /// Camera rotation about the view direction, degrees (vtkCamera::Roll), after azimuth
+    /// and elevation.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    roll: f64,
     /// Zoom factor (vtkCamera::Zoom).
     #[arg(long, default_value_t = 1.0)]
     zoom: f64,
@@ -459,7 +468,19 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     view.camera.parallel = a.parallel;
     view.camera.azimuth(a.azimuth);
     view.camera.elevation(a.elevation);
+    if let Some(up) = a.view_up {
+        let up = glam::DVec3::from_array(up);
+        let dir = view.camera.focal_point - view.camera.position;
+        if up.cross(dir).length() <= 1e-9 * dir.length() {
+            return Err(CliError::Usage(format!(
+                "--view-up {up}: that axis is parallel to the view direction {dir} after \
+                 --azimuth/--elevation; choose another axis or turn the camera first"
+            )));
+        }
+        view.camera.view_up = up;
+    }
     view.camera.orthogonalize_view_up();
+    view.camera.roll(a.roll);
     view.camera.zoom(a.zoom);
     view.camera.reset_clipping_range(vol.bounds());
     let mut params = RenderParams {

@@ -87,6 +87,8 @@ fn iso_flags_reject_bad_values_with_a_message() {
         ),
         (vec!["--iso", "0.5", "--env-cube", "a.png,b.png"], "six"),
         (vec!["--iso", "0.5", "--env-up", "w"], "x, y, z"),
+        (vec!["--iso", "0.5", "--view-up", "up"], "x, y, z"),
+        (vec!["--iso", "0.5", "--view-up", "z"], "parallel"),
         (
             vec!["--iso", "0.5", "--specular-samples", "0"],
             "specular samples",
