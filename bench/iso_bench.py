@@ -23,6 +23,10 @@ import vtk
 
 import ferrovol
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "vtk_plugin",
+                                "tests"))
+import fvtest  # noqa: E402  (offscreen windows on one X connection: Xvfb drops new ones now and then)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, ".."))
 
@@ -59,8 +63,7 @@ def skull_property():
 
 
 def run(data, kind, settings, frames, size, png):
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
+    win = fvtest.new_window()
     win.SetMultiSamples(0)
     win.SetSize(*size)
     ren = vtk.vtkRenderer()
