@@ -609,7 +609,8 @@ fn isosurface_errors_and_a_frame() {
             color: [0.9, 0.8, 0.7],
             opacity: 1.0,
         };
-        let cases: [(&str, fn(&mut ferrovol::FvIsoParams), &str); 7] = [
+        type Edit = fn(&mut ferrovol::FvIsoParams);
+        let cases: [(&str, Edit, &str); 7] = [
             ("9 values", |i| i.value_count = 9, "value_count 9"),
             ("opacity 0", |i| i.values[0].opacity = 0.0, "opacity 0"),
             ("colour 2", |i| i.values[0].color[0] = 2.0, "colour"),
