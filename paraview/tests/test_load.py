@@ -8,8 +8,8 @@
    combo box shows) and one frame drawn by ferrovol.
 In 1-3 the properties panel's groups are checked too: with "Ferrovol Volume" the panel
 shows the Ferrovol group and the standard volume properties ferrovol honours (Shade,
-opacity, unit distance, cropping), and not those it ignores (BlendMode, render mode,
-isosurfaces); "Volume" keeps all of its own.
+opacity, unit distance, cropping, isosurface values), and not those it ignores (BlendMode,
+render mode); "Volume" keeps all of its own.
 
 Run with any Python 3 (it starts pvpython, pvbatch and paraview itself):
     FERROVOL_PV_PLUGIN_DIR=build/paraview/lib/paraview-5.11/plugins/Ferrovol python3 test_load.py
@@ -58,11 +58,12 @@ for i in range(p.GetNumberOfPropertyGroups()):
         if g.GetProperty(k) is not None:
             group[p.GetPropertyName(g.GetProperty(k))] = values(g.GetHints())
 shown = ["Shade", "ScalarOpacityFunction", "ScalarOpacityUnitDistance", "UseCropping",
-         "CroppingOrigin", "FerrovolBlendMode", "FerrovolSampleDistance", "FerrovolUseJittering"]
-hidden = ["BlendMode", "VolumeRenderingMode", "IsosurfaceValues"]
+         "CroppingOrigin", "IsosurfaceValues", "FerrovolBlendMode", "FerrovolSampleDistance",
+         "FerrovolUseJittering", "FerrovolEnvironmentLighting", "FerrovolAmbientOcclusionSamples"]
+hidden = ["BlendMode", "VolumeRenderingMode"]
 panel = all("Ferrovol Volume" in group.get(n, []) for n in shown) and not any(
     "Ferrovol Volume" in group.get(n, []) for n in hidden) and all(
-    "Volume" in group.get(n, []) for n in shown[:5] + hidden)
+    "Volume" in group.get(n, []) for n in shown[:6] + hidden)
 print("RESULT loaded=%s has_proxy=%s panel=%s reps=%s" % (
     "Ferrovol" in loaded,
     servermanager.ProxyManager().SMProxyManager.GetProxyDefinitionManager().HasDefinition(
