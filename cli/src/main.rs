@@ -7,8 +7,8 @@ mod readers;
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
     synth, AmbientOcclusion, BlendMode, Context, Environment, GradientMethod, Interpolation,
-    IsoParams, IsoValue, RenderParams, Renderer, Shininess, SpecularMode, UploadOptions, View,
-    VolumeData,
+    IsoParams, IsoValue, PathTraceParams, RenderParams, Renderer, Shininess, SpecularMode,
+    UploadOptions, View, VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -48,6 +48,9 @@ enum Mode {
     /// Isosurfaces (--iso): first hit with bisection, deferred shading with environment
     /// lighting and ambient occlusion.
     Iso,
+    /// Monte Carlo path tracing of the volume as a scattering medium (--spp, --g,
+    /// --bounces; the environment flags light it).
+    Pathtrace,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -134,9 +137,26 @@ struct RenderArgs {
     repeat: u32,
     #[command(flatten)]
     iso: IsoArgs,
+    #[command(flatten)]
+    pt: PathTraceArgs,
     /// Output PNG.
     #[arg(long, short, default_value = "ferrovol.png")]
     out: PathBuf,
+}
+
+/// Path tracing options (--mode pathtrace); --env, --env-up, --env-azimuth,
+/// --env-intensity, --env-light and --env-background light it too.
+#[derive(clap::Args)]
+struct PathTraceArgs {
+    /// Paths per pixel (accumulated over frames of at most 64 paths each).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: u32,
+    /// Henyey–Greenstein anisotropy g in (−1, 1): 0 isotropic, > 0 forward scattering.
+    #[arg(long = "g", default_value_t = 0.0, allow_hyphen_values = true)]
+    anisotropy: f32,
+    /// Most scattering events per path.
+    #[arg(long, default_value_t = 64)]
+    bounces: u32,
 }
 
 /// Isosurface options (--mode iso).
@@ -163,10 +183,10 @@ struct IsoArgs {
     /// Multiply the environment's radiance.
     #[arg(long, default_value_t = 1.0)]
     env_intensity: f32,
-    /// Weight of environment lighting on the surfaces (0: the headlight only; 1 with
-    /// --no-lights).
-    #[arg(long, default_value_t = 0.6)]
-    env_light: f32,
+    /// Weight of environment lighting (0: the lights only). Default: 0.6 on isosurfaces
+    /// (beside the headlight; 1 with --no-lights), 1 when path tracing.
+    #[arg(long)]
+    env_light: Option<f32>,
     /// Show the environment behind the surfaces.
     #[arg(long)]
     env_background: bool,
@@ -336,10 +356,15 @@ fn iso_setup(a: &IsoArgs, vol: &VolumeData) -> Result<(IsoParams, Environment), 
             steps: a.ao_steps,
             radius: a.ao_radius,
         }),
-        environment_light: a.env_light,
+        environment_light: a.env_light.unwrap_or(0.6),
         background: a.env_background,
     };
     iso.validate()?;
+    Ok((iso, environment_setup(a)?))
+}
+
+/// The environment the flags describe (the procedural sky by default).
+fn environment_setup(a: &IsoArgs) -> Result<Environment, CliError> {
     let mut env = match (&a.env, &a.env_cube) {
         (Some(e), _) if e != "sky" => Environment::load(std::path::Path::new(e))?,
         (_, Some(list)) => {
@@ -358,7 +383,7 @@ fn iso_setup(a: &IsoArgs, vol: &VolumeData) -> Result<(IsoParams, Environment), 
     env.azimuth = a.env_azimuth;
     env.intensity = a.env_intensity;
     env.validate()?;
-    Ok((iso, env))
+    Ok(env)
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -447,6 +472,20 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     } else {
         None
     };
+    let path_tracing = if a.mode == Mode::Pathtrace {
+        let p = PathTraceParams {
+            samples_per_frame: a.pt.spp.min(64),
+            max_bounces: a.pt.bounces,
+            anisotropy: a.pt.anisotropy,
+            environment_light: a.iso.env_light.unwrap_or(1.0),
+            background: a.iso.env_background,
+            seed: 0,
+        };
+        p.validate()?;
+        Some((p, environment_setup(&a.iso)?))
+    } else {
+        None
+    };
     pb.set_message("starting the GPU");
     let mut r = Renderer::new(Context::new()?)?;
     pb.set_message("uploading");
@@ -461,6 +500,11 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     if let Some((p, env)) = &iso {
         pb.set_message("filtering the environment");
         r.set_isosurface(p)?;
+        r.set_environment(env)?;
+    }
+    if let Some((p, env)) = &path_tracing {
+        pb.set_message("filtering the environment");
+        r.set_path_tracing(p)?;
         r.set_environment(env)?;
     }
     let (w, h) = a.size;
@@ -491,6 +535,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             Mode::Average => BlendMode::Average,
             Mode::Additive => BlendMode::Additive,
             Mode::Iso => BlendMode::Isosurface,
+            Mode::Pathtrace => BlendMode::PathTrace,
         },
         interpolation: if a.interpolation == InterpArg::Nearest {
             Interpolation::Nearest
@@ -512,7 +557,28 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         view.lights.clear();
     }
     pb.set_message("rendering");
+    let t0 = std::time::Instant::now();
     let mut img = r.render_image(&view, &params)?;
+    if path_tracing.is_some() {
+        while r.accumulated_samples() < a.pt.spp {
+            pb.set_message(format!(
+                "path tracing: {} of {} paths per pixel",
+                r.accumulated_samples(),
+                a.pt.spp
+            ));
+            // (the paths per frame do not restart the accumulation)
+            let mut p = *r.path_tracing();
+            p.samples_per_frame = (a.pt.spp - r.accumulated_samples()).min(64);
+            r.set_path_tracing(&p)?;
+            r.render(&view, &params, None)?;
+        }
+        img = r.read_image()?;
+        eprintln!(
+            "ferrovol: {} paths per pixel in {:.2} s",
+            r.accumulated_samples(),
+            t0.elapsed().as_secs_f64()
+        );
+    }
     let mut timing = None;
     if a.repeat > 1 {
         let t0 = std::time::Instant::now();

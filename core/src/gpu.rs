@@ -82,6 +82,27 @@ pub struct IsoUniforms {
     pub shade_rect: [u32; 4],
 }
 
+/// The path tracer's uniforms (`PathTrace` in shaders/pathtrace.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PathTraceUniforms {
+    pub env_rotation: [f32; 16],
+    pub medium: [f32; 4],
+    pub counts: [u32; 4],
+    pub options: [u32; 4],
+    pub rect: [u32; 4],
+}
+
+/// The phase-function sampling check's uniforms (`PhaseTest` in shaders/phase_test.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PhaseTestUniforms {
+    pub params: [f32; 4],
+    pub counts: [u32; 4],
+}
+
+pub const PT_FLAG_BACKGROUND: u32 = 1;
+
 /// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -261,12 +282,22 @@ mod layout_tests {
             EnvUniforms,
             [zenith, horizon, ground, sun, sun_color, scale, params]
         );
+        let m = module("pathtrace.wgsl");
+        check!(
+            m,
+            "PathTrace",
+            PathTraceUniforms,
+            [env_rotation, medium, counts, options, rect]
+        );
+        let m = module("phase_test.wgsl");
+        check!(m, "PhaseTest", PhaseTestUniforms, [params, counts]);
     }
 
     #[test]
     fn iso_constants_match_wgsl() {
         let iso = crate::shaders::compose("deferred.wgsl");
         let env = crate::shaders::compose("environment.wgsl");
+        let pt = crate::shaders::compose("pathtrace.wgsl");
         for (src, name, v) in [
             (&iso, "MAX_ISO", ISO_MAX_VALUES as u32),
             (&iso, "SPECULAR_CONE", SPECULAR_CONE),
@@ -274,6 +305,7 @@ mod layout_tests {
             (&iso, "ISO_FLAG_BACKGROUND", ISO_FLAG_BACKGROUND),
             (&env, "ENV_SKY", ENV_SKY),
             (&env, "ENV_EQUIRECT", ENV_EQUIRECT),
+            (&pt, "PT_FLAG_BACKGROUND", PT_FLAG_BACKGROUND),
         ] {
             let decl = format!("const {name}: u32 = {v}u;");
             assert!(src.contains(&decl), "WGSL lacks `{decl}`");

@@ -392,8 +392,8 @@ pub(crate) struct IsoGpu {
     deferred_bgl: wgpu::BindGroupLayout,
     firsthit: HashMap<FirstHitVariant, wgpu::ComputePipeline>,
     deferred: HashMap<DeferredVariant, wgpu::ComputePipeline>,
-    env_pipelines: EnvPipelines,
-    environment: Option<GpuEnvironment>,
+    pub(crate) env_pipelines: EnvPipelines,
+    pub(crate) environment: Option<GpuEnvironment>,
     iso_buf: wgpu::Buffer,
     lobe_dirs: wgpu::Buffer,
     gbuffer: Option<GBufferTargets>,
@@ -422,7 +422,7 @@ pub(crate) fn shader_module(ctx: &Context, name: &str) -> Result<wgpu::ShaderMod
     })
 }
 
-fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -431,7 +431,10 @@ fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn buffer_entry(
+    binding: u32,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
     entry(
         binding,
         wgpu::BindingType::Buffer {
@@ -442,7 +445,7 @@ fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLay
     )
 }
 
-fn texture_entry(
+pub(crate) fn texture_entry(
     binding: u32,
     filterable: bool,
     dim: wgpu::TextureViewDimension,
@@ -457,7 +460,7 @@ fn texture_entry(
     )
 }
 
-fn storage_texture_entry(
+pub(crate) fn storage_texture_entry(
     binding: u32,
     format: wgpu::TextureFormat,
     dim: wgpu::TextureViewDimension,
@@ -472,7 +475,7 @@ fn storage_texture_entry(
     )
 }
 
-fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+pub(crate) fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource }
 }
 
@@ -747,7 +750,7 @@ pub(crate) fn read_texture_layer(
 }
 
 /// Copies a storage buffer to the CPU.
-fn read_buffer(ctx: &Context, src: &wgpu::Buffer) -> Result<Vec<u8>> {
+pub(crate) fn read_buffer(ctx: &Context, src: &wgpu::Buffer) -> Result<Vec<u8>> {
     let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: src.size(),
@@ -795,7 +798,7 @@ fn read_cube(ctx: &Context, tex: &wgpu::Texture, mip: u32) -> Result<CubeImage> 
 }
 
 impl Renderer {
-    fn iso_gpu(&mut self) -> Result<&mut IsoGpu> {
+    pub(crate) fn iso_gpu(&mut self) -> Result<&mut IsoGpu> {
         if self.iso.is_none() {
             self.iso = Some(Box::new(IsoGpu::new(&self.ctx, &self.brick_bgl)?));
         }
@@ -824,6 +827,7 @@ impl Renderer {
         let g = self.iso_gpu()?;
         g.environment = None;
         g.environment = Some(GpuEnvironment::build(&ctx, &g.env_pipelines, env)?);
+        self.environment_generation += 1;
         Ok(())
     }
 

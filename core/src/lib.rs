@@ -24,6 +24,7 @@ pub mod interop;
 pub mod iso;
 pub mod light;
 pub mod params;
+pub mod pathtrace;
 pub mod renderer;
 pub mod shaders;
 pub mod synth;
@@ -41,6 +42,7 @@ pub use light::{Light, LightSpace};
 pub use params::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
 };
+pub use pathtrace::PathTraceParams;
 pub use renderer::{Image, Renderer, Stats, UploadOptions, View};
 pub use transfer::{ComponentTransfer, Piecewise, TransferFunction};
 pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

@@ -21,6 +21,9 @@ pub enum BlendMode {
     /// and ambient occlusion; the iso-values and their shading come from
     /// [`crate::Renderer::set_isosurface`] (crate::iso), not the transfer function.
     Isosurface,
+    /// Progressive Monte Carlo path tracing of the volume as a scattering medium
+    /// (crate::pathtrace; settings from [`crate::Renderer::set_path_tracing`]).
+    PathTrace,
 }
 
 impl BlendMode {
@@ -32,6 +35,7 @@ impl BlendMode {
             BlendMode::Average => 3,
             BlendMode::Additive => 4,
             BlendMode::Isosurface => 5,
+            BlendMode::PathTrace => 6,
         }
     }
 }

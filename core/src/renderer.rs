@@ -98,7 +98,7 @@ pub(crate) struct GpuBrick {
     _texture: wgpu::Texture,
     _uniform: wgpu::Buffer,
     pub(crate) bind_linear: wgpu::BindGroup,
-    bind_nearest: wgpu::BindGroup,
+    pub(crate) bind_nearest: wgpu::BindGroup,
 }
 
 pub(crate) struct GpuVolume {
@@ -147,7 +147,7 @@ pub(crate) enum DepthSource<'a> {
 
 /// Everything that decides the tables' contents; tables are rebuilt only when it changes.
 #[derive(PartialEq)]
-struct TableKey {
+pub(crate) struct TableKey {
     tf: TransferFunction,
     step_bits: u64,
 }
@@ -266,8 +266,8 @@ pub struct Renderer {
     pub(crate) nearest: wgpu::Sampler,
     pub(crate) frame_buf: wgpu::Buffer,
     pub(crate) volume: Option<GpuVolume>,
-    tf: Option<TransferFunction>,
-    tables: Option<(TableKey, wgpu::Buffer)>,
+    pub(crate) tf: Option<TransferFunction>,
+    pub(crate) tables: Option<(TableKey, wgpu::Buffer)>,
     occupancy: Option<(TableKey, wgpu::Buffer, f64)>,
     pub(crate) targets: Option<Targets>,
     output_path: OutputPath,
@@ -277,6 +277,11 @@ pub struct Renderer {
     /// The isosurface passes (crate::iso), created on first use.
     pub(crate) iso: Option<Box<crate::iso::IsoGpu>>,
     pub(crate) iso_params: Option<crate::iso::IsoParams>,
+    /// Counts set_environment calls (path tracing restarts its accumulation on a change).
+    pub(crate) environment_generation: u64,
+    /// The path tracer (crate::pathtrace), created on first use, and its accumulation.
+    pub(crate) pt: Option<Box<crate::pathtrace::PathTraceGpu>>,
+    pub(crate) pt_params: crate::pathtrace::PathTraceParams,
 }
 
 fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -483,6 +488,9 @@ impl Renderer {
             stats: Stats::default(),
             iso: None,
             iso_params: None,
+            environment_generation: 0,
+            pt: None,
+            pt_params: Default::default(),
         })
     }
 
@@ -666,7 +674,7 @@ impl Renderer {
         })
     }
 
-    fn ensure_tables(&mut self, step: f64) -> Result<()> {
+    pub(crate) fn ensure_tables(&mut self, step: f64) -> Result<()> {
         let tf = self
             .tf
             .as_ref()
@@ -1157,6 +1165,9 @@ impl Renderer {
     ) -> Result<()> {
         if params.blend == BlendMode::Isosurface {
             return self.render_isosurface(view, params, depth);
+        }
+        if params.blend == BlendMode::PathTrace {
+            return self.render_pathtrace(view, params, depth);
         }
         params.validate()?;
         if view.lights.len() > MAX_LIGHTS && params.shading.enabled {

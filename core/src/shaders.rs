@@ -30,6 +30,10 @@ pub const FILES: &[(&str, &str)] = &[
     ),
     ("lib/iso.wgsl", include_str!("../../shaders/lib/iso.wgsl")),
     (
+        "lib/phase.wgsl",
+        include_str!("../../shaders/lib/phase.wgsl"),
+    ),
+    (
         "lib/surface.wgsl",
         include_str!("../../shaders/lib/surface.wgsl"),
     ),
@@ -41,6 +45,14 @@ pub const FILES: &[(&str, &str)] = &[
         "environment.wgsl",
         include_str!("../../shaders/environment.wgsl"),
     ),
+    (
+        "pathtrace.wgsl",
+        include_str!("../../shaders/pathtrace.wgsl"),
+    ),
+    (
+        "phase_test.wgsl",
+        include_str!("../../shaders/phase_test.wgsl"),
+    ),
 ];
 
 /// The passes (entry files, not library pieces).
@@ -50,6 +62,8 @@ pub const PASSES: &[&str] = &[
     "firsthit.wgsl",
     "deferred.wgsl",
     "environment.wgsl",
+    "pathtrace.wgsl",
+    "phase_test.wgsl",
 ];
 
 fn source(path: &str) -> Option<&'static str> {

@@ -14,14 +14,23 @@ fn unproject(ndc: vec3<f32>) -> vec3<f32> {
     return p.xyz / p.w;
 }
 
-fn pixel_ndc(px: vec2<u32>) -> vec2<f32> {
+// NDC of the point p of the image (pixels, from the top left corner).
+fn image_ndc(p: vec2<f32>) -> vec2<f32> {
     let size = vec2<f32>(f32(frame.viewport.x), f32(frame.viewport.y));
-    let uv = (vec2<f32>(px) + 0.5) / size;
+    let uv = p / size;
     return vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
 }
 
+fn pixel_ndc(px: vec2<u32>) -> vec2<f32> {
+    return image_ndc(vec2<f32>(px) + 0.5);
+}
+
 fn make_ray(px: vec2<u32>) -> Ray {
-    let ndc = pixel_ndc(px);
+    return ray_through(pixel_ndc(px));
+}
+
+// The ray through the point ndc of the image, from the near to the far plane.
+fn ray_through(ndc: vec2<f32>) -> Ray {
     let near = unproject(vec3<f32>(ndc, -1.0));
     let far = unproject(vec3<f32>(ndc, 1.0));
     var r: Ray;

@@ -1,0 +1,551 @@
+//! Progressive Monte Carlo path tracing of the volume as a participating medium
+//! ([`BlendMode::PathTrace`](crate::BlendMode::PathTrace), shaders/pathtrace.wgsl).
+//!
+//! The medium is the transfer function read physically: extinction
+//! σ = −ln(1 − α) / unit distance from the opacity α as given (a slab one
+//! ScalarOpacityUnitDistance thick lets 1 − α through, VTK's meaning), the colour as the
+//! single-scattering albedo, and a Henyey–Greenstein phase function. Paths fly by delta
+//! tracking against the majorant σ̄ = max σ of the transfer function, take next-event
+//! estimates toward the environment (multiple importance sampling with the phase
+//! function) and the view's directional lights (ratio-tracking transmittance), and end by
+//! Russian roulette or after [`PathTraceParams::max_bounces`] scattering events.
+//!
+//! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
+//! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before,
+//! until anything that changes the image changes (camera, lights, size, render or path
+//! tracing parameters, volume, transfer function, environment); the count is
+//! [`Renderer::accumulated_samples`]. The environment is the one
+//! [`Renderer::set_environment`](crate::Renderer::set_environment) built (the procedural sky
+//! by default).
+//!
+//! Limits of this version: the volume must fit in one brick; the first component is the
+//! medium; cropping and positional lights are refused; the majorant is one value for the
+//! whole volume (no per-block majorant grid yet).
+
+use crate::environment::Environment;
+use crate::error::{Error, Result};
+use crate::gpu::{PathTraceUniforms, PhaseTestUniforms, PT_FLAG_BACKGROUND};
+use crate::iso::{
+    bind, buffer_entry, entry, read_buffer, shader_module, storage_texture_entry, texture_entry,
+};
+use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
+use crate::renderer::{DepthSource, Renderer, View};
+use crate::transfer::TABLE_SIZE;
+use crate::Context;
+use bytemuck::Zeroable;
+use glam::DMat4;
+
+/// Largest opacity the medium takes (σ stays finite: 9.2 per unit distance); the same
+/// clamp as PT_MAX_OPACITY in pathtrace.wgsl.
+const MAX_OPACITY: f64 = 0.9999;
+/// Most paths per pixel and frame.
+pub const MAX_SAMPLES_PER_FRAME: u32 = 4096;
+/// Most scattering events per path.
+pub const MAX_BOUNCES: u32 = 100_000;
+
+/// How the path tracer samples (set with [`Renderer::set_path_tracing`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathTraceParams {
+    /// Paths per pixel each frame adds (1 to [`MAX_SAMPLES_PER_FRAME`]).
+    pub samples_per_frame: u32,
+    /// Most scattering events per path (0: single scattering is off too; the medium only
+    /// attenuates what is behind it).
+    pub max_bounces: u32,
+    /// Henyey–Greenstein anisotropy g, |g| < 1 (0 isotropic, > 0 forward scattering).
+    pub anisotropy: f32,
+    /// Weight of the environment's light (0: the view's directional lights only).
+    pub environment_light: f32,
+    /// Show the environment behind the medium (the frame becomes opaque).
+    pub background: bool,
+    /// Seed of the random streams (a different seed gives an independent image).
+    pub seed: u32,
+}
+
+impl Default for PathTraceParams {
+    fn default() -> Self {
+        PathTraceParams {
+            samples_per_frame: 4,
+            max_bounces: 64,
+            anisotropy: 0.0,
+            environment_light: 1.0,
+            background: false,
+            seed: 0,
+        }
+    }
+}
+
+impl PathTraceParams {
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidParameter(m));
+        if !(1..=MAX_SAMPLES_PER_FRAME).contains(&self.samples_per_frame) {
+            return bad(format!(
+                "{} paths per pixel and frame: give 1 to {MAX_SAMPLES_PER_FRAME}",
+                self.samples_per_frame
+            ));
+        }
+        if self.max_bounces > MAX_BOUNCES {
+            return bad(format!(
+                "{} scattering events per path: at most {MAX_BOUNCES}",
+                self.max_bounces
+            ));
+        }
+        if self.anisotropy.is_nan() || self.anisotropy.abs() >= 1.0 {
+            return bad(format!(
+                "Henyey–Greenstein anisotropy {} must be in (−1, 1)",
+                self.anisotropy
+            ));
+        }
+        if !(self.environment_light.is_finite() && self.environment_light >= 0.0) {
+            return bad(format!(
+                "environment light weight {} must be finite and non-negative",
+                self.environment_light
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The path tracer's GPU state, created on first use.
+pub(crate) struct PathTraceGpu {
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    bgl: wgpu::BindGroupLayout,
+    /// One pipeline per table interpolation (NEAREST).
+    pipelines: std::collections::HashMap<bool, wgpu::ComputePipeline>,
+    uniforms: wgpu::Buffer,
+    /// Per pixel: sums of radiance and coverage over the accumulated paths.
+    accum: Option<(u32, u32, wgpu::Buffer)>,
+    /// What the accumulated paths were traced with; a different key starts over.
+    key: String,
+    samples: u32,
+}
+
+impl PathTraceGpu {
+    fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<PathTraceGpu> {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        let d = &ctx.device;
+        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("path tracing"),
+            entries: &[
+                buffer_entry(0, B::Uniform),
+                buffer_entry(1, B::Storage { read_only: true }),
+                buffer_entry(2, B::Storage { read_only: false }),
+                texture_entry(4, false, V::D2),
+                storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+                storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
+                buffer_entry(7, B::Uniform),
+                texture_entry(11, true, V::Cube),
+                entry(
+                    13,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+            ],
+        });
+        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pathtrace.wgsl"),
+            bind_group_layouts: &[Some(&bgl), Some(brick_bgl)],
+            immediate_size: 0,
+        });
+        let module = shader_module(ctx, "pathtrace.wgsl")?;
+        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("path tracing uniforms"),
+            size: std::mem::size_of::<PathTraceUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(PathTraceGpu {
+            module,
+            layout,
+            bgl,
+            pipelines: Default::default(),
+            uniforms,
+            accum: None,
+            key: String::new(),
+            samples: 0,
+        })
+    }
+
+    fn pipeline(&mut self, ctx: &Context, nearest: bool) -> Result<wgpu::ComputePipeline> {
+        if let Some(p) = self.pipelines.get(&nearest) {
+            return Ok(p.clone());
+        }
+        let constants = [("NEAREST", if nearest { 1.0 } else { 0.0 })];
+        let p = ctx.checked("creating the path tracing pipeline", || {
+            ctx.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("path tracing"),
+                    layout: Some(&self.layout),
+                    module: &self.module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        zero_initialize_workgroup_memory: false,
+                    },
+                    cache: None,
+                })
+        })?;
+        self.pipelines.insert(nearest, p.clone());
+        Ok(p)
+    }
+
+    fn ensure_accum(&mut self, ctx: &Context, width: u32, height: u32) -> Result<()> {
+        if self
+            .accum
+            .as_ref()
+            .is_some_and(|(w, h, _)| *w == width && *h == height)
+        {
+            return Ok(());
+        }
+        self.accum = None;
+        let buf = ctx.checked("allocating the path tracing accumulation", || {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("path tracing accumulation"),
+                size: 16 * width as u64 * height as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        })?;
+        self.accum = Some((width, height, buf));
+        self.samples = 0;
+        Ok(())
+    }
+}
+
+impl Renderer {
+    /// Sets how frames with [`BlendMode::PathTrace`](crate::BlendMode::PathTrace) sample
+    /// (a change other than of the paths per frame starts the accumulation over).
+    pub fn set_path_tracing(&mut self, p: &PathTraceParams) -> Result<()> {
+        p.validate()?;
+        self.pt_params = *p;
+        Ok(())
+    }
+
+    /// The path tracing settings set last (the defaults before any call).
+    pub fn path_tracing(&self) -> &PathTraceParams {
+        &self.pt_params
+    }
+
+    /// Paths per pixel the last path-traced frame shows (0 before the first).
+    pub fn accumulated_samples(&self) -> u32 {
+        self.pt.as_ref().map_or(0, |g| g.samples)
+    }
+
+    /// Starts the accumulation over at the next path-traced frame.
+    pub fn reset_accumulation(&mut self) {
+        if let Some(g) = self.pt.as_mut() {
+            g.samples = 0;
+            g.key.clear();
+        }
+    }
+
+    /// The medium's majorant: the largest extinction (per world unit) the first
+    /// component's transfer function gives anywhere on its table.
+    fn majorant(&self) -> Result<f64> {
+        let tf = self
+            .tf
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
+        let c = tf.component(0);
+        let [lo, hi] = c.table_range();
+        let amax = (0..TABLE_SIZE)
+            .map(|i| {
+                let x = lo + (hi - lo) * i as f64 / (TABLE_SIZE - 1) as f64;
+                c.opacity.eval(x)[0].clamp(0.0, 1.0) as f64
+            })
+            .fold(0.0_f64, f64::max)
+            .min(MAX_OPACITY);
+        Ok(-(1.0 - amax).ln() / c.unit_distance)
+    }
+
+    /// One path-traced frame: `samples_per_frame` more paths per pixel.
+    pub(crate) fn render_pathtrace(
+        &mut self,
+        view: &View,
+        params: &RenderParams,
+        depth: DepthSource<'_>,
+    ) -> Result<()> {
+        params.validate()?;
+        let pp = self.pt_params;
+        pp.validate()?;
+        let vol = self
+            .volume
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
+        if vol.bricks.len() != 1 {
+            return Err(Error::Unsupported(format!(
+                "path tracing needs the volume in one brick; it is split into {} (it exceeds \
+                 the device's 3D texture or allocation limits)",
+                vol.bricks.len()
+            )));
+        }
+        if params.cropping.is_some() {
+            return Err(Error::Unsupported(
+                "path tracing does not crop yet: turn cropping off (clipping planes work)".into(),
+            ));
+        }
+        if view.lights.len() > MAX_LIGHTS {
+            return Err(Error::InvalidParameter(format!(
+                "{} lights; at most {MAX_LIGHTS} are supported",
+                view.lights.len()
+            )));
+        }
+        if let Some(i) = view.lights.iter().position(|l| l.positional) {
+            return Err(Error::Unsupported(format!(
+                "light {i} is positional: path tracing lights with directional lights, the \
+                 headlight and the environment"
+            )));
+        }
+        let majorant = self.majorant()?;
+        let unit = self
+            .tf
+            .as_ref()
+            .map_or(1.0, |tf| tf.component(0).unit_distance);
+        let step = self.sample_distance(params)?;
+        self.ensure_tables(step)?;
+        self.iso_gpu()?;
+        if self.iso.as_ref().is_some_and(|g| g.environment.is_none()) {
+            self.set_environment(&Environment::default())?;
+        }
+        self.ensure_targets(view.width, view.height)?;
+        if let DepthSource::Cpu(d) = depth {
+            let n = (view.width * view.height) as usize;
+            if d.len() != n {
+                return Err(Error::InvalidParameter(format!(
+                    "depth image has {} values for a {}x{} frame ({n} expected)",
+                    d.len(),
+                    view.width,
+                    view.height
+                )));
+            }
+        }
+        if self.pt.is_none() {
+            self.pt = Some(Box::new(PathTraceGpu::new(&self.ctx, &self.brick_bgl)?));
+        }
+        // The view's directional lights light the medium whatever `shading.enabled` says.
+        let lit = RenderParams {
+            blend: BlendMode::PathTrace,
+            shading: Shading {
+                enabled: true,
+                ..params.shading
+            },
+            ..params.clone()
+        };
+        let depth_input = !matches!(depth, DepthSource::None);
+        let (frame, _) = self.frame_uniforms(view, &lit, step, depth_input, false)?;
+        // (the paths per frame are not part of what the image converges to)
+        let converges_to = PathTraceParams {
+            samples_per_frame: 0,
+            ..pp
+        };
+        let key = format!(
+            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{depth_input}",
+            (self.stats.volume_uploads, self.stats.table_uploads),
+            self.environment_generation
+        );
+        let ctx = self.ctx.clone();
+        let nearest = params.interpolation == Interpolation::Nearest;
+        let g = self.pt.as_mut().expect("created above");
+        let pipeline = g.pipeline(&ctx, nearest)?;
+        g.ensure_accum(&ctx, view.width, view.height)?;
+        if g.key != key || depth_input {
+            // (a host's depth may change from frame to frame without telling)
+            g.key = key;
+            g.samples = 0;
+        }
+        let before = g.samples;
+        let full = [0, 0, view.width, view.height];
+        let rect = if pp.background { full } else { frame.rect };
+        let env = self
+            .iso
+            .as_ref()
+            .and_then(|i| i.environment.as_ref())
+            .expect("built above");
+        let mut u = PathTraceUniforms::zeroed();
+        u.env_rotation = DMat4::from_mat3(env.rotation).as_mat4().to_cols_array();
+        u.medium = [
+            majorant as f32,
+            pp.anisotropy,
+            (1.0 / unit) as f32,
+            pp.environment_light,
+        ];
+        u.counts = [pp.samples_per_frame, before, pp.max_bounces, pp.seed];
+        u.options = [if pp.background { PT_FLAG_BACKGROUND } else { 0 }, 0, 0, 0];
+        u.rect = rect;
+        let q = &ctx.queue;
+        q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
+        q.write_buffer(&g.uniforms, 0, bytemuck::bytes_of(&u));
+        let t = self.targets.as_ref().expect("allocated above");
+        if let DepthSource::Cpu(depth) = depth {
+            q.write_texture(
+                t.depth_in.as_image_copy(),
+                bytemuck::cast_slice(depth),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * view.width),
+                    rows_per_image: None,
+                },
+                t.depth_in.size(),
+            );
+        }
+        let (_, tables) = self.tables.as_ref().expect("built above");
+        let (_, _, accum) = g.accum.as_ref().expect("allocated above");
+        let iso = self.iso.as_ref().expect("created above");
+        let depth_in_view = t.depth_in.create_view(&Default::default());
+        let color_view = t.color.create_view(&Default::default());
+        let depth_view = t.depth.create_view(&Default::default());
+        let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("path tracing"),
+            layout: &g.bgl,
+            entries: &[
+                bind(0, self.frame_buf.as_entire_binding()),
+                bind(1, tables.as_entire_binding()),
+                bind(2, accum.as_entire_binding()),
+                bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
+                bind(5, wgpu::BindingResource::TextureView(&color_view)),
+                bind(6, wgpu::BindingResource::TextureView(&depth_view)),
+                bind(7, g.uniforms.as_entire_binding()),
+                bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
+                bind(
+                    13,
+                    wgpu::BindingResource::Sampler(&iso.env_pipelines.cube_sampler),
+                ),
+            ],
+        });
+        let vol = self.volume.as_ref().expect("checked above");
+        let brick = if nearest {
+            &vol.bricks[0].bind_nearest
+        } else {
+            &vol.bricks[0].bind_linear
+        };
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("path-traced frame"),
+            });
+        if rect != full {
+            enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("clear outside the volume"),
+                color_attachments: &[
+                    crate::renderer::clear_attachment(&color_view, 0.0),
+                    crate::renderer::clear_attachment(&depth_view, 1.0),
+                ],
+                ..Default::default()
+            });
+        }
+        if rect[2] > rect[0] && rect[3] > rect[1] {
+            let wg = crate::renderer::WORKGROUP;
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("path tracing"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.set_bind_group(1, brick, &[]);
+            pass.dispatch_workgroups(
+                (rect[2] - rect[0]).div_ceil(wg),
+                (rect[3] - rect[1]).div_ceil(wg),
+                1,
+            );
+        }
+        ctx.checked("rendering the path-traced frame", || {
+            q.submit([enc.finish()]);
+        })?;
+        let g = self.pt.as_mut().expect("created above");
+        g.samples = before + pp.samples_per_frame;
+        self.stats.frames += 1;
+        Ok(())
+    }
+
+    /// Waits for the last path-traced frame and returns its per-pixel mean over the
+    /// accumulated paths, rows top to bottom: radiance (rgb, linear, not clipped) and the
+    /// fraction of paths that met the medium (a; 1 everywhere with the background on).
+    pub fn read_accumulation(&self) -> Result<Vec<[f32; 4]>> {
+        let g = self.pt.as_ref().filter(|g| g.samples > 0).ok_or_else(|| {
+            Error::InvalidParameter("no path-traced frame has been rendered yet".into())
+        })?;
+        let (_, _, buf) = g.accum.as_ref().expect("allocated with the first frame");
+        let bytes = read_buffer(&self.ctx, buf)?;
+        let n = g.samples as f32;
+        Ok(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes)
+            .iter()
+            .map(|v| v.map(|c| c / n))
+            .collect())
+    }
+
+    /// Draws `n` Henyey–Greenstein scattering directions with anisotropy `g` by the path
+    /// tracer's own sampling code (shaders/lib/phase.wgsl) and returns the cosine of each
+    /// to the propagation direction: for checking the sampler against the density.
+    pub fn sample_phase_cosines(&self, g: f32, n: u32, seed: u32) -> Result<Vec<f32>> {
+        if g.is_nan() || g.abs() >= 1.0 || n == 0 || n > 1 << 24 {
+            return Err(Error::InvalidParameter(format!(
+                "phase sampling check: anisotropy {g} must be in (−1, 1) and the count {n} in \
+                 1 to 2^24"
+            )));
+        }
+        use wgpu::BufferBindingType as B;
+        let ctx = &self.ctx;
+        let d = &ctx.device;
+        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("phase test"),
+            entries: &[
+                buffer_entry(0, B::Uniform),
+                buffer_entry(1, B::Storage { read_only: false }),
+            ],
+        });
+        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("phase_test.wgsl"),
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
+        let module = shader_module(ctx, "phase_test.wgsl")?;
+        let pipeline = ctx.checked("creating the phase test pipeline", || {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("phase test"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        let dir = glam::Vec3::new(0.3, -0.5, 0.8).normalize();
+        let u = PhaseTestUniforms {
+            params: [g, dir.x, dir.y, dir.z],
+            counts: [n, seed, 0, 0],
+        };
+        let ubuf = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("phase test uniforms"),
+            size: std::mem::size_of::<PhaseTestUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue.write_buffer(&ubuf, 0, bytemuck::bytes_of(&u));
+        let out = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("phase test cosines"),
+            size: 4 * n as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("phase test"),
+            layout: &bgl,
+            entries: &[
+                bind(0, ubuf.as_entire_binding()),
+                bind(1, out.as_entire_binding()),
+            ],
+        });
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(n.div_ceil(64), 1, 1);
+        }
+        ctx.checked("sampling the phase function", || {
+            ctx.queue.submit([enc.finish()]);
+        })?;
+        let bytes = read_buffer(ctx, &out)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+}

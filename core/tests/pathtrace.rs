@@ -1,0 +1,397 @@
+//! The path tracer on a real wgpu device (lavapipe on CI): its Henyey–Greenstein sampler
+//! against the density (chi-square), the white furnace, delta tracking against the ray
+//! marcher's transmittance on a heterogeneous slab, convergence like 1/√spp, accumulation
+//! and the errors of the API.
+//!
+//! Every test prints what it measured and asserts a tolerance with the reason for it.
+//! Images go to `target/test-images/pathtrace-*.png` for inspection.
+
+use ferrovol_core::*;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+/// One GPU context per test binary; tests take turns on it.
+fn renderer() -> MutexGuard<'static, Renderer> {
+    static R: OnceLock<Mutex<Renderer>> = OnceLock::new();
+    R.get_or_init(|| {
+        let ctx = Context::new().expect("a wgpu device (lavapipe: mesa-vulkan-drivers)");
+        println!("{}", ctx.info);
+        Mutex::new(Renderer::new(ctx).expect("creating the renderer"))
+    })
+    .lock()
+    .unwrap_or_else(|e| e.into_inner())
+}
+
+/// A single-component float volume with unit spacing, `f` evaluated at index coordinates.
+fn volume(dims: [u32; 3], f: impl Fn(f64, f64, f64) -> f64) -> VolumeData {
+    let mut data = Vec::with_capacity(dims.iter().map(|&d| d as usize).product());
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                data.push(f(i as f64, j as f64, k as f64) as f32);
+            }
+        }
+    }
+    VolumeData::new(dims, 1, Scalars::F32(data)).expect("valid volume")
+}
+
+/// Colour `rgb` everywhere, opacity ramping linearly over [0, 1] from `a0` to `a1`.
+fn medium(rgb: [f32; 3], a0: f32, a1: f32, unit: f64) -> TransferFunction {
+    let color = Piecewise::new(vec![(0.0, rgb), (1.0, rgb)]).expect("colour");
+    let opacity = Piecewise::new(vec![(0.0, [a0]), (1.0, [a1])]).expect("opacity");
+    let mut c = ComponentTransfer::new(color, opacity);
+    c.unit_distance = unit;
+    TransferFunction::single(c)
+}
+
+fn save(img: &Image, name: &str) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-images");
+    std::fs::create_dir_all(&dir).expect("creating target/test-images");
+    img.save_png(&dir.join(format!("pathtrace-{name}.png")), [0.0; 3])
+        .expect("writing a test image");
+}
+
+fn pt_params() -> RenderParams {
+    RenderParams {
+        blend: BlendMode::PathTrace,
+        ..Default::default()
+    }
+}
+
+/// Renders frames until `spp` paths per pixel are accumulated; returns the mean per pixel.
+fn trace(r: &mut Renderer, view: &View, p: &PathTraceParams, spp: u32) -> Vec<[f32; 4]> {
+    r.set_path_tracing(p).expect("valid path tracing settings");
+    r.reset_accumulation();
+    while r.accumulated_samples() < spp {
+        r.render(view, &pt_params(), None)
+            .expect("a path-traced frame");
+    }
+    assert_eq!(r.accumulated_samples(), spp);
+    r.read_accumulation().expect("the accumulation")
+}
+
+/// The Henyey–Greenstein CDF of the cosine μ between propagation directions.
+fn hg_cdf(mu: f64, g: f64) -> f64 {
+    if g.abs() < 1e-3 {
+        return 0.5 * (mu + 1.0);
+    }
+    (1.0 - g * g) / (2.0 * g) * (1.0 / (1.0 + g * g - 2.0 * g * mu).sqrt() - 1.0 / (1.0 + g))
+}
+
+#[test]
+fn phase_sampling_matches_henyey_greenstein() {
+    let r = renderer();
+    let n = 200_000u32;
+    let bins = 40usize;
+    // 99.9% quantile of chi-square with 39 degrees of freedom: a correct sampler fails one
+    // run in a thousand; a wrong g or a flipped sign gives chi-square in the thousands.
+    let limit = 72.05;
+    for g in [-0.7f32, 0.0, 0.5, 0.9] {
+        let cosines = r.sample_phase_cosines(g, n, 7).expect("sampling");
+        let mut hist = vec![0usize; bins];
+        for &c in &cosines {
+            assert!((-1.0001..=1.0001).contains(&c), "cosine {c}");
+            let b = (((c as f64 + 1.0) * 0.5 * bins as f64) as usize).min(bins - 1);
+            hist[b] += 1;
+        }
+        let mut chi2 = 0.0;
+        for (b, &count) in hist.iter().enumerate() {
+            let lo = -1.0 + 2.0 * b as f64 / bins as f64;
+            let hi = lo + 2.0 / bins as f64;
+            let expected = n as f64 * (hg_cdf(hi, g as f64) - hg_cdf(lo, g as f64));
+            chi2 += (count as f64 - expected).powi(2) / expected;
+        }
+        let mean: f64 = cosines.iter().map(|&c| c as f64).sum::<f64>() / n as f64;
+        println!(
+            "g = {g:+.1}: chi-square {chi2:.1} over {bins} bins (limit {limit}); mean cosine \
+             {mean:+.4} (HG's is g)"
+        );
+        assert!(chi2 < limit, "g = {g}: chi-square {chi2}");
+        // The mean cosine of HG is g; its standard error here is below 0.0013.
+        assert!(
+            (mean - g as f64).abs() < 0.006,
+            "g = {g}: mean cosine {mean}"
+        );
+    }
+}
+
+#[test]
+fn white_furnace_returns_the_environment() {
+    let mut r = renderer();
+    // A non-absorbing medium (albedo 1) of optical depth ~5 across, under a uniform
+    // environment of radiance 1: every path must bring back exactly 1 on average, however
+    // often it scatters (and the environment behind is 1 too).
+    let vol = volume([16, 16, 16], |_, _, _| 0.5);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&medium([1.0; 3], 0.3, 0.3, 1.0))
+        .unwrap();
+    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    let mut view = View::fit(vol.bounds(), 24, 24);
+    view.lights.clear();
+    for g in [0.0f32, 0.6] {
+        let p = PathTraceParams {
+            samples_per_frame: 64,
+            max_bounces: MAX_BOUNCES_FOR_FURNACE,
+            anisotropy: g,
+            background: true,
+            ..Default::default()
+        };
+        let img = trace(&mut r, &view, &p, 256);
+        let mean: f64 = img.iter().map(|v| v[0] as f64).sum::<f64>() / img.len() as f64;
+        let worst = img
+            .iter()
+            .map(|v| (v[0] as f64 - 1.0).abs())
+            .fold(0.0, f64::max);
+        println!("furnace g = {g}: mean radiance {mean:.4}, worst pixel off by {worst:.3}");
+        // 1% on the mean (the issue's tolerance); 256 paths per pixel leave each pixel a
+        // few percent of noise.
+        assert!((mean - 1.0).abs() < 0.01, "furnace mean {mean}");
+        assert!(worst < 0.15, "a pixel off by {worst}");
+    }
+    // Without the background, radiance / coverage is 1 where the medium is.
+    let p = PathTraceParams {
+        samples_per_frame: 64,
+        max_bounces: MAX_BOUNCES_FOR_FURNACE,
+        ..Default::default()
+    };
+    let img = trace(&mut r, &view, &p, 256);
+    let (mut sum, mut cov) = (0.0, 0.0);
+    for v in &img {
+        sum += v[0] as f64;
+        cov += v[3] as f64;
+    }
+    println!(
+        "furnace without background: radiance / coverage {:.4}",
+        sum / cov
+    );
+    assert!((sum / cov - 1.0).abs() < 0.01);
+    save(&r.read_image().unwrap(), "furnace");
+}
+
+/// Enough scattering events that the furnace is not cut short (Russian roulette never
+/// stops an albedo-1 path, so only this bound ends it inside the medium).
+const MAX_BOUNCES_FOR_FURNACE: u32 = 10_000;
+
+#[test]
+fn delta_tracking_agrees_with_ray_marching() {
+    let mut r = renderer();
+    // A heterogeneous black slab (opacity from 0 to 0.25 per unit across x) in front of a
+    // uniform white background: the path tracer sees only the transmittance T, estimated
+    // by delta tracking; the composite ray caster's 1 − alpha is the same T by ray
+    // marching (sample distance 0.25).
+    let vol = volume([32, 32, 8], |x, _, _| x / 31.0);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&medium([0.0; 3], 0.0, 0.25, 1.0))
+        .unwrap();
+    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    let mut view = View::fit(vol.bounds(), 40, 40);
+    view.camera.parallel = true;
+    view.lights.clear();
+    let p = PathTraceParams {
+        samples_per_frame: 128,
+        max_bounces: 0,
+        background: true,
+        ..Default::default()
+    };
+    let pt = trace(&mut r, &view, &p, 512);
+    let dvr = r
+        .render_image(
+            &view,
+            &RenderParams {
+                sample_distance: Some(0.25),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    let (mut n, mut sum_pt, mut sum_dvr, mut sq) = (0usize, 0.0, 0.0, 0.0);
+    for (i, v) in pt.iter().enumerate() {
+        let a = dvr.rgba[4 * i + 3] as f64 / 255.0;
+        if a < 0.02 {
+            continue; // outside the slab, or where it is nearly clear
+        }
+        let t_dvr = 1.0 - a;
+        let t_pt = v[0] as f64;
+        n += 1;
+        sum_pt += t_pt;
+        sum_dvr += t_dvr;
+        sq += (t_pt - t_dvr).powi(2);
+    }
+    let rms = (sq / n as f64).sqrt();
+    println!(
+        "{n} pixels: mean transmittance delta tracking {:.4}, ray marching {:.4}; RMS \
+         per-pixel difference {rms:.4}",
+        sum_pt / n as f64,
+        sum_dvr / n as f64
+    );
+    assert!(n > 500);
+    // 512 binary estimates per pixel: a pixel's standard error is at most 0.022; over the
+    // slab the means agree to 1% (plus the 8-bit quantisation of the ray caster's alpha).
+    assert!(((sum_pt - sum_dvr) / sum_dvr).abs() < 0.01);
+    assert!(rms < 0.03);
+}
+
+#[test]
+fn error_falls_like_one_over_root_spp() {
+    let mut r = renderer();
+    // A scattering blob under a two-hemisphere sky with the headlight: RMS error of 4, 16
+    // and 64 paths per pixel against 2048 (another seed), fitted on log-log axes. (Under
+    // the default sky, whose sun the uniform next-event directions rarely find, single
+    // paths that hit the sun dominate the error at these counts: the environment is not
+    // importance-sampled yet.)
+    let vol = volume([20, 20, 20], |x, y, z| {
+        let d = ((x - 9.5).powi(2) + (y - 9.5).powi(2) + (z - 9.5).powi(2)).sqrt();
+        (1.0 - d / 9.0).clamp(0.0, 1.0)
+    });
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0))
+        .unwrap();
+    r.set_environment(&Environment::hemisphere([0.9, 0.95, 1.0], [0.3, 0.25, 0.2]))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 24, 24);
+    let p = |spp: u32, seed: u32| PathTraceParams {
+        samples_per_frame: spp.min(256),
+        seed,
+        anisotropy: 0.3,
+        ..Default::default()
+    };
+    let reference = trace(&mut r, &view, &p(2048, 1), 2048);
+    let mut points = vec![];
+    for spp in [4u32, 16, 64] {
+        let img = trace(&mut r, &view, &p(spp, 2), spp);
+        let se: f64 = img
+            .iter()
+            .zip(&reference)
+            .map(|(a, b)| {
+                (0..3)
+                    .map(|c| (a[c] - b[c]) as f64)
+                    .map(|d| d * d)
+                    .sum::<f64>()
+            })
+            .sum();
+        let rmse = (se / (3 * img.len()) as f64).sqrt();
+        println!("{spp:3} paths per pixel: RMSE {rmse:.5} against 2048");
+        points.push(((spp as f64).ln(), rmse.ln()));
+    }
+    let (mx, my) = (
+        points.iter().map(|p| p.0).sum::<f64>() / 3.0,
+        points.iter().map(|p| p.1).sum::<f64>() / 3.0,
+    );
+    let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    println!("fitted slope of log RMSE over log spp: {slope:.3} (Monte Carlo: -0.5)");
+    // The reference's own noise (1/√32 of the 64-spp error) flattens the slope slightly.
+    assert!((-0.6..=-0.4).contains(&slope), "slope {slope}");
+    save(&r.read_image().unwrap(), "blob-64spp");
+}
+
+#[test]
+fn accumulation_restarts_on_changes() {
+    let mut r = renderer();
+    let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&medium([0.8; 3], 0.0, 0.5, 1.0))
+        .unwrap();
+    let mut view = View::fit(vol.bounds(), 16, 16);
+    let p = PathTraceParams {
+        samples_per_frame: 3,
+        ..Default::default()
+    };
+    r.set_path_tracing(&p).unwrap();
+    r.reset_accumulation();
+    let params = pt_params();
+    let mut counts = vec![];
+    for _ in 0..3 {
+        r.render(&view, &params, None).unwrap();
+        counts.push(r.accumulated_samples());
+    }
+    view.camera.azimuth(5.0);
+    r.render(&view, &params, None).unwrap();
+    counts.push(r.accumulated_samples());
+    r.set_path_tracing(&PathTraceParams {
+        anisotropy: 0.5,
+        ..p
+    })
+    .unwrap();
+    r.render(&view, &params, None).unwrap();
+    counts.push(r.accumulated_samples());
+    r.set_transfer_function(&medium([0.8; 3], 0.0, 0.4, 1.0))
+        .unwrap();
+    r.render(&view, &params, None).unwrap();
+    counts.push(r.accumulated_samples());
+    r.render(&view, &params, None).unwrap();
+    counts.push(r.accumulated_samples());
+    println!("accumulated paths per pixel: {counts:?} (camera, g, transfer function changed)");
+    assert_eq!(counts, vec![3, 6, 9, 3, 3, 3, 6]);
+}
+
+#[test]
+fn errors_say_what_is_wrong() {
+    let mut r = renderer();
+    let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&medium([0.8; 3], 0.0, 0.5, 1.0))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 16, 16);
+    let bad = |p: PathTraceParams, words: &str| {
+        let e = PathTraceParams::validate(&p).expect_err("refused");
+        println!("{e}");
+        assert!(e.to_string().contains(words), "'{e}' lacks '{words}'");
+    };
+    let d = PathTraceParams::default();
+    bad(
+        PathTraceParams {
+            samples_per_frame: 0,
+            ..d
+        },
+        "paths per pixel",
+    );
+    bad(
+        PathTraceParams {
+            anisotropy: 1.0,
+            ..d
+        },
+        "anisotropy",
+    );
+    bad(
+        PathTraceParams {
+            environment_light: f32::NAN,
+            ..d
+        },
+        "environment light",
+    );
+    assert!(r
+        .set_path_tracing(&PathTraceParams {
+            max_bounces: u32::MAX,
+            ..d
+        })
+        .is_err());
+    let mut crop = pt_params();
+    crop.cropping = Some(Cropping {
+        planes: [0.0, 4.0, 0.0, 4.0, 0.0, 4.0],
+        regions: Cropping::SUBVOLUME,
+    });
+    let e = r.render(&view, &crop, None).expect_err("cropping refused");
+    println!("{e}");
+    assert!(e.to_string().contains("crop"));
+    let mut lit = view.clone();
+    let mut l = Light::headlight();
+    l.positional = true;
+    lit.lights = vec![l];
+    let e = r
+        .render(&lit, &pt_params(), None)
+        .expect_err("positional refused");
+    println!("{e}");
+    assert!(e.to_string().contains("positional"));
+    r.set_volume_with(
+        &vol,
+        UploadOptions {
+            max_brick_points: Some(6),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let e = r
+        .render(&view, &pt_params(), None)
+        .expect_err("bricks refused");
+    println!("{e}");
+    assert!(e.to_string().contains("one brick"));
+}

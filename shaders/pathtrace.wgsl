@@ -1,0 +1,223 @@
+// Progressive Monte Carlo path tracing of the volume as a participating medium: per pixel,
+// `pt.counts.x` paths this frame, added to the sums of the frames before (accum).
+//
+// The medium: extinction σ(x) = −ln(1 − α(s(x))) / unit distance, α the transfer
+// function's opacity as given (so a slab one unit distance thick lets 1 − α through, VTK's
+// meaning of ScalarOpacityUnitDistance), single-scattering albedo the transfer function's
+// colour, Henyey–Greenstein scattering with anisotropy g. A path starts at the camera
+// (jittered in its pixel), flies freely by delta (Woodcock) tracking against the majorant
+// σ̄ = max σ, scatters at real collisions; at each one it takes next-event estimates toward
+// the environment (a uniform direction, combined with the phase-sampled continuation by
+// multiple importance sampling, power heuristic) and toward each directional light
+// (transmittance by ratio tracking); Russian roulette after 3 bounces, at most
+// pt.counts.z scattering events. Camera paths that miss the medium see the environment
+// when it is the background; alpha is the fraction of paths that met the medium.
+#include "lib/common.wgsl"
+#include "lib/ray.wgsl"
+#include "lib/volume.wgsl"
+#include "lib/march.wgsl"
+#include "lib/envmap.wgsl"
+#include "lib/phase.wgsl"
+
+struct PathTrace {
+    env_rotation: mat4x4<f32>,  // world → environment directions
+    medium: vec4<f32>,          // x majorant σ̄ (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
+    counts: vec4<u32>,          // x paths per pixel this frame, y paths accumulated before, z most scattering events, w seed
+    options: vec4<u32>,         // x flags (PT_FLAG_*), yzw unused
+    rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
+}
+
+const PT_FLAG_BACKGROUND: u32 = 1u;
+// Opacity is clamped below 1 so that extinction stays finite (σ ≤ 9.2 / unit distance).
+const PT_MAX_OPACITY: f32 = 0.9999;
+// Bound on the tentative collisions of one free flight or transmittance estimate (a
+// majorant of 9.2 per unit over thousands of units: never reached in practice).
+const PT_MAX_STEPS: u32 = 1000000u;
+
+// Per pixel: the sums of radiance (rgb) and of coverage (a) over all paths so far.
+@group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
+@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(7) var<uniform> pt: PathTrace;
+@group(0) @binding(11) var env_cube: texture_cube<f32>;
+@group(0) @binding(13) var env_sampler: sampler;
+
+fn env_radiance(d: vec3<f32>) -> vec3<f32> {
+    let e = (pt.env_rotation * vec4<f32>(d, 0.0)).xyz;
+    return pt.medium.w * textureSampleLevel(env_cube, env_sampler, e, 0.0).rgb;
+}
+
+// A ray from a world point in a world direction (secondary rays).
+fn ray_from(origin: vec3<f32>, dir: vec3<f32>) -> Ray {
+    var r: Ray;
+    r.origin = origin;
+    r.dir = dir;
+    r.far = 3.0e38;
+    r.index_origin = (frame.world_to_index * vec4<f32>(origin, 1.0)).xyz;
+    r.index_dir = (frame.world_to_index * vec4<f32>(dir, 0.0)).xyz;
+    return r;
+}
+
+// The part of a secondary ray inside the volume and on the kept side of the clipping planes.
+fn inner_segment(r: Ray) -> vec2<f32> {
+    var seg = box_interval(r, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    seg.x = max(seg.x, 0.0);
+    return clip_interval(r, seg);
+}
+
+fn extinction(s: f32) -> f32 {
+    let a = min(raw_alpha(0u, s), PT_MAX_OPACITY);
+    return -log(1.0 - a) * pt.medium.z;
+}
+
+fn extinction_at(r: Ray, t: f32) -> f32 {
+    return extinction(sample_scalars(r.index_origin + t * r.index_dir).x);
+}
+
+// Delta tracking: the distance of the first real collision in [t0, t1), or t1 when the
+// ray gets through.
+fn free_flight(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
+    let maj = pt.medium.x;
+    if (!(maj > 0.0) || t0 >= t1) {
+        return t1;
+    }
+    var t = t0;
+    for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
+        t = t - log(1.0 - rand(rng)) / maj;
+        if (t >= t1) {
+            return t1;
+        }
+        if (rand(rng) * maj < extinction_at(r, t)) {
+            return t;
+        }
+    }
+    return t1;
+}
+
+// Ratio tracking: an unbiased estimate of the transmittance over [t0, t1), with Russian
+// roulette once it is small.
+fn transmittance(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
+    let maj = pt.medium.x;
+    if (!(maj > 0.0) || t0 >= t1) {
+        return 1.0;
+    }
+    var t = t0;
+    var tr = 1.0;
+    for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
+        t = t - log(1.0 - rand(rng)) / maj;
+        if (t >= t1) {
+            break;
+        }
+        tr = tr * (1.0 - extinction_at(r, t) / maj);
+        if (tr < 0.1) {
+            if (rand(rng) >= 0.5) {
+                return 0.0;
+            }
+            tr = tr * 2.0;
+        }
+    }
+    return tr;
+}
+
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    return a * a / max(a * a + b * b, 1e-30);
+}
+
+// One path through the pixel: (radiance, met the medium ? 1 : 0).
+fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>) -> vec4<f32> {
+    let g = pt.medium.y;
+    let uniform_pdf = 1.0 / (4.0 * PI);
+    let background = (pt.options.x & PT_FLAG_BACKGROUND) != 0u;
+    var r = camera_ray;
+    var seg = ray_segment(r, px);
+    var beta = vec3<f32>(1.0);
+    var radiance = vec3<f32>(0.0);
+    var hit = 0.0;
+    // the pdf of the phase-sampled direction the path now travels in
+    var phase_pdf = 0.0;
+    for (var bounce = 0u; bounce <= pt.counts.z; bounce = bounce + 1u) {
+        let t = free_flight(r, seg.x, seg.y, rng);
+        if (t >= seg.y) {
+            if (bounce == 0u) {
+                if (background) {
+                    radiance = env_radiance(r.dir);
+                }
+            } else {
+                let w = power_heuristic(phase_pdf, uniform_pdf);
+                radiance = radiance + beta * w * env_radiance(r.dir);
+            }
+            break;
+        }
+        if (bounce == 0u) {
+            hit = 1.0;
+        }
+        if (bounce == pt.counts.z) {
+            break;   // the path has scattered as often as it may
+        }
+        let x = r.origin + t * r.dir;
+        let s = sample_scalars(r.index_origin + t * r.index_dir).x;
+        beta = beta * classify(0u, s).rgb;
+        // Next-event estimation: the environment, from a uniform direction.
+        let wl = uniform_sphere(rand2(rng));
+        let ph = hg_pdf(dot(r.dir, wl), g);
+        let rl = ray_from(x, wl);
+        let sl = inner_segment(rl);
+        let tl = transmittance(rl, sl.x, sl.y, rng);
+        radiance = radiance + beta * (ph * tl * power_heuristic(uniform_pdf, ph) / uniform_pdf) * env_radiance(wl);
+        // ... and the directional lights (the headlight along the camera ray).
+        for (var i = 0u; i < frame.counts.y; i = i + 1u) {
+            let light = frame.lights[i];
+            let l = select(light.position.xyz, -camera_ray.dir, light.position.w > 1.5);
+            let rd = ray_from(x, l);
+            let sd = inner_segment(rd);
+            let td = transmittance(rd, sd.x, sd.y, rng);
+            radiance = radiance + beta * (hg_pdf(dot(r.dir, l), g) * td) * light.diffuse.rgb;
+        }
+        // Continue along a phase-sampled direction (phase / pdf = 1).
+        let wn = hg_sample(r.dir, g, rand2(rng));
+        phase_pdf = hg_pdf(dot(r.dir, wn), g);
+        r = ray_from(x, wn);
+        seg = inner_segment(r);
+        if (bounce >= 3u) {
+            let q = clamp(max(max(beta.x, beta.y), beta.z), 0.05, 1.0);
+            if (rand(rng) >= q) {
+                break;
+            }
+            beta = beta / q;
+        }
+    }
+    return vec4<f32>(radiance, select(hit, 1.0, background));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let px = gid.xy + pt.rect.xy;
+    if (px.x >= pt.rect.z || px.y >= pt.rect.w) {
+        return;
+    }
+    let idx = px.y * frame.viewport.x + px.x;
+    var sum = vec4<f32>(0.0);
+    for (var s = 0u; s < pt.counts.x; s = s + 1u) {
+        var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ (pt.counts.y + s));
+        let ray = ray_through(image_ndc(vec2<f32>(px) + rand2(&rng)));
+        sum = sum + trace(ray, px, &rng);
+    }
+    if (pt.counts.y > 0u) {
+        sum = sum + accum[idx];
+    }
+    accum[idx] = sum;
+    let mean = sum / f32(pt.counts.y + pt.counts.x);
+    // Premultiplied output: radiance beyond the coverage is clipped, as an 8-bit image must.
+    let a = clamp(mean.a, 0.0, 1.0);
+    textureStore(out_color, vec2<i32>(px), vec4<f32>(clamp(mean.rgb, vec3<f32>(0.0), vec3<f32>(a)), a));
+    // Depth: where the pixel's centre ray enters the medium's segment, once any path met it.
+    var depth = 1.0;
+    if (a > 0.0) {
+        let centre = make_ray(px);
+        let seg = ray_segment(centre, px);
+        if (seg.x < seg.y) {
+            depth = distance_to_depth(centre, seg.x);
+        }
+    }
+    textureStore(out_depth, vec2<i32>(px), vec4<f32>(depth, 0.0, 0.0, 0.0));
+}
