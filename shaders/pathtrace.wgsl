@@ -7,8 +7,9 @@
 // colour, Henyey–Greenstein scattering with anisotropy g. A path starts at the camera
 // (jittered in its pixel), flies freely by delta (Woodcock) tracking against the majorant
 // σ̄ = max σ, scatters at real collisions; at each one it takes next-event estimates toward
-// the environment (a uniform direction, combined with the phase-sampled continuation by
-// multiple importance sampling, power heuristic) and toward each directional light
+// the environment (a direction importance-sampled from the environment's luminance,
+// combined with the phase-sampled continuation by multiple importance sampling, power
+// heuristic) and toward each directional light
 // (transmittance by ratio tracking); Russian roulette after 3 bounces, at most
 // pt.counts.z scattering events. Camera paths that miss the medium see the environment
 // when it is the background; alpha is the fraction of paths that met the medium.
@@ -23,7 +24,7 @@ struct PathTrace {
     env_rotation: mat4x4<f32>,  // world → environment directions
     medium: vec4<f32>,          // x majorant σ̄ (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
     counts: vec4<u32>,          // x paths per pixel this frame, y paths accumulated before, z most scattering events, w seed
-    options: vec4<u32>,         // x flags (PT_FLAG_*), yzw unused
+    options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, zw unused
     rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
 }
 
@@ -41,10 +42,73 @@ const PT_MAX_STEPS: u32 = 1000000u;
 @group(0) @binding(7) var<uniform> pt: PathTrace;
 @group(0) @binding(11) var env_cube: texture_cube<f32>;
 @group(0) @binding(13) var env_sampler: sampler;
+// The environment's sampling distribution over the texels of a small cube (options.y² per
+// face, faces +X … −Z, rows top to bottom): the cumulative probabilities, last = 1
+// (core/src/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
+@group(0) @binding(14) var<storage, read> env_cdf: array<f32>;
 
 fn env_radiance(d: vec3<f32>) -> vec3<f32> {
     let e = (pt.env_rotation * vec4<f32>(d, 0.0)).xyz;
     return pt.medium.w * textureSampleLevel(env_cube, env_sampler, e, 0.0).rgb;
+}
+
+// Face (x) and face coordinates sc, tc ∈ [−1, 1] (yz) of a direction, the inverse of
+// cube_direction (environment.rs: cube_face_coords).
+fn cube_face_coords(d: vec3<f32>) -> vec3<f32> {
+    let a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        if (d.x > 0.0) {
+            return vec3<f32>(0.0, -d.z / a.x, -d.y / a.x);
+        }
+        return vec3<f32>(1.0, d.z / a.x, -d.y / a.x);
+    }
+    if (a.y >= a.z) {
+        if (d.y > 0.0) {
+            return vec3<f32>(2.0, d.x / a.y, d.z / a.y);
+        }
+        return vec3<f32>(3.0, d.x / a.y, -d.z / a.y);
+    }
+    if (d.z > 0.0) {
+        return vec3<f32>(4.0, d.x / a.z, -d.y / a.z);
+    }
+    return vec3<f32>(5.0, -d.x / a.z, -d.y / a.z);
+}
+
+// Density over directions (per steradian) of env_sample for the world direction d: the
+// texel's probability spread uniformly over its face coordinates, whose solid angle per
+// unit area is (1 + sc² + tc²)^(−3/2).
+fn env_pdf(d: vec3<f32>) -> f32 {
+    let n = pt.options.y;
+    let f = cube_face_coords((pt.env_rotation * vec4<f32>(d, 0.0)).xyz);
+    let ij = min(vec2<u32>((f.yz + 1.0) * 0.5 * f32(n)), vec2<u32>(n - 1u));
+    let i = (u32(f.x) * n + ij.y) * n + ij.x;
+    let p = env_cdf[i] - select(0.0, env_cdf[max(i, 1u) - 1u], i > 0u);
+    let q = 1.0 + f.y * f.y + f.z * f.z;
+    return p * f32(n * n) * q * sqrt(q) * 0.25;
+}
+
+// A world direction drawn from the environment's distribution (pdf: env_pdf).
+fn env_sample(u: vec3<f32>) -> vec3<f32> {
+    let n = pt.options.y;
+    let count = 6u * n * n;
+    // the first texel whose cumulative probability exceeds u.x
+    var lo = 0u;
+    var hi = count - 1u;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (env_cdf[mid] > u.x) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    let face = lo / (n * n);
+    let rest = lo % (n * n);
+    let st = (vec2<f32>(f32(rest % n), f32(rest / n)) + u.yz) / f32(n);
+    let e = normalize(cube_direction(face, st));
+    // environment → world: the rotation's transpose
+    let m = mat3x3<f32>(pt.env_rotation[0].xyz, pt.env_rotation[1].xyz, pt.env_rotation[2].xyz);
+    return transpose(m) * e;
 }
 
 // A ray from a world point in a world direction (secondary rays).
@@ -126,7 +190,6 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 // One path through the pixel: (radiance, met the medium ? 1 : 0).
 fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>) -> vec4<f32> {
     let g = pt.medium.y;
-    let uniform_pdf = 1.0 / (4.0 * PI);
     let background = (pt.options.x & PT_FLAG_BACKGROUND) != 0u;
     var r = camera_ray;
     var seg = ray_segment(r, px);
@@ -143,7 +206,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>) -> vec4<f32> {
                     radiance = env_radiance(r.dir);
                 }
             } else {
-                let w = power_heuristic(phase_pdf, uniform_pdf);
+                let w = power_heuristic(phase_pdf, env_pdf(r.dir));
                 radiance = radiance + beta * w * env_radiance(r.dir);
             }
             break;
@@ -157,13 +220,16 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>) -> vec4<f32> {
         let x = r.origin + t * r.dir;
         let s = sample_scalars(r.index_origin + t * r.index_dir).x;
         beta = beta * classify(0u, s).rgb;
-        // Next-event estimation: the environment, from a uniform direction.
-        let wl = uniform_sphere(rand2(rng));
+        // Next-event estimation: the environment, from its own distribution.
+        let wl = env_sample(vec3<f32>(rand(rng), rand2(rng)));
+        let pl = env_pdf(wl);
         let ph = hg_pdf(dot(r.dir, wl), g);
-        let rl = ray_from(x, wl);
-        let sl = inner_segment(rl);
-        let tl = transmittance(rl, sl.x, sl.y, rng);
-        radiance = radiance + beta * (ph * tl * power_heuristic(uniform_pdf, ph) / uniform_pdf) * env_radiance(wl);
+        if (pl > 0.0) {
+            let rl = ray_from(x, wl);
+            let sl = inner_segment(rl);
+            let tl = transmittance(rl, sl.x, sl.y, rng);
+            radiance = radiance + beta * (ph * tl * power_heuristic(pl, ph) / pl) * env_radiance(wl);
+        }
         // ... and the directional lights (the headlight along the camera ray).
         for (var i = 0u; i < frame.counts.y; i = i + 1u) {
             let light = frame.lights[i];

@@ -6,8 +6,8 @@
 //! ScalarOpacityUnitDistance thick lets 1 − α through, VTK's meaning), the colour as the
 //! single-scattering albedo, and a Henyey–Greenstein phase function. Paths fly by delta
 //! tracking against the majorant σ̄ = max σ of the transfer function, take next-event
-//! estimates toward the environment (multiple importance sampling with the phase
-//! function) and the view's directional lights (ratio-tracking transmittance), and end by
+//! estimates toward the environment (directions drawn from its luminance on a 32² cube,
+//! multiple importance sampling with the phase function) and the view's directional lights (ratio-tracking transmittance), and end by
 //! Russian roulette or after [`PathTraceParams::max_bounces`] scattering events.
 //!
 //! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
@@ -115,6 +115,9 @@ pub(crate) struct PathTraceGpu {
     uniforms: wgpu::Buffer,
     /// Per pixel: sums of radiance and coverage over the accumulated paths.
     accum: Option<(u32, u32, wgpu::Buffer)>,
+    /// The environment's sampling distribution: (environment generation, texels per face
+    /// edge, cumulative probabilities).
+    env_dist: Option<(u64, u32, wgpu::Buffer)>,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
     samples: u32,
@@ -140,6 +143,7 @@ impl PathTraceGpu {
                     13,
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 ),
+                buffer_entry(14, B::Storage { read_only: true }),
             ],
         });
         let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -161,6 +165,7 @@ impl PathTraceGpu {
             pipelines: Default::default(),
             uniforms,
             accum: None,
+            env_dist: None,
             key: String::new(),
             samples: 0,
         })
@@ -212,7 +217,87 @@ impl PathTraceGpu {
     }
 }
 
+/// Texels per face edge of the cube the environment is importance-sampled on (at most).
+const ENV_DIST_SIZE: u32 = 32;
+/// Share of the environment's sampling probability spread uniformly over the sphere, so
+/// every direction keeps some (the distribution is built from a coarse mip level).
+const ENV_DIST_UNIFORM: f64 = 0.1;
+
+/// The cumulative sampling probabilities of the texels of a cube image: luminance × solid
+/// angle, mixed with a uniform share (pathtrace.wgsl: env_sample, env_pdf).
+fn environment_cdf(cube: &crate::environment::CubeImage) -> Vec<f32> {
+    let n = cube.size as usize;
+    let mut weights = Vec::with_capacity(6 * n * n);
+    let mut solid = Vec::with_capacity(6 * n * n);
+    for face in &cube.faces {
+        for (i, t) in face.iter().enumerate() {
+            let sc = 2.0 * ((i % n) as f64 + 0.5) / n as f64 - 1.0;
+            let tc = 2.0 * ((i / n) as f64 + 0.5) / n as f64 - 1.0;
+            let q = 1.0 + sc * sc + tc * tc;
+            let omega = 4.0 / (n * n) as f64 / (q * q.sqrt());
+            let lum = 0.2126 * t[0] as f64 + 0.7152 * t[1] as f64 + 0.0722 * t[2] as f64;
+            weights.push(lum.max(0.0) * omega);
+            solid.push(omega);
+        }
+    }
+    let total: f64 = weights.iter().sum();
+    let total_solid: f64 = solid.iter().sum();
+    let mut acc = 0.0;
+    let mut cdf: Vec<f32> = weights
+        .iter()
+        .zip(&solid)
+        .map(|(w, o)| {
+            let lum_share = if total > 0.0 { w / total } else { o / total_solid };
+            acc += (1.0 - ENV_DIST_UNIFORM) * lum_share + ENV_DIST_UNIFORM * o / total_solid;
+            acc as f32
+        })
+        .collect();
+    if let Some(last) = cdf.last_mut() {
+        *last = 1.0;
+    }
+    cdf
+}
+
 impl Renderer {
+    /// Builds the environment's sampling distribution when the environment changed.
+    fn ensure_environment_distribution(&mut self) -> Result<()> {
+        let generation = self.environment_generation;
+        if self
+            .pt
+            .as_ref()
+            .and_then(|g| g.env_dist.as_ref())
+            .is_some_and(|(gen, _, _)| *gen == generation)
+        {
+            return Ok(());
+        }
+        let (size, mips) = {
+            let env = self
+                .iso
+                .as_ref()
+                .and_then(|i| i.environment.as_ref())
+                .ok_or_else(|| Error::InvalidParameter("no environment yet".into()))?;
+            (env.size, env.mips)
+        };
+        let mut level = 0;
+        while level + 1 < mips && (size >> level) > ENV_DIST_SIZE {
+            level += 1;
+        }
+        let cube = self.read_environment(level)?;
+        let cdf = environment_cdf(&cube);
+        let buf = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("environment sampling distribution"),
+            size: (4 * cdf.len()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.ctx
+            .queue
+            .write_buffer(&buf, 0, bytemuck::cast_slice(&cdf));
+        let g = self.pt.as_mut().expect("created before");
+        g.env_dist = Some((generation, cube.size, buf));
+        Ok(())
+    }
+
     /// Sets how frames with [`BlendMode::PathTrace`](crate::BlendMode::PathTrace) sample
     /// (a change other than of the paths per frame starts the accumulation over).
     pub fn set_path_tracing(&mut self, p: &PathTraceParams) -> Result<()> {
@@ -322,6 +407,7 @@ impl Renderer {
         if self.pt.is_none() {
             self.pt = Some(Box::new(PathTraceGpu::new(&self.ctx, &self.brick_bgl)?));
         }
+        self.ensure_environment_distribution()?;
         // The view's directional lights light the medium whatever `shading.enabled` says.
         let lit = RenderParams {
             blend: BlendMode::PathTrace,
@@ -370,7 +456,13 @@ impl Renderer {
             pp.environment_light,
         ];
         u.counts = [pp.samples_per_frame, before, pp.max_bounces, pp.seed];
-        u.options = [if pp.background { PT_FLAG_BACKGROUND } else { 0 }, 0, 0, 0];
+        let (_, dist_size, dist) = g.env_dist.as_ref().expect("built above");
+        u.options = [
+            if pp.background { PT_FLAG_BACKGROUND } else { 0 },
+            *dist_size,
+            0,
+            0,
+        ];
         u.rect = rect;
         let q = &ctx.queue;
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
@@ -410,6 +502,7 @@ impl Renderer {
                     13,
                     wgpu::BindingResource::Sampler(&iso.env_pipelines.cube_sampler),
                 ),
+                bind(14, dist.as_entire_binding()),
             ],
         });
         let vol = self.volume.as_ref().expect("checked above");

@@ -58,10 +58,3 @@ fn hg_sample(d: vec3<f32>, g: f32, u: vec2<f32>) -> vec3<f32> {
     return basis_around(d) * vec3<f32>(s * cos(phi), s * sin(phi), c);
 }
 
-// Uniform direction on the sphere (pdf 1 / 4π).
-fn uniform_sphere(u: vec2<f32>) -> vec3<f32> {
-    let z = 1.0 - 2.0 * u.x;
-    let r = sqrt(max(0.0, 1.0 - z * z));
-    let phi = 2.0 * PI * u.y;
-    return vec3<f32>(r * cos(phi), r * sin(phi), z);
-}
