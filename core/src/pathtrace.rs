@@ -247,7 +247,11 @@ fn environment_cdf(cube: &crate::environment::CubeImage) -> Vec<f32> {
         .iter()
         .zip(&solid)
         .map(|(w, o)| {
-            let lum_share = if total > 0.0 { w / total } else { o / total_solid };
+            let lum_share = if total > 0.0 {
+                w / total
+            } else {
+                o / total_solid
+            };
             acc += (1.0 - ENV_DIST_UNIFORM) * lum_share + ENV_DIST_UNIFORM * o / total_solid;
             acc as f32
         })
