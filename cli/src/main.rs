@@ -185,7 +185,7 @@ struct IsoArgs {
     env_intensity: f32,
     /// Weight of environment lighting (0: the lights only). Default: 0.6 on isosurfaces
     /// (beside the headlight; 1 with --no-lights), 1 when path tracing.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     env_light: Option<f32>,
     /// Show the environment behind the surfaces.
     #[arg(long)]

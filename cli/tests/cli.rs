@@ -142,3 +142,47 @@ fn iso_render_of_nested_surfaces_with_ao() {
     println!("black pixels: {black}");
     assert_eq!(black, 0);
 }
+
+#[test]
+fn pathtrace_render_and_bad_settings() {
+    let out = std::env::temp_dir().join("ferrovol-cli-test-pathtrace.png");
+    let path = out.to_str().expect("utf-8 temp path");
+    let (code, _, err) = ferrovol(&[
+        "render",
+        "--demo",
+        "marschner-lobb",
+        "--mode",
+        "pathtrace",
+        "--spp",
+        "70",
+        "--g",
+        "0.3",
+        "--size",
+        "24x24",
+        "--out",
+        path,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // 64 paths in the first frame, 6 in the second: one accumulation, not a restart
+    assert!(err.contains("70 paths per pixel"), "{err}");
+    let img = image::open(&out).expect("a PNG").to_rgba8();
+    let lit = img.pixels().filter(|p| p.0[3] > 0).count();
+    println!("{lit} of {} pixels met the medium", 24 * 24);
+    assert!(lit > 100);
+    for (args, words) in [
+        (vec!["--g", "1.5"], "anisotropy"),
+        (vec!["--spp", "0"], "spp"),
+        (vec!["--env-light", "-1"], "environment light"),
+    ] {
+        let mut all = vec!["render", "--demo", "sphere", "--mode", "pathtrace"];
+        all.extend(&args);
+        all.extend(["--size", "8x8", "--out", "/tmp/ferrovol-cli-never.png"]);
+        let (code, _, err) = ferrovol(&all);
+        println!(
+            "{args:?}: exit {code}: {}",
+            err.lines().next().unwrap_or("")
+        );
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.contains(words), "{args:?}: '{err}' lacks '{words}'");
+    }
+}
