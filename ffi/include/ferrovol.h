@@ -102,6 +102,11 @@ typedef enum FvBlendMode {
    * shading with environment light and ambient occlusion.
    */
   FV_BLEND_MODE_ISOSURFACE = 5,
+  /**
+   * Progressive Monte Carlo path tracing of the volume as a scattering medium
+   * (fv_renderer_set_path_tracing; each frame adds paths to the ones before).
+   */
+  FV_BLEND_MODE_PATH_TRACE = 6,
 } FvBlendMode;
 
 /**
@@ -497,6 +502,37 @@ typedef struct FvIsoParams {
 } FvIsoParams;
 
 /**
+ * How frames with FV_BLEND_MODE_PATH_TRACE sample. Fill with fv_path_trace_params_default()
+ * and change what you need. Thread use: plain data.
+ */
+typedef struct FvPathTraceParams {
+  /**
+   * Paths per pixel each frame adds (1 to 4096).
+   */
+  uint32_t samples_per_frame;
+  /**
+   * Most scattering events per path.
+   */
+  uint32_t max_bounces;
+  /**
+   * Henyey–Greenstein anisotropy g in (−1, 1).
+   */
+  float anisotropy;
+  /**
+   * Weight of the environment's light (0: the directional lights only).
+   */
+  float environment_light;
+  /**
+   * Show the environment behind the medium (the frame becomes opaque).
+   */
+  bool background;
+  /**
+   * Seed of the random streams.
+   */
+  uint32_t seed;
+} FvPathTraceParams;
+
+/**
  * One exported image, for glCreateMemoryObjectsEXT + glImportMemoryFdEXT(size,
  * GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd) + glTexStorageMem2DEXT(GL_TEXTURE_2D, 1,
  * gl_internal_format, width, height, memory, 0) with GL_TEXTURE_TILING_EXT =
@@ -725,7 +761,7 @@ enum FvStatus fv_renderer_set_isosurface(struct FvRenderer *renderer,
                                          const struct FvIsoParams *params);
 
 /**
- * Sets the environment that lights isosurfaces and builds its maps now (an irradiance
+ * Sets the environment that lights isosurfaces and path-traced media and builds its maps now (an irradiance
  * cube and a mip-filtered environment cube; ~0.2 s on a CPU device). `path` (UTF-8) is an
  * equirectangular .hdr, .exr, .png or .jpg image twice as wide as high, or NULL for the
  * built-in procedural sky. `up` (3 doubles, or NULL for +Y) is the world direction that
@@ -737,6 +773,26 @@ enum FvStatus fv_renderer_set_environment(struct FvRenderer *renderer,
                                           float intensity,
                                           const double *up,
                                           double azimuth_degrees);
+
+/**
+ * Fills `*params` with the path tracing defaults (4 paths per pixel and frame, at most 64
+ * scattering events, isotropic scattering, environment weight 1, no background, seed 0).
+ */
+enum FvStatus fv_path_trace_params_default(struct FvPathTraceParams *params);
+
+/**
+ * Sets how frames with FV_BLEND_MODE_PATH_TRACE sample (validated: out-of-range values are
+ * refused and the previous settings kept). A change other than of the paths per frame
+ * starts the accumulation over.
+ */
+enum FvStatus fv_renderer_set_path_tracing(struct FvRenderer *renderer,
+                                           const struct FvPathTraceParams *params);
+
+/**
+ * Paths per pixel the last path-traced frame shows into `*samples` (0 before the first);
+ * a frame after any change of camera, data, transfer function or settings starts over.
+ */
+enum FvStatus fv_renderer_accumulated_samples(const struct FvRenderer *renderer, uint32_t *samples);
 
 /**
  * Renders a `width × height` frame. `depth` (NULL for none) holds `depth_count` =

@@ -1,9 +1,12 @@
-//! The isosurface render mode through the C ABI: iso-values, deferred shading and
-//! ambient-occlusion settings ([`FvIsoParams`]) and the environment map.
+//! The isosurface and path tracing render modes through the C ABI: iso-values, deferred
+//! shading and ambient-occlusion settings ([`FvIsoParams`]), path tracing settings
+//! ([`FvPathTraceParams`]) and the environment map both are lit by.
 
 use crate::status::{FfiError, FfiResult};
 use ferrovol_core::iso::MAX_ISO_VALUES;
-use ferrovol_core::{AmbientOcclusion, IsoParams, IsoValue, Shininess, SpecularMode};
+use ferrovol_core::{
+    AmbientOcclusion, IsoParams, IsoValue, PathTraceParams, Shininess, SpecularMode,
+};
 
 /// Most iso-values in one FvIsoParams.
 pub const FV_MAX_ISO_VALUES: usize = 8;
@@ -152,6 +155,52 @@ impl FvIsoParams {
             }),
             environment_light: self.environment_light,
             background: self.background,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+/// How frames with FV_BLEND_MODE_PATH_TRACE sample. Fill with fv_path_trace_params_default()
+/// and change what you need. Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvPathTraceParams {
+    /// Paths per pixel each frame adds (1 to 4096).
+    pub samples_per_frame: u32,
+    /// Most scattering events per path.
+    pub max_bounces: u32,
+    /// Henyey–Greenstein anisotropy g in (−1, 1).
+    pub anisotropy: f32,
+    /// Weight of the environment's light (0: the directional lights only).
+    pub environment_light: f32,
+    /// Show the environment behind the medium (the frame becomes opaque).
+    pub background: bool,
+    /// Seed of the random streams.
+    pub seed: u32,
+}
+
+impl FvPathTraceParams {
+    pub fn defaults() -> Self {
+        let d = PathTraceParams::default();
+        FvPathTraceParams {
+            samples_per_frame: d.samples_per_frame,
+            max_bounces: d.max_bounces,
+            anisotropy: d.anisotropy,
+            environment_light: d.environment_light,
+            background: d.background,
+            seed: d.seed,
+        }
+    }
+
+    pub fn to_core(&self) -> FfiResult<PathTraceParams> {
+        let p = PathTraceParams {
+            samples_per_frame: self.samples_per_frame,
+            max_bounces: self.max_bounces,
+            anisotropy: self.anisotropy,
+            environment_light: self.environment_light,
+            background: self.background,
+            seed: self.seed,
         };
         p.validate()?;
         Ok(p)

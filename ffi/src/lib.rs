@@ -690,7 +690,7 @@ pub unsafe extern "C" fn fv_renderer_set_isosurface(
     })
 }
 
-/// Sets the environment that lights isosurfaces and builds its maps now (an irradiance
+/// Sets the environment that lights isosurfaces and path-traced media and builds its maps now (an irradiance
 /// cube and a mip-filtered environment cube; ~0.2 s on a CPU device). `path` (UTF-8) is an
 /// equirectangular .hdr, .exr, .png or .jpg image twice as wide as high, or NULL for the
 /// built-in procedural sky. `up` (3 doubles, or NULL for +Y) is the world direction that
@@ -723,6 +723,46 @@ pub unsafe extern "C" fn fv_renderer_set_environment(
         env.intensity = intensity;
         env.azimuth = azimuth_degrees;
         r.r.set_environment(&env)?;
+        Ok(())
+    })
+}
+
+/// Fills `*params` with the path tracing defaults (4 paths per pixel and frame, at most 64
+/// scattering events, isotropic scattering, environment weight 1, no background, seed 0).
+#[no_mangle]
+pub unsafe extern "C" fn fv_path_trace_params_default(params: *mut FvPathTraceParams) -> FvStatus {
+    guard(|| {
+        *mut_ref(params, "params")? = FvPathTraceParams::defaults();
+        Ok(())
+    })
+}
+
+/// Sets how frames with FV_BLEND_MODE_PATH_TRACE sample (validated: out-of-range values are
+/// refused and the previous settings kept). A change other than of the paths per frame
+/// starts the accumulation over.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_path_tracing(
+    renderer: *mut FvRenderer,
+    params: *const FvPathTraceParams,
+) -> FvStatus {
+    guard(|| {
+        let r = mut_ref(renderer, "renderer")?;
+        let p = const_ref(params, "params")?.to_core()?;
+        r.r.set_path_tracing(&p)?;
+        Ok(())
+    })
+}
+
+/// Paths per pixel the last path-traced frame shows into `*samples` (0 before the first);
+/// a frame after any change of camera, data, transfer function or settings starts over.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_accumulated_samples(
+    renderer: *const FvRenderer,
+    samples: *mut u32,
+) -> FvStatus {
+    guard(|| {
+        let r = const_ref(renderer, "renderer")?;
+        *mut_ref(samples, "samples")? = r.r.accumulated_samples();
         Ok(())
     })
 }

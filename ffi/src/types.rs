@@ -84,6 +84,9 @@ pub enum FvBlendMode {
     /// Isosurfaces (fv_renderer_set_isosurface): first hit with bisection, deferred
     /// shading with environment light and ambient occlusion.
     Isosurface = 5,
+    /// Progressive Monte Carlo path tracing of the volume as a scattering medium
+    /// (fv_renderer_set_path_tracing; each frame adds paths to the ones before).
+    PathTrace = 6,
 }
 
 /// Volume interpolation (vtkVolumeProperty::InterpolationType).
@@ -298,6 +301,7 @@ impl FvRenderParams {
                 B::Average,
                 B::Additive,
                 B::Isosurface,
+                B::PathTrace,
             ],
         )?;
         let interpolation = enum_value(

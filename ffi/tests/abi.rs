@@ -680,3 +680,114 @@ fn isosurface_errors_and_a_frame() {
         lib.f::<Free>("fv_context_free")(ctx);
     }
 }
+
+type SetPt = unsafe extern "C" fn(H, *const ferrovol::FvPathTraceParams) -> FvStatus;
+type Accumulated = unsafe extern "C" fn(H, *mut u32) -> FvStatus;
+
+/// Path tracing through the C ABI: refusals name their problem, frames accumulate and a
+/// camera change starts over.
+#[test]
+fn path_tracing_accumulates_and_refuses_bad_settings() {
+    let lib = Lib::open();
+    let mut ctx: H = null_mut();
+    let mut r: H = null_mut();
+    let data: Vec<f32> = (0..8 * 8 * 8).map(|i| (i % 8) as f32 / 7.0).collect();
+    // SAFETY: arguments follow the header; invalid ones are the test.
+    unsafe {
+        assert_eq!(lib.f::<NewCtx>("fv_context_new")(&mut ctx), FvStatus::Ok);
+        assert_eq!(
+            lib.f::<NewRenderer>("fv_renderer_new")(ctx, &mut r),
+            FvStatus::Ok
+        );
+        let d = desc([8, 8, 8], 1, ferrovol::FvScalarType::F32 as u32);
+        let mut v: H = null_mut();
+        assert_eq!(
+            lib.f::<NewVolume>("fv_volume_new")(&d, data.as_ptr().cast(), 4 * 512, &mut v),
+            FvStatus::Ok
+        );
+        assert_eq!(lib.f::<SetH>("fv_renderer_set_volume")(r, v), FvStatus::Ok);
+        let mut tf: H = null_mut();
+        assert_eq!(
+            lib.f::<NewTf>("fv_transfer_function_new")(1, true, &mut tf),
+            FvStatus::Ok
+        );
+        let c = [0.0, 0.9, 0.8, 0.7, 1.0, 0.9, 0.8, 0.7];
+        let o = [0.0, 0.0, 1.0, 0.6];
+        let set_points = lib.f::<SetPoints>("fv_transfer_function_set_color");
+        assert_eq!(set_points(tf, 0, c.as_ptr(), 2), FvStatus::Ok);
+        let set_points = lib.f::<SetPoints>("fv_transfer_function_set_opacity");
+        assert_eq!(set_points(tf, 0, o.as_ptr(), 2), FvStatus::Ok);
+        assert_eq!(
+            lib.f::<SetH>("fv_renderer_set_transfer_function")(r, tf),
+            FvStatus::Ok
+        );
+        let mut cam: FvCamera = std::mem::zeroed();
+        cam.position = [3.5, 3.5, 40.0];
+        cam.focal_point = [3.5, 3.5, 3.5];
+        cam.view_up = [0.0, 1.0, 0.0];
+        cam.view_angle = 30.0;
+        cam.clipping_range = [1.0, 100.0];
+        let set_cam = lib.f::<SetCamera>("fv_renderer_set_camera");
+        assert_eq!(set_cam(r, &cam), FvStatus::Ok);
+        let mut p = FvRenderParams::defaults();
+        p.blend_mode = ferrovol::FvBlendMode::PathTrace as u32;
+        assert_eq!(
+            lib.f::<SetParams>("fv_renderer_set_params")(r, &p),
+            FvStatus::Ok
+        );
+        let set_pt = lib.f::<SetPt>("fv_renderer_set_path_tracing");
+        let defaults = lib.f::<unsafe extern "C" fn(*mut ferrovol::FvPathTraceParams) -> FvStatus>(
+            "fv_path_trace_params_default",
+        );
+        let mut pt: ferrovol::FvPathTraceParams = std::mem::zeroed();
+        assert_eq!(defaults(&mut pt), FvStatus::Ok);
+        let mut bad = pt;
+        bad.anisotropy = 1.0;
+        lib.expect(
+            "g = 1",
+            set_pt(r, &bad),
+            FvStatus::InvalidArgument,
+            "anisotropy 1",
+        );
+        bad = pt;
+        bad.samples_per_frame = 0;
+        lib.expect(
+            "0 paths",
+            set_pt(r, &bad),
+            FvStatus::InvalidArgument,
+            "0 paths per pixel",
+        );
+        lib.expect(
+            "NULL params",
+            set_pt(r, null()),
+            FvStatus::NullArgument,
+            "params is NULL",
+        );
+        pt.samples_per_frame = 2;
+        assert_eq!(set_pt(r, &pt), FvStatus::Ok);
+        let render = lib.f::<Render>("fv_renderer_render");
+        let accumulated = lib.f::<Accumulated>("fv_renderer_accumulated_samples");
+        let mut counts = vec![];
+        for i in 0..4 {
+            if i == 3 {
+                cam.position = [3.5, 10.0, 40.0];
+                assert_eq!(set_cam(r, &cam), FvStatus::Ok);
+            }
+            assert_eq!(
+                render(r, 16, 16, null(), 0),
+                FvStatus::Ok,
+                "{}",
+                lib.last_error()
+            );
+            let mut n = 0u32;
+            assert_eq!(accumulated(r, &mut n), FvStatus::Ok);
+            counts.push(n);
+        }
+        println!("accumulated paths per pixel: {counts:?} (camera moved before the last)");
+        assert_eq!(counts, vec![2, 4, 6, 2]);
+        lib.f::<Free>("fv_transfer_function_free")(tf);
+        lib.f::<Free>("fv_volume_free")(v);
+        lib.f::<Free>("fv_renderer_free")(r);
+        lib.f::<Free>("fv_context_free")(ctx);
+    }
+}
