@@ -475,6 +475,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     let path_tracing = if a.mode == Mode::Pathtrace {
         let p = PathTraceParams {
             samples_per_frame: a.pt.spp.min(64),
+            max_samples: a.pt.spp,
             max_bounces: a.pt.bounces,
             anisotropy: a.pt.anisotropy,
             environment_light: a.iso.env_light.unwrap_or(1.0),
@@ -566,10 +567,6 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
                 r.accumulated_samples(),
                 a.pt.spp
             ));
-            // (the paths per frame do not restart the accumulation)
-            let mut p = *r.path_tracing();
-            p.samples_per_frame = (a.pt.spp - r.accumulated_samples()).min(64);
-            r.set_path_tracing(&p)?;
             r.render(&view, &params, None)?;
         }
         img = r.read_image()?;

@@ -13,7 +13,8 @@
 //! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
 //! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before,
 //! until anything that changes the image changes (camera, lights, size, render or path
-//! tracing parameters, volume, transfer function, environment); the count is
+//! tracing parameters but the paths per frame and the budget, volume, transfer function,
+//! environment), or until [`PathTraceParams::max_samples`]; the count is
 //! [`Renderer::accumulated_samples`]. The environment is the one
 //! [`Renderer::set_environment`](crate::Renderer::set_environment) built (the procedural sky
 //! by default).
@@ -48,6 +49,9 @@ pub const MAX_BOUNCES: u32 = 100_000;
 pub struct PathTraceParams {
     /// Paths per pixel each frame adds (1 to [`MAX_SAMPLES_PER_FRAME`]).
     pub samples_per_frame: u32,
+    /// Paths per pixel after which frames stop adding any and show the converged image
+    /// again (a still render's budget); 0: no limit.
+    pub max_samples: u32,
     /// Most scattering events per path (0: single scattering is off too; the medium only
     /// attenuates what is behind it).
     pub max_bounces: u32,
@@ -65,6 +69,7 @@ impl Default for PathTraceParams {
     fn default() -> Self {
         PathTraceParams {
             samples_per_frame: 4,
+            max_samples: 0,
             max_bounces: 64,
             anisotropy: 0.0,
             environment_light: 1.0,
@@ -426,6 +431,7 @@ impl Renderer {
         // (the paths per frame are not part of what the image converges to)
         let converges_to = PathTraceParams {
             samples_per_frame: 0,
+            max_samples: 0,
             ..pp
         };
         let key = format!(
@@ -444,6 +450,12 @@ impl Renderer {
             g.samples = 0;
         }
         let before = g.samples;
+        let add = if pp.max_samples > 0 {
+            pp.samples_per_frame
+                .min(pp.max_samples.saturating_sub(before))
+        } else {
+            pp.samples_per_frame
+        };
         let full = [0, 0, view.width, view.height];
         let rect = if pp.background { full } else { frame.rect };
         let env = self
@@ -459,7 +471,7 @@ impl Renderer {
             (1.0 / unit) as f32,
             pp.environment_light,
         ];
-        u.counts = [pp.samples_per_frame, before, pp.max_bounces, pp.seed];
+        u.counts = [add, before, pp.max_bounces, pp.seed];
         let (_, dist_size, dist) = g.env_dist.as_ref().expect("built above");
         u.options = [
             if pp.background { PT_FLAG_BACKGROUND } else { 0 },
@@ -549,7 +561,7 @@ impl Renderer {
             q.submit([enc.finish()]);
         })?;
         let g = self.pt.as_mut().expect("created above");
-        g.samples = before + pp.samples_per_frame;
+        g.samples = before + add;
         self.stats.frames += 1;
         Ok(())
     }

@@ -319,8 +319,28 @@ fn accumulation_restarts_on_changes() {
     counts.push(r.accumulated_samples());
     r.render(&view, &params, None).unwrap();
     counts.push(r.accumulated_samples());
-    println!("accumulated paths per pixel: {counts:?} (camera, g, transfer function changed)");
-    assert_eq!(counts, vec![3, 6, 9, 3, 3, 3, 6]);
+    // A budget of 7: frames stop adding paths there and show the same image again.
+    r.set_path_tracing(&PathTraceParams {
+        anisotropy: 0.5,
+        max_samples: 7,
+        ..p
+    })
+    .unwrap();
+    r.render(&view, &params, None).unwrap();
+    counts.push(r.accumulated_samples());
+    let first = r.read_image().unwrap();
+    r.render(&view, &params, None).unwrap();
+    counts.push(r.accumulated_samples());
+    assert_eq!(
+        r.read_image().unwrap().rgba,
+        first.rgba,
+        "the converged image, again"
+    );
+    println!(
+        "accumulated paths per pixel: {counts:?} (camera, g, transfer function changed; then \
+         a budget of 7)"
+    );
+    assert_eq!(counts, vec![3, 6, 9, 3, 3, 3, 6, 7, 7]);
 }
 
 #[test]

@@ -511,6 +511,11 @@ typedef struct FvPathTraceParams {
    */
   uint32_t samples_per_frame;
   /**
+   * Paths per pixel after which frames add none and show the converged image again (a
+   * still render's budget); 0: no limit.
+   */
+  uint32_t max_samples;
+  /**
    * Most scattering events per path.
    */
   uint32_t max_bounces;

@@ -168,6 +168,9 @@ impl FvIsoParams {
 pub struct FvPathTraceParams {
     /// Paths per pixel each frame adds (1 to 4096).
     pub samples_per_frame: u32,
+    /// Paths per pixel after which frames add none and show the converged image again (a
+    /// still render's budget); 0: no limit.
+    pub max_samples: u32,
     /// Most scattering events per path.
     pub max_bounces: u32,
     /// Henyey–Greenstein anisotropy g in (−1, 1).
@@ -185,6 +188,7 @@ impl FvPathTraceParams {
         let d = PathTraceParams::default();
         FvPathTraceParams {
             samples_per_frame: d.samples_per_frame,
+            max_samples: d.max_samples,
             max_bounces: d.max_bounces,
             anisotropy: d.anisotropy,
             environment_light: d.environment_light,
@@ -196,6 +200,7 @@ impl FvPathTraceParams {
     pub fn to_core(&self) -> FfiResult<PathTraceParams> {
         let p = PathTraceParams {
             samples_per_frame: self.samples_per_frame,
+            max_samples: self.max_samples,
             max_bounces: self.max_bounces,
             anisotropy: self.anisotropy,
             environment_light: self.environment_light,
