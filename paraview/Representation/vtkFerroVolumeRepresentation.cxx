@@ -148,6 +148,21 @@ void vtkFerroVolumeRepresentation::SetFresnel(double reflectance)
   this->GetFerroVolumeMapper()->SetFresnel(reflectance);
 }
 
+void vtkFerroVolumeRepresentation::SetRenderMode(int mode)
+{
+  this->GetFerroVolumeMapper()->SetRenderMode(mode);
+}
+
+void vtkFerroVolumeRepresentation::SetSamplesPerPixel(int samples)
+{
+  this->GetFerroVolumeMapper()->SetSamplesPerPixel(samples);
+}
+
+void vtkFerroVolumeRepresentation::SetPathTracingBounces(int bounces)
+{
+  this->GetFerroVolumeMapper()->SetPathTracingBounces(bounces);
+}
+
 //------------------------------------------------------------------------------------------
 const char* vtkFerroVolumeRepresentation::GetFerrovolVersion()
 {

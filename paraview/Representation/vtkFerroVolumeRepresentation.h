@@ -100,6 +100,17 @@ public:
   void SetFresnel(double reflectance);
   ///@}
 
+  ///@{
+  /**
+   * Forwarded to vtkFerroVolumeMapper's path tracing settings: the render mode (ray cast 0,
+   * path trace 1), the still render's paths per pixel and the bounces per path. The
+   * anisotropy is the shared "VolumeAnisotropy" (vtkVolumeProperty::ScatteringAnisotropy).
+   */
+  void SetRenderMode(int mode);
+  void SetSamplesPerPixel(int samples);
+  void SetPathTracingBounces(int bounces);
+  ///@}
+
   /**
    * The mapper this representation renders with.
    */

@@ -69,6 +69,7 @@ CHANGES = [
     ("FerrovolBlendMode", "Minimum Intensity", True),
     ("FerrovolBlendMode", "Average Intensity", True),
     ("FerrovolBlendMode", "Additive", True),
+    (("FerrovolRenderMode", "FerrovolSamplesPerPixel"), ["Path Trace", 4], True),
     ("Shade", 1, True),
     ("FerrovolUseJittering", 1, True),
     (("FerrovolAutoAdjustSampleDistances", "FerrovolSampleDistance"), [0, 3.0], True),

@@ -35,6 +35,7 @@
 #include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
+#include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 #include "vtkSmartPointer.h"
@@ -1184,6 +1185,10 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , ShininessGradientRange{ 0.0, 0.0 }
   , Fresnel(-1.0)
   , IsosurfaceLayers(4)
+  , RenderMode(RENDER_MODE_RAY_CAST)
+  , SamplesPerPixel(64)
+  , InteractiveSamplesPerPixel(1)
+  , PathTracingBounces(64)
   , LastRenderDrew(0)
   , LastRenderSize{ 0, 0 }
   , Internals(new vtkInternals)
@@ -1213,6 +1218,17 @@ int vtkFerroVolumeMapper::GetTableUploadCount()
 {
   FvStats s;
   return this->Internals->Stats(s) ? static_cast<int>(s.table_uploads) : -1;
+}
+
+int vtkFerroVolumeMapper::GetAccumulatedSamples()
+{
+  uint32_t n = 0;
+  if (!this->Internals->Renderer ||
+    fv_renderer_accumulated_samples(this->Internals->Renderer, &n) != FV_STATUS_OK)
+  {
+    return -1;
+  }
+  return static_cast<int>(n);
 }
 
 int vtkFerroVolumeMapper::GetFrameCount()
@@ -1788,15 +1804,8 @@ bool BuildTransferFunction(vtkFerroVolumeMapper* self, vtkVolumeProperty* prop, 
 //------------------------------------------------------------------------------------------
 namespace
 {
-enum class IsoSetup
-{
-  Failed,
-  NothingVisible,
-  Ready
-};
-
 // What the mapper remembers about the environment between frames.
-struct IsoEnvironment
+struct EnvironmentState
 {
   bool& Have;
   std::string& Key;
@@ -1805,13 +1814,87 @@ struct IsoEnvironment
   bool& Background;
 };
 
+// Gives the renderer the mapper's environment when the map or its placement changed since
+// the last frame; false (said once per setting with vtkErrorMacro) when it cannot be used.
+bool UseEnvironment(vtkFerroVolumeMapper* self, FvRenderer* r, EnvironmentState& env)
+{
+  const char* file = self->GetEnvironmentMap();
+  const bool sky = !file || !*file;
+  const double* up = self->GetEnvironmentUp();
+  std::ostringstream key;
+  key << (sky ? "" : file) << '|' << up[0] << ',' << up[1] << ',' << up[2] << '|'
+      << self->GetEnvironmentAzimuth() << '|' << self->GetEnvironmentIntensity();
+  if (!env.Have || (env.Key != key.str() && env.Key != "failed:" + key.str()))
+  {
+    env.Have = true;
+    env.Key = key.str();
+    const FvStatus st = fv_renderer_set_environment(r, sky ? nullptr : file,
+      static_cast<float>(self->GetEnvironmentIntensity()), up, self->GetEnvironmentAzimuth());
+    if (st != FV_STATUS_OK)
+    {
+      vtkErrorWithObjectMacro(self, << FvError("use the environment map", st)
+                                    << " (drawing without environment light)");
+      env.Key = "failed:" + key.str();
+    }
+  }
+  return env.Key.rfind("failed:", 0) != 0;
+}
+
+// Gives the renderer the path tracing settings: the property's ScatteringAnisotropy, the
+// mapper's budget (the still budget, or InteractiveSamplesPerPixel per frame while the
+// window renders interactively), bounces and environment (weight 1; background when
+// EnvironmentBackground is on).
+bool SetUpPathTracing(vtkFerroVolumeMapper* self, FvRenderer* r, vtkRenderer* ren,
+  vtkVolumeProperty* prop, EnvironmentState env, std::string& error)
+{
+  FvPathTraceParams pt;
+  fv_path_trace_params_default(&pt);
+  vtkRenderWindow* win = ren->GetRenderWindow();
+  const bool interactive = win && win->GetDesiredUpdateRate() > 1.0;
+  if (interactive)
+  {
+    pt.samples_per_frame = static_cast<uint32_t>(self->GetInteractiveSamplesPerPixel());
+    pt.max_samples = 0;
+  }
+  else
+  {
+    pt.samples_per_frame = static_cast<uint32_t>(std::min(self->GetSamplesPerPixel(), 4096));
+    pt.max_samples = static_cast<uint32_t>(self->GetSamplesPerPixel());
+  }
+  pt.max_bounces = static_cast<uint32_t>(self->GetPathTracingBounces());
+  // (|g| = 1 is a delta, which a Monte Carlo estimate cannot sample: clamp inside)
+  pt.anisotropy = std::max(-0.99f, std::min(0.99f, prop->GetScatteringAnisotropy()));
+  pt.background = self->GetEnvironmentBackground() != 0;
+  if (!UseEnvironment(self, r, env))
+  {
+    pt.environment_light = 0.0f;
+    pt.background = false;
+  }
+  env.Background = pt.background;
+  const FvStatus st = fv_renderer_set_path_tracing(r, &pt);
+  if (st != FV_STATUS_OK)
+  {
+    error = FvError("use the path tracing settings", st);
+    return false;
+  }
+  return true;
+}
+
+enum class IsoSetup
+{
+  Failed,
+  NothingVisible,
+  Ready
+};
+
+
 // Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
 // environment when it changed. The surfaces' colours and opacities are the property's
 // colour and scalar opacity functions at the iso-values (first component), as
 // vtkGPUVolumeRayCastMapper's; Shade off draws flat colours (ambient 1, no diffuse or
 // specular light, no environment light).
 IsoSetup SetUpIsosurfaces(vtkFerroVolumeMapper* self, FvRenderer* r, vtkVolumeProperty* prop,
-  IsoEnvironment env, FvRenderParams& params, std::string& error)
+  EnvironmentState env, FvRenderParams& params, std::string& error)
 {
   vtkContourValues* contours = prop->GetIsoSurfaceValues();
   const int n = contours ? contours->GetNumberOfContours() : 0;
@@ -1902,34 +1985,10 @@ IsoSetup SetUpIsosurfaces(vtkFerroVolumeMapper* self, FvRenderer* r, vtkVolumePr
     params.specular = 0.0f;
   }
 
-  // The environment: built again only when the map or its placement changed.
-  if (iso.environment_light > 0.0f || iso.background)
+  if ((iso.environment_light > 0.0f || iso.background) && !UseEnvironment(self, r, env))
   {
-    const char* file = self->GetEnvironmentMap();
-    const bool sky = !file || !*file;
-    const double* up = self->GetEnvironmentUp();
-    std::ostringstream key;
-    key << (sky ? "" : file) << '|' << up[0] << ',' << up[1] << ',' << up[2] << '|'
-        << self->GetEnvironmentAzimuth() << '|' << self->GetEnvironmentIntensity();
-    if (!env.Have || env.Key != key.str())
-    {
-      env.Have = true;
-      env.Key = key.str();
-      const FvStatus st = fv_renderer_set_environment(r, sky ? nullptr : file,
-        static_cast<float>(self->GetEnvironmentIntensity()), up, self->GetEnvironmentAzimuth());
-      if (st != FV_STATUS_OK)
-      {
-        // Said once per setting; the surfaces go on without environment light.
-        vtkErrorWithObjectMacro(self, << FvError("use the environment map", st)
-                                      << " (the surfaces are drawn without environment light)");
-        env.Key = "failed:" + key.str();
-      }
-    }
-    if (env.Key.rfind("failed:", 0) == 0)
-    {
-      iso.environment_light = 0.0f;
-      iso.background = false;
-    }
+    iso.environment_light = 0.0f;
+    iso.background = false;
   }
   env.Background = iso.background;
   const FvStatus st = fv_renderer_set_isosurface(r, &iso);
@@ -2065,6 +2124,12 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
           " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
           "additive and isosurface are): nothing is drawn");
       return;
+  }
+
+  const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
+  if (pathTrace)
+  {
+    blend = FV_BLEND_MODE_PATH_TRACE;
   }
 
   // ---- input
@@ -2287,7 +2352,7 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   bool fullViewport = false;
   if (isosurface)
   {
-    IsoEnvironment env{ in->HaveEnvironment, in->EnvironmentKey, in->Warned, fullViewport };
+    EnvironmentState env{ in->HaveEnvironment, in->EnvironmentKey, in->Warned, fullViewport };
     switch (SetUpIsosurfaces(this, r, prop, env, params, error))
     {
       case IsoSetup::Failed:
@@ -2297,6 +2362,15 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         return; // every iso-value is transparent (SetUpIsosurfaces warned once)
       case IsoSetup::Ready:
         break;
+    }
+  }
+  if (pathTrace)
+  {
+    EnvironmentState env{ in->HaveEnvironment, in->EnvironmentKey, in->Warned, fullViewport };
+    if (!SetUpPathTracing(this, r, ren, prop, env, error))
+    {
+      Fail(this, error);
+      return;
     }
   }
   FvStatus st = fv_renderer_set_params(r, &params);
@@ -2361,7 +2435,7 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     l.attenuation[0] = 1.0f;
     lights.push_back(l);
   }
-  else if (params.shade)
+  else if (params.shade || pathTrace)
   {
     vtkLightCollection* lc = ren->GetLights();
     vtkCollectionSimpleIterator it;
@@ -2614,6 +2688,11 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << this->ShininessGradientRange[1] << "\n";
   os << indent << "Fresnel: " << this->Fresnel << "\n";
   os << indent << "IsosurfaceLayers: " << this->IsosurfaceLayers << "\n";
+  os << indent << "RenderMode: "
+     << (this->RenderMode == RENDER_MODE_PATH_TRACE ? "path trace" : "ray cast") << "\n";
+  os << indent << "SamplesPerPixel: " << this->SamplesPerPixel << "\n";
+  os << indent << "InteractiveSamplesPerPixel: " << this->InteractiveSamplesPerPixel << "\n";
+  os << indent << "PathTracingBounces: " << this->PathTracingBounces << "\n";
   os << indent << "LastRenderDrew: " << this->LastRenderDrew << "\n";
   os << indent << "LastRenderSize: " << this->LastRenderSize[0] << " x "
      << this->LastRenderSize[1] << "\n";

@@ -30,6 +30,13 @@
  * - opaque geometry: rays stop at VTK's depth buffer, and the volume writes its own depth
  *   (first visible sample) so that later passes composite against it.
  *
+ * - path tracing (SetRenderModeToPathTrace): the transfer function read as a scattering
+ *   medium (opacity per ScalarOpacityUnitDistance as extinction, colour as albedo),
+ *   Henyey–Greenstein scattering with the property's ScatteringAnisotropy, lit by the
+ *   environment map and the renderer's directional lights; SamplesPerPixel paths per pixel
+ *   on still renders, InteractiveSamplesPerPixel while the window renders interactively
+ *   (DesiredUpdateRate above 1), accumulated while nothing changes;
+ *
  * The volume is uploaded again only when the input scalars change, the tables only when the
  * property changes; camera changes never upload anything (GetVolumeUploadCount,
  * GetTableUploadCount).
@@ -220,6 +227,45 @@ public:
   vtkGetMacro(IsosurfaceLayers, int);
   ///@}
 
+  enum RenderModes
+  {
+    RENDER_MODE_RAY_CAST = 0,
+    RENDER_MODE_PATH_TRACE = 1
+  };
+
+  ///@{
+  /**
+   * RENDER_MODE_RAY_CAST (the default): ray casting in the blend mode. RENDER_MODE_PATH_TRACE:
+   * progressive Monte Carlo path tracing of the volume as a scattering medium (the blend
+   * mode is not used; see the class documentation). Path tracing needs a volume that fits
+   * in one 3D texture, no cropping and no positional lights (each is reported).
+   */
+  vtkSetClampMacro(RenderMode, int, RENDER_MODE_RAY_CAST, RENDER_MODE_PATH_TRACE);
+  vtkGetMacro(RenderMode, int);
+  void SetRenderModeToRayCast() { this->SetRenderMode(RENDER_MODE_RAY_CAST); }
+  void SetRenderModeToPathTrace() { this->SetRenderMode(RENDER_MODE_PATH_TRACE); }
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing: paths per pixel of a still render (default 64; a render traces what is
+   * missing, at most 4096 at once, and renders after that show the converged image), and
+   * per interactive frame (default 1); PathTracingBounces scattering events at most per
+   * path (default 64).
+   */
+  vtkSetClampMacro(SamplesPerPixel, int, 1, 1000000);
+  vtkGetMacro(SamplesPerPixel, int);
+  vtkSetClampMacro(InteractiveSamplesPerPixel, int, 1, 4096);
+  vtkGetMacro(InteractiveSamplesPerPixel, int);
+  vtkSetClampMacro(PathTracingBounces, int, 0, 100000);
+  vtkGetMacro(PathTracingBounces, int);
+  ///@}
+
+  /**
+   * Path tracing: the paths per pixel the last frame shows (-1 before the first frame).
+   */
+  int GetAccumulatedSamples();
+
   enum OutputPaths
   {
     OUTPUT_PATH_AUTOMATIC = 0,
@@ -324,6 +370,10 @@ protected:
   double ShininessGradientRange[2];
   double Fresnel;
   int IsosurfaceLayers;
+  int RenderMode;
+  int SamplesPerPixel;
+  int InteractiveSamplesPerPixel;
+  int PathTracingBounces;
   vtkTypeBool LastRenderDrew;
   int LastRenderSize[2];
 

@@ -1,0 +1,94 @@
+"""vtkFerroVolumeMapper's path tracing render mode: a still render traces its whole budget
+and later still renders show the converged image; interactive renders add a few paths per
+frame; the property's ScatteringAnisotropy changes the image; what path tracing cannot do
+yet is reported. Images: build/vtk/test-images (pathtrace-*.png)."""
+import unittest
+
+import numpy as np
+import vtk
+
+import ferrovol
+import fvtest
+from fvtest import Errors, Scene, coverage, log, save, wavelet
+
+
+def view(cam):
+    cam.Azimuth(30.0)
+    cam.Elevation(20.0)
+    cam.OrthogonalizeViewUp()
+
+
+def medium(g=0.0):
+    p = fvtest.tf_property(opacity=[(37.3531, 0.0), (276.829, 0.4)], interpolation="linear")
+    p.SetScatteringAnisotropy(g)
+    return p
+
+
+class PathTrace(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.src = wavelet(15)
+
+    def scene(self, prop=None, configure=None, size=(96, 96)):
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        mapper.SetRenderModeToPathTrace()
+        mapper.SetSamplesPerPixel(16)
+        self.errors = Errors(mapper)
+        if configure:
+            configure(mapper)
+        return Scene(mapper, self.src, prop or medium(), size=size, camera=view)
+
+    def test_still_renders_trace_the_budget_once(self):
+        s = self.scene()
+        first = s.render()
+        n1 = s.mapper.GetAccumulatedSamples()
+        again = s.render()
+        n2 = s.mapper.GetAccumulatedSamples()
+        log("still renders: %d then %d paths per pixel; coverage %.3f; unchanged: %s"
+            % (n1, n2, coverage(first), np.array_equal(first, again)))
+        save("pathtrace-still", first)
+        self.assertEqual(self.errors.messages, [])
+        self.assertEqual((n1, n2), (16, 16))
+        self.assertGreater(coverage(first), 0.2)
+        self.assertTrue(np.array_equal(first, again), "the converged image, shown again")
+
+    def test_interactive_renders_accumulate(self):
+        s = self.scene(configure=lambda m: m.SetInteractiveSamplesPerPixel(2))
+        s.window.SetDesiredUpdateRate(15.0)
+        counts = []
+        for _ in range(3):
+            s.render()
+            counts.append(s.mapper.GetAccumulatedSamples())
+        s.renderer.GetActiveCamera().Azimuth(10.0)
+        s.render()
+        counts.append(s.mapper.GetAccumulatedSamples())
+        log("interactive renders: %s paths per pixel (the camera moved before the last)"
+            % counts)
+        self.assertEqual(counts, [2, 4, 6, 2])
+
+    def test_anisotropy_changes_the_image(self):
+        images = [self.scene(medium(g)).render() for g in (-0.6, 0.0, 0.6)]
+        save("pathtrace-anisotropy", *images)
+        d = [float(np.abs(images[i] - images[1]).mean()) for i in (0, 2)]
+        log("mean |difference| to isotropic: g = -0.6: %.2f, g = +0.6: %.2f levels" % tuple(d))
+        self.assertGreater(min(d), 0.3)
+
+    def test_what_path_tracing_cannot_do_is_reported(self):
+        s = self.scene(configure=lambda m: (m.CroppingOn(),
+                                            m.SetCroppingRegionPlanes(-5, 5, -5, 5, -5, 5)))
+        s.render()
+        log("cropping:", self.errors.last().strip().splitlines()[-1])
+        self.assertIn("crop", self.errors.last())
+        self.assertFalse(s.mapper.GetLastRenderDrew())
+        s = self.scene()
+        light = vtk.vtkLight()
+        light.SetPositional(1)
+        light.SetPosition(0, 0, 50)
+        s.renderer.AddLight(light)
+        s.render()
+        log("positional light:", self.errors.last().strip().splitlines()[-1])
+        self.assertIn("positional", self.errors.last())
+
+
+if __name__ == "__main__":
+    unittest.main()
