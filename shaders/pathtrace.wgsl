@@ -1,5 +1,8 @@
-// Progressive Monte Carlo path tracing of the volume as a participating medium: per pixel,
-// `pt.counts.x` paths this frame, added to the sums of the frames before (accum).
+// Progressive Monte Carlo path tracing of the volume as a participating medium: one path
+// per pixel per dispatch, added to the sums of the paths before (accum). A frame is several
+// dispatches: on lavapipe every loop iteration of an invocation draws on one budget of
+// 65535 (llvmpipe's loop limiter), after which all its loops stop, so an invocation traces
+// one path and no more (several per invocation lost paths, measured).
 //
 // The medium: extinction σ(x) = −ln(1 − α(s(x))) / unit distance, α the transfer
 // function's opacity as given (so a slab one unit distance thick lets 1 − α through, VTK's
@@ -23,7 +26,7 @@
 struct PathTrace {
     env_rotation: mat4x4<f32>,  // world → environment directions
     medium: vec4<f32>,          // x majorant σ̄ (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
-    counts: vec4<u32>,          // x paths per pixel this frame, y paths accumulated before, z most scattering events, w seed
+    counts: vec4<u32>,          // x unused, y paths accumulated before this one, z most scattering events, w seed
     options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, zw unused
     rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
 }
@@ -139,45 +142,48 @@ fn extinction_at(r: Ray, t: f32) -> f32 {
 }
 
 // Delta tracking: the distance of the first real collision in [t0, t1), or t1 when the
-// ray gets through.
+// ray gets through. (No `return` inside the loops of these two functions: on lavapipe, a
+// return from inside a loop of a function called in the per-sample loop of `main` made
+// that loop skip samples, found by the accumulation's coverage.)
 fn free_flight(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
     let maj = pt.medium.x;
-    if (!(maj > 0.0) || t0 >= t1) {
-        return t1;
-    }
-    var t = t0;
-    for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
-        t = t - log(1.0 - rand(rng)) / maj;
-        if (t >= t1) {
-            return t1;
+    var result = t1;
+    if (maj > 0.0 && t0 < t1) {
+        var t = t0;
+        for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
+            t = t - log(1.0 - rand(rng)) / maj;
+            if (t >= t1) {
+                break;
+            }
+            if (rand(rng) * maj < extinction_at(r, t)) {
+                result = t;
+                break;
+            }
         }
-        if (rand(rng) * maj < extinction_at(r, t)) {
-            return t;
-        }
     }
-    return t1;
+    return result;
 }
 
 // Ratio tracking: an unbiased estimate of the transmittance over [t0, t1), with Russian
 // roulette once it is small.
 fn transmittance(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
     let maj = pt.medium.x;
-    if (!(maj > 0.0) || t0 >= t1) {
-        return 1.0;
-    }
-    var t = t0;
     var tr = 1.0;
-    for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
-        t = t - log(1.0 - rand(rng)) / maj;
-        if (t >= t1) {
-            break;
-        }
-        tr = tr * (1.0 - extinction_at(r, t) / maj);
-        if (tr < 0.1) {
-            if (rand(rng) >= 0.5) {
-                return 0.0;
+    if (maj > 0.0 && t0 < t1) {
+        var t = t0;
+        for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
+            t = t - log(1.0 - rand(rng)) / maj;
+            if (t >= t1) {
+                break;
             }
-            tr = tr * 2.0;
+            tr = tr * (1.0 - extinction_at(r, t) / maj);
+            if (tr < 0.1) {
+                if (rand(rng) >= 0.5) {
+                    tr = 0.0;
+                    break;
+                }
+                tr = tr * 2.0;
+            }
         }
     }
     return tr;
@@ -262,17 +268,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let idx = px.y * frame.viewport.x + px.x;
-    var sum = vec4<f32>(0.0);
-    for (var s = 0u; s < pt.counts.x; s = s + 1u) {
-        var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ (pt.counts.y + s));
-        let ray = ray_through(image_ndc(vec2<f32>(px) + rand2(&rng)));
-        sum = sum + trace(ray, px, &rng);
-    }
+    var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ pt.counts.y);
+    let ray = ray_through(image_ndc(vec2<f32>(px) + rand2(&rng)));
+    var sum = trace(ray, px, &rng);
     if (pt.counts.y > 0u) {
         sum = sum + accum[idx];
     }
     accum[idx] = sum;
-    let mean = sum / f32(pt.counts.y + pt.counts.x);
+    let mean = sum / f32(pt.counts.y + 1u);
     // Premultiplied output: radiance beyond the coverage is clipped, as an 8-bit image must.
     let a = clamp(mean.a, 0.0, 1.0);
     textureStore(out_color, vec2<i32>(px), vec4<f32>(clamp(mean.rgb, vec3<f32>(0.0), vec3<f32>(a)), a));

@@ -110,6 +110,11 @@ impl PathTraceParams {
     }
 }
 
+/// Bytes between the uniforms of consecutive dispatches of a frame (one path per pixel
+/// each; 256 is the largest dynamic-offset alignment a device may ask for).
+const UNIFORM_STRIDE: u64 = 256;
+const _: () = assert!(std::mem::size_of::<PathTraceUniforms>() as u64 <= UNIFORM_STRIDE);
+
 /// The path tracer's GPU state, created on first use.
 pub(crate) struct PathTraceGpu {
     module: wgpu::ShaderModule,
@@ -142,7 +147,17 @@ impl PathTraceGpu {
                 texture_entry(4, false, V::D2),
                 storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
                 storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
-                buffer_entry(7, B::Uniform),
+                entry(
+                    7,
+                    wgpu::BindingType::Buffer {
+                        ty: B::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<
+                            PathTraceUniforms,
+                        >()
+                            as u64),
+                    },
+                ),
                 texture_entry(11, true, V::Cube),
                 entry(
                     13,
@@ -159,7 +174,7 @@ impl PathTraceGpu {
         let module = shader_module(ctx, "pathtrace.wgsl")?;
         let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("path tracing uniforms"),
-            size: std::mem::size_of::<PathTraceUniforms>() as u64,
+            size: UNIFORM_STRIDE * MAX_SAMPLES_PER_FRAME as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -435,9 +450,10 @@ impl Renderer {
             ..pp
         };
         let key = format!(
-            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{depth_input}",
+            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{depth_input}",
             (self.stats.volume_uploads, self.stats.table_uploads),
-            self.environment_generation
+            self.environment_generation,
+            self.generation
         );
         let ctx = self.ctx.clone();
         let nearest = params.interpolation == Interpolation::Nearest;
@@ -456,6 +472,11 @@ impl Renderer {
         } else {
             pp.samples_per_frame
         };
+        if add == 0 {
+            // The budget is reached: the output images hold the converged frame.
+            self.stats.frames += 1;
+            return Ok(());
+        }
         let full = [0, 0, view.width, view.height];
         let rect = if pp.background { full } else { frame.rect };
         let env = self
@@ -471,7 +492,7 @@ impl Renderer {
             (1.0 / unit) as f32,
             pp.environment_light,
         ];
-        u.counts = [add, before, pp.max_bounces, pp.seed];
+        u.counts = [1, before, pp.max_bounces, pp.seed];
         let (_, dist_size, dist) = g.env_dist.as_ref().expect("built above");
         u.options = [
             if pp.background { PT_FLAG_BACKGROUND } else { 0 },
@@ -482,7 +503,15 @@ impl Renderer {
         u.rect = rect;
         let q = &ctx.queue;
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
-        q.write_buffer(&g.uniforms, 0, bytemuck::bytes_of(&u));
+        // One path per pixel per dispatch, each with its own uniforms (the path index).
+        let mut blocks = vec![0u8; (UNIFORM_STRIDE * add as u64) as usize];
+        for i in 0..add {
+            u.counts[1] = before + i;
+            let at = (UNIFORM_STRIDE * i as u64) as usize;
+            blocks[at..at + std::mem::size_of::<PathTraceUniforms>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        q.write_buffer(&g.uniforms, 0, &blocks);
         let t = self.targets.as_ref().expect("allocated above");
         if let DepthSource::Cpu(depth) = depth {
             q.write_texture(
@@ -512,7 +541,16 @@ impl Renderer {
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
                 bind(6, wgpu::BindingResource::TextureView(&depth_view)),
-                bind(7, g.uniforms.as_entire_binding()),
+                bind(
+                    7,
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &g.uniforms,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(
+                            std::mem::size_of::<PathTraceUniforms>() as u64
+                        ),
+                    }),
+                ),
                 bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
                 bind(
                     13,
@@ -549,13 +587,15 @@ impl Renderer {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bg, &[]);
             pass.set_bind_group(1, brick, &[]);
-            pass.dispatch_workgroups(
-                (rect[2] - rect[0]).div_ceil(wg),
-                (rect[3] - rect[1]).div_ceil(wg),
-                1,
-            );
+            for i in 0..add {
+                pass.set_bind_group(0, &bg, &[(UNIFORM_STRIDE * i as u64) as u32]);
+                pass.dispatch_workgroups(
+                    (rect[2] - rect[0]).div_ceil(wg),
+                    (rect[3] - rect[1]).div_ceil(wg),
+                    1,
+                );
+            }
         }
         ctx.checked("rendering the path-traced frame", || {
             q.submit([enc.finish()]);

@@ -272,7 +272,7 @@ pub struct Renderer {
     pub(crate) targets: Option<Targets>,
     output_path: OutputPath,
     /// Counts allocations of the output images.
-    generation: u64,
+    pub(crate) generation: u64,
     pub(crate) stats: Stats,
     /// The isosurface passes (crate::iso), created on first use.
     pub(crate) iso: Option<Box<crate::iso::IsoGpu>>,
