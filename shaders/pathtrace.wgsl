@@ -9,7 +9,8 @@
 // meaning of ScalarOpacityUnitDistance), single-scattering albedo the transfer function's
 // colour, Henyey–Greenstein scattering with anisotropy g. A path starts at the camera
 // (jittered in its pixel), flies freely by delta (Woodcock) tracking against the majorant
-// σ̄ = max σ, scatters at real collisions; at each one it takes next-event estimates toward
+// of each min–max block it crosses (σ̄ = the largest σ the block's scalar range can take;
+// empty blocks are crossed in one step), scatters at real collisions; at each one it takes next-event estimates toward
 // the environment (a direction importance-sampled from the environment's luminance,
 // combined with the phase-sampled continuation by multiple importance sampling, power
 // heuristic) and toward each directional light
@@ -25,7 +26,7 @@
 
 struct PathTrace {
     env_rotation: mat4x4<f32>,  // world → environment directions
-    medium: vec4<f32>,          // x majorant σ̄ (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
+    medium: vec4<f32>,          // x largest block majorant (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
     counts: vec4<u32>,          // x unused, y paths accumulated before this one, z most scattering events, w seed
     options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, zw unused
     rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
@@ -49,6 +50,9 @@ const PT_MAX_STEPS: u32 = 1000000u;
 // face, faces +X … −Z, rows top to bottom): the cumulative probabilities, last = 1
 // (core/src/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
 @group(0) @binding(14) var<storage, read> env_cdf: array<f32>;
+// Per min–max block (march.wgsl: block_of): the largest extinction (per world unit) its
+// scalar range can take under the transfer function.
+@group(0) @binding(15) var<storage, read> majorants: array<f32>;
 
 fn env_radiance(d: vec3<f32>) -> vec3<f32> {
     let e = (pt.env_rotation * vec4<f32>(d, 0.0)).xyz;
@@ -141,21 +145,35 @@ fn extinction_at(r: Ray, t: f32) -> f32 {
     return extinction(sample_scalars(r.index_origin + t * r.index_dir).x);
 }
 
+// The majorant over the block the ray is in at t (just past t, so that a ray on a block
+// boundary sees the block ahead) and the distance where it leaves that block (at least a
+// little past t, so that every step advances).
+fn block_span(r: Ray, t: f32) -> vec2<f32> {
+    let p = r.index_origin + (t + 1e-4) * r.index_dir;
+    return vec2<f32>(majorants[block_of(p)], max(block_exit(r, p), t + 1e-4));
+}
+
 // Delta tracking: the distance of the first real collision in [t0, t1), or t1 when the
-// ray gets through. (No `return` inside the loops of these two functions: on lavapipe, a
-// return from inside a loop of a function called in the per-sample loop of `main` made
-// that loop skip samples, found by the accumulation's coverage.)
+// ray gets through. Tentative collisions are drawn against each block's majorant, afresh at
+// every block boundary (the exponential distribution is memoryless).
 fn free_flight(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
-    let maj = pt.medium.x;
     var result = t1;
-    if (maj > 0.0 && t0 < t1) {
+    if (pt.medium.x > 0.0) {
         var t = t0;
-        for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
-            t = t - log(1.0 - rand(rng)) / maj;
-            if (t >= t1) {
-                break;
+        for (var i = 0u; i < PT_MAX_STEPS && t < t1; i = i + 1u) {
+            let span = block_span(r, t);
+            let end = min(span.y, t1);
+            if (span.x <= 0.0) {
+                t = end;
+                continue;
             }
-            if (rand(rng) * maj < extinction_at(r, t)) {
+            let step = -log(1.0 - rand(rng)) / span.x;
+            if (t + step >= end) {
+                t = end;
+                continue;
+            }
+            t = t + step;
+            if (rand(rng) * span.x < extinction_at(r, t)) {
                 result = t;
                 break;
             }
@@ -164,19 +182,26 @@ fn free_flight(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
     return result;
 }
 
-// Ratio tracking: an unbiased estimate of the transmittance over [t0, t1), with Russian
-// roulette once it is small.
+// Ratio tracking: an unbiased estimate of the transmittance over [t0, t1) against each
+// block's majorant, with Russian roulette once it is small.
 fn transmittance(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
-    let maj = pt.medium.x;
     var tr = 1.0;
-    if (maj > 0.0 && t0 < t1) {
+    if (pt.medium.x > 0.0) {
         var t = t0;
-        for (var i = 0u; i < PT_MAX_STEPS; i = i + 1u) {
-            t = t - log(1.0 - rand(rng)) / maj;
-            if (t >= t1) {
-                break;
+        for (var i = 0u; i < PT_MAX_STEPS && t < t1; i = i + 1u) {
+            let span = block_span(r, t);
+            let end = min(span.y, t1);
+            if (span.x <= 0.0) {
+                t = end;
+                continue;
             }
-            tr = tr * (1.0 - extinction_at(r, t) / maj);
+            let step = -log(1.0 - rand(rng)) / span.x;
+            if (t + step >= end) {
+                t = end;
+                continue;
+            }
+            t = t + step;
+            tr = tr * (1.0 - extinction_at(r, t) / span.x);
             if (tr < 0.1) {
                 if (rand(rng) >= 0.5) {
                     tr = 0.0;

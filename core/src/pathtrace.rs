@@ -5,10 +5,12 @@
 //! σ = −ln(1 − α) / unit distance from the opacity α as given (a slab one
 //! ScalarOpacityUnitDistance thick lets 1 − α through, VTK's meaning), the colour as the
 //! single-scattering albedo, and a Henyey–Greenstein phase function. Paths fly by delta
-//! tracking against the majorant σ̄ = max σ of the transfer function, take next-event
-//! estimates toward the environment (directions drawn from its luminance on a 32² cube,
-//! multiple importance sampling with the phase function) and the view's directional lights (ratio-tracking transmittance), and end by
-//! Russian roulette or after [`PathTraceParams::max_bounces`] scattering events.
+//! tracking against the majorant of each 8³-cell block they cross (from the block's
+//! scalar range, so empty space is crossed block by block), take next-event estimates
+//! toward the environment (directions drawn from its luminance on a 32² cube, multiple
+//! importance sampling with the phase function) and the view's directional lights
+//! (ratio-tracking transmittance), and end by Russian roulette or after
+//! [`PathTraceParams::max_bounces`] scattering events.
 //!
 //! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
 //! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before,
@@ -20,8 +22,7 @@
 //! by default).
 //!
 //! Limits of this version: the volume must fit in one brick; the first component is the
-//! medium; cropping and positional lights are refused; the majorant is one value for the
-//! whole volume (no per-block majorant grid yet).
+//! medium; cropping and positional lights are refused.
 
 use crate::environment::Environment;
 use crate::error::{Error, Result};
@@ -128,6 +129,8 @@ pub(crate) struct PathTraceGpu {
     /// The environment's sampling distribution: (environment generation, texels per face
     /// edge, cumulative probabilities).
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
+    /// The block majorants: (what they were computed from, buffer, the largest).
+    majorants: Option<(String, wgpu::Buffer, f32)>,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
     samples: u32,
@@ -164,6 +167,7 @@ impl PathTraceGpu {
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 ),
                 buffer_entry(14, B::Storage { read_only: true }),
+                buffer_entry(15, B::Storage { read_only: true }),
             ],
         });
         let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -186,6 +190,7 @@ impl PathTraceGpu {
             uniforms,
             accum: None,
             env_dist: None,
+            majorants: None,
             key: String::new(),
             samples: 0,
         })
@@ -348,23 +353,69 @@ impl Renderer {
         }
     }
 
-    /// The medium's majorant: the largest extinction (per world unit) the first
-    /// component's transfer function gives anywhere on its table.
-    fn majorant(&self) -> Result<f64> {
+    /// The medium's majorant per min–max block: the largest extinction (per world unit) the
+    /// first component's transfer function gives on the table entries the block's scalar
+    /// range touches (the table is linear between entries, so its maximum over the range is
+    /// at one of them).
+    fn block_majorants(&self) -> Result<Vec<f32>> {
         let tf = self
             .tf
             .as_ref()
             .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))?;
+        let vol = self
+            .volume
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
         let c = tf.component(0);
         let [lo, hi] = c.table_range();
-        let amax = (0..TABLE_SIZE)
+        let last = (TABLE_SIZE - 1) as f64;
+        let sigma: Vec<f64> = (0..TABLE_SIZE)
             .map(|i| {
-                let x = lo + (hi - lo) * i as f64 / (TABLE_SIZE - 1) as f64;
-                c.opacity.eval(x)[0].clamp(0.0, 1.0) as f64
+                let x = lo + (hi - lo) * i as f64 / last;
+                let a = (c.opacity.eval(x)[0].clamp(0.0, 1.0) as f64).min(MAX_OPACITY);
+                -(1.0 - a).ln() / c.unit_distance
             })
-            .fold(0.0_f64, f64::max)
-            .min(MAX_OPACITY);
-        Ok(-(1.0 - amax).ln() / c.unit_distance)
+            .collect();
+        let nc = vol.components as usize;
+        Ok(vol
+            .minmax
+            .ranges
+            .chunks(nc)
+            .map(|r| {
+                let [mn, mx] = r[0];
+                if mn > mx {
+                    return 0.0;
+                }
+                let at = |v: f32| (v as f64 - lo) / (hi - lo) * last;
+                let i0 = at(mn).floor().clamp(0.0, last) as usize;
+                let i1 = at(mx).ceil().clamp(0.0, last) as usize;
+                sigma[i0..=i1].iter().copied().fold(0.0, f64::max) as f32
+            })
+            .collect())
+    }
+
+    /// Uploads the block majorants when the volume or the transfer function changed.
+    fn ensure_majorants(&mut self) -> Result<f32> {
+        let key = format!("{:?}|{}", self.tf, self.stats.volume_uploads);
+        if let Some((k, _, max)) = self.pt.as_ref().and_then(|g| g.majorants.as_ref()) {
+            if *k == key {
+                return Ok(*max);
+            }
+        }
+        let m = self.block_majorants()?;
+        let max = m.iter().copied().fold(0.0f32, f32::max);
+        let buf = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("path tracing block majorants"),
+            size: (4 * m.len().max(1)) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.ctx
+            .queue
+            .write_buffer(&buf, 0, bytemuck::cast_slice(&m));
+        let g = self.pt.as_mut().expect("created before");
+        g.majorants = Some((key, buf, max));
+        Ok(max)
     }
 
     /// One path-traced frame: `samples_per_frame` more paths per pixel.
@@ -405,7 +456,6 @@ impl Renderer {
                  headlight and the environment"
             )));
         }
-        let majorant = self.majorant()?;
         let unit = self
             .tf
             .as_ref()
@@ -432,6 +482,7 @@ impl Renderer {
             self.pt = Some(Box::new(PathTraceGpu::new(&self.ctx, &self.brick_bgl)?));
         }
         self.ensure_environment_distribution()?;
+        let majorant = self.ensure_majorants()?;
         // The view's directional lights light the medium whatever `shading.enabled` says.
         let lit = RenderParams {
             blend: BlendMode::PathTrace,
@@ -494,6 +545,7 @@ impl Renderer {
         ];
         u.counts = [1, before, pp.max_bounces, pp.seed];
         let (_, dist_size, dist) = g.env_dist.as_ref().expect("built above");
+        let (_, majorant_buf, _) = g.majorants.as_ref().expect("built above");
         u.options = [
             if pp.background { PT_FLAG_BACKGROUND } else { 0 },
             *dist_size,
@@ -557,6 +609,7 @@ impl Renderer {
                     wgpu::BindingResource::Sampler(&iso.env_pipelines.cube_sampler),
                 ),
                 bind(14, dist.as_entire_binding()),
+                bind(15, majorant_buf.as_entire_binding()),
             ],
         });
         let vol = self.volume.as_ref().expect("checked above");

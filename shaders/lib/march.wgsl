@@ -30,11 +30,16 @@ fn in_crop(p: vec3<f32>) -> bool {
     return ((frame.mode.z >> bit) & 1u) != 0u;
 }
 
-fn block_occupied(p: vec3<f32>) -> bool {
+// Index of the min–max block holding index-space point p (clamped to the grid).
+fn block_of(p: vec3<f32>) -> u32 {
     let bs = f32(frame.counts.z);
     let b = min(vec3<u32>(max(floor(p / bs), vec3<f32>(0.0))), frame.occupancy_dims.xyz - 1u);
     let d = frame.occupancy_dims;
-    return occupancy[(b.z * d.y + b.y) * d.x + b.x] != 0u;
+    return (b.z * d.y + b.y) * d.x + b.x;
+}
+
+fn block_occupied(p: vec3<f32>) -> bool {
+    return occupancy[block_of(p)] != 0u;
 }
 
 // Distance at which the ray leaves the occupancy block holding p.
