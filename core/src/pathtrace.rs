@@ -538,7 +538,7 @@ impl Renderer {
         let mut u = PathTraceUniforms::zeroed();
         u.env_rotation = DMat4::from_mat3(env.rotation).as_mat4().to_cols_array();
         u.medium = [
-            majorant as f32,
+            majorant,
             pp.anisotropy,
             (1.0 / unit) as f32,
             pp.environment_light,
