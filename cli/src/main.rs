@@ -132,7 +132,8 @@ struct RenderArgs {
     #[arg(long)]
     brick: Option<u32>,
     /// Render this many frames and print the mean time per frame (the first, which builds
-    /// pipelines and maps, is not counted).
+    /// pipelines and maps, is not counted). Path tracing: each timed frame starts the
+    /// accumulation over, as a moving camera does, and traces --spp paths per pixel.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     repeat: u32,
     #[command(flatten)]
@@ -580,7 +581,14 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     if a.repeat > 1 {
         let t0 = std::time::Instant::now();
         for _ in 1..a.repeat {
-            r.render(&view, &params, None)?;
+            if path_tracing.is_some() {
+                r.reset_accumulation();
+                while r.accumulated_samples() < a.pt.spp {
+                    r.render(&view, &params, None)?;
+                }
+            } else {
+                r.render(&view, &params, None)?;
+            }
             r.finish()?;
         }
         timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);
