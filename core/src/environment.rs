@@ -18,6 +18,7 @@
 //! taken as linear radiance as they come: LDR images are not sRGB-decoded (the renderer's
 //! output is not encoded either).
 
+use crate::binding::{bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry};
 use crate::error::{Error, Result};
 use crate::gpu::{EnvUniforms, ENV_EQUIRECT, ENV_SKY};
 use glam::{DMat3, DQuat, DVec3};
@@ -499,55 +500,6 @@ pub(crate) struct GpuEnvironment {
 
 const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-fn layout_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty,
-        count: None,
-    }
-}
-
-fn uniform_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
-}
-
-fn storage_array_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format: ENV_FORMAT,
-            view_dimension: wgpu::TextureViewDimension::D2Array,
-        },
-    )
-}
-
-fn texture_layout(binding: u32, dim: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: dim,
-            multisampled: false,
-        },
-    )
-}
-
-fn sampler_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-    )
-}
-
 impl EnvPipelines {
     pub(crate) fn new(ctx: &crate::Context) -> Result<EnvPipelines> {
         let d = &ctx.device;
@@ -562,27 +514,27 @@ impl EnvPipelines {
         let build_bgl = bgl(
             "environment build",
             &[
-                uniform_layout(0),
-                texture_layout(1, V::D2),
-                sampler_layout(2),
-                storage_array_layout(3),
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                texture_entry(1, true, V::D2),
+                sampler_entry(2),
+                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
             ],
         );
         let downsample_bgl = bgl(
             "environment downsample",
             &[
-                uniform_layout(0),
-                storage_array_layout(3),
-                texture_layout(4, V::D2Array),
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
+                texture_entry(4, true, V::D2Array),
             ],
         );
         let irradiance_bgl = bgl(
             "environment irradiance",
             &[
-                uniform_layout(0),
-                storage_array_layout(3),
-                texture_layout(5, V::Cube),
-                sampler_layout(6),
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
+                texture_entry(5, true, V::Cube),
+                sampler_entry(6),
             ],
         );
         let pipeline = |entry: &str, layout: &wgpu::BindGroupLayout| {
@@ -813,22 +765,10 @@ impl GpuEnvironment {
                     label: Some("environment build"),
                     layout: &p.build_bgl,
                     entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: ub.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(&src_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::Sampler(&p.equirect_sampler),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::TextureView(&dst),
-                        },
+                        bind(0, ub.as_entire_binding()),
+                        bind(1, wgpu::BindingResource::TextureView(&src_view)),
+                        bind(2, wgpu::BindingResource::Sampler(&p.equirect_sampler)),
+                        bind(3, wgpu::BindingResource::TextureView(&dst)),
                     ],
                 });
                 let mut pass = enc.begin_compute_pass(&Default::default());
@@ -850,18 +790,9 @@ impl GpuEnvironment {
                 label: Some("environment downsample"),
                 layout: &p.downsample_bgl,
                 entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: ub.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&dst),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: wgpu::BindingResource::TextureView(&src),
-                    },
+                    bind(0, ub.as_entire_binding()),
+                    bind(3, wgpu::BindingResource::TextureView(&dst)),
+                    bind(4, wgpu::BindingResource::TextureView(&src)),
                 ],
             });
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -883,22 +814,10 @@ impl GpuEnvironment {
             label: Some("environment irradiance"),
             layout: &p.irradiance_bgl,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: ub.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&dst),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&cube_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::Sampler(&p.cube_sampler),
-                },
+                bind(0, ub.as_entire_binding()),
+                bind(3, wgpu::BindingResource::TextureView(&dst)),
+                bind(5, wgpu::BindingResource::TextureView(&cube_view)),
+                bind(6, wgpu::BindingResource::Sampler(&p.cube_sampler)),
             ],
         });
         {

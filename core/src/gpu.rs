@@ -169,76 +169,14 @@ mod layout_tests {
 
     #[test]
     fn frame_uniforms_match_wgsl() {
-        let m = module("dvr.wgsl");
-        check!(
-            m,
-            "Frame",
-            FrameUniforms,
-            [
-                inv_view_proj,
-                view_proj,
-                world_to_index,
-                index_to_data,
-                gradient_to_world,
-                dims,
-                scalar_scale,
-                scalar_shift,
-                tf_lo,
-                tf_inv_width,
-                go_lo,
-                go_inv_width,
-                weights,
-                material,
-                crop_lo,
-                crop_hi,
-                misc,
-                average_range,
-                additive_scale,
-                clip,
-                lights,
-                viewport,
-                mode,
-                counts,
-                occupancy_dims,
-                rect
-            ]
-        );
-        check!(
-            m,
-            "Light",
-            GpuLight,
-            [position, spot, diffuse, specular, ambient, attenuation]
-        );
-        check!(
-            m,
-            "Brick",
-            BrickUniforms,
-            [core_lo, core_hi, tex_lo, tex_inv_size]
-        );
-        let (_, ps) = wgsl_struct(&m, "PixelState");
-        assert_eq!(ps as u64, PIXEL_STATE_BYTES);
-    }
-
-    #[test]
-    fn iso_uniforms_match_wgsl() {
-        for pass in ["firsthit.wgsl", "deferred.wgsl"] {
+        // lib/common.wgsl's Frame and PixelState, as every pass that includes it composes it
+        for pass in [
+            "dvr.wgsl",
+            "firsthit.wgsl",
+            "deferred.wgsl",
+            "pathtrace.wgsl",
+        ] {
             let m = module(pass);
-            check!(
-                m,
-                "Iso",
-                IsoUniforms,
-                [
-                    env_rotation,
-                    values,
-                    colors,
-                    shininess,
-                    ao,
-                    env,
-                    counts,
-                    options,
-                    shade_rect
-                ]
-            );
             check!(
                 m,
                 "Frame",
@@ -274,6 +212,42 @@ mod layout_tests {
             );
             let (_, ps) = wgsl_struct(&m, "PixelState");
             assert_eq!(ps as u64, PIXEL_STATE_BYTES);
+        }
+        let m = module("dvr.wgsl");
+        check!(
+            m,
+            "Light",
+            GpuLight,
+            [position, spot, diffuse, specular, ambient, attenuation]
+        );
+        check!(
+            m,
+            "Brick",
+            BrickUniforms,
+            [core_lo, core_hi, tex_lo, tex_inv_size]
+        );
+    }
+
+    #[test]
+    fn iso_uniforms_match_wgsl() {
+        for pass in ["firsthit.wgsl", "deferred.wgsl"] {
+            let m = module(pass);
+            check!(
+                m,
+                "Iso",
+                IsoUniforms,
+                [
+                    env_rotation,
+                    values,
+                    colors,
+                    shininess,
+                    ao,
+                    env,
+                    counts,
+                    options,
+                    shade_rect
+                ]
+            );
         }
         let m = module("environment.wgsl");
         check!(

@@ -22,10 +22,12 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::environment`]).
 
+use crate::binding::{bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry};
 use crate::environment::{CubeImage, EnvPipelines, Environment, GpuEnvironment};
 use crate::error::{Error, Result};
 use crate::gpu::*;
 use crate::params::{BlendMode, RenderParams, Shading, MAX_LIGHTS};
+use crate::readback::{read_buffer, read_texture_layer};
 use crate::renderer::{DepthSource, Renderer, View};
 use crate::Context;
 use bytemuck::Zeroable;
@@ -422,63 +424,6 @@ pub(crate) fn shader_module(ctx: &Context, name: &str) -> Result<wgpu::ShaderMod
     })
 }
 
-pub(crate) fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty,
-        count: None,
-    }
-}
-
-pub(crate) fn buffer_entry(
-    binding: u32,
-    ty: wgpu::BufferBindingType,
-) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
-}
-
-pub(crate) fn texture_entry(
-    binding: u32,
-    filterable: bool,
-    dim: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable },
-            view_dimension: dim,
-            multisampled: false,
-        },
-    )
-}
-
-pub(crate) fn storage_texture_entry(
-    binding: u32,
-    format: wgpu::TextureFormat,
-    dim: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: dim,
-        },
-    )
-}
-
-pub(crate) fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource }
-}
-
 /// `n` unit vectors uniform over the sphere from a fixed seed (PCG), as vec4s.
 fn random_unit_vectors(n: usize) -> Vec<[f32; 4]> {
     let mut state: u64 = 0x853c_49e6_748f_ea9b;
@@ -524,10 +469,7 @@ impl IsoGpu {
                 gb_write(8),
                 gb_write(9),
                 gb_write(10),
-                entry(
-                    11,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                ),
+                sampler_entry(11),
             ],
         });
         let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -543,10 +485,7 @@ impl IsoGpu {
                 texture_entry(10, false, V::D2Array),
                 texture_entry(11, true, V::Cube),
                 texture_entry(12, true, V::Cube),
-                entry(
-                    13,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                ),
+                sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
             ],
         });
@@ -695,92 +634,6 @@ impl IsoGpu {
     }
 }
 
-/// Copies one mip level / array layer of a texture to the CPU (rows tightly packed).
-pub(crate) fn read_texture_layer(
-    ctx: &Context,
-    tex: &wgpu::Texture,
-    mip: u32,
-    layer: u32,
-    bytes_per_texel: u32,
-) -> Result<Vec<u8>> {
-    let w = (tex.width() >> mip).max(1);
-    let h = (tex.height() >> mip).max(1);
-    let row = w * bytes_per_texel;
-    let padded =
-        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: padded as u64 * h as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: tex,
-            mip_level: mip,
-            origin: wgpu::Origin3d {
-                x: 0,
-                y: 0,
-                z: layer,
-            },
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buf,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: None,
-            },
-        },
-        wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-    );
-    ctx.queue.submit([enc.finish()]);
-    let bytes = map_read(ctx, &buf)?;
-    let mut out = Vec::with_capacity((row * h) as usize);
-    for y in 0..h as usize {
-        out.extend_from_slice(&bytes[y * padded as usize..y * padded as usize + row as usize]);
-    }
-    Ok(out)
-}
-
-/// Copies a storage buffer to the CPU.
-pub(crate) fn read_buffer(ctx: &Context, src: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: src.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = ctx.device.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(src, 0, &buf, 0, src.size());
-    ctx.queue.submit([enc.finish()]);
-    map_read(ctx, &buf)
-}
-
-fn map_read(ctx: &Context, buf: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.wait_idle()?;
-    rx.recv()
-        .map_err(|_| Error::Gpu("readback never completed".into()))?
-        .map_err(|e| Error::Gpu(format!("mapping the readback buffer: {e}")))?;
-    let out = buf
-        .slice(..)
-        .get_mapped_range()
-        .map_err(|e| Error::Gpu(format!("{e:?}")))?
-        .to_vec();
-    buf.unmap();
-    Ok(out)
-}
-
 fn read_cube(ctx: &Context, tex: &wgpu::Texture, mip: u32) -> Result<CubeImage> {
     let size = (tex.width() >> mip).max(1);
     let mut faces = Vec::with_capacity(6);
@@ -828,6 +681,15 @@ impl Renderer {
         g.environment = None;
         g.environment = Some(GpuEnvironment::build(&ctx, &g.env_pipelines, env)?);
         self.environment_generation += 1;
+        Ok(())
+    }
+
+    /// Builds the default environment (the procedural sky) unless one is set: isosurfaces
+    /// and path tracing are lit by it.
+    pub(crate) fn ensure_environment(&mut self) -> Result<()> {
+        if self.iso_gpu()?.environment.is_none() {
+            self.set_environment(&Environment::default())?;
+        }
         Ok(())
     }
 
@@ -969,10 +831,7 @@ impl Renderer {
         if self.volume.is_none() {
             return Err(Error::InvalidParameter("no volume has been set".into()));
         }
-        self.iso_gpu()?;
-        if self.iso.as_ref().is_some_and(|g| g.environment.is_none()) {
-            self.set_environment(&Environment::default())?;
-        }
+        self.ensure_environment()?;
         let step = self.sample_distance(params)?;
         let spacing = self.sample_distance(&RenderParams {
             sample_distance: None,
@@ -981,17 +840,7 @@ impl Renderer {
         let values: Vec<f32> = iso.values.iter().map(|v| v.value as f32).collect();
         self.ensure_iso_occupancy(&values)?;
         self.ensure_targets(view.width, view.height)?;
-        if let DepthSource::Cpu(d) = depth {
-            let n = (view.width * view.height) as usize;
-            if d.len() != n {
-                return Err(Error::InvalidParameter(format!(
-                    "depth image has {} values for a {}x{} frame ({n} expected)",
-                    d.len(),
-                    view.width,
-                    view.height
-                )));
-            }
-        }
+        self.write_depth_input(view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
         // Lighting is the point of this mode: the material applies whatever `enabled` says.
         let lit = RenderParams {
@@ -1094,18 +943,6 @@ impl Renderer {
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
         q.write_buffer(&g.iso_buf, 0, bytemuck::bytes_of(&u));
         let t = self.targets.as_ref().expect("allocated above");
-        if let DepthSource::Cpu(depth) = depth {
-            q.write_texture(
-                t.depth_in.as_image_copy(),
-                bytemuck::cast_slice(depth),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * view.width),
-                    rows_per_image: None,
-                },
-                t.depth_in.size(),
-            );
-        }
         let (_, occupancy, _) = g.occupancy.as_ref().expect("built above");
         let gb = g.gbuffer.as_ref().expect("allocated above");
         let array_view = |tex: &wgpu::Texture| {
@@ -1163,15 +1000,7 @@ impl Renderer {
             label: Some("isosurface frame"),
         });
         if shade_rect != full {
-            // Pixels outside the rectangle get no ray: clear them (transparent, far depth).
-            enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("clear outside the volume"),
-                color_attachments: &[
-                    crate::renderer::clear_attachment(&color_view, 0.0),
-                    crate::renderer::clear_attachment(&depth_view, 1.0),
-                ],
-                ..Default::default()
-            });
+            crate::renderer::clear_outputs(&mut enc, &color_view, &depth_view);
         }
         if !single_brick {
             enc.clear_buffer(&t.state, 0, None);

@@ -15,6 +15,7 @@
 //! # Ok::<(), ferrovol_core::Error>(())
 //! ```
 
+mod binding;
 pub mod camera;
 pub mod device;
 pub mod environment;
@@ -25,6 +26,7 @@ pub mod iso;
 pub mod light;
 pub mod params;
 pub mod pathtrace;
+mod readback;
 pub mod renderer;
 pub mod shaders;
 pub mod synth;

@@ -24,13 +24,14 @@
 //! Limits of this version: the volume must fit in one brick; the first component is the
 //! medium; cropping and positional lights are refused.
 
-use crate::environment::Environment;
+use crate::binding::{
+    bind, buffer_entry, entry, sampler_entry, storage_texture_entry, texture_entry,
+};
 use crate::error::{Error, Result};
 use crate::gpu::{PathTraceUniforms, PhaseTestUniforms, PT_FLAG_BACKGROUND};
-use crate::iso::{
-    bind, buffer_entry, entry, read_buffer, shader_module, storage_texture_entry, texture_entry,
-};
+use crate::iso::shader_module;
 use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
+use crate::readback::read_buffer;
 use crate::renderer::{DepthSource, Renderer, View};
 use crate::transfer::TABLE_SIZE;
 use crate::Context;
@@ -162,10 +163,7 @@ impl PathTraceGpu {
                     },
                 ),
                 texture_entry(11, true, V::Cube),
-                entry(
-                    13,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                ),
+                sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
                 buffer_entry(15, B::Storage { read_only: true }),
             ],
@@ -462,22 +460,9 @@ impl Renderer {
             .map_or(1.0, |tf| tf.component(0).unit_distance);
         let step = self.sample_distance(params)?;
         self.ensure_tables(step)?;
-        self.iso_gpu()?;
-        if self.iso.as_ref().is_some_and(|g| g.environment.is_none()) {
-            self.set_environment(&Environment::default())?;
-        }
+        self.ensure_environment()?;
         self.ensure_targets(view.width, view.height)?;
-        if let DepthSource::Cpu(d) = depth {
-            let n = (view.width * view.height) as usize;
-            if d.len() != n {
-                return Err(Error::InvalidParameter(format!(
-                    "depth image has {} values for a {}x{} frame ({n} expected)",
-                    d.len(),
-                    view.width,
-                    view.height
-                )));
-            }
-        }
+        self.write_depth_input(view, depth)?;
         if self.pt.is_none() {
             self.pt = Some(Box::new(PathTraceGpu::new(&self.ctx, &self.brick_bgl)?));
         }
@@ -565,18 +550,6 @@ impl Renderer {
         }
         q.write_buffer(&g.uniforms, 0, &blocks);
         let t = self.targets.as_ref().expect("allocated above");
-        if let DepthSource::Cpu(depth) = depth {
-            q.write_texture(
-                t.depth_in.as_image_copy(),
-                bytemuck::cast_slice(depth),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * view.width),
-                    rows_per_image: None,
-                },
-                t.depth_in.size(),
-            );
-        }
         let (_, tables) = self.tables.as_ref().expect("built above");
         let (_, _, accum) = g.accum.as_ref().expect("allocated above");
         let iso = self.iso.as_ref().expect("created above");
@@ -624,14 +597,7 @@ impl Renderer {
                 label: Some("path-traced frame"),
             });
         if rect != full {
-            enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("clear outside the volume"),
-                color_attachments: &[
-                    crate::renderer::clear_attachment(&color_view, 0.0),
-                    crate::renderer::clear_attachment(&depth_view, 1.0),
-                ],
-                ..Default::default()
-            });
+            crate::renderer::clear_outputs(&mut enc, &color_view, &depth_view);
         }
         if rect[2] > rect[0] && rect[3] > rect[1] {
             let wg = crate::renderer::WORKGROUP;

@@ -1,5 +1,6 @@
 //! The renderer: long-lived pipelines, the uploaded volume and tables; one call per frame.
 
+use crate::binding::{bind, buffer_entry, entry};
 use crate::camera::Camera;
 use crate::device::Context;
 use crate::error::{Error, Result};
@@ -7,6 +8,7 @@ use crate::gpu::*;
 use crate::interop::{self, ExportableMemory, OutputPath, SharedOutput};
 use crate::light::{Light, LightSpace};
 use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, MAX_LIGHTS};
+use crate::readback::read_texture_layer;
 use crate::transfer::{build_tables, TransferFunction, TABLE_SIZE};
 use crate::upload::{self, BrickExtent, Layout, MinMaxGrid, BLOCK_SIZE};
 use crate::volume::VolumeData;
@@ -284,17 +286,22 @@ pub struct Renderer {
     pub(crate) pt_params: crate::pathtrace::PathTraceParams,
 }
 
-fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty,
-        count: None,
-    }
+/// Clears the frame's colour (transparent) and depth (far) images; the passes that cover only
+/// the volume's projected rectangle call it first, since pixels outside get no ray.
+pub(crate) fn clear_outputs(
+    enc: &mut wgpu::CommandEncoder,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+) {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("clear outside the volume"),
+        color_attachments: &[clear_attachment(color, 0.0), clear_attachment(depth, 1.0)],
+        ..Default::default()
+    });
 }
 
 /// A colour attachment that clears its first channel to `value` and the rest to zero.
-pub(crate) fn clear_attachment(
+fn clear_attachment(
     view: &wgpu::TextureView,
     value: f64,
 ) -> Option<wgpu::RenderPassColorAttachment<'_>> {
@@ -312,32 +319,6 @@ pub(crate) fn clear_attachment(
             store: wgpu::StoreOp::Store,
         },
     })
-}
-
-fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource }
-}
-
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
-}
-
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
 }
 
 impl Renderer {
@@ -365,10 +346,10 @@ impl Renderer {
         let dvr_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dvr frame"),
             entries: &[
-                uniform_entry(0),
-                storage_entry(1, true),
-                storage_entry(2, false),
-                storage_entry(3, true),
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
+                buffer_entry(3, wgpu::BufferBindingType::Storage { read_only: true }),
                 entry(
                     4,
                     wgpu::BindingType::Texture {
@@ -384,7 +365,7 @@ impl Renderer {
         let brick_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("brick"),
             entries: &[
-                uniform_entry(0),
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
                 entry(
                     1,
                     wgpu::BindingType::Texture {
@@ -402,9 +383,9 @@ impl Renderer {
         let resolve_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
             entries: &[
-                uniform_entry(0),
-                storage_entry(1, true),
-                storage_entry(2, true),
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: true }),
                 output_entries[0],
                 output_entries[1],
             ],
@@ -600,28 +581,19 @@ impl Renderer {
                 (texture, uniform)
             })?;
             let view = texture.create_view(&Default::default());
-            let bind = |s: &wgpu::Sampler| {
+            let brick_group = |s: &wgpu::Sampler| {
                 d.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("brick"),
                     layout: &self.brick_bgl,
                     entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: uniform.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(&view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::Sampler(s),
-                        },
+                        bind(0, uniform.as_entire_binding()),
+                        bind(1, wgpu::BindingResource::TextureView(&view)),
+                        bind(2, wgpu::BindingResource::Sampler(s)),
                     ],
                 })
             };
-            let bind_linear = bind(&self.linear);
-            let bind_nearest = bind(&self.nearest);
+            let bind_linear = brick_group(&self.linear);
+            let bind_nearest = brick_group(&self.nearest);
             bricks.push(GpuBrick {
                 extent: *e,
                 _texture: texture,
@@ -1186,17 +1158,7 @@ impl Renderer {
             && params.blend == BlendMode::Composite
             && occupied < SKIP_MAX_OCCUPANCY;
         self.ensure_targets(view.width, view.height)?;
-        if let DepthSource::Cpu(d) = depth {
-            let n = (view.width * view.height) as usize;
-            if d.len() != n {
-                return Err(Error::InvalidParameter(format!(
-                    "depth image has {} values for a {}x{} frame ({n} expected)",
-                    d.len(),
-                    view.width,
-                    view.height
-                )));
-            }
-        }
+        self.write_depth_input(view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
         let (u, variant) = self.frame_uniforms(view, params, step, depth_input, skip)?;
         if !self.dvr_variants.contains_key(&variant) {
@@ -1227,27 +1189,6 @@ impl Renderer {
         let q = &self.ctx.queue;
         let d = &self.ctx.device;
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&u));
-        if let DepthSource::Cpu(depth) = depth {
-            q.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &t.depth_in,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytemuck::cast_slice(depth),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * view.width),
-                    rows_per_image: None,
-                },
-                wgpu::Extent3d {
-                    width: view.width,
-                    height: view.height,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
         let depth_view = t.depth.create_view(&Default::default());
@@ -1280,15 +1221,7 @@ impl Renderer {
             label: Some("frame"),
         });
         if rect != [0, 0, view.width, view.height] {
-            // Pixels outside the rectangle get no ray: clear them (transparent, far depth).
-            enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("clear outside the volume"),
-                color_attachments: &[
-                    clear_attachment(&color_view, 0.0),
-                    clear_attachment(&depth_view, 1.0),
-                ],
-                ..Default::default()
-            });
+            clear_outputs(&mut enc, &color_view, &depth_view);
         }
         if !variant.single_brick {
             enc.clear_buffer(&t.state, 0, None);
@@ -1411,14 +1344,47 @@ impl Renderer {
         self.ctx.wait_idle()
     }
 
+    /// Checks a CPU depth input (window depth per pixel) against the frame's size and copies
+    /// it into the depth-input image; nothing to do for the other sources. The output images
+    /// must be allocated for the frame.
+    pub(crate) fn write_depth_input(&self, view: &View, depth: DepthSource<'_>) -> Result<()> {
+        let DepthSource::Cpu(d) = depth else {
+            return Ok(());
+        };
+        let n = (view.width * view.height) as usize;
+        if d.len() != n {
+            return Err(Error::InvalidParameter(format!(
+                "depth image has {} values for a {}x{} frame ({n} expected)",
+                d.len(),
+                view.width,
+                view.height
+            )));
+        }
+        let t = self
+            .targets
+            .as_ref()
+            .expect("output images allocated for the frame");
+        self.ctx.queue.write_texture(
+            t.depth_in.as_image_copy(),
+            bytemuck::cast_slice(d),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * view.width),
+                rows_per_image: None,
+            },
+            t.depth_in.size(),
+        );
+        Ok(())
+    }
+
     /// Waits for the last frame and copies its colour and depth to the CPU.
     pub fn read_image(&self) -> Result<Image> {
         let t = self
             .targets
             .as_ref()
             .ok_or_else(|| Error::InvalidParameter("nothing has been rendered yet".into()))?;
-        let rgba = self.read_texture(&t.color, 4)?;
-        let depth_bytes = self.read_texture(&t.depth, 4)?;
+        let rgba = read_texture_layer(&self.ctx, &t.color, 0, 0, 4)?;
+        let depth_bytes = read_texture_layer(&self.ctx, &t.depth, 0, 0, 4)?;
         let depth = bytemuck::cast_slice::<u8, f32>(&depth_bytes).to_vec();
         Ok(Image {
             width: t.width,
@@ -1426,62 +1392,6 @@ impl Renderer {
             rgba,
             depth,
         })
-    }
-
-    fn read_texture(&self, tex: &wgpu::Texture, bpp: u32) -> Result<Vec<u8>> {
-        let (w, h) = (tex.width(), tex.height());
-        let row = w * bpp;
-        let padded =
-            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let d = &self.ctx.device;
-        let buf = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: padded as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = d.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: tex,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buf,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: None,
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        self.ctx.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.ctx.wait_idle()?;
-        rx.recv()
-            .map_err(|_| Error::Gpu("readback never completed".into()))?
-            .map_err(|e| Error::Gpu(format!("mapping the readback buffer: {e}")))?;
-        let view = buf
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| Error::Gpu(format!("{e:?}")))?;
-        let mut out = Vec::with_capacity((row * h) as usize);
-        for y in 0..h as usize {
-            out.extend_from_slice(&view[y * padded as usize..y * padded as usize + row as usize]);
-        }
-        drop(view);
-        buf.unmap();
-        Ok(out)
     }
 
     /// Renders and reads back in one call.
