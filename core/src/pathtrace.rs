@@ -130,8 +130,9 @@ pub(crate) struct PathTraceGpu {
     /// The environment's sampling distribution: (environment generation, texels per face
     /// edge, cumulative probabilities).
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
-    /// The block majorants: (what they were computed from, buffer, the largest).
-    majorants: Option<(String, wgpu::Buffer, f32)>,
+    /// The block majorants: (the volume and table upload counts they were computed at,
+    /// buffer, the largest).
+    majorants: Option<((u32, u32), wgpu::Buffer, f32)>,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
     samples: u32,
@@ -392,9 +393,10 @@ impl Renderer {
             .collect())
     }
 
-    /// Uploads the block majorants when the volume or the transfer function changed.
+    /// Uploads the block majorants when the volume or the transfer function changed (the
+    /// upload counters say so: the tables are built for this frame before this is called).
     fn ensure_majorants(&mut self) -> Result<f32> {
-        let key = format!("{:?}|{}", self.tf, self.stats.volume_uploads);
+        let key = (self.stats.volume_uploads, self.stats.table_uploads);
         if let Some((k, _, max)) = self.pt.as_ref().and_then(|g| g.majorants.as_ref()) {
             if *k == key {
                 return Ok(*max);
