@@ -7,7 +7,15 @@
 // The medium: extinction σ(x) = −ln(1 − α(s(x))) / unit distance, α the transfer
 // function's opacity as given (so a slab one unit distance thick lets 1 − α through, VTK's
 // meaning of ScalarOpacityUnitDistance), single-scattering albedo the transfer function's
-// colour, Henyey–Greenstein scattering with anisotropy g. A path starts at the camera
+// colour. Scattering follows the hybrid model: where the gradient magnitude |∇s| exceeds ψ
+// (or, with the stochastic blend, with probability 1 − exp(−k|∇s|)) by the surface-like
+// BSDF oriented by the gradient (lib/bsdf.wgsl), elsewhere by Henyey–Greenstein with
+// anisotropy g. The scattering regions restrict where collisions scatter (nowhere, at
+// surfaces only, between surfaces only, everywhere); the other collisions absorb the path
+// (attenuation on) or do not happen (attenuation off: the medium is transparent there).
+// Ray budgets: counts.x paths share one primary ray (the jittered camera ray and its first
+// free flight are drawn from a stream keyed by the primary ray, the rest of the path from
+// one keyed by the path). A path starts at the camera
 // (jittered in its pixel), flies freely by delta (Woodcock) tracking against the majorant
 // of each min–max block it crosses (σ̄ = the largest σ the block's scalar range can take;
 // empty blocks are crossed in one step), scatters at real collisions; at each one it takes next-event estimates toward
@@ -23,16 +31,25 @@
 #include "lib/march.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/phase.wgsl"
+#include "lib/bsdf.wgsl"
 
 struct PathTrace {
     env_rotation: mat4x4<f32>,  // world → environment directions
     medium: vec4<f32>,          // x largest block majorant (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
-    counts: vec4<u32>,          // x unused, y paths accumulated before this one, z most scattering events, w seed
-    options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, zw unused
+    surface: vec4<f32>,         // x gradient threshold ψ (world units; 3e38: none), y stochastic blend rate k (0: the hard switch), z GGX roughness, w Fresnel reflectance at normal incidence
+    lobe: vec4<f32>,            // x transmitted share of the BSDF's non-specular part, y its Phong exponent, zw unused
+    counts: vec4<u32>,          // x paths per primary ray, y paths accumulated before this one, z most scattering events, w seed
+    options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, z scattering regions (PT_SCATTER_*), w unused
     rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
 }
 
 const PT_FLAG_BACKGROUND: u32 = 1u;
+// Collisions that do not scatter absorb (otherwise they do not happen).
+const PT_FLAG_ATTENUATION: u32 = 2u;
+const PT_SCATTER_NONE: u32 = 0u;
+const PT_SCATTER_SURFACES: u32 = 1u;
+const PT_SCATTER_BETWEEN: u32 = 2u;
+const PT_SCATTER_EVERYWHERE: u32 = 3u;
 // Opacity is clamped below 1 so that extinction stays finite (σ ≤ 9.2 / unit distance).
 const PT_MAX_OPACITY: f32 = 0.9999;
 // Bound on the tentative collisions of one free flight or transmittance estimate (a
@@ -141,8 +158,80 @@ fn extinction(s: f32) -> f32 {
     return -log(1.0 - a) * pt.medium.z;
 }
 
+// The probability that a collision where the gradient magnitude is m scatters by the BSDF
+// (the rest scatter by Henyey–Greenstein).
+fn bsdf_share(m: f32) -> f32 {
+    if (pt.surface.y > 0.0) {
+        return 1.0 - exp(-pt.surface.y * m);
+    }
+    return select(0.0, 1.0, m > pt.surface.x);
+}
+
+// Whether the hybrid model looks at the gradient at all.
+fn uses_gradient() -> bool {
+    return pt.surface.y > 0.0 || pt.surface.x < 3.0e38;
+}
+
+// The share of the collisions at a point that scatter, for its BSDF share b.
+fn scatter_share(b: f32) -> f32 {
+    switch pt.options.z {
+        case PT_SCATTER_NONE: {
+            return 0.0;
+        }
+        case PT_SCATTER_SURFACES: {
+            return b;
+        }
+        case PT_SCATTER_BETWEEN: {
+            return 1.0 - b;
+        }
+        default: {
+            return 1.0;
+        }
+    }
+}
+
+fn attenuates() -> bool {
+    return (pt.options.x & PT_FLAG_ATTENUATION) != 0u;
+}
+
+// The extinction the paths meet at t: the medium's, less the collisions that neither
+// scatter nor absorb when attenuation is off (the host sets no majorant at all when
+// nothing scatters and nothing attenuates).
 fn extinction_at(r: Ray, t: f32) -> f32 {
-    return extinction(sample_scalars(r.index_origin + t * r.index_dir).x);
+    let p = r.index_origin + t * r.index_dir;
+    let s = sample_scalars(p);
+    var sigma = extinction(s.x);
+    let partial = pt.options.z == PT_SCATTER_SURFACES || pt.options.z == PT_SCATTER_BETWEEN;
+    if (!attenuates() && partial && sigma > 0.0) {
+        let m = length(world_gradient(gradient_at(p, s), 0u));
+        sigma = sigma * scatter_share(bsdf_share(m));
+    }
+    return sigma;
+}
+
+// How a collision scatters: by the BSDF (surface) or by Henyey–Greenstein with the
+// colour in b.color.
+struct Scatterer {
+    surface: bool,
+    b: Bsdf,
+}
+
+// The scattering's value (rgb) toward w for a path that arrived along d, and the density
+// (a) with which scatter_sample draws w.
+fn scatter_eval(sc: Scatterer, d: vec3<f32>, w: vec3<f32>) -> vec4<f32> {
+    if (sc.surface) {
+        return bsdf_eval(sc.b, d, w);
+    }
+    let p = hg_pdf(dot(d, w), pt.medium.y);
+    return vec4<f32>(sc.b.color * p, p);
+}
+
+fn scatter_sample(sc: Scatterer, d: vec3<f32>, rng: ptr<function, Rng>) -> vec3<f32> {
+    if (sc.surface) {
+        let a = rand(rng);
+        return bsdf_sample(sc.b, d, vec3<f32>(a, rand2(rng)));
+    }
+    return hg_sample(d, pt.medium.y, rand2(rng));
 }
 
 // The majorant over the block the ray is in at t (just past t, so that a ray on a block
@@ -218,17 +307,17 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     return a * a / max(a * a + b * b, 1e-30);
 }
 
-// One path through the pixel: (radiance, met the medium ? 1 : 0).
-fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>) -> vec4<f32> {
-    let g = pt.medium.y;
+// One path through the pixel: (radiance, met the medium ? 1 : 0). `secondary` is the
+// stream the path continues with after its first collision.
+fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng) -> vec4<f32> {
     let background = (pt.options.x & PT_FLAG_BACKGROUND) != 0u;
     var r = camera_ray;
     var seg = ray_segment(r, px);
     var beta = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
     var hit = 0.0;
-    // the pdf of the phase-sampled direction the path now travels in
-    var phase_pdf = 0.0;
+    // the density of the sampled direction the path now travels in
+    var dir_pdf = 0.0;
     for (var bounce = 0u; bounce <= pt.counts.z; bounce = bounce + 1u) {
         let t = free_flight(r, seg.x, seg.y, rng);
         if (t >= seg.y) {
@@ -237,42 +326,81 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>) -> vec4<f32> {
                     radiance = env_radiance(r.dir);
                 }
             } else {
-                let w = power_heuristic(phase_pdf, env_pdf(r.dir));
+                let w = power_heuristic(dir_pdf, env_pdf(r.dir));
                 radiance = radiance + beta * w * env_radiance(r.dir);
             }
             break;
         }
         if (bounce == 0u) {
             hit = 1.0;
+            *rng = secondary;
         }
         if (bounce == pt.counts.z) {
             break;   // the path has scattered as often as it may
         }
         let x = r.origin + t * r.dir;
-        let s = sample_scalars(r.index_origin + t * r.index_dir).x;
-        beta = beta * classify(0u, s).rgb;
+        let p = r.index_origin + t * r.index_dir;
+        let s = sample_scalars(p);
+        var sc: Scatterer;
+        sc.b.color = classify(0u, s.x).rgb;
+        var share = 0.0;
+        var grad = vec3<f32>(0.0);
+        if (uses_gradient()) {
+            grad = world_gradient(gradient_at(p, s), 0u);
+            share = bsdf_share(length(grad));
+        }
+        if (attenuates()) {
+            // the absorbing share of the collisions (without attenuation, extinction_at
+            // left them out)
+            beta = beta * scatter_share(share);
+            if (all(beta <= vec3<f32>(0.0))) {
+                break;
+            }
+        }
+        switch pt.options.z {
+            case PT_SCATTER_SURFACES: {
+                sc.surface = true;
+            }
+            case PT_SCATTER_BETWEEN: {
+                sc.surface = false;
+            }
+            default: {
+                sc.surface = share > 0.0 && rand(rng) < share;
+            }
+        }
+        if (sc.surface) {
+            sc.b = bsdf_at(grad, r.dir, sc.b.color, pt.surface.z, pt.surface.w, pt.lobe.x, pt.lobe.y);
+        }
         // Next-event estimation: the environment, from its own distribution.
         let wl = env_sample(vec3<f32>(rand(rng), rand2(rng)));
         let pl = env_pdf(wl);
-        let ph = hg_pdf(dot(r.dir, wl), g);
-        if (pl > 0.0) {
+        let el = scatter_eval(sc, r.dir, wl);
+        if (pl > 0.0 && any(el.rgb > vec3<f32>(0.0))) {
             let rl = ray_from(x, wl);
             let sl = inner_segment(rl);
             let tl = transmittance(rl, sl.x, sl.y, rng);
-            radiance = radiance + beta * (ph * tl * power_heuristic(pl, ph) / pl) * env_radiance(wl);
+            radiance = radiance + beta * el.rgb * (tl * power_heuristic(pl, el.a) / pl) * env_radiance(wl);
         }
         // ... and the directional lights (the headlight along the camera ray).
         for (var i = 0u; i < frame.counts.y; i = i + 1u) {
             let light = frame.lights[i];
             let l = select(light.position.xyz, -camera_ray.dir, light.position.w > 1.5);
-            let rd = ray_from(x, l);
-            let sd = inner_segment(rd);
-            let td = transmittance(rd, sd.x, sd.y, rng);
-            radiance = radiance + beta * (hg_pdf(dot(r.dir, l), g) * td) * light.diffuse.rgb;
+            let ed = scatter_eval(sc, r.dir, l);
+            if (any(ed.rgb > vec3<f32>(0.0))) {
+                let rd = ray_from(x, l);
+                let sd = inner_segment(rd);
+                let td = transmittance(rd, sd.x, sd.y, rng);
+                radiance = radiance + beta * ed.rgb * td * light.diffuse.rgb;
+            }
         }
-        // Continue along a phase-sampled direction (phase / pdf = 1).
-        let wn = hg_sample(r.dir, g, rand2(rng));
-        phase_pdf = hg_pdf(dot(r.dir, wn), g);
+        // Continue along a sampled direction, weighted by value / density.
+        let wn = scatter_sample(sc, r.dir, rng);
+        let en = scatter_eval(sc, r.dir, wn);
+        if (en.a <= 0.0 || all(en.rgb <= vec3<f32>(0.0))) {
+            break;
+        }
+        beta = beta * en.rgb / en.a;
+        dir_pdf = en.a;
         r = ray_from(x, wn);
         seg = inner_segment(r);
         if (bounce >= 3u) {
@@ -293,9 +421,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let idx = px.y * frame.viewport.x + px.x;
-    var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ pt.counts.y);
+    // the primary ray's stream, shared by the counts.x paths of one primary ray
+    var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ (pt.counts.y / pt.counts.x));
+    let secondary = rng_seed(idx, pcg_hash(pt.counts.w ^ 0x68e31da4u) ^ pt.counts.y);
     let ray = ray_through(image_ndc(vec2<f32>(px) + rand2(&rng)));
-    var sum = trace(ray, px, &rng);
+    var sum = trace(ray, px, &rng, secondary);
     if (pt.counts.y > 0u) {
         sum = sum + accum[idx];
     }

@@ -88,6 +88,8 @@ pub struct IsoUniforms {
 pub struct PathTraceUniforms {
     pub env_rotation: [f32; 16],
     pub medium: [f32; 4],
+    pub surface: [f32; 4],
+    pub lobe: [f32; 4],
     pub counts: [u32; 4],
     pub options: [u32; 4],
     pub rect: [u32; 4],
@@ -98,10 +100,13 @@ pub struct PathTraceUniforms {
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct PhaseTestUniforms {
     pub params: [f32; 4],
+    pub bsdf: [f32; 4],
+    pub normal: [f32; 4],
     pub counts: [u32; 4],
 }
 
 pub const PT_FLAG_BACKGROUND: u32 = 1;
+pub const PT_FLAG_ATTENUATION: u32 = 2;
 
 /// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
 #[repr(C)]
@@ -131,6 +136,7 @@ pub fn mat(m: glam::DMat4) -> [f32; 16] {
 #[cfg(test)]
 mod layout_tests {
     use super::*;
+    use crate::pathtrace::ScatterRegions;
     use std::mem::{offset_of, size_of};
 
     fn module(pass: &str) -> naga::Module {
@@ -261,10 +267,15 @@ mod layout_tests {
             m,
             "PathTrace",
             PathTraceUniforms,
-            [env_rotation, medium, counts, options, rect]
+            [env_rotation, medium, surface, lobe, counts, options, rect]
         );
         let m = module("phase_test.wgsl");
-        check!(m, "PhaseTest", PhaseTestUniforms, [params, counts]);
+        check!(
+            m,
+            "PhaseTest",
+            PhaseTestUniforms,
+            [params, bsdf, normal, counts]
+        );
     }
 
     #[test]
@@ -280,6 +291,15 @@ mod layout_tests {
             (&env, "ENV_SKY", ENV_SKY),
             (&env, "ENV_EQUIRECT", ENV_EQUIRECT),
             (&pt, "PT_FLAG_BACKGROUND", PT_FLAG_BACKGROUND),
+            (&pt, "PT_FLAG_ATTENUATION", PT_FLAG_ATTENUATION),
+            (&pt, "PT_SCATTER_NONE", ScatterRegions::Nowhere.code()),
+            (&pt, "PT_SCATTER_SURFACES", ScatterRegions::Surfaces.code()),
+            (&pt, "PT_SCATTER_BETWEEN", ScatterRegions::Between.code()),
+            (
+                &pt,
+                "PT_SCATTER_EVERYWHERE",
+                ScatterRegions::Everywhere.code(),
+            ),
         ] {
             let decl = format!("const {name}: u32 = {v}u;");
             assert!(src.contains(&decl), "WGSL lacks `{decl}`");

@@ -44,7 +44,7 @@ pub use light::{Light, LightSpace};
 pub use params::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
 };
-pub use pathtrace::PathTraceParams;
+pub use pathtrace::{BsdfParams, PathTraceParams, ScatterRegions};
 pub use renderer::{Image, Renderer, Stats, UploadOptions, View};
 pub use transfer::{ComponentTransfer, Piecewise, TransferFunction};
 pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

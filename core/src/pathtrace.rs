@@ -28,7 +28,7 @@ use crate::binding::{
     bind, buffer_entry, entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::error::{Error, Result};
-use crate::gpu::{PathTraceUniforms, PhaseTestUniforms, PT_FLAG_BACKGROUND};
+use crate::gpu::{PathTraceUniforms, PhaseTestUniforms, PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND};
 use crate::iso::shader_module;
 use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::read_buffer;
@@ -46,6 +46,101 @@ pub const MAX_SAMPLES_PER_FRAME: u32 = 4096;
 /// Most scattering events per path.
 pub const MAX_BOUNCES: u32 = 100_000;
 
+/// Where collisions with the medium scatter light (the lecture's scattering regions). The
+/// surfaces are where the hybrid model scatters by the BSDF (the gradient magnitude above
+/// [`PathTraceParams::gradient_threshold`], or by chance with the stochastic blend); the
+/// other collisions absorb the path or, without [`PathTraceParams::attenuation`], do not
+/// happen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ScatterRegions {
+    /// No collision scatters: the medium only absorbs (or, without attenuation, vanishes).
+    Nowhere,
+    /// Only at surfaces, by the BSDF.
+    Surfaces,
+    /// Only between surfaces, by Henyey–Greenstein.
+    Between,
+    /// At every collision, by the hybrid model.
+    #[default]
+    Everywhere,
+}
+
+impl ScatterRegions {
+    /// The code pathtrace.wgsl knows it by (PT_SCATTER_*).
+    pub fn code(self) -> u32 {
+        match self {
+            ScatterRegions::Nowhere => 0,
+            ScatterRegions::Surfaces => 1,
+            ScatterRegions::Between => 2,
+            ScatterRegions::Everywhere => 3,
+        }
+    }
+}
+
+/// The surface-like scattering of the hybrid model (shaders/lib/bsdf.wgsl): GGX specular
+/// reflection weighted by Schlick's Fresnel term, the rest split between Lambertian
+/// reflection and an "inward-looking" Phong lobe transmitted through the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfParams {
+    /// GGX roughness α, 0.01 to 1.
+    pub roughness: f32,
+    /// Fresnel reflectance at normal incidence, 0 to 1 (0.04: water, plastics, tissue).
+    pub fresnel: f32,
+    /// Share of the non-specular part that is transmitted, 0 to 1.
+    pub transmission: f32,
+    /// Half the transmitted lobe's directions lie within this angle of the continued
+    /// propagation direction, degrees, 0.5 to 60 (60: uniform over the hemisphere).
+    pub cone_angle: f32,
+}
+
+impl Default for BsdfParams {
+    fn default() -> Self {
+        BsdfParams {
+            roughness: 0.4,
+            fresnel: 0.04,
+            transmission: 0.0,
+            cone_angle: 30.0,
+        }
+    }
+}
+
+impl BsdfParams {
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidParameter(m));
+        if !(0.01..=1.0).contains(&self.roughness) {
+            return bad(format!(
+                "BSDF roughness {} must be in [0.01, 1]",
+                self.roughness
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.fresnel) {
+            return bad(format!(
+                "BSDF Fresnel reflectance {} must be in [0, 1]",
+                self.fresnel
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.transmission) {
+            return bad(format!(
+                "BSDF transmission {} must be in [0, 1]",
+                self.transmission
+            ));
+        }
+        if !(0.5..=60.0).contains(&self.cone_angle) {
+            return bad(format!(
+                "transmission cone angle {}° must be in [0.5°, 60°]",
+                self.cone_angle
+            ));
+        }
+        Ok(())
+    }
+
+    /// The exponent m of the transmitted Phong lobe cos^m: half its directions lie within
+    /// the cone angle (P(θ < c) = 1 − cos^(m+1) c).
+    pub fn lobe_exponent(&self) -> f32 {
+        let c = (self.cone_angle as f64).to_radians().cos();
+        ((0.5f64.ln() / c.ln()) - 1.0).max(0.0) as f32
+    }
+}
+
 /// How the path tracer samples (set with [`Renderer::set_path_tracing`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTraceParams {
@@ -54,11 +149,28 @@ pub struct PathTraceParams {
     /// Paths per pixel after which frames stop adding any and show the converged image
     /// again (a still render's budget); 0: no limit.
     pub max_samples: u32,
+    /// Secondary rays per primary ray, 1 to [`MAX_SAMPLES_PER_FRAME`] (the lecture's ray
+    /// budget P × S: each group of S consecutive paths of a pixel shares its jittered
+    /// camera ray and first collision, and differs from there on; 1: independent paths).
+    pub secondary_rays: u32,
     /// Most scattering events per path (0: single scattering is off too; the medium only
     /// attenuates what is behind it).
     pub max_bounces: u32,
     /// Henyey–Greenstein anisotropy g, |g| < 1 (0 isotropic, > 0 forward scattering).
     pub anisotropy: f32,
+    /// The hybrid model's switch ψ: collisions where the gradient magnitude (scalar units
+    /// per world unit) exceeds it scatter by the BSDF, the others by Henyey–Greenstein.
+    /// Infinite (the default): Henyey–Greenstein everywhere.
+    pub gradient_threshold: f32,
+    /// The stochastic blend instead of the switch: a collision scatters by the BSDF with
+    /// probability 1 − exp(−k·|∇s|) for this k > 0 (0: the hard switch at ψ).
+    pub stochastic_blend: f32,
+    /// The BSDF of the surfaces.
+    pub bsdf: BsdfParams,
+    /// Where collisions scatter.
+    pub scatter: ScatterRegions,
+    /// Collisions that do not scatter absorb the path (on) or do not happen (off).
+    pub attenuation: bool,
     /// Weight of the environment's light (0: the view's directional lights only).
     pub environment_light: f32,
     /// Show the environment behind the medium (the frame becomes opaque).
@@ -72,8 +184,14 @@ impl Default for PathTraceParams {
         PathTraceParams {
             samples_per_frame: 4,
             max_samples: 0,
+            secondary_rays: 1,
             max_bounces: 64,
             anisotropy: 0.0,
+            gradient_threshold: f32::INFINITY,
+            stochastic_blend: 0.0,
+            bsdf: BsdfParams::default(),
+            scatter: ScatterRegions::Everywhere,
+            attenuation: true,
             environment_light: 1.0,
             background: false,
             seed: 0,
@@ -90,6 +208,12 @@ impl PathTraceParams {
                 self.samples_per_frame
             ));
         }
+        if !(1..=MAX_SAMPLES_PER_FRAME).contains(&self.secondary_rays) {
+            return bad(format!(
+                "{} secondary rays per primary ray: give 1 to {MAX_SAMPLES_PER_FRAME}",
+                self.secondary_rays
+            ));
+        }
         if self.max_bounces > MAX_BOUNCES {
             return bad(format!(
                 "{} scattering events per path: at most {MAX_BOUNCES}",
@@ -102,6 +226,20 @@ impl PathTraceParams {
                 self.anisotropy
             ));
         }
+        if self.gradient_threshold.is_nan() || self.gradient_threshold < 0.0 {
+            return bad(format!(
+                "gradient threshold ψ {} must be non-negative (infinite: no BSDF)",
+                self.gradient_threshold
+            ));
+        }
+        if !(self.stochastic_blend.is_finite() && self.stochastic_blend >= 0.0) {
+            return bad(format!(
+                "stochastic blend rate k {} must be finite and non-negative (0: the hard \
+                 switch)",
+                self.stochastic_blend
+            ));
+        }
+        self.bsdf.validate()?;
         if !(self.environment_light.is_finite() && self.environment_light >= 0.0) {
             return bad(format!(
                 "environment light weight {} must be finite and non-negative",
@@ -524,21 +662,32 @@ impl Renderer {
             .expect("built above");
         let mut u = PathTraceUniforms::zeroed();
         u.env_rotation = DMat4::from_mat3(env.rotation).as_mat4().to_cols_array();
+        // Nothing scatters and nothing absorbs: no collisions at all.
+        let transparent = pp.scatter == ScatterRegions::Nowhere && !pp.attenuation;
         u.medium = [
-            majorant,
+            if transparent { 0.0 } else { majorant },
             pp.anisotropy,
             (1.0 / unit) as f32,
             pp.environment_light,
         ];
-        u.counts = [1, before, pp.max_bounces, pp.seed];
+        u.surface = [
+            pp.gradient_threshold.min(f32::MAX),
+            pp.stochastic_blend,
+            pp.bsdf.roughness,
+            pp.bsdf.fresnel,
+        ];
+        u.lobe = [pp.bsdf.transmission, pp.bsdf.lobe_exponent(), 0.0, 0.0];
+        u.counts = [pp.secondary_rays, before, pp.max_bounces, pp.seed];
         let (_, dist_size, dist) = g.env_dist.as_ref().expect("built above");
         let (_, majorant_buf, _) = g.majorants.as_ref().expect("built above");
-        u.options = [
-            if pp.background { PT_FLAG_BACKGROUND } else { 0 },
-            *dist_size,
-            0,
-            0,
-        ];
+        let mut flags = 0;
+        if pp.background {
+            flags |= PT_FLAG_BACKGROUND;
+        }
+        if pp.attenuation {
+            flags |= PT_FLAG_ATTENUATION;
+        }
+        u.options = [flags, *dist_size, pp.scatter.code(), 0];
         u.rect = rect;
         let q = &ctx.queue;
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
@@ -647,10 +796,65 @@ impl Renderer {
     /// tracer's own sampling code (shaders/lib/phase.wgsl) and returns the cosine of each
     /// to the propagation direction: for checking the sampler against the density.
     pub fn sample_phase_cosines(&self, g: f32, n: u32, seed: u32) -> Result<Vec<f32>> {
-        if g.is_nan() || g.abs() >= 1.0 || n == 0 || n > 1 << 24 {
+        if g.is_nan() || g.abs() >= 1.0 {
             return Err(Error::InvalidParameter(format!(
-                "phase sampling check: anisotropy {g} must be in (−1, 1) and the count {n} in \
-                 1 to 2^24"
+                "phase sampling check: anisotropy {g} must be in (−1, 1)"
+            )));
+        }
+        let dir = glam::Vec3::new(0.3, -0.5, 0.8).normalize();
+        let u = PhaseTestUniforms {
+            params: [g, dir.x, dir.y, dir.z],
+            counts: [n, seed, 0, 0],
+            ..Default::default()
+        };
+        Ok(self.run_phase_check(&u)?.iter().map(|v| v[0]).collect())
+    }
+
+    /// Checks the path tracer's BSDF (shaders/lib/bsdf.wgsl, colour 1) at a surface with
+    /// gradient direction `normal` for a path arriving along `dir` (both unit vectors):
+    /// per sample, [value / density of a direction drawn by its sampler, 4π × value and 4π ×
+    /// density of a uniformly drawn direction]. The means of the first two estimate the
+    /// albedo (≤ 1 when energy is conserved; equal when sampler and density agree), the
+    /// mean of the third is 1 when the density is normalised.
+    pub fn sample_bsdf(
+        &self,
+        bsdf: &BsdfParams,
+        normal: [f32; 3],
+        dir: [f32; 3],
+        n: u32,
+        seed: u32,
+    ) -> Result<Vec<[f32; 3]>> {
+        bsdf.validate()?;
+        let unit = |v: [f32; 3]| (glam::Vec3::from(v).length() - 1.0).abs() < 1e-3;
+        if !unit(normal) || !unit(dir) {
+            return Err(Error::InvalidParameter(format!(
+                "BSDF check: normal {normal:?} and direction {dir:?} must be unit vectors"
+            )));
+        }
+        let u = PhaseTestUniforms {
+            params: [0.0, dir[0], dir[1], dir[2]],
+            bsdf: [
+                bsdf.roughness,
+                bsdf.fresnel,
+                bsdf.transmission,
+                bsdf.lobe_exponent(),
+            ],
+            normal: [normal[0], normal[1], normal[2], 0.0],
+            counts: [n, seed, 1, 0],
+        };
+        Ok(self
+            .run_phase_check(&u)?
+            .iter()
+            .map(|v| [v[0], v[1], v[2]])
+            .collect())
+    }
+
+    /// Runs shaders/phase_test.wgsl: `u.counts[0]` samples.
+    fn run_phase_check(&self, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>> {
+        let n = u.counts[0];
+        if n == 0 || n > 1 << 24 {
+            return Err(Error::InvalidParameter(format!(
+                "scattering check: the sample count {n} must be in 1 to 2^24"
             )));
         }
         use wgpu::BufferBindingType as B;
@@ -679,21 +883,16 @@ impl Renderer {
                 cache: None,
             })
         })?;
-        let dir = glam::Vec3::new(0.3, -0.5, 0.8).normalize();
-        let u = PhaseTestUniforms {
-            params: [g, dir.x, dir.y, dir.z],
-            counts: [n, seed, 0, 0],
-        };
         let ubuf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("phase test uniforms"),
             size: std::mem::size_of::<PhaseTestUniforms>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        ctx.queue.write_buffer(&ubuf, 0, bytemuck::bytes_of(&u));
+        ctx.queue.write_buffer(&ubuf, 0, bytemuck::bytes_of(u));
         let out = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("phase test cosines"),
-            size: 4 * n as u64,
+            label: Some("phase test results"),
+            size: 16 * n as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
@@ -712,7 +911,7 @@ impl Renderer {
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(n.div_ceil(64), 1, 1);
         }
-        ctx.checked("sampling the phase function", || {
+        ctx.checked("running the scattering check", || {
             ctx.queue.submit([enc.finish()]);
         })?;
         let bytes = read_buffer(ctx, &out)?;

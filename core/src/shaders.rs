@@ -33,6 +33,7 @@ pub const FILES: &[(&str, &str)] = &[
         "lib/phase.wgsl",
         include_str!("../../shaders/lib/phase.wgsl"),
     ),
+    ("lib/bsdf.wgsl", include_str!("../../shaders/lib/bsdf.wgsl")),
     (
         "lib/surface.wgsl",
         include_str!("../../shaders/lib/surface.wgsl"),
