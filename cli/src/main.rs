@@ -6,9 +6,9 @@ mod readers;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
-    synth, AmbientOcclusion, BlendMode, Context, Environment, GradientMethod, Interpolation,
-    IsoParams, IsoValue, PathTraceParams, RenderParams, Renderer, Shininess, SpecularMode,
-    UploadOptions, View, VolumeData,
+    synth, AmbientOcclusion, BlendMode, BsdfParams, Context, Environment, GradientMethod,
+    Interpolation, IsoParams, IsoValue, PathTraceParams, RenderParams, Renderer, ScatterRegions,
+    Shininess, SpecularMode, UploadOptions, View, VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -152,12 +152,105 @@ struct PathTraceArgs {
     /// Paths per pixel (accumulated over frames of at most 64 paths each).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     spp: u32,
+    /// Ray budget PxS instead of --spp: P primary rays per pixel, each continued by S
+    /// secondary rays (P·S paths; 1x64, 8x8 and 64x1 are the lecture's comparison).
+    #[arg(long, value_parser = parse_budget, conflicts_with = "spp")]
+    budget: Option<(u32, u32)>,
+    /// The hybrid model's gradient threshold ψ (scalar units per world unit): the BSDF
+    /// where |∇s| > ψ, Henyey–Greenstein elsewhere. Default: Henyey–Greenstein everywhere.
+    #[arg(long, allow_hyphen_values = true)]
+    psi: Option<f32>,
+    /// The stochastic blend instead of the switch at ψ: the BSDF with probability
+    /// 1 − exp(−K·|∇s|).
+    #[arg(long = "blend-k", conflicts_with = "psi", allow_hyphen_values = true)]
+    blend_k: Option<f32>,
+    /// Where collisions scatter: none, iso (at surfaces, by the BSDF), between (between
+    /// surfaces, by Henyey–Greenstein) or everywhere.
+    #[arg(long, value_enum, default_value_t = Scatter::Everywhere)]
+    scatter: Scatter,
+    /// Collisions that do not scatter are left out instead of absorbing.
+    #[arg(long)]
+    no_attenuation: bool,
+    /// The BSDF's GGX roughness in [0.01, 1].
+    #[arg(long, default_value_t = BsdfParams::default().roughness)]
+    roughness: f32,
+    /// The BSDF's Fresnel reflectance at normal incidence in [0, 1].
+    #[arg(long = "bsdf-fresnel", default_value_t = BsdfParams::default().fresnel)]
+    bsdf_fresnel: f32,
+    /// Share of the BSDF's non-specular part transmitted through the surface, [0, 1].
+    #[arg(long, default_value_t = BsdfParams::default().transmission)]
+    transmission: f32,
+    /// Half the transmitted lobe lies within this angle, degrees in [0.5, 60].
+    #[arg(long, default_value_t = BsdfParams::default().cone_angle)]
+    cone_angle: f32,
+    /// Seed of the random streams.
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
     /// Henyey–Greenstein anisotropy g in (−1, 1): 0 isotropic, > 0 forward scattering.
     #[arg(long = "g", default_value_t = 0.0, allow_hyphen_values = true)]
     anisotropy: f32,
     /// Most scattering events per path.
     #[arg(long, default_value_t = 64)]
     bounces: u32,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
+enum Scatter {
+    None,
+    Iso,
+    Between,
+    Everywhere,
+}
+
+impl PathTraceArgs {
+    /// Paths per pixel: the budget's P·S, or --spp.
+    fn paths(&self) -> u32 {
+        self.budget.map_or(self.spp, |(p, s)| p * s)
+    }
+
+    fn params(&self, env_light: f32, background: bool) -> Result<PathTraceParams, CliError> {
+        let p = PathTraceParams {
+            samples_per_frame: self.paths().min(64),
+            max_samples: self.paths(),
+            secondary_rays: self.budget.map_or(1, |(_, s)| s),
+            max_bounces: self.bounces,
+            anisotropy: self.anisotropy,
+            gradient_threshold: self.psi.unwrap_or(f32::INFINITY),
+            stochastic_blend: self.blend_k.unwrap_or(0.0),
+            bsdf: BsdfParams {
+                roughness: self.roughness,
+                fresnel: self.bsdf_fresnel,
+                transmission: self.transmission,
+                cone_angle: self.cone_angle,
+            },
+            scatter: match self.scatter {
+                Scatter::None => ScatterRegions::Nowhere,
+                Scatter::Iso => ScatterRegions::Surfaces,
+                Scatter::Between => ScatterRegions::Between,
+                Scatter::Everywhere => ScatterRegions::Everywhere,
+            },
+            attenuation: !self.no_attenuation,
+            environment_light: env_light,
+            background,
+            seed: self.seed,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+/// PxS: primary and secondary rays per pixel, each at least 1, at most 1,000,000 paths.
+fn parse_budget(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("ray budget '{s}': write PxS, e.g. 8x8");
+    let (p, q) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
+    let p: u32 = p.trim().parse().map_err(|_| bad())?;
+    let q: u32 = q.trim().parse().map_err(|_| bad())?;
+    if p == 0 || q == 0 || p as u64 * q as u64 > 1_000_000 {
+        return Err(format!(
+            "ray budget '{s}': both counts at least 1, at most 1,000,000 paths in all"
+        ));
+    }
+    Ok((p, q))
 }
 
 /// Isosurface options (--mode iso).
@@ -474,16 +567,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         None
     };
     let path_tracing = if a.mode == Mode::Pathtrace {
-        let p = PathTraceParams {
-            samples_per_frame: a.pt.spp.min(64),
-            max_samples: a.pt.spp,
-            max_bounces: a.pt.bounces,
-            anisotropy: a.pt.anisotropy,
-            environment_light: a.iso.env_light.unwrap_or(1.0),
-            background: a.iso.env_background,
-            seed: 0,
-        };
-        p.validate()?;
+        let p =
+            a.pt.params(a.iso.env_light.unwrap_or(1.0), a.iso.env_background)?;
         Some((p, environment_setup(&a.iso)?))
     } else {
         None
@@ -562,11 +647,11 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     let t0 = std::time::Instant::now();
     let mut img = r.render_image(&view, &params)?;
     if path_tracing.is_some() {
-        while r.accumulated_samples() < a.pt.spp {
+        while r.accumulated_samples() < a.pt.paths() {
             pb.set_message(format!(
                 "path tracing: {} of {} paths per pixel",
                 r.accumulated_samples(),
-                a.pt.spp
+                a.pt.paths()
             ));
             r.render(&view, &params, None)?;
         }
@@ -583,7 +668,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         for _ in 1..a.repeat {
             if path_tracing.is_some() {
                 r.reset_accumulation();
-                while r.accumulated_samples() < a.pt.spp {
+                while r.accumulated_samples() < a.pt.paths() {
                     r.render(&view, &params, None)?;
                 }
             } else {

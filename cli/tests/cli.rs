@@ -169,10 +169,43 @@ fn pathtrace_render_and_bad_settings() {
     let lit = img.pixels().filter(|p| p.0[3] > 0).count();
     println!("{lit} of {} pixels met the medium", 24 * 24);
     assert!(lit > 100);
+    // The hybrid model, scattering at surfaces only, with a 2x4 ray budget.
+    let (code, _, err) = ferrovol(&[
+        "render",
+        "--demo",
+        "marschner-lobb",
+        "--mode",
+        "pathtrace",
+        "--budget",
+        "2x4",
+        "--psi",
+        "0.5",
+        "--scatter",
+        "iso",
+        "--transmission",
+        "0.5",
+        "--size",
+        "24x24",
+        "--out",
+        path,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("8 paths per pixel"), "{err}");
     for (args, words) in [
         (vec!["--g", "1.5"], "anisotropy"),
         (vec!["--spp", "0"], "spp"),
         (vec!["--env-light", "-1"], "environment light"),
+        (vec!["--budget", "8"], "PxS"),
+        (vec!["--budget", "0x8"], "at least 1"),
+        (vec!["--budget", "8x8", "--spp", "4"], "cannot be used with"),
+        (vec!["--psi", "-1"], "gradient threshold"),
+        (vec!["--psi", "1", "--blend-k", "2"], "cannot be used with"),
+        (vec!["--blend-k", "inf"], "stochastic blend"),
+        (vec!["--roughness", "0"], "roughness"),
+        (vec!["--bsdf-fresnel", "2"], "Fresnel"),
+        (vec!["--transmission", "1.5"], "transmission"),
+        (vec!["--cone-angle", "90"], "cone angle"),
+        (vec!["--scatter", "sometimes"], "invalid value"),
     ] {
         let mut all = vec!["render", "--demo", "sphere", "--mode", "pathtrace"];
         all.extend(&args);
