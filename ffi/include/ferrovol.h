@@ -214,6 +214,28 @@ typedef enum FvSpecularMode {
 } FvSpecularMode;
 
 /**
+ * Where collisions with the medium scatter light (FvPathTraceParams::scatter_regions).
+ */
+typedef enum FvScatterRegions {
+  /**
+   * No collision scatters: the medium only absorbs (or, without attenuation, vanishes).
+   */
+  FV_SCATTER_REGIONS_NOWHERE = 0,
+  /**
+   * Only at surfaces (where the hybrid model chooses the BSDF).
+   */
+  FV_SCATTER_REGIONS_SURFACES = 1,
+  /**
+   * Only between surfaces (by Henyey–Greenstein).
+   */
+  FV_SCATTER_REGIONS_BETWEEN = 2,
+  /**
+   * At every collision, by the hybrid model.
+   */
+  FV_SCATTER_REGIONS_EVERYWHERE = 3,
+} FvScatterRegions;
+
+/**
  * A GPU adapter and device. Create one per process (or per host graphics context) and
  * share it between renderers. Thread use: may be used from any thread; calls on one
  * context may run concurrently (the device is internally synchronised).
@@ -535,6 +557,45 @@ typedef struct FvPathTraceParams {
    * Seed of the random streams.
    */
   uint32_t seed;
+  /**
+   * Secondary rays per primary ray, 1 to 4096 (the ray budget P × S: each S consecutive
+   * paths of a pixel share their camera ray and first collision).
+   */
+  uint32_t secondary_rays;
+  /**
+   * The hybrid model's gradient threshold ψ (scalar units per world unit): the BSDF
+   * where the gradient magnitude exceeds it; INFINITY: Henyey–Greenstein everywhere.
+   */
+  float gradient_threshold;
+  /**
+   * k > 0: the stochastic blend instead of the threshold, the BSDF with probability
+   * 1 − exp(−k·|∇s|); 0: the threshold.
+   */
+  float stochastic_blend;
+  /**
+   * The BSDF's GGX roughness in [0.01, 1].
+   */
+  float roughness;
+  /**
+   * The BSDF's Fresnel reflectance at normal incidence in [0, 1].
+   */
+  float fresnel;
+  /**
+   * Share of the BSDF's non-specular part transmitted through the surface, [0, 1].
+   */
+  float transmission;
+  /**
+   * Half the transmitted lobe lies within this angle, degrees in [0.5, 60].
+   */
+  float cone_angle;
+  /**
+   * One of FvScatterRegions.
+   */
+  uint32_t scatter_regions;
+  /**
+   * Collisions that do not scatter absorb (true) or are left out (false).
+   */
+  bool attenuation;
 } FvPathTraceParams;
 
 /**

@@ -5,7 +5,8 @@
 use crate::status::{FfiError, FfiResult};
 use ferrovol_core::iso::MAX_ISO_VALUES;
 use ferrovol_core::{
-    AmbientOcclusion, IsoParams, IsoValue, PathTraceParams, Shininess, SpecularMode,
+    AmbientOcclusion, BsdfParams, IsoParams, IsoValue, PathTraceParams, ScatterRegions, Shininess,
+    SpecularMode,
 };
 
 /// Most iso-values in one FvIsoParams.
@@ -161,6 +162,20 @@ impl FvIsoParams {
     }
 }
 
+/// Where collisions with the medium scatter light (FvPathTraceParams::scatter_regions).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvScatterRegions {
+    /// No collision scatters: the medium only absorbs (or, without attenuation, vanishes).
+    Nowhere = 0,
+    /// Only at surfaces (where the hybrid model chooses the BSDF).
+    Surfaces = 1,
+    /// Only between surfaces (by Henyey–Greenstein).
+    Between = 2,
+    /// At every collision, by the hybrid model.
+    Everywhere = 3,
+}
+
 /// How frames with FV_BLEND_MODE_PATH_TRACE sample. Fill with fv_path_trace_params_default()
 /// and change what you need. Thread use: plain data.
 #[repr(C)]
@@ -181,6 +196,27 @@ pub struct FvPathTraceParams {
     pub background: bool,
     /// Seed of the random streams.
     pub seed: u32,
+    /// Secondary rays per primary ray, 1 to 4096 (the ray budget P × S: each S consecutive
+    /// paths of a pixel share their camera ray and first collision).
+    pub secondary_rays: u32,
+    /// The hybrid model's gradient threshold ψ (scalar units per world unit): the BSDF
+    /// where the gradient magnitude exceeds it; INFINITY: Henyey–Greenstein everywhere.
+    pub gradient_threshold: f32,
+    /// k > 0: the stochastic blend instead of the threshold, the BSDF with probability
+    /// 1 − exp(−k·|∇s|); 0: the threshold.
+    pub stochastic_blend: f32,
+    /// The BSDF's GGX roughness in [0.01, 1].
+    pub roughness: f32,
+    /// The BSDF's Fresnel reflectance at normal incidence in [0, 1].
+    pub fresnel: f32,
+    /// Share of the BSDF's non-specular part transmitted through the surface, [0, 1].
+    pub transmission: f32,
+    /// Half the transmitted lobe lies within this angle, degrees in [0.5, 60].
+    pub cone_angle: f32,
+    /// One of FvScatterRegions.
+    pub scatter_regions: u32,
+    /// Collisions that do not scatter absorb (true) or are left out (false).
+    pub attenuation: bool,
 }
 
 impl FvPathTraceParams {
@@ -194,15 +230,47 @@ impl FvPathTraceParams {
             environment_light: d.environment_light,
             background: d.background,
             seed: d.seed,
+            secondary_rays: d.secondary_rays,
+            gradient_threshold: d.gradient_threshold,
+            stochastic_blend: d.stochastic_blend,
+            roughness: d.bsdf.roughness,
+            fresnel: d.bsdf.fresnel,
+            transmission: d.bsdf.transmission,
+            cone_angle: d.bsdf.cone_angle,
+            scatter_regions: d.scatter.code(),
+            attenuation: d.attenuation,
         }
     }
 
     pub fn to_core(&self) -> FfiResult<PathTraceParams> {
+        let scatter = match self.scatter_regions {
+            0 => ScatterRegions::Nowhere,
+            1 => ScatterRegions::Surfaces,
+            2 => ScatterRegions::Between,
+            3 => ScatterRegions::Everywhere,
+            m => {
+                return Err(FfiError::invalid(format!(
+                    "scatter_regions {m} is not an FvScatterRegions (0 nowhere, 1 surfaces, \
+                     2 between, 3 everywhere)"
+                )))
+            }
+        };
         let p = PathTraceParams {
             samples_per_frame: self.samples_per_frame,
             max_samples: self.max_samples,
+            secondary_rays: self.secondary_rays,
             max_bounces: self.max_bounces,
             anisotropy: self.anisotropy,
+            gradient_threshold: self.gradient_threshold,
+            stochastic_blend: self.stochastic_blend,
+            bsdf: BsdfParams {
+                roughness: self.roughness,
+                fresnel: self.fresnel,
+                transmission: self.transmission,
+                cone_angle: self.cone_angle,
+            },
+            scatter,
+            attenuation: self.attenuation,
             environment_light: self.environment_light,
             background: self.background,
             seed: self.seed,

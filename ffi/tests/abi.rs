@@ -757,11 +757,52 @@ fn path_tracing_accumulates_and_refuses_bad_settings() {
             FvStatus::InvalidArgument,
             "0 paths per pixel",
         );
+        for (what, edit, words) in [
+            (
+                "scatter regions 7",
+                (|p: &mut ferrovol::FvPathTraceParams| p.scatter_regions = 7)
+                    as fn(&mut ferrovol::FvPathTraceParams),
+                "not an FvScatterRegions",
+            ),
+            ("roughness 0", |p| p.roughness = 0.0, "roughness 0"),
+            ("cone 90°", |p| p.cone_angle = 90.0, "cone angle 90"),
+            (
+                "ψ < 0",
+                |p| p.gradient_threshold = -1.0,
+                "gradient threshold",
+            ),
+            (
+                "k NaN",
+                |p| p.stochastic_blend = f32::NAN,
+                "stochastic blend",
+            ),
+            (
+                "0 secondary rays",
+                |p| p.secondary_rays = 0,
+                "secondary rays",
+            ),
+        ] {
+            bad = pt;
+            edit(&mut bad);
+            lib.expect(what, set_pt(r, &bad), FvStatus::InvalidArgument, words);
+        }
         lib.expect(
             "NULL params",
             set_pt(r, null()),
             FvStatus::NullArgument,
             "params is NULL",
+        );
+        // the hybrid model with a 2×2 budget renders
+        bad = pt;
+        bad.gradient_threshold = 0.5;
+        bad.secondary_rays = 2;
+        bad.scatter_regions = ferrovol::FvScatterRegions::Surfaces as u32;
+        assert_eq!(set_pt(r, &bad), FvStatus::Ok);
+        assert_eq!(
+            lib.f::<Render>("fv_renderer_render")(r, 16, 16, null(), 0),
+            FvStatus::Ok,
+            "{}",
+            lib.last_error()
         );
         pt.samples_per_frame = 2;
         assert_eq!(set_pt(r, &pt), FvStatus::Ok);
