@@ -163,6 +163,51 @@ void vtkFerroVolumeRepresentation::SetPathTracingBounces(int bounces)
   this->GetFerroVolumeMapper()->SetPathTracingBounces(bounces);
 }
 
+void vtkFerroVolumeRepresentation::SetSecondaryRays(int value)
+{
+  this->GetFerroVolumeMapper()->SetSecondaryRays(value);
+}
+
+void vtkFerroVolumeRepresentation::SetGradientThreshold(double value)
+{
+  this->GetFerroVolumeMapper()->SetGradientThreshold(value);
+}
+
+void vtkFerroVolumeRepresentation::SetStochasticBlend(double value)
+{
+  this->GetFerroVolumeMapper()->SetStochasticBlend(value);
+}
+
+void vtkFerroVolumeRepresentation::SetScatterRegions(int value)
+{
+  this->GetFerroVolumeMapper()->SetScatterRegions(value);
+}
+
+void vtkFerroVolumeRepresentation::SetAttenuation(int value)
+{
+  this->GetFerroVolumeMapper()->SetAttenuation(value);
+}
+
+void vtkFerroVolumeRepresentation::SetBsdfRoughness(double value)
+{
+  this->GetFerroVolumeMapper()->SetBsdfRoughness(value);
+}
+
+void vtkFerroVolumeRepresentation::SetBsdfFresnel(double value)
+{
+  this->GetFerroVolumeMapper()->SetBsdfFresnel(value);
+}
+
+void vtkFerroVolumeRepresentation::SetTransmission(double value)
+{
+  this->GetFerroVolumeMapper()->SetTransmission(value);
+}
+
+void vtkFerroVolumeRepresentation::SetTransmissionConeAngle(double value)
+{
+  this->GetFerroVolumeMapper()->SetTransmissionConeAngle(value);
+}
+
 //------------------------------------------------------------------------------------------
 const char* vtkFerroVolumeRepresentation::GetFerrovolVersion()
 {

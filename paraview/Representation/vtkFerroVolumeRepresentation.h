@@ -103,12 +103,24 @@ public:
   ///@{
   /**
    * Forwarded to vtkFerroVolumeMapper's path tracing settings: the render mode (ray cast 0,
-   * path trace 1), the still render's paths per pixel and the bounces per path. The
-   * anisotropy is the shared "VolumeAnisotropy" (vtkVolumeProperty::ScatteringAnisotropy).
+   * path trace 1), the still render's paths per pixel, the bounces per path, the ray
+   * budget's secondary rays, the hybrid model (gradient threshold, stochastic blend,
+   * scattering regions, attenuation) and the BSDF (roughness, Fresnel reflectance,
+   * transmission and its cone angle). The anisotropy is the shared "VolumeAnisotropy"
+   * (vtkVolumeProperty::ScatteringAnisotropy).
    */
   void SetRenderMode(int mode);
   void SetSamplesPerPixel(int samples);
   void SetPathTracingBounces(int bounces);
+  void SetSecondaryRays(int value);
+  void SetGradientThreshold(double value);
+  void SetStochasticBlend(double value);
+  void SetScatterRegions(int value);
+  void SetAttenuation(int value);
+  void SetBsdfRoughness(double value);
+  void SetBsdfFresnel(double value);
+  void SetTransmission(double value);
+  void SetTransmissionConeAngle(double value);
   ///@}
 
   /**

@@ -70,6 +70,11 @@ CHANGES = [
     ("FerrovolBlendMode", "Average Intensity", True),
     ("FerrovolBlendMode", "Additive", True),
     (("FerrovolRenderMode", "FerrovolSamplesPerPixel"), ["Path Trace", 4], True),
+    (("FerrovolRenderMode", "FerrovolSamplesPerPixel", "FerrovolSecondaryRays",
+      "FerrovolGradientThreshold", "FerrovolScatterRegions", "FerrovolAttenuation",
+      "FerrovolBsdfRoughness", "FerrovolBsdfFresnel", "FerrovolTransmission",
+      "FerrovolTransmissionConeAngle", "FerrovolStochasticBlend"),
+     ["Path Trace", 4, 2, 5.0, "At Surfaces", 0, 0.2, 0.1, 0.5, 20.0, 0.0], True),
     ("Shade", 1, True),
     ("FerrovolUseJittering", 1, True),
     (("FerrovolAutoAdjustSampleDistances", "FerrovolSampleDistance"), [0, 3.0], True),
@@ -92,7 +97,8 @@ for name, value, must_change in CHANGES:
     setp(name, value)
     Render(view)
     label = "%s=%s" % (name if not isinstance(name, tuple) else "+".join(name), value)
-    tag = "props-" + "".join(c if c.isalnum() or c in "-_." else "_" for c in label)
+    # (file names stay well under 255 bytes)
+    tag = "props-" + "".join(c if c.isalnum() or c in "-_." else "_" for c in label)[:100]
     img, _, _ = T.screenshot(view, tag)
     info = T.ferrovol_info(disp)
     box = T.volume_box(img, base)

@@ -50,6 +50,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -1189,6 +1190,15 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , SamplesPerPixel(64)
   , InteractiveSamplesPerPixel(1)
   , PathTracingBounces(64)
+  , SecondaryRays(1)
+  , GradientThreshold(VTK_DOUBLE_MAX)
+  , StochasticBlend(0.0)
+  , ScatterRegions(SCATTER_EVERYWHERE)
+  , Attenuation(1)
+  , BsdfRoughness(0.4)
+  , BsdfFresnel(0.04)
+  , Transmission(0.0)
+  , TransmissionConeAngle(30.0)
   , LastRenderDrew(0)
   , LastRenderSize{ 0, 0 }
   , Internals(new vtkInternals)
@@ -1860,8 +1870,20 @@ bool SetUpPathTracing(vtkFerroVolumeMapper* self, FvRenderer* r, vtkRenderer* re
   {
     pt.samples_per_frame = static_cast<uint32_t>(std::min(self->GetSamplesPerPixel(), 4096));
     pt.max_samples = static_cast<uint32_t>(self->GetSamplesPerPixel());
+    pt.secondary_rays = static_cast<uint32_t>(self->GetSecondaryRays());
   }
   pt.max_bounces = static_cast<uint32_t>(self->GetPathTracingBounces());
+  const double psi = self->GetGradientThreshold();
+  pt.gradient_threshold = psi >= static_cast<double>(FLT_MAX)
+    ? std::numeric_limits<float>::infinity()
+    : static_cast<float>(psi);
+  pt.stochastic_blend = static_cast<float>(std::min(self->GetStochasticBlend(), 1e30));
+  pt.scatter_regions = static_cast<uint32_t>(self->GetScatterRegions());
+  pt.attenuation = self->GetAttenuation() != 0;
+  pt.roughness = static_cast<float>(self->GetBsdfRoughness());
+  pt.fresnel = static_cast<float>(self->GetBsdfFresnel());
+  pt.transmission = static_cast<float>(self->GetTransmission());
+  pt.cone_angle = static_cast<float>(self->GetTransmissionConeAngle());
   // (|g| = 1 is a delta, which a Monte Carlo estimate cannot sample: clamp inside)
   pt.anisotropy = std::max(-0.99f, std::min(0.99f, prop->GetScatteringAnisotropy()));
   pt.background = self->GetEnvironmentBackground() != 0;
@@ -2693,6 +2715,15 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SamplesPerPixel: " << this->SamplesPerPixel << "\n";
   os << indent << "InteractiveSamplesPerPixel: " << this->InteractiveSamplesPerPixel << "\n";
   os << indent << "PathTracingBounces: " << this->PathTracingBounces << "\n";
+  os << indent << "SecondaryRays: " << this->SecondaryRays << "\n";
+  os << indent << "GradientThreshold: " << this->GradientThreshold << "\n";
+  os << indent << "StochasticBlend: " << this->StochasticBlend << "\n";
+  os << indent << "ScatterRegions: " << this->ScatterRegions << "\n";
+  os << indent << "Attenuation: " << this->Attenuation << "\n";
+  os << indent << "BsdfRoughness: " << this->BsdfRoughness << "\n";
+  os << indent << "BsdfFresnel: " << this->BsdfFresnel << "\n";
+  os << indent << "Transmission: " << this->Transmission << "\n";
+  os << indent << "TransmissionConeAngle: " << this->TransmissionConeAngle << "\n";
   os << indent << "LastRenderDrew: " << this->LastRenderDrew << "\n";
   os << indent << "LastRenderSize: " << this->LastRenderSize[0] << " x "
      << this->LastRenderSize[1] << "\n";

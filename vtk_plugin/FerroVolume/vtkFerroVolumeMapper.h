@@ -261,6 +261,74 @@ public:
   vtkGetMacro(PathTracingBounces, int);
   ///@}
 
+  ///@{
+  /**
+   * Path tracing, the ray budget: each SecondaryRays consecutive paths of a pixel share
+   * their camera ray and first collision (SamplesPerPixel = primary x secondary rays;
+   * default 1, independent paths). Interactive frames use independent paths.
+   */
+  vtkSetClampMacro(SecondaryRays, int, 1, 4096);
+  vtkGetMacro(SecondaryRays, int);
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing, the hybrid scattering model: collisions where the gradient magnitude
+   * (scalar units per world unit) exceeds GradientThreshold scatter by the surface-like
+   * BSDF oriented by the gradient, the others by Henyey-Greenstein with the property's
+   * ScatteringAnisotropy (default VTK_DOUBLE_MAX: Henyey-Greenstein everywhere). A
+   * StochasticBlend k > 0 replaces the threshold: the BSDF with probability
+   * 1 - exp(-k |grad s|) (default 0).
+   */
+  vtkSetClampMacro(GradientThreshold, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(GradientThreshold, double);
+  vtkSetClampMacro(StochasticBlend, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(StochasticBlend, double);
+  ///@}
+
+  enum ScatterRegionModes
+  {
+    SCATTER_NOWHERE = 0,
+    SCATTER_SURFACES = 1,
+    SCATTER_BETWEEN = 2,
+    SCATTER_EVERYWHERE = 3
+  };
+
+  ///@{
+  /**
+   * Path tracing: where collisions scatter (SCATTER_EVERYWHERE by default; SURFACES: only
+   * where the BSDF applies, BETWEEN: only where Henyey-Greenstein does, NOWHERE: none).
+   * With Attenuation on (the default) the other collisions absorb; off, they are left out
+   * (the medium is transparent there).
+   */
+  vtkSetClampMacro(ScatterRegions, int, SCATTER_NOWHERE, SCATTER_EVERYWHERE);
+  vtkGetMacro(ScatterRegions, int);
+  void SetScatterRegionsToNowhere() { this->SetScatterRegions(SCATTER_NOWHERE); }
+  void SetScatterRegionsToSurfaces() { this->SetScatterRegions(SCATTER_SURFACES); }
+  void SetScatterRegionsToBetween() { this->SetScatterRegions(SCATTER_BETWEEN); }
+  void SetScatterRegionsToEverywhere() { this->SetScatterRegions(SCATTER_EVERYWHERE); }
+  vtkSetMacro(Attenuation, vtkTypeBool);
+  vtkGetMacro(Attenuation, vtkTypeBool);
+  vtkBooleanMacro(Attenuation, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing, the BSDF: GGX roughness (0.01 to 1, default 0.4), Fresnel reflectance at
+   * normal incidence (0 to 1, default 0.04), the share of the rest transmitted through the
+   * surface (0 to 1, default 0) and the transmitted lobe's cone angle (half of it within
+   * this many degrees, 0.5 to 60, default 30).
+   */
+  vtkSetClampMacro(BsdfRoughness, double, 0.01, 1.0);
+  vtkGetMacro(BsdfRoughness, double);
+  vtkSetClampMacro(BsdfFresnel, double, 0.0, 1.0);
+  vtkGetMacro(BsdfFresnel, double);
+  vtkSetClampMacro(Transmission, double, 0.0, 1.0);
+  vtkGetMacro(Transmission, double);
+  vtkSetClampMacro(TransmissionConeAngle, double, 0.5, 60.0);
+  vtkGetMacro(TransmissionConeAngle, double);
+  ///@}
+
   /**
    * Path tracing: the paths per pixel the last frame shows (-1 before the first frame).
    */
@@ -374,6 +442,15 @@ protected:
   int SamplesPerPixel;
   int InteractiveSamplesPerPixel;
   int PathTracingBounces;
+  int SecondaryRays;
+  double GradientThreshold;
+  double StochasticBlend;
+  int ScatterRegions;
+  vtkTypeBool Attenuation;
+  double BsdfRoughness;
+  double BsdfFresnel;
+  double Transmission;
+  double TransmissionConeAngle;
   vtkTypeBool LastRenderDrew;
   int LastRenderSize[2];
 

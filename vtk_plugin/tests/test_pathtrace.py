@@ -73,6 +73,44 @@ class PathTrace(unittest.TestCase):
         log("mean |difference| to isotropic: g = -0.6: %.2f, g = +0.6: %.2f levels" % tuple(d))
         self.assertGreater(min(d), 0.3)
 
+    def test_hybrid_model_and_regions_change_the_image(self):
+        def hybrid(regions, attenuation=True):
+            def configure(m):
+                m.SetGradientThreshold(5.0)
+                m.SetScatterRegions(regions)
+                m.SetAttenuation(attenuation)
+                m.SetBsdfRoughness(0.3)
+                m.SetTransmission(0.3)
+            return configure
+        M = ferrovol.vtkFerroVolumeMapper
+        base = self.scene().render()
+        surfaces = self.scene(configure=hybrid(M.SCATTER_SURFACES)).render()
+        between = self.scene(configure=hybrid(M.SCATTER_BETWEEN)).render()
+        clear = self.scene(configure=hybrid(M.SCATTER_SURFACES, False)).render()
+        save("pathtrace-regions", base, surfaces, between, clear)
+        d = [float(np.abs(x - base).mean()) for x in (surfaces, between)]
+        d.append(float(np.abs(clear - surfaces).mean()))
+        log("mean |difference| to Henyey-Greenstein everywhere: surfaces only %.2f, "
+            "between only %.2f levels; surfaces only without attenuation against with: "
+            "%.2f levels" % tuple(d))
+        self.assertEqual(self.errors.messages, [])
+        self.assertGreater(min(d), 0.3)
+
+    def test_ray_budget_shares_primary_rays(self):
+        plain = self.scene().render()
+        s = self.scene(configure=lambda m: m.SetSecondaryRays(16))
+        shared = s.render()
+        save("pathtrace-budget", plain, shared)
+        d = float(np.abs(shared - plain).mean())
+        ratio = float(shared.mean() / plain.mean())
+        log("budget 1x16 against 16x1: mean |difference| %.2f levels, mean brightness ratio "
+            "%.3f, %d paths per pixel" % (d, ratio, s.mapper.GetAccumulatedSamples()))
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 16)
+        # the same image on average (5%: 96x96 pixels of 1 primary ray each), with the noise
+        # of one primary ray per pixel
+        self.assertLess(abs(ratio - 1.0), 0.05)
+        self.assertGreater(d, 0.3)
+
     def test_what_path_tracing_cannot_do_is_reported(self):
         s = self.scene(configure=lambda m: (m.CroppingOn(),
                                             m.SetCroppingRegionPlanes(-5, 5, -5, 5, -5, 5)))
