@@ -9,6 +9,7 @@
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
 #include "lib/shading.wgsl"
+#include "lib/shadow.wgsl"
 #include "lib/output.wgsl"
 
 // Pipeline constants: each combination is its own pipeline, so the ray loop carries only
@@ -23,6 +24,8 @@ override CROP: bool = false;
 // One brick: the ray state starts empty here and the pass writes the output pixel itself
 // (no state buffer traffic, no resolve pass).
 override SINGLE_BRICK: bool = false;
+// Volumetric shadows (lib/shadow.wgsl; one component, one brick, shading on).
+override VOLUMETRIC: bool = false;
 
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
 // Per block of the occupancy grid: 1 when the transfer function gives some block voxel a
@@ -63,11 +66,16 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         }
         if (need_grad) {
             let g = world_gradient(gradient_at(p, s), 0u);
+            let a = e.a;
             if (GRAD_OPACITY) {
                 e.a = e.a * gradient_opacity(0u, length(g));
             }
             if (SHADE) {
-                e = vec4<f32>(shade(e.rgb, g, pos, view_dir), e.a);
+                var rgb = shade(e.rgb, g, pos, view_dir);
+                if (VOLUMETRIC) {
+                    rgb = volumetric_shade(e.rgb, a, g, rgb, p, pos, view_dir, GRAD_OPACITY);
+                }
+                e = vec4<f32>(rgb, e.a);
             }
         }
         return e;
@@ -183,6 +191,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var jit = 1.0; // VTK: g_rayOrigin += g_dirStep (no jitter): the first sample one step in
     if (has_flag(FLAG_JITTER)) {
         jit = hash01(pix ^ frame.viewport.w);
+        shadow_jitter = jit;
     }
     if (!(max(seg.x, cl.x) < min(seg.y, cl.y))) {
         seg = vec2<f32>(1.0, 0.0);

@@ -88,6 +88,13 @@ struct RenderArgs {
     /// Phong shading from on-the-fly gradients (VTK's Shade on).
     #[arg(long)]
     shade: bool,
+    /// Volumetric shadows with --shade, blended with the gradient shading as VTK's
+    /// VolumetricScatteringBlending: 0 off, 2 volumetric only (anisotropy: --g).
+    #[arg(long, default_value_t = 0.0, requires = "shade")]
+    volumetric: f32,
+    /// How far shadow rays reach, 0 to 1 (VTK's GlobalIlluminationReach).
+    #[arg(long, default_value_t = 0.0)]
+    reach: f32,
     /// Transfer function: a preset name (see --help-presets) or a JSON file.
     #[arg(long)]
     tf: Option<String>,
@@ -640,6 +647,9 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         ..Default::default()
     };
     params.shading.enabled = a.shade;
+    params.shading.volumetric_blending = a.volumetric;
+    params.shading.global_illumination_reach = a.reach;
+    params.shading.scattering_anisotropy = a.pt.anisotropy;
     if a.iso.no_lights {
         view.lights.clear();
     }

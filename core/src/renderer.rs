@@ -234,10 +234,11 @@ pub(crate) struct DvrVariant {
     single_brick: bool,
     positional_lights: bool,
     lights: u32,
+    volumetric: bool,
 }
 
 impl DvrVariant {
-    fn constants(&self) -> [(&'static str, f64); 11] {
+    fn constants(&self) -> [(&'static str, f64); 12] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         [
             ("BLEND", self.blend as f64),
@@ -251,6 +252,7 @@ impl DvrVariant {
             ("SINGLE_BRICK", b(self.single_brick)),
             ("POSITIONAL_LIGHTS", b(self.positional_lights)),
             ("NUM_LIGHTS", self.lights as f64),
+            ("VOLUMETRIC", b(self.volumetric)),
         ]
     }
 }
@@ -1012,6 +1014,49 @@ impl Renderer {
         if depth_input {
             flags |= FLAG_DEPTH_INPUT;
         }
+        // VTK's volumetric shadows: composite, shaded, lit; one component in one brick (the
+        // shadow rays read the whole volume from one texture).
+        let volumetric = s.enabled
+            && s.volumetric_blending > 0.0
+            && nl > 0
+            && params.blend == BlendMode::Composite;
+        if volumetric {
+            if vol.bricks.len() != 1 || vol.components != 1 {
+                return Err(Error::Unsupported(format!(
+                    "volumetric scattering needs a one-component volume in one brick (this one \
+                     has {} component(s) in {} brick(s)): turn the scattering blending off",
+                    vol.components,
+                    vol.bricks.len()
+                )));
+            }
+            let extent = [DVec3::X, DVec3::Y, DVec3::Z]
+                .iter()
+                .zip(vol.data_dims)
+                .map(|(axis, n)| {
+                    index_to_world.transform_vector3(*axis).length() * (n.max(2) - 1) as f64
+                })
+                .fold(0.0, f64::max);
+            // VTK: reach = √3 + (m − √3)(1 − R)^0.33 texture units, m the sample distance
+            // over the largest extent
+            let m = step / extent;
+            let root3 = 3f64.sqrt();
+            let reach = root3 + (m - root3) * (1.0 - s.global_illumination_reach as f64).powf(0.33);
+            let (lo, hi) = vol
+                .minmax
+                .ranges
+                .iter()
+                .step_by(vol.components as usize)
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), r| {
+                    (lo.min(r[0]), hi.max(r[1]))
+                });
+            let range = if hi > lo { (hi - lo) as f64 } else { 1.0 };
+            u.scatter = [
+                s.volumetric_blending,
+                s.scattering_anisotropy,
+                reach as f32,
+                (2.0 / range) as f32,
+            ];
+        }
         u.viewport = [view.width, view.height, 0, 0x9e37_79b9];
         u.rect = screen_rect(vp, index_to_world, vol.data_dims, view.width, view.height);
         u.mode[0] = params.blend.code();
@@ -1040,6 +1085,7 @@ impl Renderer {
             single_brick: vol.bricks.len() == 1,
             positional_lights: u.lights[..nl].iter().any(|l| l.position[3] == 1.0),
             lights: nl as u32,
+            volumetric,
         };
         Ok((u, variant))
     }

@@ -35,6 +35,10 @@ pub const FILES: &[(&str, &str)] = &[
     ),
     ("lib/bsdf.wgsl", include_str!("../../shaders/lib/bsdf.wgsl")),
     (
+        "lib/shadow.wgsl",
+        include_str!("../../shaders/lib/shadow.wgsl"),
+    ),
+    (
         "lib/surface.wgsl",
         include_str!("../../shaders/lib/surface.wgsl"),
     ),

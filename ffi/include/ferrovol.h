@@ -447,6 +447,20 @@ typedef struct FvRenderParams {
    * The vtkVolume's matrix (data → world), column-major.
    */
   double volume_matrix[16];
+  /**
+   * Volumetric shadows blended with the gradient shading (composite, shade on), as
+   * vtkGPUVolumeRayCastMapper::VolumetricScatteringBlending: 0 off … 2 volumetric only.
+   */
+  float volumetric_scattering_blending;
+  /**
+   * How far shadow rays reach, [0, 1] (GlobalIlluminationReach).
+   */
+  float global_illumination_reach;
+  /**
+   * Henyey–Greenstein anisotropy of the volumetric term, [−1, 1]
+   * (vtkVolumeProperty::ScatteringAnisotropy).
+   */
+  float scattering_anisotropy;
 } FvRenderParams;
 
 /**

@@ -234,6 +234,14 @@ pub struct FvRenderParams {
     pub depth_threshold: f32,
     /// The vtkVolume's matrix (data → world), column-major.
     pub volume_matrix: [f64; 16],
+    /// Volumetric shadows blended with the gradient shading (composite, shade on), as
+    /// vtkGPUVolumeRayCastMapper::VolumetricScatteringBlending: 0 off … 2 volumetric only.
+    pub volumetric_scattering_blending: f32,
+    /// How far shadow rays reach, [0, 1] (GlobalIlluminationReach).
+    pub global_illumination_reach: f32,
+    /// Henyey–Greenstein anisotropy of the volumetric term, [−1, 1]
+    /// (vtkVolumeProperty::ScatteringAnisotropy).
+    pub scattering_anisotropy: f32,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -286,6 +294,9 @@ impl FvRenderParams {
             empty_space_skipping: d.empty_space_skipping,
             depth_threshold: d.depth_threshold,
             volume_matrix: DMat4::IDENTITY.to_cols_array(),
+            volumetric_scattering_blending: d.shading.volumetric_blending,
+            global_illumination_reach: d.shading.global_illumination_reach,
+            scattering_anisotropy: d.shading.scattering_anisotropy,
         }
     }
 
@@ -340,6 +351,9 @@ impl FvRenderParams {
                 specular: self.specular,
                 specular_power: self.specular_power,
                 two_sided: self.two_sided_lighting,
+                volumetric_blending: self.volumetric_scattering_blending,
+                global_illumination_reach: self.global_illumination_reach,
+                scattering_anisotropy: self.scattering_anisotropy,
             },
             cropping: self.cropping.then_some(Cropping {
                 planes: self.cropping_planes,

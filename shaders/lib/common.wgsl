@@ -63,6 +63,7 @@ struct Frame {
     misc: vec4<f32>,              // sample distance, termination threshold, depth threshold, gradient epsilon
     average_range: vec4<f32>,     // xy: scalar range the average blend mode keeps
     additive_scale: vec4<f32>,    // per component: sample distance / unit distance
+    scatter: vec4<f32>,           // volumetric shadows: x blending (0 off), y anisotropy, z reach (texture units), w 2 / data range
     clip: array<vec4<f32>, 6>,    // index-space planes: keep dot(xyz, p) + w >= 0
     lights: array<Light, 8>,
     viewport: vec4<u32>,          // width, height, unused, jitter seed

@@ -134,6 +134,8 @@ def render(scene, kind):
         ren.AddVolume(vol)
         for a in (scene.actors() if scene.actors else []):
             ren.AddActor(a)
+        if scene.lights:
+            scene.lights(ren)
         win.AddRenderer(ren)
         ren.ResetCamera()
         if view.camera:

@@ -1190,6 +1190,8 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , SamplesPerPixel(64)
   , InteractiveSamplesPerPixel(1)
   , PathTracingBounces(64)
+  , VolumetricScatteringBlending(0.0)
+  , GlobalIlluminationReach(0.0)
   , SecondaryRays(1)
   , GradientThreshold(VTK_DOUBLE_MAX)
   , StochasticBlend(0.0)
@@ -2340,6 +2342,13 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   params.specular = static_cast<float>(prop->GetSpecular(0));
   params.specular_power = static_cast<float>(prop->GetSpecularPower(0));
   params.two_sided_lighting = ren->GetTwoSidedLighting() != 0;
+  if (!isosurface)
+  {
+    params.volumetric_scattering_blending =
+      static_cast<float>(this->VolumetricScatteringBlending);
+    params.global_illumination_reach = static_cast<float>(this->GlobalIlluminationReach);
+    params.scattering_anisotropy = std::max(-1.0f, std::min(1.0f, prop->GetScatteringAnisotropy()));
+  }
   params.cropping = this->Cropping != 0;
   for (int i = 0; i < 6; ++i)
   {
@@ -2715,6 +2724,8 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SamplesPerPixel: " << this->SamplesPerPixel << "\n";
   os << indent << "InteractiveSamplesPerPixel: " << this->InteractiveSamplesPerPixel << "\n";
   os << indent << "PathTracingBounces: " << this->PathTracingBounces << "\n";
+  os << indent << "VolumetricScatteringBlending: " << this->VolumetricScatteringBlending << "\n";
+  os << indent << "GlobalIlluminationReach: " << this->GlobalIlluminationReach << "\n";
   os << indent << "SecondaryRays: " << this->SecondaryRays << "\n";
   os << indent << "GradientThreshold: " << this->GradientThreshold << "\n";
   os << indent << "StochasticBlend: " << this->StochasticBlend << "\n";

@@ -263,6 +263,21 @@ public:
 
   ///@{
   /**
+   * Volumetric shadows (single scattering) in the composite blend mode with Shade on and
+   * at least one light, with vtkGPUVolumeRayCastMapper's meaning: VolumetricScatteringBlending
+   * 0 (default) off, up to 1 the volumetric share grows where gradient and opacity are
+   * small, 2 volumetric only; GlobalIlluminationReach from 0 (shadow rays about one step
+   * long, the default) to 1 (across the volume). The anisotropy is the property's
+   * ScatteringAnisotropy. Needs a one-component volume that fits in one 3D texture.
+   */
+  vtkSetClampMacro(VolumetricScatteringBlending, double, 0.0, 2.0);
+  vtkGetMacro(VolumetricScatteringBlending, double);
+  vtkSetClampMacro(GlobalIlluminationReach, double, 0.0, 1.0);
+  vtkGetMacro(GlobalIlluminationReach, double);
+  ///@}
+
+  ///@{
+  /**
    * Path tracing, the ray budget: each SecondaryRays consecutive paths of a pixel share
    * their camera ray and first collision (SamplesPerPixel = primary x secondary rays;
    * default 1, independent paths). Interactive frames use independent paths.
@@ -442,6 +457,8 @@ protected:
   int SamplesPerPixel;
   int InteractiveSamplesPerPixel;
   int PathTracingBounces;
+  double VolumetricScatteringBlending;
+  double GlobalIlluminationReach;
   int SecondaryRays;
   double GradientThreshold;
   double StochasticBlend;
