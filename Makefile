@@ -129,4 +129,6 @@ pictures: build
 	$(FERROVOL) render build/data/cranium.vti --tf ct-skin-bone --shade --elevation -90 --size 640x640 --out docs/img/cranium-ct.png
 	$(FERROVOL) render build/data/cranium.vti --mode iso --iso 400 --iso=-500:0.25 --ao 16 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 640x640 --out docs/img/cranium-iso.png
 	$(FERROVOL) render build/data/cranium.vti --mode pathtrace --tf ct-bone --spp 64 --g 0.2 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 256x256 --out docs/img/cranium-pathtrace.png
+	$(FERROVOL) render build/data/cranium.vti --mode pathtrace --tf ct-bone --spp 64 --g 0.2 --psi 100 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 256x256 --out docs/img/cranium-pathtrace-hybrid.png
+	for b in 1x64 8x8 64x1; do $(FERROVOL) render build/data/cranium.vti --mode pathtrace --tf ct-bone --budget $$b --g 0.2 --psi 100 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 256x256 --out docs/img/cranium-budget-$$b.png; done
 	$(FERROVOL) render build/data/colin27.nii.gz --mode iso --iso 60:0.35:0.92,0.72,0.62 --iso 115:1:0.9,0.88,0.82 --ao 16 --elevation 90 --view-up z --env-up z --zoom 1.2 --size 640x640 --out docs/img/mri-iso.png
