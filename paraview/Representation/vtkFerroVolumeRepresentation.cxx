@@ -148,6 +148,18 @@ void vtkFerroVolumeRepresentation::SetFresnel(double reflectance)
   this->GetFerroVolumeMapper()->SetFresnel(reflectance);
 }
 
+void vtkFerroVolumeRepresentation::SetGlobalIlluminationReach(float reach)
+{
+  this->Superclass::SetGlobalIlluminationReach(reach);
+  this->GetFerroVolumeMapper()->SetGlobalIlluminationReach(reach);
+}
+
+void vtkFerroVolumeRepresentation::SetVolumetricScatteringBlending(float blending)
+{
+  this->Superclass::SetVolumetricScatteringBlending(blending);
+  this->GetFerroVolumeMapper()->SetVolumetricScatteringBlending(blending);
+}
+
 void vtkFerroVolumeRepresentation::SetRenderMode(int mode)
 {
   this->GetFerroVolumeMapper()->SetRenderMode(mode);

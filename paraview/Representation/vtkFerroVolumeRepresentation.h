@@ -110,6 +110,18 @@ public:
    * (vtkVolumeProperty::ScatteringAnisotropy).
    */
   void SetRenderMode(int mode);
+
+  ///@{
+  /**
+   * ParaView's shared "Global Illumination Reach" and "Volumetric Scattering Blending":
+   * forwarded to the base class's mapper and to vtkFerroVolumeMapper (volumetric shadows).
+   * (The base class's setters are not virtual: the client-server wrapping of this class
+   * calls these.)
+   */
+  void SetGlobalIlluminationReach(float reach);
+  void SetVolumetricScatteringBlending(float blending);
+  ///@}
+
   void SetSamplesPerPixel(int samples);
   void SetPathTracingBounces(int bounces);
   void SetSecondaryRays(int value);

@@ -76,6 +76,7 @@ CHANGES = [
       "FerrovolTransmissionConeAngle", "FerrovolStochasticBlend"),
      ["Path Trace", 4, 2, 5.0, "At Surfaces", 0, 0.2, 0.1, 0.5, 20.0, 0.0], True),
     ("Shade", 1, True),
+    (("Shade", "VolumetricScatteringBlending", "GlobalIlluminationReach"), [1, 2.0, 0.5], True),
     ("FerrovolUseJittering", 1, True),
     (("FerrovolAutoAdjustSampleDistances", "FerrovolSampleDistance"), [0, 3.0], True),
     (("FerrovolAutoAdjustSampleDistances", "FerrovolImageSampleDistance"), [0, 4.0], True),
