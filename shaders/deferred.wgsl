@@ -7,11 +7,27 @@
 //   - specular weighted by Schlick's Fresnel term when enabled; the exponent s from the
 //     gradient magnitude (or constant);
 // and composited with its iso-value's opacity; then the environment behind, if asked for.
+//
+// Scattering restricted to the isosurfaces (the lecture's fast path, SCATTER > 0): light
+// enters at the first surface, travels inward along the view ray to the next surface (or
+// out of the volume), absorbed by the medium between (extinction from the transfer
+// function's opacity, as the path tracer reads it), scatters there (Lambertian, the
+// inner surface's colour as albedo), and leaves toward the environment. The preview
+// (SCATTER 1) assumes the way out absorbs as much as the way in (the transmittance
+// squared) and reads the irradiance cube at the inner surface; the traced version
+// (SCATTER 2) marches iso.scatter.y cosine-distributed directions from the inner surface
+// out of the volume and reads the environment where each leaves. The first surface's own
+// shading and the scattered light are blended by Schlick's Fresnel term, and the first
+// surface is then opaque.
 #include "lib/common.wgsl"
 #include "lib/ray.wgsl"
+#include "lib/volume.wgsl"
 #include "lib/surface.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/iso.wgsl"
+
+// 0: no scattering; 1: the preview; 2: traced (pipeline constant).
+override SCATTER: u32 = 0u;
 
 @group(0) @binding(2) var<storage, read> state: array<PixelState>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
@@ -104,6 +120,55 @@ fn shade_surface(color: vec3<f32>, pos: vec3<f32>, n: vec3<f32>, gmag: f32, ao: 
     return clamp(rgb, vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
+// Extinction per world unit at world point x (the first component's opacity α as
+// −ln(1 − α) per unit distance, scaled).
+fn absorption_at(x: vec3<f32>) -> f32 {
+    let p = (frame.world_to_index * vec4<f32>(x, 1.0)).xyz;
+    let a = min(raw_alpha(0u, sample_scalars(p).x), 0.9999);
+    return -log(1.0 - a) * iso.scatter.x;
+}
+
+// Optical depth from x along the unit direction d over `len` world units (midpoint rule
+// in steps of at most the sample distance).
+fn optical_depth(x: vec3<f32>, d: vec3<f32>, len: f32) -> f32 {
+    let n = min(u32(ceil(max(len, 0.0) / frame.misc.x)), 8192u);
+    let h = len / f32(max(n, 1u));
+    var tau = 0.0;
+    for (var i = 0u; i < n; i = i + 1u) {
+        tau = tau + absorption_at(x + (f32(i) + 0.5) * h * d) * h;
+    }
+    return tau;
+}
+
+// World distance from x along the unit direction d to where it leaves the volume.
+fn volume_exit(x: vec3<f32>, d: vec3<f32>) -> f32 {
+    let seg = box_interval(ray_from(x, d), vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    return max(seg.y, 0.0);
+}
+
+// The light scattered back toward the viewer by the inner surface at x1 (normal n1 facing
+// the viewer, albedo c1), reached through transmittance t_in from the first surface.
+fn scattered_light(x1: vec3<f32>, n1: vec3<f32>, c1: vec3<f32>, t_in: f32, px: vec2<u32>) -> vec3<f32> {
+    if (SCATTER == 1u) {
+        let irr = textureSampleLevel(irradiance_cube, env_sampler, env_direction(n1), 0.0).rgb;
+        return c1 * irr * t_in * t_in;
+    }
+    // cosine-distributed directions (the irradiance cube's weighting), the Hammersley set
+    // turned by a per-pixel angle
+    let count = u32(iso.scatter.y);
+    let b = basis_around(n1);
+    let turn = 2.0 * PI * hash01(px.y * 65536u + px.x);
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < count; k = k + 1u) {
+        let u = hammersley(k, count);
+        let w = b * cosine_hemisphere(vec2<f32>(u.x, fract(u.y + turn / (2.0 * PI))));
+        let start = x1 + 1e-3 * frame.misc.x * w;
+        let tau = optical_depth(start, w, volume_exit(start, w));
+        sum = sum + exp(-tau) * env_radiance(env_direction(w), 0.0);
+    }
+    return c1 * (sum / f32(max(count, 1u))) * t_in;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = iso.shade_rect;
@@ -122,6 +187,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var color = vec4<f32>(0.0);
     var depth = 1.0;
     var depth_set = false;
+    if (SCATTER > 0u && layers > 0u) {
+        let gp = textureLoad(g_position, c, 0, 0);
+        let gn = textureLoad(g_normal, c, 0, 0);
+        let ge = textureLoad(g_extra, c, 0, 0);
+        let c0 = iso.colors[min(u32(gp.w), MAX_ISO - 1u)].rgb;
+        // the next surface inward along the view ray, or where the ray leaves the volume
+        var x1 = gp.xyz + ray.dir * volume_exit(gp.xyz, ray.dir);
+        var n1 = gn.xyz;
+        var c1 = c0;
+        if (layers > 1u) {
+            let gp1 = textureLoad(g_position, c, 1, 0);
+            x1 = gp1.xyz;
+            n1 = textureLoad(g_normal, c, 1, 0).xyz;
+            c1 = iso.colors[min(u32(gp1.w), MAX_ISO - 1u)].rgb;
+        }
+        let t_in = exp(-optical_depth(gp.xyz, ray.dir, distance(gp.xyz, x1)));
+        let inner = iso.env.x * scattered_light(x1, n1, c1, t_in, px);
+        let f0 = iso.scatter.z;
+        let f = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(gn.xyz, v), 0.0, 1.0), 5.0);
+        let surface = shade_surface(c0, gp.xyz, gn.xyz, gn.w, ge.y, v);
+        color = vec4<f32>(clamp(f * surface + (1.0 - f) * inner, vec3<f32>(0.0), vec3<f32>(1.0)), 1.0);
+        depth = ge.x;
+        layers = 0u;
+    }
     for (var l = 0u; l < layers; l = l + 1u) {
         let gp = textureLoad(g_position, c, i32(l), 0);
         let gn = textureLoad(g_normal, c, i32(l), 0);

@@ -135,17 +135,6 @@ fn env_sample(u: vec3<f32>) -> vec3<f32> {
     return transpose(m) * e;
 }
 
-// A ray from a world point in a world direction (secondary rays).
-fn ray_from(origin: vec3<f32>, dir: vec3<f32>) -> Ray {
-    var r: Ray;
-    r.origin = origin;
-    r.dir = dir;
-    r.far = 3.0e38;
-    r.index_origin = (frame.world_to_index * vec4<f32>(origin, 1.0)).xyz;
-    r.index_dir = (frame.world_to_index * vec4<f32>(dir, 0.0)).xyz;
-    return r;
-}
-
 // The part of a secondary ray inside the volume and on the kept side of the clipping planes.
 fn inner_segment(r: Ray) -> vec2<f32> {
     var seg = box_interval(r, vec3<f32>(0.0), frame.dims.xyz - 1.0);

@@ -7,8 +7,9 @@ mod readers;
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
     synth, AmbientOcclusion, BlendMode, BsdfParams, Context, Environment, GradientMethod,
-    Interpolation, IsoParams, IsoValue, PathTraceParams, RenderParams, Renderer, ScatterRegions,
-    Shininess, SpecularMode, UploadOptions, View, VolumeData,
+    Interpolation, IsoParams, IsoScatterMode, IsoScattering, IsoValue, PathTraceParams,
+    RenderParams, Renderer, ScatterRegions, Shininess, SpecularMode, UploadOptions, View,
+    VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -260,9 +261,27 @@ fn parse_budget(s: &str) -> Result<(u32, u32), String> {
     Ok((p, q))
 }
 
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
+enum ScatterInside {
+    Preview,
+    Traced,
+}
+
 /// Isosurface options (--mode iso).
 #[derive(clap::Args)]
 struct IsoArgs {
+    /// Light scattered between the isosurfaces (lit by the environment): preview
+    /// (transmittance squared, the irradiance cube) or traced (--scatter-samples
+    /// directions out of the volume); the first surface becomes opaque, blended with the
+    /// scattered light by --fresnel (default 0.04).
+    #[arg(long = "scatter-inside", value_enum)]
+    scatter_inside: Option<ScatterInside>,
+    /// Directions traced per pixel with --scatter-inside traced.
+    #[arg(long, default_value_t = 16)]
+    scatter_samples: u32,
+    /// Multiplies the medium's extinction between the surfaces (0: no absorption).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    absorption: f32,
     /// An isosurface, VALUE[:OPACITY[:R,G,B]] (opacity in (0, 1], default 1; colour
     /// components in [0, 1]); repeat for nested surfaces, e.g. --iso 300 --iso -300:0.3.
     /// Default: the middle of the data range.
@@ -459,6 +478,15 @@ fn iso_setup(a: &IsoArgs, vol: &VolumeData) -> Result<(IsoParams, Environment), 
         }),
         environment_light: a.env_light.unwrap_or(0.6),
         background: a.env_background,
+        scattering: a.scatter_inside.map(|mode| IsoScattering {
+            mode: match mode {
+                ScatterInside::Preview => IsoScatterMode::Preview,
+                ScatterInside::Traced => IsoScatterMode::Traced,
+            },
+            samples: a.scatter_samples,
+            absorption: a.absorption,
+            fresnel: a.fresnel.unwrap_or(IsoScattering::default().fresnel),
+        }),
     };
     iso.validate()?;
     Ok((iso, environment_setup(a)?))

@@ -97,6 +97,32 @@ fn iso_flags_reject_bad_values_with_a_message() {
         (vec!["--iso", "0.5", "--layers", "9"], "layers"),
         (vec!["--iso", "0.5", "--shininess", "-1"], "non-negative"),
         (vec!["--iso", "0.5", "--fresnel", "2"], "Fresnel"),
+        (
+            vec![
+                "--iso",
+                "0.5",
+                "--scatter-inside",
+                "traced",
+                "--scatter-samples",
+                "0",
+            ],
+            "scattering directions",
+        ),
+        (
+            vec![
+                "--iso",
+                "0.5",
+                "--scatter-inside",
+                "preview",
+                "--absorption",
+                "-1",
+            ],
+            "absorption",
+        ),
+        (
+            vec!["--iso", "0.5", "--scatter-inside", "sometimes"],
+            "invalid value",
+        ),
     ] {
         let mut all = vec!["render", "--demo", "marschner-lobb", "--mode", "iso"];
         all.extend(&args);
@@ -141,6 +167,29 @@ fn iso_render_of_nested_surfaces_with_ao() {
     let black = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
     println!("black pixels: {black}");
     assert_eq!(black, 0);
+    // light scattered between the surfaces, traced
+    let (code, _, err) = ferrovol(&[
+        "render",
+        "--demo",
+        "marschner-lobb",
+        "--mode",
+        "iso",
+        "--iso",
+        "0.7",
+        "--iso",
+        "0.3",
+        "--scatter-inside",
+        "traced",
+        "--scatter-samples",
+        "4",
+        "--absorption",
+        "0.5",
+        "--size",
+        "32x32",
+        "--out",
+        path,
+    ]);
+    assert_eq!(code, 0, "{err}");
 }
 
 #[test]

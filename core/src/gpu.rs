@@ -81,6 +81,7 @@ pub struct IsoUniforms {
     pub counts: [u32; 4],
     pub options: [u32; 4],
     pub shade_rect: [u32; 4],
+    pub scatter: [f32; 4],
 }
 
 /// The path tracer's uniforms (`PathTrace` in shaders/pathtrace.wgsl).
@@ -253,7 +254,8 @@ mod layout_tests {
                     env,
                     counts,
                     options,
-                    shade_rect
+                    shade_rect,
+                    scatter
                 ]
             );
         }

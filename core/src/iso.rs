@@ -166,7 +166,52 @@ pub struct IsoParams {
     pub environment_light: f32,
     /// Show the environment behind the surfaces (the frame becomes opaque).
     pub background: bool,
+    /// Light scattered between the surfaces (the fast path of multiple scattering):
+    /// `None` (the default) shades the layers as surfaces only.
+    pub scattering: Option<IsoScattering>,
 }
+
+/// How [`IsoScattering`] follows the light inside.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IsoScatterMode {
+    /// The real-time preview: the way out absorbs as much as the way in (transmittance
+    /// squared), the environment's light from the irradiance cube.
+    Preview,
+    /// The final version: directions traced from the inner surface out of the volume.
+    Traced,
+}
+
+/// Scattering restricted to the isosurfaces (shaders/deferred.wgsl): light enters at the
+/// first surface, is absorbed on its way inward to the next surface (extinction from the
+/// first component's transfer function, as the path tracer reads it, times `absorption`),
+/// scatters there (Lambertian, albedo the inner surface's colour), and leaves toward the
+/// environment; the result and the first surface's own shading are blended by Schlick's
+/// Fresnel term, and the first surface is opaque. Lit by the environment (weight
+/// [`IsoParams::environment_light`]); the volume must fit in one brick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsoScattering {
+    pub mode: IsoScatterMode,
+    /// Directions traced per pixel (Traced), 1 to [`MAX_SCATTER_SAMPLES`].
+    pub samples: u32,
+    /// Multiplies the medium's extinction (0: nothing is absorbed).
+    pub absorption: f32,
+    /// Fresnel reflectance at normal incidence of the first surface (0 to 1).
+    pub fresnel: f32,
+}
+
+impl Default for IsoScattering {
+    fn default() -> Self {
+        IsoScattering {
+            mode: IsoScatterMode::Preview,
+            samples: 16,
+            absorption: 1.0,
+            fresnel: 0.04,
+        }
+    }
+}
+
+/// Most directions [`IsoScattering`] traces per pixel.
+pub const MAX_SCATTER_SAMPLES: u32 = 256;
 
 impl Default for IsoParams {
     fn default() -> Self {
@@ -181,6 +226,7 @@ impl Default for IsoParams {
             ambient_occlusion: None,
             environment_light: 0.6,
             background: false,
+            scattering: None,
         }
     }
 }
@@ -290,6 +336,26 @@ impl IsoParams {
                 self.environment_light
             ));
         }
+        if let Some(sc) = &self.scattering {
+            if !(1..=MAX_SCATTER_SAMPLES).contains(&sc.samples) {
+                return bad(format!(
+                    "{} scattering directions: give 1 to {MAX_SCATTER_SAMPLES}",
+                    sc.samples
+                ));
+            }
+            if !(sc.absorption.is_finite() && sc.absorption >= 0.0) {
+                return bad(format!(
+                    "scattering absorption scale {} must be finite and non-negative",
+                    sc.absorption
+                ));
+            }
+            if !(0.0..=1.0).contains(&sc.fresnel) {
+                return bad(format!(
+                    "scattering Fresnel reflectance {} must be in [0, 1]",
+                    sc.fresnel
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -365,6 +431,8 @@ struct FirstHitVariant {
 struct DeferredVariant {
     lights: u32,
     positional_lights: bool,
+    /// 0 none, 1 preview, 2 traced (IsoScattering).
+    scatter: u32,
 }
 
 struct GBufferTargets {
@@ -487,6 +555,7 @@ impl IsoGpu {
                 texture_entry(12, true, V::Cube),
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
+                buffer_entry(1, B::Storage { read_only: true }),
             ],
         });
         let layout = |name: &str, bgls: &[Option<&wgpu::BindGroupLayout>]| {
@@ -497,7 +566,7 @@ impl IsoGpu {
             })
         };
         let firsthit_layout = layout("firsthit.wgsl", &[Some(&firsthit_bgl), Some(brick_bgl)]);
-        let deferred_layout = layout("deferred.wgsl", &[Some(&deferred_bgl)]);
+        let deferred_layout = layout("deferred.wgsl", &[Some(&deferred_bgl), Some(brick_bgl)]);
         let firsthit_module = shader_module(ctx, "firsthit.wgsl")?;
         let deferred_module = shader_module(ctx, "deferred.wgsl")?;
         let env_pipelines = EnvPipelines::new(ctx)?;
@@ -621,6 +690,7 @@ impl IsoGpu {
             let c = [
                 ("NUM_LIGHTS", df.lights as f64),
                 ("POSITIONAL_LIGHTS", b(df.positional_lights)),
+                ("SCATTER", df.scatter as f64),
             ];
             let p = create(
                 "deferred shading",
@@ -833,6 +903,8 @@ impl Renderer {
         }
         self.ensure_environment()?;
         let step = self.sample_distance(params)?;
+        // (the scattering pass reads the transfer function's opacity)
+        self.ensure_tables(step)?;
         let spacing = self.sample_distance(&RenderParams {
             sample_distance: None,
             ..params.clone()
@@ -862,6 +934,17 @@ impl Renderer {
                 [a[0].min(r[0][0]), a[1].max(r[0][1])]
             });
         let single_brick = vol.bricks.len() == 1;
+        if iso.scattering.is_some() && !single_brick {
+            return Err(Error::Unsupported(format!(
+                "scattering between isosurfaces needs the volume in one brick; it is split \
+                 into {} (it exceeds the device's 3D texture or allocation limits)",
+                vol.bricks.len()
+            )));
+        }
+        let unit = self
+            .tf
+            .as_ref()
+            .map_or(1.0, |tf| tf.component(0).unit_distance);
         let full = [0, 0, view.width, view.height];
         let ctx = self.ctx.clone();
         let g = self.iso.as_mut().expect("created above");
@@ -876,12 +959,24 @@ impl Renderer {
             positional_lights: frame.lights[..frame.counts[1] as usize]
                 .iter()
                 .any(|l| l.position[3] == 1.0),
+            scatter: match iso.scattering.map(|s| s.mode) {
+                None => 0,
+                Some(IsoScatterMode::Preview) => 1,
+                Some(IsoScatterMode::Traced) => 2,
+            },
         };
         let (firsthit, deferred) = {
             let (a, b) = g.pipeline(&ctx, fh, df)?;
             (a.clone(), b.clone())
         };
-        g.ensure_gbuffer(&ctx, view.width, view.height, iso.max_layers)?;
+        // With scattering the surfaces are interfaces: the first-hit pass keeps the first two
+        // crossings whatever their opacities (the deferred pass makes the first opaque).
+        let layers = if iso.scattering.is_some() {
+            2
+        } else {
+            iso.max_layers
+        };
+        g.ensure_gbuffer(&ctx, view.width, view.height, layers)?;
         g.last_rect = frame.rect;
         let g = self.iso.as_ref().expect("created above");
         let env = g.environment.as_ref().expect("built above");
@@ -890,7 +985,12 @@ impl Renderer {
         u.env_rotation = mat(DMat4::from_mat3(env.rotation));
         for (i, v) in iso.values.iter().enumerate() {
             u.values[i / 4][i % 4] = v.value as f32;
-            u.colors[i] = [v.color[0], v.color[1], v.color[2], v.opacity];
+            let opacity = if iso.scattering.is_some() {
+                0.0
+            } else {
+                v.opacity
+            };
+            u.colors[i] = [v.color[0], v.color[1], v.color[2], opacity];
         }
         u.shininess = match iso.shininess {
             Shininess::Constant(s) => [0.0, 0.0, s, s],
@@ -923,7 +1023,7 @@ impl Renderer {
         u.counts = [
             iso.values.len() as u32,
             iso.bisection_steps,
-            iso.max_layers,
+            layers,
             ao.map_or(0, |a| a.samples),
         ];
         u.options = [
@@ -936,6 +1036,14 @@ impl Renderer {
                 0
             },
         ];
+        if let Some(sc) = &iso.scattering {
+            u.scatter = [
+                (sc.absorption as f64 / unit) as f32,
+                sc.samples as f32,
+                sc.fresnel,
+                0.0,
+            ];
+        }
         let rect = frame.rect;
         u.shade_rect = if iso.background { full } else { rect };
         let shade_rect = u.shade_rect;
@@ -944,6 +1052,7 @@ impl Renderer {
         q.write_buffer(&g.iso_buf, 0, bytemuck::bytes_of(&u));
         let t = self.targets.as_ref().expect("allocated above");
         let (_, occupancy, _) = g.occupancy.as_ref().expect("built above");
+        let (_, tables) = self.tables.as_ref().expect("built above");
         let gb = g.gbuffer.as_ref().expect("allocated above");
         let array_view = |tex: &wgpu::Texture| {
             tex.create_view(&wgpu::TextureViewDescriptor {
@@ -994,6 +1103,7 @@ impl Renderer {
                     wgpu::BindingResource::Sampler(&g.env_pipelines.cube_sampler),
                 ),
                 bind(14, g.lobe_dirs.as_entire_binding()),
+                bind(1, tables.as_entire_binding()),
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -1026,6 +1136,8 @@ impl Renderer {
             });
             pass.set_pipeline(&deferred);
             pass.set_bind_group(0, &deferred_bg, &[]);
+            // (the scattering pass samples the volume: one brick)
+            pass.set_bind_group(1, &vol.bricks[0].bind_linear, &[]);
             pass.dispatch_workgroups(gs[0], gs[1], 1);
         }
         ctx.checked("rendering the isosurface frame", || {

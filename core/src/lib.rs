@@ -39,7 +39,10 @@ pub use device::{Context, DeviceInfo};
 pub use environment::{CubeImage, Environment, EnvironmentSource, Sky};
 pub use error::{Error, Result};
 pub use interop::{DeviceUuids, OutputPath, SharedImage, SharedOutput};
-pub use iso::{AmbientOcclusion, GBuffer, Hit, IsoParams, IsoValue, Shininess, SpecularMode};
+pub use iso::{
+    AmbientOcclusion, GBuffer, Hit, IsoParams, IsoScatterMode, IsoScattering, IsoValue, Shininess,
+    SpecularMode, MAX_SCATTER_SAMPLES,
+};
 pub use light::{Light, LightSpace};
 pub use params::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,

@@ -535,6 +535,24 @@ typedef struct FvIsoParams {
    * Show the environment behind the surfaces (the frame becomes opaque).
    */
   bool background;
+  /**
+   * Light scattered between the surfaces: 0 none (the default), 1 the preview
+   * (transmittance squared, the irradiance cube), 2 traced (`scatter_samples` directions
+   * from the inner surface out of the volume). Needs the volume in one brick.
+   */
+  uint32_t scatter_mode;
+  /**
+   * Directions traced per pixel (scatter_mode 2), 1 to 256.
+   */
+  uint32_t scatter_samples;
+  /**
+   * Multiplies the medium's extinction between the surfaces (0: no absorption).
+   */
+  float scatter_absorption;
+  /**
+   * Fresnel reflectance at normal incidence of the first surface when scattering.
+   */
+  float scatter_fresnel;
 } FvIsoParams;
 
 /**

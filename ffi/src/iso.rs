@@ -5,8 +5,8 @@
 use crate::status::{FfiError, FfiResult};
 use ferrovol_core::iso::MAX_ISO_VALUES;
 use ferrovol_core::{
-    AmbientOcclusion, BsdfParams, IsoParams, IsoValue, PathTraceParams, ScatterRegions, Shininess,
-    SpecularMode,
+    AmbientOcclusion, BsdfParams, IsoParams, IsoScatterMode, IsoScattering, IsoValue,
+    PathTraceParams, ScatterRegions, Shininess, SpecularMode,
 };
 
 /// Most iso-values in one FvIsoParams.
@@ -69,6 +69,16 @@ pub struct FvIsoParams {
     pub environment_light: f32,
     /// Show the environment behind the surfaces (the frame becomes opaque).
     pub background: bool,
+    /// Light scattered between the surfaces: 0 none (the default), 1 the preview
+    /// (transmittance squared, the irradiance cube), 2 traced (`scatter_samples` directions
+    /// from the inner surface out of the volume). Needs the volume in one brick.
+    pub scatter_mode: u32,
+    /// Directions traced per pixel (scatter_mode 2), 1 to 256.
+    pub scatter_samples: u32,
+    /// Multiplies the medium's extinction between the surfaces (0: no absorption).
+    pub scatter_absorption: f32,
+    /// Fresnel reflectance at normal incidence of the first surface when scattering.
+    pub scatter_fresnel: f32,
 }
 
 impl FvIsoParams {
@@ -99,6 +109,10 @@ impl FvIsoParams {
             ao_radius: 0.0,
             environment_light: d.environment_light,
             background: d.background,
+            scatter_mode: 0,
+            scatter_samples: IsoScattering::default().samples,
+            scatter_absorption: IsoScattering::default().absorption,
+            scatter_fresnel: IsoScattering::default().fresnel,
         }
     }
 
@@ -156,6 +170,24 @@ impl FvIsoParams {
             }),
             environment_light: self.environment_light,
             background: self.background,
+            scattering: match self.scatter_mode {
+                0 => None,
+                m @ (1 | 2) => Some(IsoScattering {
+                    mode: if m == 1 {
+                        IsoScatterMode::Preview
+                    } else {
+                        IsoScatterMode::Traced
+                    },
+                    samples: self.scatter_samples,
+                    absorption: self.scatter_absorption,
+                    fresnel: self.scatter_fresnel,
+                }),
+                m => {
+                    return Err(FfiError::invalid(format!(
+                        "scatter_mode {m}: 0 none, 1 preview, 2 traced"
+                    )))
+                }
+            },
         };
         p.validate()?;
         Ok(p)

@@ -148,6 +148,21 @@ void vtkFerroVolumeRepresentation::SetFresnel(double reflectance)
   this->GetFerroVolumeMapper()->SetFresnel(reflectance);
 }
 
+void vtkFerroVolumeRepresentation::SetIsosurfaceScattering(int value)
+{
+  this->GetFerroVolumeMapper()->SetIsosurfaceScattering(value);
+}
+
+void vtkFerroVolumeRepresentation::SetIsosurfaceScatteringSamples(int value)
+{
+  this->GetFerroVolumeMapper()->SetIsosurfaceScatteringSamples(value);
+}
+
+void vtkFerroVolumeRepresentation::SetIsosurfaceScatteringAbsorption(double value)
+{
+  this->GetFerroVolumeMapper()->SetIsosurfaceScatteringAbsorption(value);
+}
+
 void vtkFerroVolumeRepresentation::SetGlobalIlluminationReach(float reach)
 {
   this->Superclass::SetGlobalIlluminationReach(reach);

@@ -98,6 +98,9 @@ public:
   void SetShininessFromGradient(int value);
   void SetShininessRange(double weak, double strong);
   void SetFresnel(double reflectance);
+  void SetIsosurfaceScattering(int mode);
+  void SetIsosurfaceScatteringSamples(int samples);
+  void SetIsosurfaceScatteringAbsorption(double scale);
   ///@}
 
   ///@{

@@ -168,7 +168,7 @@ if T.ferrovol_info(disp)["FerrovolLastRenderDrew"] != 1:
 T.compare("Isosurface 150 vs Volume's Isosurface", iso["Ferrovol Volume"], iso["Volume"], 0.7,
           17.0, failures)
 for name, value in (("FerrovolEnvironmentLighting", 0.6), ("FerrovolAmbientOcclusionSamples", 16),
-                    ("FerrovolShininessFromGradient", 1)):
+                    ("FerrovolShininessFromGradient", 1), ("FerrovolIsosurfaceScattering", "Preview")):
     before = getattr(disp, name)
     disp.FerrovolEnvironmentLighting = 0.6 if name != "FerrovolEnvironmentLighting" else 0.0
     Render(view)

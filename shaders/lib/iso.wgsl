@@ -18,6 +18,8 @@ struct Iso {
     counts: vec4<u32>,            // iso-values, bisection steps, max layers, AO directions
     options: vec4<u32>,           // AO steps, specular samples, specular mode, flags
     shade_rect: vec4<u32>,        // pixels the deferred pass covers: x0, y0, x1, y1
+    scatter: vec4<f32>,           // scattering between the surfaces: x absorption scale / unit
+                                  // distance, y traced directions, z Fresnel F0
 }
 
 @group(0) @binding(7) var<uniform> iso: Iso;

@@ -79,3 +79,14 @@ fn clip_interval(r: Ray, t_in: vec2<f32>) -> vec2<f32> {
     }
     return t;
 }
+
+// A ray from a world point in a world direction (secondary rays).
+fn ray_from(origin: vec3<f32>, dir: vec3<f32>) -> Ray {
+    var r: Ray;
+    r.origin = origin;
+    r.dir = dir;
+    r.far = 3.0e38;
+    r.index_origin = (frame.world_to_index * vec4<f32>(origin, 1.0)).xyz;
+    r.index_dir = (frame.world_to_index * vec4<f32>(dir, 0.0)).xyz;
+    return r;
+}

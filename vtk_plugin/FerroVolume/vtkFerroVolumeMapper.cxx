@@ -1186,6 +1186,9 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , ShininessGradientRange{ 0.0, 0.0 }
   , Fresnel(-1.0)
   , IsosurfaceLayers(4)
+  , IsosurfaceScattering(ISOSURFACE_SCATTERING_OFF)
+  , IsosurfaceScatteringSamples(16)
+  , IsosurfaceScatteringAbsorption(1.0)
   , RenderMode(RENDER_MODE_RAY_CAST)
   , SamplesPerPixel(64)
   , InteractiveSamplesPerPixel(1)
@@ -1997,6 +2000,14 @@ IsoSetup SetUpIsosurfaces(vtkFerroVolumeMapper* self, FvRenderer* r, vtkVolumePr
     iso.shininess[0] = iso.shininess[1] = params.specular_power;
   }
   iso.fresnel = static_cast<float>(self->GetFresnel());
+  iso.scatter_mode = static_cast<uint32_t>(self->GetIsosurfaceScattering());
+  iso.scatter_samples = static_cast<uint32_t>(self->GetIsosurfaceScatteringSamples());
+  iso.scatter_absorption =
+    static_cast<float>(std::min(self->GetIsosurfaceScatteringAbsorption(), 1e30));
+  if (self->GetFresnel() >= 0.0)
+  {
+    iso.scatter_fresnel = static_cast<float>(self->GetFresnel());
+  }
   iso.ao_samples = static_cast<uint32_t>(self->GetAmbientOcclusionSamples());
   iso.ao_steps = static_cast<uint32_t>(self->GetAmbientOcclusionSteps());
   iso.ao_radius = self->GetAmbientOcclusionRadius();
@@ -2719,6 +2730,10 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << this->ShininessGradientRange[1] << "\n";
   os << indent << "Fresnel: " << this->Fresnel << "\n";
   os << indent << "IsosurfaceLayers: " << this->IsosurfaceLayers << "\n";
+  os << indent << "IsosurfaceScattering: " << this->IsosurfaceScattering << "\n";
+  os << indent << "IsosurfaceScatteringSamples: " << this->IsosurfaceScatteringSamples << "\n";
+  os << indent << "IsosurfaceScatteringAbsorption: " << this->IsosurfaceScatteringAbsorption
+     << "\n";
   os << indent << "RenderMode: "
      << (this->RenderMode == RENDER_MODE_PATH_TRACE ? "path trace" : "ray cast") << "\n";
   os << indent << "SamplesPerPixel: " << this->SamplesPerPixel << "\n";

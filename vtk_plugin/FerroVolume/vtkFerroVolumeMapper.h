@@ -227,6 +227,33 @@ public:
   vtkGetMacro(IsosurfaceLayers, int);
   ///@}
 
+  enum IsosurfaceScatteringModes
+  {
+    ISOSURFACE_SCATTERING_OFF = 0,
+    ISOSURFACE_SCATTERING_PREVIEW = 1,
+    ISOSURFACE_SCATTERING_TRACED = 2
+  };
+
+  ///@{
+  /**
+   * Isosurface blend mode: light scattered between the isosurfaces (the fast path of
+   * multiple scattering), lit by the environment (EnvironmentLighting > 0): it enters at the
+   * first surface, is absorbed on its way to the next (the scalar opacity function read as
+   * extinction per ScalarOpacityUnitDistance, times IsosurfaceScatteringAbsorption), scatters
+   * there and leaves toward the environment. PREVIEW squares the inward transmittance and
+   * reads the irradiance map; TRACED follows IsosurfaceScatteringSamples directions out of
+   * the volume. The first surface becomes opaque, blended with the scattered light by
+   * Schlick's term (Fresnel, 0.04 when negative). Needs a volume in one 3D texture.
+   */
+  vtkSetClampMacro(IsosurfaceScattering, int, ISOSURFACE_SCATTERING_OFF,
+    ISOSURFACE_SCATTERING_TRACED);
+  vtkGetMacro(IsosurfaceScattering, int);
+  vtkSetClampMacro(IsosurfaceScatteringSamples, int, 1, 256);
+  vtkGetMacro(IsosurfaceScatteringSamples, int);
+  vtkSetClampMacro(IsosurfaceScatteringAbsorption, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(IsosurfaceScatteringAbsorption, double);
+  ///@}
+
   enum RenderModes
   {
     RENDER_MODE_RAY_CAST = 0,
@@ -453,6 +480,9 @@ protected:
   double ShininessGradientRange[2];
   double Fresnel;
   int IsosurfaceLayers;
+  int IsosurfaceScattering;
+  int IsosurfaceScatteringSamples;
+  double IsosurfaceScatteringAbsorption;
   int RenderMode;
   int SamplesPerPixel;
   int InteractiveSamplesPerPixel;

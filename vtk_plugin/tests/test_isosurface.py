@@ -151,6 +151,15 @@ class Isosurface(unittest.TestCase):
             "cone-sampling": lambda m: (m.SetEnvironmentLighting(0.6),
                                         m.SetSpecularSampling(m.SPECULAR_CONE),
                                         m.SetSpecularSamples(4)),
+            "scattering-preview": lambda m: (
+                m.SetEnvironmentLighting(0.6),
+                m.SetIsosurfaceScattering(m.ISOSURFACE_SCATTERING_PREVIEW),
+                m.SetIsosurfaceScatteringAbsorption(0.2)),
+            "scattering-traced": lambda m: (
+                m.SetEnvironmentLighting(0.6),
+                m.SetIsosurfaceScattering(m.ISOSURFACE_SCATTERING_TRACED),
+                m.SetIsosurfaceScatteringSamples(8),
+                m.SetIsosurfaceScatteringAbsorption(0.2)),
         }
         images = {k: self.render(v) for k, v in shots.items()}
         save("iso-settings", plain, *images.values())
