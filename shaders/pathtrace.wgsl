@@ -46,6 +46,8 @@ struct PathTrace {
 const PT_FLAG_BACKGROUND: u32 = 1u;
 // Collisions that do not scatter absorb (otherwise they do not happen).
 const PT_FLAG_ATTENUATION: u32 = 2u;
+// Sum the denoiser's guide (the first collision's normal and distance) into `guide`.
+const PT_FLAG_GUIDE: u32 = 4u;
 const PT_SCATTER_NONE: u32 = 0u;
 const PT_SCATTER_SURFACES: u32 = 1u;
 const PT_SCATTER_BETWEEN: u32 = 2u;
@@ -70,6 +72,13 @@ const PT_MAX_STEPS: u32 = 1000000u;
 // Per min–max block (march.wgsl: block_of): the largest extinction (per world unit) its
 // scalar range can take under the transfer function.
 @group(0) @binding(15) var<storage, read> majorants: array<f32>;
+// Per pixel (PT_FLAG_GUIDE), summed over the paths: the unit normal at the camera path's
+// first collision (facing the camera; the gradient's direction) and its distance along
+// the ray (denoise.wgsl reads them).
+@group(0) @binding(16) var<storage, read_write> guide: array<vec4<f32>>;
+
+// This path's contribution to `guide` (zero when it met nothing).
+var<private> path_guide: vec4<f32> = vec4<f32>(0.0);
 
 fn env_radiance(d: vec3<f32>) -> vec3<f32> {
     let e = (pt.env_rotation * vec4<f32>(d, 0.0)).xyz;
@@ -323,6 +332,16 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         if (bounce == 0u) {
             hit = 1.0;
             *rng = secondary;
+            if ((pt.options.x & PT_FLAG_GUIDE) != 0u) {
+                let p0 = r.index_origin + t * r.index_dir;
+                let g0 = world_gradient(gradient_at(p0, sample_scalars(p0)), 0u);
+                var n0 = -r.dir;
+                if (dot(g0, g0) > 1e-20) {
+                    n0 = normalize(g0);
+                    n0 = select(n0, -n0, dot(n0, r.dir) > 0.0);
+                }
+                path_guide = vec4<f32>(n0, t);
+            }
         }
         if (bounce == pt.counts.z) {
             break;   // the path has scattered as often as it may
@@ -419,6 +438,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         sum = sum + accum[idx];
     }
     accum[idx] = sum;
+    if ((pt.options.x & PT_FLAG_GUIDE) != 0u) {
+        var gs = path_guide;
+        if (pt.counts.y > 0u) {
+            gs = gs + guide[idx];
+        }
+        guide[idx] = gs;
+    }
     let mean = sum / f32(pt.counts.y + 1u);
     // Premultiplied output: radiance beyond the coverage is clipped, as an 8-bit image must.
     let a = clamp(mean.a, 0.0, 1.0);

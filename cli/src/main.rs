@@ -191,6 +191,10 @@ struct PathTraceArgs {
     /// Half the transmitted lobe lies within this angle, degrees in [0.5, 60].
     #[arg(long, default_value_t = BsdfParams::default().cone_angle)]
     cone_angle: f32,
+    /// Show the image through the edge-aware à-trous denoiser (guided by the normal and
+    /// depth where the paths first meet the medium).
+    #[arg(long)]
+    denoise: bool,
     /// Seed of the random streams.
     #[arg(long, default_value_t = 0)]
     seed: u32,
@@ -240,6 +244,7 @@ impl PathTraceArgs {
             attenuation: !self.no_attenuation,
             environment_light: env_light,
             background,
+            denoise: self.denoise,
             seed: self.seed,
         };
         p.validate()?;

@@ -109,6 +109,19 @@ pub struct PhaseTestUniforms {
 
 pub const PT_FLAG_BACKGROUND: u32 = 1;
 pub const PT_FLAG_ATTENUATION: u32 = 2;
+pub const PT_FLAG_GUIDE: u32 = 4;
+
+/// The denoiser's uniforms (`Denoise` in shaders/denoise.wgsl), one block per iteration.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DenoiseUniforms {
+    pub rect: [u32; 4],
+    pub size: [u32; 4],
+    pub params: [f32; 4],
+}
+
+pub const DENOISE_FROM_SUMS: u32 = 1;
+pub const DENOISE_LAST: u32 = 2;
 
 /// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
 #[repr(C)]
@@ -273,6 +286,8 @@ mod layout_tests {
             PathTraceUniforms,
             [env_rotation, medium, surface, lobe, counts, options, rect]
         );
+        let m = module("denoise.wgsl");
+        check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
         let m = module("phase_test.wgsl");
         check!(
             m,
@@ -287,6 +302,7 @@ mod layout_tests {
         let iso = crate::shaders::compose("deferred.wgsl");
         let env = crate::shaders::compose("environment.wgsl");
         let pt = crate::shaders::compose("pathtrace.wgsl");
+        let dn = crate::shaders::compose("denoise.wgsl");
         for (src, name, v) in [
             (&iso, "MAX_ISO", ISO_MAX_VALUES as u32),
             (&iso, "SPECULAR_CONE", SPECULAR_CONE),
@@ -296,6 +312,9 @@ mod layout_tests {
             (&env, "ENV_EQUIRECT", ENV_EQUIRECT),
             (&pt, "PT_FLAG_BACKGROUND", PT_FLAG_BACKGROUND),
             (&pt, "PT_FLAG_ATTENUATION", PT_FLAG_ATTENUATION),
+            (&pt, "PT_FLAG_GUIDE", PT_FLAG_GUIDE),
+            (&dn, "DENOISE_FROM_SUMS", DENOISE_FROM_SUMS),
+            (&dn, "DENOISE_LAST", DENOISE_LAST),
             (&pt, "PT_SCATTER_NONE", ScatterRegions::Nowhere.code()),
             (&pt, "PT_SCATTER_SURFACES", ScatterRegions::Surfaces.code()),
             (&pt, "PT_SCATTER_BETWEEN", ScatterRegions::Between.code()),

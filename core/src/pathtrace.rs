@@ -28,7 +28,10 @@ use crate::binding::{
     bind, buffer_entry, entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::error::{Error, Result};
-use crate::gpu::{PathTraceUniforms, PhaseTestUniforms, PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND};
+use crate::gpu::{
+    DenoiseUniforms, PathTraceUniforms, PhaseTestUniforms, DENOISE_FROM_SUMS, DENOISE_LAST,
+    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE,
+};
 use crate::iso::shader_module;
 use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::read_buffer;
@@ -175,6 +178,10 @@ pub struct PathTraceParams {
     pub environment_light: f32,
     /// Show the environment behind the medium (the frame becomes opaque).
     pub background: bool,
+    /// Show the progressive image through the edge-aware à-trous denoiser
+    /// (shaders/denoise.wgsl), guided by the normal and depth at the paths' first
+    /// collision. The accumulation ([`Renderer::read_accumulation`]) stays unfiltered.
+    pub denoise: bool,
     /// Seed of the random streams (a different seed gives an independent image).
     pub seed: u32,
 }
@@ -194,6 +201,7 @@ impl Default for PathTraceParams {
             attenuation: true,
             environment_light: 1.0,
             background: false,
+            denoise: false,
             seed: 0,
         }
     }
@@ -265,6 +273,9 @@ pub(crate) struct PathTraceGpu {
     uniforms: wgpu::Buffer,
     /// Per pixel: sums of radiance and coverage over the accumulated paths.
     accum: Option<(u32, u32, wgpu::Buffer)>,
+    /// Per pixel, the same size: the denoiser's guide sums, then its two ping-pong images.
+    denoise_buffers: Option<[wgpu::Buffer; 3]>,
+    denoise: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline, wgpu::Buffer)>,
     /// The environment's sampling distribution: (environment generation, texels per face
     /// edge, cumulative probabilities).
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
@@ -305,6 +316,7 @@ impl PathTraceGpu {
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
                 buffer_entry(15, B::Storage { read_only: true }),
+                buffer_entry(16, B::Storage { read_only: false }),
             ],
         });
         let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -326,6 +338,8 @@ impl PathTraceGpu {
             pipelines: Default::default(),
             uniforms,
             accum: None,
+            denoise_buffers: None,
+            denoise: None,
             env_dist: None,
             majorants: None,
             key: String::new(),
@@ -365,14 +379,25 @@ impl PathTraceGpu {
             return Ok(());
         }
         self.accum = None;
-        let buf = ctx.checked("allocating the path tracing accumulation", || {
-            ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("path tracing accumulation"),
-                size: 16 * width as u64 * height as u64,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
+        self.denoise_buffers = None;
+        let buffer = |label| {
+            ctx.checked("allocating the path tracing accumulation", || {
+                ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: 16 * width as u64 * height as u64,
+                    usage: wgpu::BufferUsages::STORAGE
+                        | wgpu::BufferUsages::COPY_SRC
+                        | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
             })
-        })?;
+        };
+        let buf = buffer("path tracing accumulation")?;
+        self.denoise_buffers = Some([
+            buffer("denoiser guide")?,
+            buffer("denoiser image A")?,
+            buffer("denoiser image B")?,
+        ]);
         self.accum = Some((width, height, buf));
         self.samples = 0;
         Ok(())
@@ -422,6 +447,163 @@ fn environment_cdf(cube: &crate::environment::CubeImage) -> Vec<f32> {
         *last = 1.0;
     }
     cdf
+}
+
+/// Iterations of the à-trous denoiser (taps 1, 2, 4, 8 and 16 pixels apart).
+const DENOISE_ITERATIONS: u32 = 3;
+/// Edge-stopping scales of the denoiser: colour (radiance units, shrinking by √2 each
+/// iteration), the power of the normals' cosine (low: a medium's first-collision normals are
+/// noisy), depth (sample distances per pixel of tap spacing).
+const DENOISE_COLOR_SIGMA: f32 = 1.0;
+const DENOISE_NORMAL_POWER: f32 = 1.0;
+const DENOISE_DEPTH_SIGMA: f32 = 16.0;
+
+fn denoise_pipeline(
+    ctx: &Context,
+) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline, wgpu::Buffer)> {
+    use wgpu::BufferBindingType as B;
+    let d = &ctx.device;
+    let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("denoise"),
+        entries: &[
+            entry(
+                0,
+                wgpu::BindingType::Buffer {
+                    ty: B::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: std::num::NonZeroU64::new(
+                        std::mem::size_of::<DenoiseUniforms>() as u64,
+                    ),
+                },
+            ),
+            buffer_entry(1, B::Storage { read_only: true }),
+            buffer_entry(2, B::Storage { read_only: false }),
+            buffer_entry(3, B::Storage { read_only: true }),
+            buffer_entry(4, B::Storage { read_only: true }),
+            storage_texture_entry(
+                5,
+                wgpu::TextureFormat::Rgba8Unorm,
+                wgpu::TextureViewDimension::D2,
+            ),
+        ],
+    });
+    let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("denoise.wgsl"),
+        bind_group_layouts: &[Some(&bgl)],
+        immediate_size: 0,
+    });
+    let module = shader_module(ctx, "denoise.wgsl")?;
+    let pipeline = ctx.checked("creating the denoiser pipeline", || {
+        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("denoise"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })?;
+    let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("denoiser uniforms"),
+        size: UNIFORM_STRIDE * DENOISE_ITERATIONS as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    Ok((bgl, pipeline, uniforms))
+}
+
+/// What the denoiser reads and writes.
+struct DenoiseOutputs<'a> {
+    accum: &'a wgpu::Buffer,
+    guide: &'a wgpu::Buffer,
+    images: [&'a wgpu::Buffer; 2],
+    color: &'a wgpu::TextureView,
+}
+
+/// Records the denoiser's iterations over `rect`: the accumulation's means (scale[0] = 1 /
+/// paths) filtered into the ping-pong images, the last also into the output colour. The
+/// colour edge-stopping scale shrinks each iteration (Dammertz et al. halve it); depths are
+/// compared per `scale[1]` (the sample distance) times the tap spacing.
+#[allow(clippy::too_many_arguments)]
+fn encode_denoise(
+    ctx: &Context,
+    enc: &mut wgpu::CommandEncoder,
+    bgl: &wgpu::BindGroupLayout,
+    pipeline: &wgpu::ComputePipeline,
+    uniforms: &wgpu::Buffer,
+    out: &DenoiseOutputs<'_>,
+    rect: [u32; 4],
+    width: u32,
+    scale: [f32; 2],
+) {
+    let mut blocks = vec![0u8; (UNIFORM_STRIDE * DENOISE_ITERATIONS as u64) as usize];
+    for i in 0..DENOISE_ITERATIONS {
+        let mut flags = 0;
+        if i == 0 {
+            flags |= DENOISE_FROM_SUMS;
+        }
+        if i + 1 == DENOISE_ITERATIONS {
+            flags |= DENOISE_LAST;
+        }
+        let u = DenoiseUniforms {
+            rect,
+            size: [width, 0, 1 << i, flags],
+            params: [
+                scale[0],
+                DENOISE_COLOR_SIGMA * 0.5f32.powf(i as f32 * 0.5),
+                DENOISE_NORMAL_POWER,
+                DENOISE_DEPTH_SIGMA * scale[1],
+            ],
+        };
+        let at = (UNIFORM_STRIDE * i as u64) as usize;
+        blocks[at..at + std::mem::size_of::<DenoiseUniforms>()]
+            .copy_from_slice(bytemuck::bytes_of(&u));
+    }
+    ctx.queue.write_buffer(uniforms, 0, &blocks);
+    let bind = |src: &wgpu::Buffer, dst: &wgpu::Buffer| {
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("denoise"),
+            layout: bgl,
+            entries: &[
+                bind(
+                    0,
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: uniforms,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(
+                            std::mem::size_of::<DenoiseUniforms>() as u64
+                        ),
+                    }),
+                ),
+                bind(1, src.as_entire_binding()),
+                bind(2, dst.as_entire_binding()),
+                bind(3, out.guide.as_entire_binding()),
+                bind(4, out.accum.as_entire_binding()),
+                bind(5, wgpu::BindingResource::TextureView(out.color)),
+            ],
+        })
+    };
+    let [a, b] = out.images;
+    let groups = [bind(out.accum, a), bind(a, b), bind(b, a)];
+    let wg = crate::renderer::WORKGROUP;
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some("denoise"),
+        timestamp_writes: None,
+    });
+    pass.set_pipeline(pipeline);
+    for i in 0..DENOISE_ITERATIONS {
+        let g = if i == 0 {
+            &groups[0]
+        } else {
+            &groups[1 + (i as usize + 1) % 2]
+        };
+        pass.set_bind_group(0, g, &[(UNIFORM_STRIDE * i as u64) as u32]);
+        pass.dispatch_workgroups(
+            (rect[2] - rect[0]).div_ceil(wg),
+            (rect[3] - rect[1]).div_ceil(wg),
+            1,
+        );
+    }
 }
 
 impl Renderer {
@@ -636,6 +818,9 @@ impl Renderer {
         let g = self.pt.as_mut().expect("created above");
         let pipeline = g.pipeline(&ctx, nearest)?;
         g.ensure_accum(&ctx, view.width, view.height)?;
+        if pp.denoise && g.denoise.is_none() {
+            g.denoise = Some(denoise_pipeline(&ctx)?);
+        }
         if g.key != key || depth_input {
             // (a host's depth may change from frame to frame without telling)
             g.key = key;
@@ -687,6 +872,9 @@ impl Renderer {
         if pp.attenuation {
             flags |= PT_FLAG_ATTENUATION;
         }
+        if pp.denoise {
+            flags |= PT_FLAG_GUIDE;
+        }
         u.options = [flags, *dist_size, pp.scatter.code(), 0];
         u.rect = rect;
         let q = &ctx.queue;
@@ -703,6 +891,7 @@ impl Renderer {
         let t = self.targets.as_ref().expect("allocated above");
         let (_, tables) = self.tables.as_ref().expect("built above");
         let (_, _, accum) = g.accum.as_ref().expect("allocated above");
+        let [guide, ping, pong] = g.denoise_buffers.as_ref().expect("allocated above");
         let iso = self.iso.as_ref().expect("created above");
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
@@ -734,6 +923,7 @@ impl Renderer {
                 ),
                 bind(14, dist.as_entire_binding()),
                 bind(15, majorant_buf.as_entire_binding()),
+                bind(16, guide.as_entire_binding()),
             ],
         });
         let vol = self.volume.as_ref().expect("checked above");
@@ -749,6 +939,11 @@ impl Renderer {
             });
         if rect != full {
             crate::renderer::clear_outputs(&mut enc, &color_view, &depth_view);
+            if before == 0 {
+                // (pixels outside the rectangle keep no sums of an earlier accumulation)
+                enc.clear_buffer(accum, 0, None);
+                enc.clear_buffer(guide, 0, None);
+            }
         }
         if rect[2] > rect[0] && rect[3] > rect[1] {
             let wg = crate::renderer::WORKGROUP;
@@ -766,6 +961,29 @@ impl Renderer {
                     1,
                 );
             }
+        }
+        if pp.denoise && rect[2] > rect[0] && rect[3] > rect[1] {
+            let (dbgl, dpipe, dubuf) = g.denoise.as_ref().expect("created above");
+            let out = DenoiseOutputs {
+                accum,
+                guide,
+                images: [ping, pong],
+                color: &color_view,
+            };
+            encode_denoise(
+                &ctx,
+                &mut enc,
+                dbgl,
+                dpipe,
+                dubuf,
+                &out,
+                rect,
+                view.width,
+                {
+                    let n = (before + add) as f32;
+                    [1.0 / n, step as f32]
+                },
+            );
         }
         ctx.checked("rendering the path-traced frame", || {
             q.submit([enc.finish()]);

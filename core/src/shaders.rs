@@ -58,6 +58,7 @@ pub const FILES: &[(&str, &str)] = &[
         "phase_test.wgsl",
         include_str!("../../shaders/phase_test.wgsl"),
     ),
+    ("denoise.wgsl", include_str!("../../shaders/denoise.wgsl")),
 ];
 
 /// The passes (entry files, not library pieces).
@@ -68,6 +69,7 @@ pub const PASSES: &[&str] = &[
     "deferred.wgsl",
     "environment.wgsl",
     "pathtrace.wgsl",
+    "denoise.wgsl",
     "phase_test.wgsl",
 ];
 

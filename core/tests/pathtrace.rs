@@ -637,3 +637,66 @@ fn ray_budgets_share_primary_rays() {
         assert!((m / means[0] - 1.0).abs() < 0.05, "{means:?}");
     }
 }
+
+/// The optional denoiser: at 4 paths per pixel it brings the shown image closer to a
+/// 1024-path reference than the unfiltered 4-path image, and leaves the accumulation as it
+/// was.
+#[test]
+fn denoiser_lowers_the_error_and_keeps_the_accumulation() {
+    let mut r = renderer();
+    let vol = volume([24, 24, 24], |x, y, z| {
+        let d = ((x - 11.5).powi(2) + (y - 11.5).powi(2) + (z - 11.5).powi(2)).sqrt();
+        (1.0 - d / 11.0).clamp(0.0, 1.0)
+    });
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&medium([0.9, 0.7, 0.5], 0.0, 0.8, 1.0))
+        .unwrap();
+    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    let view = View::fit(vol.bounds(), 96, 96);
+    let p = PathTraceParams {
+        samples_per_frame: 64,
+        seed: 3,
+        ..Default::default()
+    };
+    trace(&mut r, &view, &p, 1024);
+    let reference = r.read_image().unwrap();
+    let rmse = |img: &Image| {
+        let n = img.rgba.len() as f64;
+        (img.rgba
+            .iter()
+            .zip(&reference.rgba)
+            .map(|(a, b)| (*a as f64 - *b as f64).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt()
+    };
+    let noisy = PathTraceParams {
+        samples_per_frame: 4,
+        ..Default::default()
+    };
+    let raw = trace(&mut r, &view, &noisy, 4);
+    let plain = r.read_image().unwrap();
+    let filtered = trace(
+        &mut r,
+        &view,
+        &PathTraceParams {
+            denoise: true,
+            ..noisy
+        },
+        4,
+    );
+    let denoised = r.read_image().unwrap();
+    save(&plain, "denoise-off");
+    save(&denoised, "denoise-on");
+    save(&reference, "denoise-reference");
+    let (e_plain, e_denoised) = (rmse(&plain), rmse(&denoised));
+    println!(
+        "4 paths per pixel against 1024: RMSE {e_plain:.2} levels unfiltered, {e_denoised:.2} \
+         denoised"
+    );
+    // (measured 9.4 against 17.0 levels: a smooth medium, where the guide can only hold
+    // the filter back; edges are where it matters)
+    assert!(e_denoised < 0.7 * e_plain, "{e_denoised} vs {e_plain}");
+    // the same paths (same seed): the accumulation is the unfiltered one
+    assert_eq!(raw, filtered, "the denoiser changed the accumulation");
+}

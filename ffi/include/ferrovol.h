@@ -628,6 +628,11 @@ typedef struct FvPathTraceParams {
    * Collisions that do not scatter absorb (true) or are left out (false).
    */
   bool attenuation;
+  /**
+   * Show the image through the edge-aware à-trous denoiser (the accumulation stays
+   * unfiltered).
+   */
+  bool denoise;
 } FvPathTraceParams;
 
 /**

@@ -249,6 +249,9 @@ pub struct FvPathTraceParams {
     pub scatter_regions: u32,
     /// Collisions that do not scatter absorb (true) or are left out (false).
     pub attenuation: bool,
+    /// Show the image through the edge-aware à-trous denoiser (the accumulation stays
+    /// unfiltered).
+    pub denoise: bool,
 }
 
 impl FvPathTraceParams {
@@ -271,6 +274,7 @@ impl FvPathTraceParams {
             cone_angle: d.bsdf.cone_angle,
             scatter_regions: d.scatter.code(),
             attenuation: d.attenuation,
+            denoise: d.denoise,
         }
     }
 
@@ -305,6 +309,7 @@ impl FvPathTraceParams {
             attenuation: self.attenuation,
             environment_light: self.environment_light,
             background: self.background,
+            denoise: self.denoise,
             seed: self.seed,
         };
         p.validate()?;

@@ -190,6 +190,11 @@ void vtkFerroVolumeRepresentation::SetPathTracingBounces(int bounces)
   this->GetFerroVolumeMapper()->SetPathTracingBounces(bounces);
 }
 
+void vtkFerroVolumeRepresentation::SetPathTracingDenoise(int denoise)
+{
+  this->GetFerroVolumeMapper()->SetPathTracingDenoise(denoise);
+}
+
 void vtkFerroVolumeRepresentation::SetSecondaryRays(int value)
 {
   this->GetFerroVolumeMapper()->SetSecondaryRays(value);

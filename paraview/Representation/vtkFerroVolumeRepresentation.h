@@ -127,6 +127,7 @@ public:
 
   void SetSamplesPerPixel(int samples);
   void SetPathTracingBounces(int bounces);
+  void SetPathTracingDenoise(int denoise);
   void SetSecondaryRays(int value);
   void SetGradientThreshold(double value);
   void SetStochasticBlend(double value);

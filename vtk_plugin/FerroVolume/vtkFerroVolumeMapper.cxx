@@ -1193,6 +1193,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , SamplesPerPixel(64)
   , InteractiveSamplesPerPixel(1)
   , PathTracingBounces(64)
+  , PathTracingDenoise(0)
   , VolumetricScatteringBlending(0.0)
   , GlobalIlluminationReach(0.0)
   , SecondaryRays(1)
@@ -1885,6 +1886,7 @@ bool SetUpPathTracing(vtkFerroVolumeMapper* self, FvRenderer* r, vtkRenderer* re
   pt.stochastic_blend = static_cast<float>(std::min(self->GetStochasticBlend(), 1e30));
   pt.scatter_regions = static_cast<uint32_t>(self->GetScatterRegions());
   pt.attenuation = self->GetAttenuation() != 0;
+  pt.denoise = self->GetPathTracingDenoise() != 0;
   pt.roughness = static_cast<float>(self->GetBsdfRoughness());
   pt.fresnel = static_cast<float>(self->GetBsdfFresnel());
   pt.transmission = static_cast<float>(self->GetTransmission());
@@ -2739,6 +2741,7 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SamplesPerPixel: " << this->SamplesPerPixel << "\n";
   os << indent << "InteractiveSamplesPerPixel: " << this->InteractiveSamplesPerPixel << "\n";
   os << indent << "PathTracingBounces: " << this->PathTracingBounces << "\n";
+  os << indent << "PathTracingDenoise: " << this->PathTracingDenoise << "\n";
   os << indent << "VolumetricScatteringBlending: " << this->VolumetricScatteringBlending << "\n";
   os << indent << "GlobalIlluminationReach: " << this->GlobalIlluminationReach << "\n";
   os << indent << "SecondaryRays: " << this->SecondaryRays << "\n";

@@ -290,6 +290,16 @@ public:
 
   ///@{
   /**
+   * Path tracing: show the progressive image through the edge-aware a-trous denoiser
+   * (guided by the normal and depth where the paths first meet the medium; default off).
+   */
+  vtkSetMacro(PathTracingDenoise, vtkTypeBool);
+  vtkGetMacro(PathTracingDenoise, vtkTypeBool);
+  vtkBooleanMacro(PathTracingDenoise, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Volumetric shadows (single scattering) in the composite blend mode with Shade on and
    * at least one light, with vtkGPUVolumeRayCastMapper's meaning: VolumetricScatteringBlending
    * 0 (default) off, up to 1 the volumetric share grows where gradient and opacity are
@@ -487,6 +497,7 @@ protected:
   int SamplesPerPixel;
   int InteractiveSamplesPerPixel;
   int PathTracingBounces;
+  vtkTypeBool PathTracingDenoise;
   double VolumetricScatteringBlending;
   double GlobalIlluminationReach;
   int SecondaryRays;

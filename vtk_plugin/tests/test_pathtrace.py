@@ -111,6 +111,21 @@ class PathTrace(unittest.TestCase):
         self.assertLess(abs(ratio - 1.0), 0.05)
         self.assertGreater(d, 0.3)
 
+    def test_denoiser_smooths_the_image(self):
+        def roughness(img):
+            # mean |pixel - mean of its 4 neighbours| inside the image
+            c = img[1:-1, 1:-1]
+            n = (img[:-2, 1:-1] + img[2:, 1:-1] + img[1:-1, :-2] + img[1:-1, 2:]) / 4.0
+            return float(np.abs(c - n).mean())
+        noisy = self.scene(configure=lambda m: m.SetSamplesPerPixel(4)).render()
+        smooth = self.scene(configure=lambda m: (m.SetSamplesPerPixel(4),
+                                                 m.PathTracingDenoiseOn())).render()
+        save("pathtrace-denoise", noisy, smooth)
+        log("4 paths per pixel: pixel-to-neighbours difference %.2f levels, denoised %.2f"
+            % (roughness(noisy), roughness(smooth)))
+        self.assertLess(roughness(smooth), 0.6 * roughness(noisy))
+        self.assertEqual(self.errors.messages, [])
+
     def test_what_path_tracing_cannot_do_is_reported(self):
         s = self.scene(configure=lambda m: (m.CroppingOn(),
                                             m.SetCroppingRegionPlanes(-5, 5, -5, 5, -5, 5)))
