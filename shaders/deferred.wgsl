@@ -16,7 +16,8 @@
 // (SCATTER 1) assumes the way out absorbs as much as the way in (the transmittance
 // squared) and reads the irradiance cube at the inner surface; the traced version
 // (SCATTER 2) marches iso.scatter.y cosine-distributed directions from the inner surface
-// out of the volume and reads the environment where each leaves. The first surface's own
+// out of the volume and reads the environment where each leaves (at the mip level its share
+// of the hemisphere calls for). The first surface's own
 // shading and the scattered light are blended by Schlick's Fresnel term, and the first
 // surface is then opaque.
 #include "lib/common.wgsl"
@@ -161,10 +162,15 @@ fn scattered_light(x1: vec3<f32>, n1: vec3<f32>, c1: vec3<f32>, t_in: f32, px: v
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < count; k = k + 1u) {
         let u = hammersley(k, count);
-        let w = b * cosine_hemisphere(vec2<f32>(u.x, fract(u.y + turn / (2.0 * PI))));
+        let l = cosine_hemisphere(vec2<f32>(u.x, fract(u.y + turn / (2.0 * PI))));
+        let w = b * l;
         let start = x1 + 1e-3 * frame.misc.x * w;
         let tau = optical_depth(start, w, volume_exit(start, w));
-        sum = sum + exp(-tau) * env_radiance(env_direction(w), 0.0);
+        // each direction reads the mip level whose texels cover the solid angle it stands
+        // for (filtered importance sampling, as the specular lobe): a small bright sun is
+        // spread over the directions instead of lighting a few pixels
+        let lod = filtered_lod(max(l.z, 1e-3) / PI, count, iso.env.z, iso.env.w);
+        sum = sum + exp(-tau) * env_radiance(env_direction(w), lod);
     }
     return c1 * (sum / f32(max(count, 1u))) * t_in;
 }
