@@ -620,7 +620,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         &vol,
         UploadOptions {
             max_brick_points: a.brick,
-            max_brick_bytes: None,
+            ..Default::default()
         },
     )?;
     r.set_transfer_function(&tf)?;

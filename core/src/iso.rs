@@ -903,8 +903,16 @@ impl Renderer {
         }
         self.ensure_environment()?;
         let step = self.sample_distance(params)?;
-        // (the scattering pass reads the transfer function's opacity)
-        self.ensure_tables(step)?;
+        if iso.scattering.is_some() {
+            if self.tf.is_none() {
+                return Err(Error::InvalidParameter(
+                    "scattering between isosurfaces reads the transfer function's opacity: \
+                     set a transfer function"
+                        .into(),
+                ));
+            }
+            self.ensure_tables(step)?;
+        }
         let spacing = self.sample_distance(&RenderParams {
             sample_distance: None,
             ..params.clone()
@@ -1052,7 +1060,8 @@ impl Renderer {
         q.write_buffer(&g.iso_buf, 0, bytemuck::bytes_of(&u));
         let t = self.targets.as_ref().expect("allocated above");
         let (_, occupancy, _) = g.occupancy.as_ref().expect("built above");
-        let (_, tables) = self.tables.as_ref().expect("built above");
+        // (the tables only matter with scattering; otherwise any storage buffer fills the slot)
+        let tables = self.tables.as_ref().map_or(&g.lobe_dirs, |(_, t)| t);
         let gb = g.gbuffer.as_ref().expect("allocated above");
         let array_view = |tex: &wgpu::Texture| {
             tex.create_view(&wgpu::TextureViewDescriptor {

@@ -1,6 +1,6 @@
 //! The renderer: long-lived pipelines, the uploaded volume and tables; one call per frame.
 
-use crate::binding::{bind, buffer_entry, entry};
+use crate::binding::{bind, buffer_entry, entry, storage_texture_entry, texture_entry};
 use crate::camera::Camera;
 use crate::device::Context;
 use crate::error::{Error, Result};
@@ -48,7 +48,15 @@ pub struct UploadOptions {
     pub max_brick_points: Option<u32>,
     /// Largest brick texture in bytes; `None` = the device's buffer limit, at most 1 GiB.
     pub max_brick_bytes: Option<u64>,
+    /// Store the first component's central-difference gradients in a texture beside each
+    /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
+    /// gradients: see shaders/gradient.wgsl). `None`: for single-component volumes whose
+    /// gradients take at most [`GRADIENT_BUDGET_BYTES`].
+    pub precompute_gradients: Option<bool>,
 }
+
+/// The most bytes of precomputed gradients an upload makes by itself.
+pub const GRADIENT_BUDGET_BYTES: u64 = 512 << 20;
 
 /// Counters that show what a frame re-uploaded.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -98,6 +106,7 @@ impl Image {
 pub(crate) struct GpuBrick {
     extent: BrickExtent,
     _texture: wgpu::Texture,
+    _gradient: Option<wgpu::Texture>,
     _uniform: wgpu::Buffer,
     pub(crate) bind_linear: wgpu::BindGroup,
     pub(crate) bind_nearest: wgpu::BindGroup,
@@ -110,6 +119,8 @@ pub(crate) struct GpuVolume {
     layout: Layout,
     pub(crate) bricks: Vec<GpuBrick>,
     pub(crate) minmax: MinMaxGrid,
+    /// The bricks carry precomputed gradients (binding 3).
+    pub(crate) gradients: bool,
 }
 
 pub(crate) struct Targets {
@@ -235,10 +246,11 @@ pub(crate) struct DvrVariant {
     positional_lights: bool,
     lights: u32,
     volumetric: bool,
+    precomputed_gradient: bool,
 }
 
 impl DvrVariant {
-    fn constants(&self) -> [(&'static str, f64); 12] {
+    fn constants(&self) -> [(&'static str, f64); 13] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         [
             ("BLEND", self.blend as f64),
@@ -253,6 +265,7 @@ impl DvrVariant {
             ("POSITIONAL_LIGHTS", b(self.positional_lights)),
             ("NUM_LIGHTS", self.lights as f64),
             ("VOLUMETRIC", b(self.volumetric)),
+            ("PRECOMPUTED_GRADIENT", b(self.precomputed_gradient)),
         ]
     }
 }
@@ -379,6 +392,14 @@ impl Renderer {
                 entry(
                     2,
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+                entry(
+                    3,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D3,
+                        multisampled: false,
+                    },
                 ),
             ],
         });
@@ -528,6 +549,19 @@ impl Renderer {
             shift,
             brick_cells,
         };
+        let texels: u64 = extents
+            .iter()
+            .map(|e| e.tex_size.iter().map(|&n| n as u64).product::<u64>())
+            .sum();
+        let gradients = v.components == 1
+            && opts
+                .precompute_gradients
+                .unwrap_or(8 * texels <= GRADIENT_BUDGET_BYTES);
+        let gradient_pipeline = if gradients {
+            Some(self.gradient_pipeline()?)
+        } else {
+            None
+        };
         let d = &self.ctx.device;
         let mut bricks = Vec::with_capacity(extents.len());
         for e in &extents {
@@ -583,6 +617,13 @@ impl Renderer {
                 (texture, uniform)
             })?;
             let view = texture.create_view(&Default::default());
+            let gradient = match &gradient_pipeline {
+                Some(p) => Some(self.build_gradients(p, &view, size, &layout)?),
+                None => None,
+            };
+            let gradient_view = gradient
+                .as_ref()
+                .map(|t| t.create_view(&Default::default()));
             let brick_group = |s: &wgpu::Sampler| {
                 d.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("brick"),
@@ -591,6 +632,12 @@ impl Renderer {
                         bind(0, uniform.as_entire_binding()),
                         bind(1, wgpu::BindingResource::TextureView(&view)),
                         bind(2, wgpu::BindingResource::Sampler(s)),
+                        bind(
+                            3,
+                            wgpu::BindingResource::TextureView(
+                                gradient_view.as_ref().unwrap_or(&view),
+                            ),
+                        ),
                     ],
                 })
             };
@@ -599,6 +646,7 @@ impl Renderer {
             bricks.push(GpuBrick {
                 extent: *e,
                 _texture: texture,
+                _gradient: gradient,
                 _uniform: uniform,
                 bind_linear,
                 bind_nearest,
@@ -611,10 +659,103 @@ impl Renderer {
             layout,
             bricks,
             minmax: MinMaxGrid::new(v),
+            gradients,
         });
         self.occupancy = None;
         self.stats.volume_uploads += 1;
         Ok(())
+    }
+
+    /// The gradient build pass (shaders/gradient.wgsl): its bind group layout and pipeline.
+    fn gradient_pipeline(&self) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
+        let d = &self.ctx.device;
+        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gradient build"),
+            entries: &[
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                texture_entry(1, false, wgpu::TextureViewDimension::D3),
+                storage_texture_entry(
+                    2,
+                    wgpu::TextureFormat::Rgba16Float,
+                    wgpu::TextureViewDimension::D3,
+                ),
+            ],
+        });
+        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gradient.wgsl"),
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
+        let module = crate::iso::shader_module(&self.ctx, "gradient.wgsl")?;
+        let pipeline = self.ctx.checked("creating the gradient pipeline", || {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("gradient build"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        Ok((bgl, pipeline))
+    }
+
+    /// A brick's gradient texture, computed from its volume texture on the GPU.
+    fn build_gradients(
+        &self,
+        (bgl, pipeline): &(wgpu::BindGroupLayout, wgpu::ComputePipeline),
+        volume: &wgpu::TextureView,
+        size: wgpu::Extent3d,
+        layout: &Layout,
+    ) -> Result<wgpu::Texture> {
+        let d = &self.ctx.device;
+        let texture = self.ctx.checked("allocating the gradient texture", || {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some("gradients"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+                view_formats: &[],
+            })
+        })?;
+        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gradient build uniforms"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let scale = [layout.scale[0], layout.shift[0], 0.0f32, 0.0];
+        self.ctx
+            .queue
+            .write_buffer(&uniforms, 0, bytemuck::bytes_of(&scale));
+        let out = texture.create_view(&Default::default());
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gradient build"),
+            layout: bgl,
+            entries: &[
+                bind(0, uniforms.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(volume)),
+                bind(2, wgpu::BindingResource::TextureView(&out)),
+            ],
+        });
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(
+                size.width.div_ceil(4),
+                size.height.div_ceil(4),
+                size.depth_or_array_layers.div_ceil(4),
+            );
+        }
+        self.ctx.checked("computing the gradients", || {
+            self.ctx.queue.submit([enc.finish()]);
+        })?;
+        Ok(texture)
     }
 
     /// Sets the transfer function; its tables are (re)built at the next frame if it changed.
@@ -1086,6 +1227,7 @@ impl Renderer {
             positional_lights: u.lights[..nl].iter().any(|l| l.position[3] == 1.0),
             lights: nl as u32,
             volumetric,
+            precomputed_gradient: vol.gradients,
         };
         Ok((u, variant))
     }

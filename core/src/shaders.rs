@@ -59,6 +59,7 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/phase_test.wgsl"),
     ),
     ("denoise.wgsl", include_str!("../../shaders/denoise.wgsl")),
+    ("gradient.wgsl", include_str!("../../shaders/gradient.wgsl")),
 ];
 
 /// The passes (entry files, not library pieces).
@@ -70,6 +71,7 @@ pub const PASSES: &[&str] = &[
     "environment.wgsl",
     "pathtrace.wgsl",
     "denoise.wgsl",
+    "gradient.wgsl",
     "phase_test.wgsl",
 ];
 

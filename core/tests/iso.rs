@@ -700,6 +700,7 @@ fn bricked_equals_unbricked() {
             UploadOptions {
                 max_brick_points: brick,
                 max_brick_bytes: None,
+                ..Default::default()
             },
         )
         .unwrap();

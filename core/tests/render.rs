@@ -2014,3 +2014,43 @@ fn volumetric_shadows_darken_the_far_side() {
     println!("bricked: {e}");
     assert!(e.contains("one brick"), "{e}");
 }
+
+/// Precomputed gradients give the on-the-fly gradients: shaded and gradient-opacity frames
+/// of a blob, one brick and several, with and without them (max difference ≤ 1 level: the
+/// half-float store).
+#[test]
+fn precomputed_gradients_equal_on_the_fly() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    let mut tf = blob_transfer();
+    tf.gradient_opacity = Some(piecewise1(&[(0.0, 0.2), (0.05, 1.0)]));
+    r.set_transfer_function(&TransferFunction::single(tf))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 80, 80);
+    for bricks in [None, Some(16)] {
+        let mut images = vec![];
+        for pre in [false, true] {
+            r.set_volume_with(
+                &vol,
+                UploadOptions {
+                    max_brick_points: bricks,
+                    precompute_gradients: Some(pre),
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            images.push(r.render_image(&view, &shaded()).unwrap());
+        }
+        let (mean, max) = image_diff(&images[0], &images[1]);
+        println!(
+            "{} brick(s): precomputed against on-the-fly gradients: mean {mean:.4}/255, max {max}/255",
+            r.brick_count()
+        );
+        save(
+            &images[1],
+            &format!("precomputed_gradients_{}", r.brick_count()),
+        );
+        assert!(footprint(&images[0]) > 1000);
+        assert!(max <= 1, "precomputed gradients differ by {max} levels");
+    }
+}

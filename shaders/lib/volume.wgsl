@@ -14,6 +14,13 @@ struct Brick {
 @group(1) @binding(0) var<uniform> brick: Brick;
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
+// The first component's central differences per texel (shaders/gradient.wgsl), where the
+// upload made them (PRECOMPUTED_GRADIENT); otherwise the volume texture again, unused.
+@group(1) @binding(3) var gradient_tex: texture_3d<f32>;
+
+// Read gradients from gradient_tex (one fetch) instead of six volume fetches: the same
+// values (a pipeline constant; single-component volumes only).
+override PRECOMPUTED_GRADIENT: bool = false;
 
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
@@ -42,6 +49,14 @@ struct Gradient {
 fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
     // neighbours one voxel away, offset directly in texture coordinates
     let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
+    if (PRECOMPUTED_GRADIENT && !has_flag(FLAG_FORWARD_DIFF)) {
+        let d = textureSampleLevel(gradient_tex, volume_sampler, tc, 0.0).xyz;
+        var g: Gradient;
+        g.x = vec4<f32>(d.x, 0.0, 0.0, 0.0);
+        g.y = vec4<f32>(d.y, 0.0, 0.0, 0.0);
+        g.z = vec4<f32>(d.z, 0.0, 0.0, 0.0);
+        return g;
+    }
     let dx = vec3<f32>(brick.tex_inv_size.x, 0.0, 0.0);
     let dy = vec3<f32>(0.0, brick.tex_inv_size.y, 0.0);
     let dz = vec3<f32>(0.0, 0.0, brick.tex_inv_size.z);
