@@ -50,8 +50,8 @@ pub struct UploadOptions {
     pub max_brick_bytes: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
-    /// gradients: see shaders/gradient.wgsl). `None`: for single-component volumes whose
-    /// gradients take at most [`GRADIENT_BUDGET_BYTES`].
+    /// gradients: see shaders/gradient.wgsl). `None`: for single-component volumes stored
+    /// with 16 or 32 bits per point whose gradients take at most [`GRADIENT_BUDGET_BYTES`].
     pub precompute_gradients: Option<bool>,
 }
 
@@ -553,10 +553,14 @@ impl Renderer {
             .iter()
             .map(|e| e.tex_size.iter().map(|&n| n as u64).product::<u64>())
             .sum();
+        // Automatic for 16- and 32-bit storage only: 8-bit textures are filtered to 8-bit
+        // precision, and the on-the-fly differences of those values (which VTK's gradients
+        // share) differ from exact ones by more than shading tolerates (uint8 MRI against
+        // vtkGPUVolumeRayCastMapper: 53.2 dB on the fly, 47.7 dB precomputed).
         let gradients = v.components == 1
             && opts
                 .precompute_gradients
-                .unwrap_or(8 * texels <= GRADIENT_BUDGET_BYTES);
+                .unwrap_or(layout.texel_bytes >= 2 && 8 * texels <= GRADIENT_BUDGET_BYTES);
         let gradient_pipeline = if gradients {
             Some(self.gradient_pipeline()?)
         } else {
