@@ -43,6 +43,12 @@ struct PathTrace {
     rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
 }
 
+// Pipeline constants: the code of the BSDF and of the scattering regions (HYBRID) and of
+// the denoiser's guide (GUIDE) is compiled only into the pipelines that use it (on
+// lavapipe a path tracer carrying unused code ran 1.7x slower, measured on the skull).
+override HYBRID: bool = true;
+override GUIDE: bool = true;
+
 const PT_FLAG_BACKGROUND: u32 = 1u;
 // Collisions that do not scatter absorb (otherwise they do not happen).
 const PT_FLAG_ATTENUATION: u32 = 2u;
@@ -167,7 +173,7 @@ fn bsdf_share(m: f32) -> f32 {
 
 // Whether the hybrid model looks at the gradient at all.
 fn uses_gradient() -> bool {
-    return pt.surface.y > 0.0 || pt.surface.x < 3.0e38;
+    return HYBRID && (pt.surface.y > 0.0 || pt.surface.x < 3.0e38);
 }
 
 // The share of the collisions at a point that scatter, for its BSDF share b.
@@ -200,7 +206,7 @@ fn extinction_at(r: Ray, t: f32) -> f32 {
     let s = sample_scalars(p);
     var sigma = extinction(s.x);
     let partial = pt.options.z == PT_SCATTER_SURFACES || pt.options.z == PT_SCATTER_BETWEEN;
-    if (!attenuates() && partial && sigma > 0.0) {
+    if (HYBRID && !attenuates() && partial && sigma > 0.0) {
         let m = length(world_gradient(gradient_at(p, s), 0u));
         sigma = sigma * scatter_share(bsdf_share(m));
     }
@@ -332,7 +338,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         if (bounce == 0u) {
             hit = 1.0;
             *rng = secondary;
-            if ((pt.options.x & PT_FLAG_GUIDE) != 0u) {
+            if (GUIDE && (pt.options.x & PT_FLAG_GUIDE) != 0u) {
                 let p0 = r.index_origin + t * r.index_dir;
                 let g0 = world_gradient(gradient_at(p0, sample_scalars(p0)), 0u);
                 var n0 = -r.dir;
@@ -438,7 +444,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         sum = sum + accum[idx];
     }
     accum[idx] = sum;
-    if ((pt.options.x & PT_FLAG_GUIDE) != 0u) {
+    if (GUIDE && (pt.options.x & PT_FLAG_GUIDE) != 0u) {
         var gs = path_guide;
         if (pt.counts.y > 0u) {
             gs = gs + guide[idx];

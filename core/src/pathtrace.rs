@@ -269,7 +269,7 @@ pub(crate) struct PathTraceGpu {
     layout: wgpu::PipelineLayout,
     bgl: wgpu::BindGroupLayout,
     /// One pipeline per table interpolation (NEAREST).
-    pipelines: std::collections::HashMap<bool, wgpu::ComputePipeline>,
+    pipelines: std::collections::HashMap<PathTraceVariant, wgpu::ComputePipeline>,
     uniforms: wgpu::Buffer,
     /// Per pixel: sums of radiance and coverage over the accumulated paths.
     accum: Option<(u32, u32, wgpu::Buffer)>,
@@ -347,11 +347,16 @@ impl PathTraceGpu {
         })
     }
 
-    fn pipeline(&mut self, ctx: &Context, nearest: bool) -> Result<wgpu::ComputePipeline> {
-        if let Some(p) = self.pipelines.get(&nearest) {
+    fn pipeline(&mut self, ctx: &Context, v: PathTraceVariant) -> Result<wgpu::ComputePipeline> {
+        if let Some(p) = self.pipelines.get(&v) {
             return Ok(p.clone());
         }
-        let constants = [("NEAREST", if nearest { 1.0 } else { 0.0 })];
+        let b = |x: bool| if x { 1.0 } else { 0.0 };
+        let constants = [
+            ("NEAREST", b(v.nearest)),
+            ("HYBRID", b(v.hybrid)),
+            ("GUIDE", b(v.guide)),
+        ];
         let p = ctx.checked("creating the path tracing pipeline", || {
             ctx.device
                 .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -366,7 +371,7 @@ impl PathTraceGpu {
                     cache: None,
                 })
         })?;
-        self.pipelines.insert(nearest, p.clone());
+        self.pipelines.insert(v, p.clone());
         Ok(p)
     }
 
@@ -402,6 +407,17 @@ impl PathTraceGpu {
         self.samples = 0;
         Ok(())
     }
+}
+
+/// The pipeline constants of one specialisation of the path tracer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct PathTraceVariant {
+    /// Nearest table lookups.
+    nearest: bool,
+    /// The BSDF and the scattering regions (anything but Henyey–Greenstein everywhere).
+    hybrid: bool,
+    /// The denoiser's guide.
+    guide: bool,
 }
 
 /// Texels per face edge of the cube the environment is importance-sampled on (at most).
@@ -816,7 +832,14 @@ impl Renderer {
         let ctx = self.ctx.clone();
         let nearest = params.interpolation == Interpolation::Nearest;
         let g = self.pt.as_mut().expect("created above");
-        let pipeline = g.pipeline(&ctx, nearest)?;
+        let variant = PathTraceVariant {
+            nearest,
+            hybrid: pp.gradient_threshold.is_finite()
+                || pp.stochastic_blend > 0.0
+                || pp.scatter != ScatterRegions::Everywhere,
+            guide: pp.denoise,
+        };
+        let pipeline = g.pipeline(&ctx, variant)?;
         g.ensure_accum(&ctx, view.width, view.height)?;
         if pp.denoise && g.denoise.is_none() {
             g.denoise = Some(denoise_pipeline(&ctx)?);
