@@ -89,6 +89,10 @@ struct RenderArgs {
     /// Phong shading from on-the-fly gradients (VTK's Shade on).
     #[arg(long)]
     shade: bool,
+    /// Store the central-difference gradients in a texture at upload (one fetch per
+    /// shaded sample instead of six; the same gradients; single-component volumes).
+    #[arg(long)]
+    precompute_gradients: bool,
     /// Volumetric shadows with --shade, blended with the gradient shading as VTK's
     /// VolumetricScatteringBlending: 0 off, 2 volumetric only (anisotropy: --g).
     #[arg(long, default_value_t = 0.0, requires = "shade")]
@@ -620,6 +624,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         &vol,
         UploadOptions {
             max_brick_points: a.brick,
+            precompute_gradients: Some(a.precompute_gradients),
             ..Default::default()
         },
     )?;

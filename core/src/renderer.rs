@@ -50,13 +50,11 @@ pub struct UploadOptions {
     pub max_brick_bytes: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
-    /// gradients: see shaders/gradient.wgsl). `None`: for single-component volumes stored
-    /// with 16 or 32 bits per point whose gradients take at most [`GRADIENT_BUDGET_BYTES`].
+    /// gradients: see shaders/gradient.wgsl); single-component volumes only. `None`: off
+    /// (measured slower on lavapipe, the one device this was measured on; a GPU's texture
+    /// units may well reverse that).
     pub precompute_gradients: Option<bool>,
 }
-
-/// The most bytes of precomputed gradients an upload makes by itself.
-pub const GRADIENT_BUDGET_BYTES: u64 = 512 << 20;
 
 /// Counters that show what a frame re-uploaded.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -549,18 +547,11 @@ impl Renderer {
             shift,
             brick_cells,
         };
-        let texels: u64 = extents
-            .iter()
-            .map(|e| e.tex_size.iter().map(|&n| n as u64).product::<u64>())
-            .sum();
-        // Automatic for 16- and 32-bit storage only: 8-bit textures are filtered to 8-bit
-        // precision, and the on-the-fly differences of those values (which VTK's gradients
-        // share) differ from exact ones by more than shading tolerates (uint8 MRI against
-        // vtkGPUVolumeRayCastMapper: 53.2 dB on the fly, 47.7 dB precomputed).
-        let gradients = v.components == 1
-            && opts
-                .precompute_gradients
-                .unwrap_or(layout.texel_bytes >= 2 && 8 * texels <= GRADIENT_BUDGET_BYTES);
+        // Off unless asked for: on lavapipe one rgba16float fetch costs more than the six
+        // single-channel fetches it replaces (wavelet 256³ shaded, 900×900: 136–142 ms
+        // against 126 ms). And 8-bit storage is filtered to 8-bit precision, which VTK's
+        // on-the-fly gradients share: exact gradients cost 5 dB against VTK on the uint8 MRI.
+        let gradients = v.components == 1 && opts.precompute_gradients.unwrap_or(false);
         let gradient_pipeline = if gradients {
             Some(self.gradient_pipeline()?)
         } else {
