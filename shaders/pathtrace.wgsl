@@ -246,27 +246,32 @@ fn block_span(r: Ray, t: f32) -> vec2<f32> {
     return vec2<f32>(majorants[block_of(p)], max(block_exit(r, p), t + 1e-4));
 }
 
+// One step of tracking over [t, t1): the next tentative collision, drawn against the
+// majorant of the block the ray is in at t (y = that majorant, > 0), or, when none falls
+// before the block or the segment ends, that end (y = 0). Drawing afresh at every block
+// boundary is exact: the exponential distribution is memoryless.
+fn tracking_step(r: Ray, t: f32, t1: f32, rng: ptr<function, Rng>) -> vec2<f32> {
+    let span = block_span(r, t);
+    let end = min(span.y, t1);
+    if (span.x > 0.0) {
+        let step = -log(1.0 - rand(rng)) / span.x;
+        if (t + step < end) {
+            return vec2<f32>(t + step, span.x);
+        }
+    }
+    return vec2<f32>(end, 0.0);
+}
+
 // Delta tracking: the distance of the first real collision in [t0, t1), or t1 when the
-// ray gets through. Tentative collisions are drawn against each block's majorant, afresh at
-// every block boundary (the exponential distribution is memoryless).
+// ray gets through.
 fn free_flight(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
     var result = t1;
     if (pt.medium.x > 0.0) {
         var t = t0;
         for (var i = 0u; i < PT_MAX_STEPS && t < t1; i = i + 1u) {
-            let span = block_span(r, t);
-            let end = min(span.y, t1);
-            if (span.x <= 0.0) {
-                t = end;
-                continue;
-            }
-            let step = -log(1.0 - rand(rng)) / span.x;
-            if (t + step >= end) {
-                t = end;
-                continue;
-            }
-            t = t + step;
-            if (rand(rng) * span.x < extinction_at(r, t)) {
+            let c = tracking_step(r, t, t1, rng);
+            t = c.x;
+            if (c.y > 0.0 && rand(rng) * c.y < extinction_at(r, t)) {
                 result = t;
                 break;
             }
@@ -282,19 +287,12 @@ fn transmittance(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
     if (pt.medium.x > 0.0) {
         var t = t0;
         for (var i = 0u; i < PT_MAX_STEPS && t < t1; i = i + 1u) {
-            let span = block_span(r, t);
-            let end = min(span.y, t1);
-            if (span.x <= 0.0) {
-                t = end;
+            let c = tracking_step(r, t, t1, rng);
+            t = c.x;
+            if (c.y <= 0.0) {
                 continue;
             }
-            let step = -log(1.0 - rand(rng)) / span.x;
-            if (t + step >= end) {
-                t = end;
-                continue;
-            }
-            t = t + step;
-            tr = tr * (1.0 - extinction_at(r, t) / span.x);
+            tr = tr * (1.0 - extinction_at(r, t) / c.y);
             if (tr < 0.1) {
                 if (rand(rng) >= 0.5) {
                     tr = 0.0;
