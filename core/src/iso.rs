@@ -492,6 +492,38 @@ pub(crate) fn shader_module(ctx: &Context, name: &str) -> Result<wgpu::ShaderMod
     })
 }
 
+/// A pass of one bind group (`entries`) running `file`'s `main`: its bind group layout and
+/// compute pipeline (the small passes: gradient build, denoiser, scattering checks).
+pub(crate) fn single_group_pipeline(
+    ctx: &Context,
+    file: &str,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
+    let d = &ctx.device;
+    let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries,
+    });
+    let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(file),
+        bind_group_layouts: &[Some(&bgl)],
+        immediate_size: 0,
+    });
+    let module = shader_module(ctx, file)?;
+    let pipeline = ctx.checked(&format!("creating the {label} pipeline"), || {
+        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })?;
+    Ok((bgl, pipeline))
+}
+
 /// `n` unit vectors uniform over the sphere from a fixed seed (PCG), as vec4s.
 fn random_unit_vectors(n: usize) -> Vec<[f32; 4]> {
     let mut state: u64 = 0x853c_49e6_748f_ea9b;

@@ -32,7 +32,7 @@ use crate::gpu::{
     DenoiseUniforms, PathTraceUniforms, PhaseTestUniforms, DENOISE_FROM_SUMS, DENOISE_LAST,
     PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE,
 };
-use crate::iso::shader_module;
+use crate::iso::{shader_module, single_group_pipeline};
 use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::read_buffer;
 use crate::renderer::{DepthSource, Renderer, View};
@@ -478,10 +478,11 @@ fn denoise_pipeline(
     ctx: &Context,
 ) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline, wgpu::Buffer)> {
     use wgpu::BufferBindingType as B;
-    let d = &ctx.device;
-    let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("denoise"),
-        entries: &[
+    let (bgl, pipeline) = single_group_pipeline(
+        ctx,
+        "denoise.wgsl",
+        "denoise",
+        &[
             entry(
                 0,
                 wgpu::BindingType::Buffer {
@@ -502,23 +503,8 @@ fn denoise_pipeline(
                 wgpu::TextureViewDimension::D2,
             ),
         ],
-    });
-    let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("denoise.wgsl"),
-        bind_group_layouts: &[Some(&bgl)],
-        immediate_size: 0,
-    });
-    let module = shader_module(ctx, "denoise.wgsl")?;
-    let pipeline = ctx.checked("creating the denoiser pipeline", || {
-        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("denoise"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    })?;
+    )?;
+    let d = &ctx.device;
     let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
         label: Some("denoiser uniforms"),
         size: UNIFORM_STRIDE * DENOISE_ITERATIONS as u64,
@@ -1101,29 +1087,15 @@ impl Renderer {
         use wgpu::BufferBindingType as B;
         let ctx = &self.ctx;
         let d = &ctx.device;
-        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("phase test"),
-            entries: &[
+        let (bgl, pipeline) = single_group_pipeline(
+            ctx,
+            "phase_test.wgsl",
+            "phase test",
+            &[
                 buffer_entry(0, B::Uniform),
                 buffer_entry(1, B::Storage { read_only: false }),
             ],
-        });
-        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("phase_test.wgsl"),
-            bind_group_layouts: &[Some(&bgl)],
-            immediate_size: 0,
-        });
-        let module = shader_module(ctx, "phase_test.wgsl")?;
-        let pipeline = ctx.checked("creating the phase test pipeline", || {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("phase test"),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
+        )?;
         let ubuf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("phase test uniforms"),
             size: std::mem::size_of::<PhaseTestUniforms>() as u64,

@@ -663,10 +663,11 @@ impl Renderer {
 
     /// The gradient build pass (shaders/gradient.wgsl): its bind group layout and pipeline.
     fn gradient_pipeline(&self) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
-        let d = &self.ctx.device;
-        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gradient build"),
-            entries: &[
+        crate::iso::single_group_pipeline(
+            &self.ctx,
+            "gradient.wgsl",
+            "gradient build",
+            &[
                 buffer_entry(0, wgpu::BufferBindingType::Uniform),
                 texture_entry(1, false, wgpu::TextureViewDimension::D3),
                 storage_texture_entry(
@@ -675,24 +676,7 @@ impl Renderer {
                     wgpu::TextureViewDimension::D3,
                 ),
             ],
-        });
-        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gradient.wgsl"),
-            bind_group_layouts: &[Some(&bgl)],
-            immediate_size: 0,
-        });
-        let module = crate::iso::shader_module(&self.ctx, "gradient.wgsl")?;
-        let pipeline = self.ctx.checked("creating the gradient pipeline", || {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("gradient build"),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })?;
-        Ok((bgl, pipeline))
+        )
     }
 
     /// A brick's gradient texture, computed from its volume texture on the GPU.
