@@ -8,6 +8,7 @@
 #include "lib/common.wgsl"
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
+#include "lib/march.wgsl"
 #include "lib/shading.wgsl"
 #include "lib/shadow.wgsl"
 #include "lib/output.wgsl"
@@ -28,10 +29,6 @@ override SINGLE_BRICK: bool = false;
 override VOLUMETRIC: bool = false;
 
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
-// Per block of the occupancy grid: 1 when the transfer function gives some block voxel a
-// non-zero opacity, 0 when the whole block is transparent.
-@group(0) @binding(3) var<storage, read> occupancy: array<u32>;
-@group(0) @binding(4) var depth_in: texture_2d<f32>;
 
 // Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
 fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
@@ -133,28 +130,6 @@ fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
         out[c] = raw_alpha(c, s[c]) * u * scale[c];
     }
     return out;
-}
-
-fn in_crop(p: vec3<f32>) -> bool {
-    let d = (frame.index_to_data * vec4<f32>(p, 1.0)).xyz;
-    let r = select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_lo.xyz)
-          + select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_hi.xyz);
-    let bit = r.x + 3u * r.y + 9u * r.z;
-    return ((frame.mode.z >> bit) & 1u) != 0u;
-}
-
-fn block_occupied(p: vec3<f32>) -> bool {
-    let bs = f32(frame.counts.z);
-    let b = min(vec3<u32>(max(floor(p / bs), vec3<f32>(0.0))), frame.occupancy_dims.xyz - 1u);
-    let d = frame.occupancy_dims;
-    return occupancy[(b.z * d.y + b.y) * d.x + b.x] != 0u;
-}
-
-// Distance at which the ray leaves the occupancy block holding p.
-fn block_exit(r: Ray, p: vec3<f32>) -> f32 {
-    let bs = f32(frame.counts.z);
-    let lo = floor(p / bs) * bs;
-    return box_interval(r, lo, lo + bs).y;
 }
 
 @compute @workgroup_size(8, 8, 1)

@@ -75,9 +75,9 @@ const PT_MAX_STEPS: u32 = 1000000u;
 // face, faces +X … −Z, rows top to bottom): the cumulative probabilities, last = 1
 // (core/src/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
 @group(0) @binding(14) var<storage, read> env_cdf: array<f32>;
-// Per min–max block (march.wgsl: block_of): the largest extinction (per world unit) its
+// Per min–max block (march.wgsl: block_coord): the largest extinction (per world unit) its
 // scalar range can take under the transfer function.
-@group(0) @binding(15) var<storage, read> majorants: array<f32>;
+@group(0) @binding(15) var majorants: texture_3d<f32>;
 // Per pixel (PT_FLAG_GUIDE), summed over the paths: the unit normal at the camera path's
 // first collision (facing the camera; the gradient's direction) and its distance along
 // the ray (denoise.wgsl reads them).
@@ -243,7 +243,7 @@ fn scatter_sample(sc: Scatterer, d: vec3<f32>, rng: ptr<function, Rng>) -> vec3<
 // little past t, so that every step advances).
 fn block_span(r: Ray, t: f32) -> vec2<f32> {
     let p = r.index_origin + (t + 1e-4) * r.index_dir;
-    return vec2<f32>(majorants[block_of(p)], max(block_exit(r, p), t + 1e-4));
+    return vec2<f32>(textureLoad(majorants, block_coord(p), 0).x, max(block_exit(r, p), t + 1e-4));
 }
 
 // One step of tracking over [t, t1): the next tentative collision, drawn against the

@@ -28,7 +28,7 @@ use crate::error::{Error, Result};
 use crate::gpu::*;
 use crate::params::{BlendMode, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::{read_buffer, read_texture_layer};
-use crate::renderer::{DepthSource, Renderer, View};
+use crate::renderer::{block_grid, grid_entry, DepthSource, Renderer, Tables, View};
 use crate::Context;
 use bytemuck::Zeroable;
 use glam::{DMat4, DVec3};
@@ -466,8 +466,10 @@ pub(crate) struct IsoGpu {
     pub(crate) environment: Option<GpuEnvironment>,
     iso_buf: wgpu::Buffer,
     lobe_dirs: wgpu::Buffer,
+    // fills the tables' slot when no transfer function is needed (scattering off)
+    no_tables: Tables,
     gbuffer: Option<GBufferTargets>,
-    occupancy: Option<(OccupancyKey, wgpu::Buffer, f64)>,
+    occupancy: Option<(OccupancyKey, wgpu::TextureView, f64)>,
     /// The pixels the last frame's first-hit pass covered.
     last_rect: [u32; 4],
 }
@@ -563,7 +565,7 @@ impl IsoGpu {
             entries: &[
                 buffer_entry(0, B::Uniform),
                 buffer_entry(2, B::Storage { read_only: false }),
-                buffer_entry(3, B::Storage { read_only: true }),
+                grid_entry(3, wgpu::TextureSampleType::Uint),
                 texture_entry(4, false, V::D2),
                 buffer_entry(7, B::Uniform),
                 gb_write(8),
@@ -587,7 +589,7 @@ impl IsoGpu {
                 texture_entry(12, true, V::Cube),
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
-                buffer_entry(1, B::Storage { read_only: true }),
+                texture_entry(1, false, V::D2),
             ],
         });
         let layout = |name: &str, bgls: &[Option<&wgpu::BindGroupLayout>]| {
@@ -630,6 +632,14 @@ impl IsoGpu {
             environment: None,
             iso_buf,
             lobe_dirs,
+            no_tables: Tables::new(
+                d,
+                wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+            ),
             gbuffer: None,
             occupancy: None,
             last_rect: [0; 4],
@@ -895,17 +905,9 @@ impl Renderer {
                 values.iter().any(|&v| v >= lo && v <= hi) as u32
             })
             .collect();
-        let buf = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("iso occupancy"),
-            size: (occ.len().max(1) * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        self.ctx
-            .queue
-            .write_buffer(&buf, 0, bytemuck::cast_slice(&occ));
+        let grid = block_grid(&self.ctx, "iso occupancy", vol.minmax.dims, &occ);
         let fraction = occ.iter().filter(|&&o| o != 0).count() as f64 / occ.len().max(1) as f64;
-        g.occupancy = Some((key, buf, fraction));
+        g.occupancy = Some((key, grid, fraction));
         Ok(())
     }
 
@@ -1092,8 +1094,8 @@ impl Renderer {
         q.write_buffer(&g.iso_buf, 0, bytemuck::bytes_of(&u));
         let t = self.targets.as_ref().expect("allocated above");
         let (_, occupancy, _) = g.occupancy.as_ref().expect("built above");
-        // (the tables only matter with scattering; otherwise any storage buffer fills the slot)
-        let tables = self.tables.as_ref().map_or(&g.lobe_dirs, |(_, t)| t);
+        // (the tables only matter with scattering; otherwise a one-texel table fills the slot)
+        let tables = self.tables.as_ref().map_or(&g.no_tables, |(_, t)| t);
         let gb = g.gbuffer.as_ref().expect("allocated above");
         let array_view = |tex: &wgpu::Texture| {
             tex.create_view(&wgpu::TextureViewDescriptor {
@@ -1116,7 +1118,7 @@ impl Renderer {
             entries: &[
                 bind(0, self.frame_buf.as_entire_binding()),
                 bind(2, t.state.as_entire_binding()),
-                bind(3, occupancy.as_entire_binding()),
+                bind(3, wgpu::BindingResource::TextureView(occupancy)),
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
                 bind(7, g.iso_buf.as_entire_binding()),
                 bind(8, wgpu::BindingResource::TextureView(&gp)),
@@ -1144,7 +1146,7 @@ impl Renderer {
                     wgpu::BindingResource::Sampler(&g.env_pipelines.cube_sampler),
                 ),
                 bind(14, g.lobe_dirs.as_entire_binding()),
-                bind(1, tables.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {

@@ -35,7 +35,7 @@ use crate::gpu::{
 use crate::iso::{shader_module, single_group_pipeline};
 use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::read_buffer;
-use crate::renderer::{DepthSource, Renderer, View};
+use crate::renderer::{block_grid, grid_entry, DepthSource, Renderer, View};
 use crate::transfer::TABLE_SIZE;
 use crate::Context;
 use bytemuck::Zeroable;
@@ -281,7 +281,7 @@ pub(crate) struct PathTraceGpu {
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
     /// The block majorants: (the volume and table upload counts they were computed at,
     /// buffer, the largest).
-    majorants: Option<((u32, u32), wgpu::Buffer, f32)>,
+    majorants: Option<((u32, u32), wgpu::TextureView, f32)>,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
     samples: u32,
@@ -296,7 +296,7 @@ impl PathTraceGpu {
             label: Some("path tracing"),
             entries: &[
                 buffer_entry(0, B::Uniform),
-                buffer_entry(1, B::Storage { read_only: true }),
+                texture_entry(1, false, V::D2),
                 buffer_entry(2, B::Storage { read_only: false }),
                 texture_entry(4, false, V::D2),
                 storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
@@ -315,7 +315,7 @@ impl PathTraceGpu {
                 texture_entry(11, true, V::Cube),
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
-                buffer_entry(15, B::Storage { read_only: true }),
+                grid_entry(15, wgpu::TextureSampleType::Float { filterable: false }),
                 buffer_entry(16, B::Storage { read_only: false }),
             ],
         });
@@ -726,17 +726,15 @@ impl Renderer {
         }
         let m = self.block_majorants()?;
         let max = m.iter().copied().fold(0.0f32, f32::max);
-        let buf = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("path tracing block majorants"),
-            size: (4 * m.len().max(1)) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        self.ctx
-            .queue
-            .write_buffer(&buf, 0, bytemuck::cast_slice(&m));
+        let dims = self
+            .volume
+            .as_ref()
+            .expect("block_majorants needs the volume")
+            .minmax
+            .dims;
+        let grid = block_grid(&self.ctx, "path tracing block majorants", dims, &m);
         let g = self.pt.as_mut().expect("created before");
-        g.majorants = Some((key, buf, max));
+        g.majorants = Some((key, grid, max));
         Ok(max)
     }
 
@@ -910,7 +908,7 @@ impl Renderer {
             layout: &g.bgl,
             entries: &[
                 bind(0, self.frame_buf.as_entire_binding()),
-                bind(1, tables.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
                 bind(2, accum.as_entire_binding()),
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
@@ -931,7 +929,7 @@ impl Renderer {
                     wgpu::BindingResource::Sampler(&iso.env_pipelines.cube_sampler),
                 ),
                 bind(14, dist.as_entire_binding()),
-                bind(15, majorant_buf.as_entire_binding()),
+                bind(15, wgpu::BindingResource::TextureView(majorant_buf)),
                 bind(16, guide.as_entire_binding()),
             ],
         });

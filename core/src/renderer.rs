@@ -229,6 +229,100 @@ pub(crate) const WORKGROUP: u32 = 8;
 /// Empty-space skipping is used only when fewer blocks than this fraction are occupied.
 pub(crate) const SKIP_MAX_OCCUPANCY: f64 = 0.9;
 
+/// A value per min–max block (occupancy flags, majorants) as a 3D texture of `dims` that
+/// the passes read with textureLoad (lib/march.wgsl, block_coord): u32 values go to an
+/// r32uint texture, f32 values to r32float. A texture for the same reason as [`Tables`].
+pub(crate) fn block_grid<T: GridValue>(
+    ctx: &Context,
+    label: &str,
+    dims: [u32; 3],
+    values: &[T],
+) -> wgpu::TextureView {
+    let size = wgpu::Extent3d {
+        width: dims[0].max(1),
+        height: dims[1].max(1),
+        depth_or_array_layers: dims[2].max(1),
+    };
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: T::FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let n = (size.width * size.height * size.depth_or_array_layers) as usize;
+    let mut data = values.to_vec();
+    data.resize(n, T::default());
+    ctx.queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(&data),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(size.width * 4),
+            rows_per_image: Some(size.height),
+        },
+        size,
+    );
+    texture.create_view(&Default::default())
+}
+
+/// The value types of [`block_grid`] textures.
+pub(crate) trait GridValue: bytemuck::Pod + Default {
+    const FORMAT: wgpu::TextureFormat;
+}
+
+impl GridValue for u32 {
+    const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+}
+
+impl GridValue for f32 {
+    const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+}
+
+/// The layout entry of a [`block_grid`] texture.
+pub(crate) fn grid_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
+    entry(
+        binding,
+        wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+    )
+}
+
+/// The transfer-function tables as the shaders read them (lib/common.wgsl): one row of
+/// `TABLE_SIZE` texels per table, two tables per component. A texture, not a storage
+/// buffer: lavapipe reads a storage buffer at per-lane indices one lane at a time, a
+/// texture with one gather (the benchmark frame took 1.5× as long with the buffer).
+pub(crate) struct Tables {
+    texture: wgpu::Texture,
+    pub(crate) view: wgpu::TextureView,
+}
+
+impl Tables {
+    pub(crate) fn new(d: &wgpu::Device, size: wgpu::Extent3d) -> Tables {
+        let texture = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("transfer tables"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Tables { texture, view }
+    }
+}
+
 /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct DvrVariant {
@@ -282,8 +376,8 @@ pub struct Renderer {
     pub(crate) frame_buf: wgpu::Buffer,
     pub(crate) volume: Option<GpuVolume>,
     pub(crate) tf: Option<TransferFunction>,
-    pub(crate) tables: Option<(TableKey, wgpu::Buffer)>,
-    occupancy: Option<(TableKey, wgpu::Buffer, f64)>,
+    pub(crate) tables: Option<(TableKey, Tables)>,
+    occupancy: Option<(TableKey, wgpu::TextureView, f64)>,
     pub(crate) targets: Option<Targets>,
     output_path: OutputPath,
     /// Counts allocations of the output images.
@@ -360,9 +454,9 @@ impl Renderer {
             label: Some("dvr frame"),
             entries: &[
                 buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                texture_entry(1, false, wgpu::TextureViewDimension::D2),
                 buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
-                buffer_entry(3, wgpu::BufferBindingType::Storage { read_only: true }),
+                grid_entry(3, wgpu::TextureSampleType::Uint),
                 entry(
                     4,
                     wgpu::BindingType::Texture {
@@ -405,7 +499,7 @@ impl Renderer {
             label: Some("resolve"),
             entries: &[
                 buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                buffer_entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                texture_entry(1, false, wgpu::TextureViewDimension::D2),
                 buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: true }),
                 output_entries[0],
                 output_entries[1],
@@ -785,18 +879,26 @@ impl Renderer {
         for c in 0..comps {
             data.extend(build_tables(tf.component(c), step));
         }
-        let bytes: &[u8] = bytemuck::cast_slice(&data);
-        let buf = match self.tables.take() {
-            Some((_, b)) if b.size() == bytes.len() as u64 => b,
-            _ => self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("transfer tables"),
-                size: bytes.len() as u64,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+        let size = wgpu::Extent3d {
+            width: TABLE_SIZE as u32,
+            height: 2 * comps as u32,
+            depth_or_array_layers: 1,
         };
-        self.ctx.queue.write_buffer(&buf, 0, bytes);
-        self.tables = Some((key, buf));
+        let tables = match self.tables.take() {
+            Some((_, t)) if t.texture.size() == size => t,
+            _ => Tables::new(&self.ctx.device, size),
+        };
+        self.ctx.queue.write_texture(
+            tables.texture.as_image_copy(),
+            bytemuck::cast_slice(&data),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(size.width * 16),
+                rows_per_image: Some(size.height),
+            },
+            size,
+        );
+        self.tables = Some((key, tables));
         self.stats.table_uploads += 1;
         Ok(())
     }
@@ -854,17 +956,9 @@ impl Renderer {
                 }
             }
         }
-        let buf = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("occupancy"),
-            size: (occ.len() * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        self.ctx
-            .queue
-            .write_buffer(&buf, 0, bytemuck::cast_slice(&occ));
+        let grid = block_grid(&self.ctx, "occupancy", vol.minmax.dims, &occ);
         let fraction = occ.iter().filter(|&&o| o != 0).count() as f64 / occ.len().max(1) as f64;
-        self.occupancy = Some((key, buf, fraction));
+        self.occupancy = Some((key, grid, fraction));
         self.stats.occupancy_updates += 1;
         Ok(())
     }
@@ -1361,13 +1455,13 @@ impl Renderer {
         let depth_view = t.depth.create_view(&Default::default());
         let common = [
             bind(0, self.frame_buf.as_entire_binding()),
-            bind(1, tables.as_entire_binding()),
+            bind(1, wgpu::BindingResource::TextureView(&tables.view)),
             bind(2, t.state.as_entire_binding()),
             bind(5, wgpu::BindingResource::TextureView(&color_view)),
             bind(6, wgpu::BindingResource::TextureView(&depth_view)),
         ];
         let mut dvr_entries = common.to_vec();
-        dvr_entries.push(bind(3, occupancy.as_entire_binding()));
+        dvr_entries.push(bind(3, wgpu::BindingResource::TextureView(occupancy)));
         dvr_entries.push(bind(4, wgpu::BindingResource::TextureView(&depth_in_view)));
         let dvr_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dvr frame"),

@@ -74,10 +74,11 @@ struct Frame {
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// Per component c: N entries (r, g, b, alpha corrected for the step) at [2·c·N, 2·c·N + N),
-// then (alpha as given, gradient opacity, 0, 0) at [2·c·N + N, 2·c·N + 2N). Composite
-// reads one entry per sample.
-@group(0) @binding(1) var<storage, read> tables: array<vec4<f32>>;
+// Per component c, two rows of N entries: row 2·c holds (r, g, b, alpha corrected for the
+// step), row 2·c + 1 holds (alpha as given, gradient opacity, 0, 0). Composite reads one
+// entry per sample. A texture rather than a storage buffer: lavapipe reads storage buffers
+// at per-lane indices one lane at a time.
+@group(0) @binding(1) var tables: texture_2d<f32>;
 
 // Per-pixel ray state carried across brick passes.
 struct PixelState {
@@ -94,13 +95,15 @@ fn has_flag(f: u32) -> bool {
 // of component `c` at normalised coordinate u in [0, 1] (clamped, like VTK's tables).
 fn table_lookup(c: u32, which: u32, u: f32) -> vec4<f32> {
     let x = clamp(u, 0.0, 1.0) * f32(TABLE_N - 1u);
-    let base = (2u * c + which) * TABLE_N;
+    let row = i32(2u * c + which);
     if (NEAREST) {
-        return tables[base + u32(x + 0.5)];
+        return textureLoad(tables, vec2<i32>(i32(x + 0.5), row), 0);
     }
     let i0 = u32(x);
     let i1 = min(i0 + 1u, TABLE_N - 1u);
-    return mix(tables[base + i0], tables[base + i1], x - f32(i0));
+    let t0 = textureLoad(tables, vec2<i32>(i32(i0), row), 0);
+    let t1 = textureLoad(tables, vec2<i32>(i32(i1), row), 0);
+    return mix(t0, t1, x - f32(i0));
 }
 
 fn scalar_coord(c: u32, s: f32) -> f32 {

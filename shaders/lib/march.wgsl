@@ -2,10 +2,11 @@
 // ray's segment inside the volume (near/far planes, the host's opaque depth, clipping
 // planes), VTK's cropping regions and the occupancy grid for empty-space skipping.
 
-// Per block of the occupancy grid: 1 when the block may hold something the pass looks for
+// Per block of the occupancy grid (a texture: lavapipe reads storage buffers at per-lane
+// indices one lane at a time): 1 when the block may hold something the pass looks for
 // (dvr: some voxel with non-zero opacity; firsthit: some iso-value within the block's
 // range), 0 when the pass can skip it.
-@group(0) @binding(3) var<storage, read> occupancy: array<u32>;
+@group(0) @binding(3) var occupancy: texture_3d<u32>;
 // The host's opaque depth (window depth per pixel), read when FLAG_DEPTH_INPUT is set.
 @group(0) @binding(4) var depth_in: texture_2d<f32>;
 
@@ -30,16 +31,16 @@ fn in_crop(p: vec3<f32>) -> bool {
     return ((frame.mode.z >> bit) & 1u) != 0u;
 }
 
-// Index of the min–max block holding index-space point p (clamped to the grid).
-fn block_of(p: vec3<f32>) -> u32 {
+// The min–max block holding index-space point p (clamped to the grid): its texel in the
+// per-block textures (occupancy, majorants).
+fn block_coord(p: vec3<f32>) -> vec3<i32> {
     let bs = f32(frame.counts.z);
     let b = min(vec3<u32>(max(floor(p / bs), vec3<f32>(0.0))), frame.occupancy_dims.xyz - 1u);
-    let d = frame.occupancy_dims;
-    return (b.z * d.y + b.y) * d.x + b.x;
+    return vec3<i32>(b);
 }
 
 fn block_occupied(p: vec3<f32>) -> bool {
-    return occupancy[block_of(p)] != 0u;
+    return textureLoad(occupancy, block_coord(p), 0).x != 0u;
 }
 
 // Distance at which the ray leaves the occupancy block holding p.
