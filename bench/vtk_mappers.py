@@ -32,6 +32,8 @@ def main(argv):
     p.add_argument("--rounds", type=int, default=3, help="alternating rounds (default 3)")
     p.add_argument("--size", default="900x900")
     p.add_argument("--extent", type=int, default=127)
+    p.add_argument("--multisamples", type=int, metavar="N",
+                   help="the window's MultiSamples (default VTK's: 8 on VTK 9.2)")
     args = p.parse_args(argv)
 
     results = {}  # (config, mode) -> [ms per round]
@@ -39,6 +41,8 @@ def main(argv):
         for name, extra in CONFIGS:
             cmd = [sys.executable, os.path.join(HERE, "vtk_bench.py"), "--frames",
                    str(args.frames), "--size", args.size, "--extent", str(args.extent)] + extra
+            if args.multisamples is not None:
+                cmd += ["--multisamples", str(args.multisamples)]
             out = subprocess.run(cmd, capture_output=True, text=True)
             if out.returncode != 0:
                 sys.stderr.write(out.stdout + out.stderr)
@@ -57,8 +61,9 @@ def main(argv):
         print("# round %d of %d done" % (r + 1, args.rounds))
         sys.stdout.flush()
 
-    print("# ms/frame: median over %d rounds of each round's mean (%d frames), %s, extent %d"
-          % (args.rounds, args.frames, args.size, args.extent))
+    print("# ms/frame: median over %d rounds of each round's mean (%d frames), %s, extent %d, "
+          "MultiSamples %s" % (args.rounds, args.frames, args.size, args.extent,
+                               "VTK's default" if args.multisamples is None else args.multisamples))
     for mode in ("unshaded", "shaded"):
         ref = statistics.median(results[("vtk_gpu", mode)])
         for name, _ in CONFIGS:
