@@ -18,8 +18,8 @@ pub struct GpuLight {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FrameUniforms {
-    pub inv_view_proj: [f32; 16],
-    pub view_proj: [f32; 16],
+    /// Clip → world and world → clip (the shaders read them at a dynamic index: ray.wgsl).
+    pub camera: [[f32; 16]; 2],
     pub world_to_index: [f32; 16],
     pub index_to_data: [f32; 16],
     pub gradient_to_world: [f32; 16],
@@ -203,8 +203,7 @@ mod layout_tests {
                 "Frame",
                 FrameUniforms,
                 [
-                    inv_view_proj,
-                    view_proj,
+                    camera,
                     world_to_index,
                     index_to_data,
                     gradient_to_world,

@@ -1112,8 +1112,7 @@ impl Renderer {
         let index_to_world = params.volume_matrix * vol.index_to_data;
         let world_to_index = index_to_world.inverse();
         let mut u = FrameUniforms::zeroed();
-        u.inv_view_proj = mat(vp.inverse());
-        u.view_proj = mat(vp);
+        u.camera = [mat(vp.inverse()), mat(vp)];
         u.world_to_index = mat(world_to_index);
         u.index_to_data = mat(vol.index_to_data);
         u.gradient_to_world = mat(world_to_index.transpose());

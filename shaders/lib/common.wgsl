@@ -44,8 +44,7 @@ struct Light {
 }
 
 struct Frame {
-    inv_view_proj: mat4x4<f32>,   // clip → world
-    view_proj: mat4x4<f32>,       // world → clip
+    camera: array<mat4x4<f32>, 2>, // clip → world, world → clip (read in lib/ray.wgsl only)
     world_to_index: mat4x4<f32>,  // world → volume index space (i, j, k)
     index_to_data: mat4x4<f32>,   // index → data coordinates (for cropping)
     gradient_to_world: mat4x4<f32>, // index-space gradient → world gradient (inverse transpose)
@@ -66,7 +65,7 @@ struct Frame {
     scatter: vec4<f32>,           // volumetric shadows: x blending (0 off), y anisotropy, z reach (texture units), w 2 / data range
     clip: array<vec4<f32>, 6>,    // index-space planes: keep dot(xyz, p) + w >= 0
     lights: array<Light, 8>,
-    viewport: vec4<u32>,          // width, height, unused, jitter seed
+    viewport: vec4<u32>,          // width, height, 0 (camera index base: lib/ray.wgsl), jitter seed
     mode: vec4<u32>,              // blend, flags, crop regions, unused
     counts: vec4<u32>,            // clip planes, lights, occupancy block size, components
     occupancy_dims: vec4<u32>,    // blocks per axis
