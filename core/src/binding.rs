@@ -26,20 +26,29 @@ pub(crate) fn buffer_entry(
     )
 }
 
+/// A sampled texture of any sample type (float, uint, …).
+pub(crate) fn sampled_texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+    dim: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    entry(
+        binding,
+        wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: dim,
+            multisampled: false,
+        },
+    )
+}
+
 /// A sampled float texture.
 pub(crate) fn texture_entry(
     binding: u32,
     filterable: bool,
     dim: wgpu::TextureViewDimension,
 ) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable },
-            view_dimension: dim,
-            multisampled: false,
-        },
-    )
+    sampled_texture_entry(binding, wgpu::TextureSampleType::Float { filterable }, dim)
 }
 
 /// A write-only storage texture.

@@ -22,13 +22,15 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::environment`]).
 
-use crate::binding::{bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry};
+use crate::binding::{
+    bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
+};
 use crate::environment::{CubeImage, EnvPipelines, Environment, GpuEnvironment};
 use crate::error::{Error, Result};
 use crate::gpu::*;
 use crate::params::{BlendMode, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::{read_buffer, read_texture_layer};
-use crate::renderer::{block_grid, grid_entry, DepthSource, Renderer, Tables, View};
+use crate::renderer::{block_grid, DepthSource, Renderer, Tables, View};
 use crate::Context;
 use bytemuck::Zeroable;
 use glam::{DMat4, DVec3};
@@ -565,7 +567,7 @@ impl IsoGpu {
             entries: &[
                 buffer_entry(0, B::Uniform),
                 buffer_entry(2, B::Storage { read_only: false }),
-                grid_entry(3, wgpu::TextureSampleType::Uint),
+                sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
                 texture_entry(4, false, V::D2),
                 buffer_entry(7, B::Uniform),
                 gb_write(8),

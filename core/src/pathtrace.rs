@@ -25,7 +25,8 @@
 //! medium; cropping and positional lights are refused.
 
 use crate::binding::{
-    bind, buffer_entry, entry, sampler_entry, storage_texture_entry, texture_entry,
+    bind, buffer_entry, entry, sampled_texture_entry, sampler_entry, storage_texture_entry,
+    texture_entry,
 };
 use crate::error::{Error, Result};
 use crate::gpu::{
@@ -35,7 +36,7 @@ use crate::gpu::{
 use crate::iso::{shader_module, single_group_pipeline};
 use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::read_buffer;
-use crate::renderer::{block_grid, grid_entry, DepthSource, Renderer, View};
+use crate::renderer::{block_grid, DepthSource, Renderer, View};
 use crate::transfer::TABLE_SIZE;
 use crate::Context;
 use bytemuck::Zeroable;
@@ -315,7 +316,11 @@ impl PathTraceGpu {
                 texture_entry(11, true, V::Cube),
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
-                grid_entry(15, wgpu::TextureSampleType::Float { filterable: false }),
+                sampled_texture_entry(
+                    15,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    V::D3,
+                ),
                 buffer_entry(16, B::Storage { read_only: false }),
             ],
         });

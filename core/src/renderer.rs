@@ -1,6 +1,8 @@
 //! The renderer: long-lived pipelines, the uploaded volume and tables; one call per frame.
 
-use crate::binding::{bind, buffer_entry, entry, storage_texture_entry, texture_entry};
+use crate::binding::{
+    bind, buffer_entry, entry, sampled_texture_entry, storage_texture_entry, texture_entry,
+};
 use crate::camera::Camera;
 use crate::device::Context;
 use crate::error::{Error, Result};
@@ -256,17 +258,29 @@ pub(crate) fn block_grid<T: GridValue>(
     let n = (size.width * size.height * size.depth_or_array_layers) as usize;
     let mut data = values.to_vec();
     data.resize(n, T::default());
-    ctx.queue.write_texture(
+    upload_texture(&ctx.queue, &texture, bytemuck::cast_slice(&data), 4);
+    texture.create_view(&Default::default())
+}
+
+/// Writes tightly packed texels (`texel_bytes` each, rows then images) over the whole of
+/// `texture`'s first mip level.
+pub(crate) fn upload_texture(
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    bytes: &[u8],
+    texel_bytes: u32,
+) {
+    let size = texture.size();
+    queue.write_texture(
         texture.as_image_copy(),
-        bytemuck::cast_slice(&data),
+        bytes,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
-            bytes_per_row: Some(size.width * 4),
+            bytes_per_row: Some(size.width * texel_bytes),
             rows_per_image: Some(size.height),
         },
         size,
     );
-    texture.create_view(&Default::default())
 }
 
 /// The value types of [`block_grid`] textures.
@@ -280,21 +294,6 @@ impl GridValue for u32 {
 
 impl GridValue for f32 {
     const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-}
-
-/// The layout entry of a [`block_grid`] texture.
-pub(crate) fn grid_entry(
-    binding: u32,
-    sample_type: wgpu::TextureSampleType,
-) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D3,
-            multisampled: false,
-        },
-    )
 }
 
 /// The transfer-function tables as the shaders read them (lib/common.wgsl): one row of
@@ -456,15 +455,12 @@ impl Renderer {
                 buffer_entry(0, wgpu::BufferBindingType::Uniform),
                 texture_entry(1, false, wgpu::TextureViewDimension::D2),
                 buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
-                grid_entry(3, wgpu::TextureSampleType::Uint),
-                entry(
-                    4,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
+                sampled_texture_entry(
+                    3,
+                    wgpu::TextureSampleType::Uint,
+                    wgpu::TextureViewDimension::D3,
                 ),
+                texture_entry(4, false, wgpu::TextureViewDimension::D2),
                 output_entries[0],
                 output_entries[1],
             ],
@@ -473,26 +469,12 @@ impl Renderer {
             label: Some("brick"),
             entries: &[
                 buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                entry(
-                    1,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D3,
-                        multisampled: false,
-                    },
-                ),
+                texture_entry(1, true, wgpu::TextureViewDimension::D3),
                 entry(
                     2,
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 ),
-                entry(
-                    3,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D3,
-                        multisampled: false,
-                    },
-                ),
+                texture_entry(3, true, wgpu::TextureViewDimension::D3),
             ],
         });
         let resolve_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -671,21 +653,7 @@ impl Renderer {
                     usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                     view_formats: &[],
                 });
-                self.ctx.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &texture,
-                        mip_level: 0,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    &texels,
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(e.tex_size[0] * texel_bytes),
-                        rows_per_image: Some(e.tex_size[1]),
-                    },
-                    size,
-                );
+                upload_texture(&self.ctx.queue, &texture, &texels, texel_bytes);
                 let v4 = |v: [u32; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
                 let tex_size = v4(e.tex_size);
                 let bu = BrickUniforms {
@@ -888,15 +856,11 @@ impl Renderer {
             Some((_, t)) if t.texture.size() == size => t,
             _ => Tables::new(&self.ctx.device, size),
         };
-        self.ctx.queue.write_texture(
-            tables.texture.as_image_copy(),
+        upload_texture(
+            &self.ctx.queue,
+            &tables.texture,
             bytemuck::cast_slice(&data),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(size.width * 16),
-                rows_per_image: Some(size.height),
-            },
-            size,
+            16,
         );
         self.tables = Some((key, tables));
         self.stats.table_uploads += 1;
@@ -1039,16 +1003,7 @@ impl Renderer {
                 // The depth input starts at the far plane: nothing occludes until the host
                 // writes its depth.
                 let far: Vec<f32> = vec![1.0; width as usize * height as usize];
-                ctx.queue.write_texture(
-                    depth_in.as_image_copy(),
-                    bytemuck::cast_slice(&far),
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(4 * width),
-                        rows_per_image: None,
-                    },
-                    depth_in.size(),
-                );
+                upload_texture(&ctx.queue, &depth_in, bytemuck::cast_slice(&far), 4);
                 ctx.queue.submit([enc.finish()]);
                 // Wait: the host may write the depth input through its own API right after
                 // this returns, and a clear landing later would wipe it.
@@ -1624,16 +1579,7 @@ impl Renderer {
             .targets
             .as_ref()
             .expect("output images allocated for the frame");
-        self.ctx.queue.write_texture(
-            t.depth_in.as_image_copy(),
-            bytemuck::cast_slice(d),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(4 * view.width),
-                rows_per_image: None,
-            },
-            t.depth_in.size(),
-        );
+        upload_texture(&self.ctx.queue, &t.depth_in, bytemuck::cast_slice(d), 4);
         Ok(())
     }
 
