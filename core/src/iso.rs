@@ -883,7 +883,7 @@ impl Renderer {
         })
     }
 
-    /// The occupancy buffer for these iso-values: blocks whose min–max range holds one.
+    /// The occupancy grid (a texture) for these iso-values: blocks whose min–max range holds one.
     fn ensure_iso_occupancy(&mut self, values: &[f32]) -> Result<()> {
         let vol = self
             .volume
