@@ -177,6 +177,9 @@ fn scattered_light(x1: vec3<f32>, n1: vec3<f32>, c1: vec3<f32>, t_in: f32, px: v
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    frame = frame_ubo;
+    brick = brick_ubo;
+    iso = iso_ubo;
     let r = iso.shade_rect;
     let px = gid.xy + r.xy;
     if (px.x >= r.z || px.y >= r.w) {

@@ -134,6 +134,8 @@ fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    frame = frame_ubo;
+    brick = brick_ubo;
     // The dispatch covers only frame.rect, the pixels the volume's box can project to.
     let px = gid.xy + frame.rect.xy;
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
@@ -207,6 +209,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var color = st.color;
     var value = st.value;
     var misc = st.misc;
+    // Where the opacity first passes the depth threshold, turned into a depth after the
+    // loop: lavapipe runs a branch's code for all lanes whenever any lane takes it, and
+    // the conversion reads the camera at a dynamic index (lib/ray.wgsl) with a gather per
+    // matrix element.
+    var depth_t = -1.0;
     loop {
         if (k >= k_end) {
             break;
@@ -228,7 +235,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 let w = (1.0 - color.a) * c.a;
                 color = vec4<f32>(color.rgb + w * c.rgb, color.a + w);
                 if (misc.z == 0.0 && color.a > frame.misc.z) {
-                    misc.y = distance_to_depth(ray, t);
+                    depth_t = t;
                     misc.z = 1.0;
                 }
                 if (color.a >= ert) {
@@ -254,6 +261,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             misc.x = misc.x + 1.0;
         }
         k = k + 1.0;
+    }
+    if (depth_t >= 0.0) {
+        misc.y = distance_to_depth(ray, depth_t);
     }
     st.color = color;
     st.value = value;

@@ -192,6 +192,9 @@ fn write_hit(px: vec2<u32>, layer: u32, ray: Ray, t: f32, which: u32, below: boo
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    frame = frame_ubo;
+    brick = brick_ubo;
+    iso = iso_ubo;
     let px = gid.xy + frame.rect.xy;
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
         return;

@@ -68,7 +68,9 @@ const PT_MAX_STEPS: u32 = 1000000u;
 @group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
 @group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
-@group(0) @binding(7) var<uniform> pt: PathTrace;
+@group(0) @binding(7) var<uniform> pt_ubo: PathTrace;
+// A private copy filled by the entry point, as lib/common.wgsl's `frame`.
+var<private> pt: PathTrace;
 @group(0) @binding(11) var env_cube: texture_cube<f32>;
 @group(0) @binding(13) var env_sampler: sampler;
 // The environment's sampling distribution over the texels of a small cube (options.y² per
@@ -428,6 +430,9 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    frame = frame_ubo;
+    brick = brick_ubo;
+    pt = pt_ubo;
     let px = gid.xy + pt.rect.xy;
     if (px.x >= pt.rect.z || px.y >= pt.rect.w) {
         return;

@@ -7,6 +7,7 @@
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    frame = frame_ubo;
     let px = gid.xy + frame.rect.xy;
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
         return;

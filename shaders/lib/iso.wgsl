@@ -22,7 +22,10 @@ struct Iso {
                                   // distance, y traced directions, z Fresnel F0
 }
 
-@group(0) @binding(7) var<uniform> iso: Iso;
+@group(0) @binding(7) var<uniform> iso_ubo: Iso;
+// A private copy filled by each entry point (`iso = iso_ubo;`), as lib/common.wgsl's
+// `frame`.
+var<private> iso: Iso;
 
 fn iso_value(i: u32) -> f32 {
     return iso.values[i / 4u][i % 4u];

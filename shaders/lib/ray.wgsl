@@ -14,11 +14,11 @@ struct Ray {
 // shader and recompiles it whenever one of them changes, and it picked the camera — a full
 // LLVM compile at every camera move (a 16×16 frame took 135 ms unshaded, 175 ms shaded).
 fn inv_view_proj() -> mat4x4<f32> {
-    return frame.camera[frame.viewport.z];
+    return frame_ubo.camera[frame_ubo.viewport.z];
 }
 
 fn view_proj() -> mat4x4<f32> {
-    return frame.camera[frame.viewport.z + 1u];
+    return frame_ubo.camera[frame_ubo.viewport.z + 1u];
 }
 
 fn unproject(ndc: vec3<f32>) -> vec3<f32> {

@@ -11,7 +11,10 @@ struct Brick {
     tex_inv_size: vec4<f32>,
 }
 
-@group(1) @binding(0) var<uniform> brick: Brick;
+@group(1) @binding(0) var<uniform> brick_ubo: Brick;
+// A private copy filled by each entry point (`brick = brick_ubo;`), as lib/common.wgsl's
+// `frame`.
+var<private> brick: Brick;
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
 // The first component's central differences per texel (shaders/gradient.wgsl), where the
