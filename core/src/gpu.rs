@@ -61,7 +61,6 @@ pub const PIXEL_STATE_BYTES: u64 = 48;
 
 // Flag bits (FLAG_* in common.wgsl).
 pub const FLAG_JITTER: u32 = 2;
-pub const FLAG_FORWARD_DIFF: u32 = 4;
 pub const FLAG_TWO_SIDED: u32 = 16;
 pub const FLAG_INDEPENDENT: u32 = 64;
 pub const FLAG_DEPTH_INPUT: u32 = 128;
@@ -350,7 +349,6 @@ mod layout_tests {
         assert!(src.contains(&table), "WGSL lacks `{table}`");
         for (name, v) in [
             ("FLAG_JITTER", FLAG_JITTER),
-            ("FLAG_FORWARD_DIFF", FLAG_FORWARD_DIFF),
             ("FLAG_TWO_SIDED", FLAG_TWO_SIDED),
             ("FLAG_INDEPENDENT", FLAG_INDEPENDENT),
             ("FLAG_DEPTH_INPUT", FLAG_DEPTH_INPUT),

@@ -34,7 +34,7 @@ use crate::gpu::{
     PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE,
 };
 use crate::iso::{shader_module, single_group_pipeline};
-use crate::params::{BlendMode, Interpolation, RenderParams, Shading, MAX_LIGHTS};
+use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, Shading, MAX_LIGHTS};
 use crate::readback::read_buffer;
 use crate::renderer::{block_grid, DepthSource, Renderer, View};
 use crate::transfer::TABLE_SIZE;
@@ -361,6 +361,7 @@ impl PathTraceGpu {
             ("NEAREST", b(v.nearest)),
             ("HYBRID", b(v.hybrid)),
             ("GUIDE", b(v.guide)),
+            ("FORWARD_DIFF", b(v.forward_diff)),
         ];
         let p = ctx.checked("creating the path tracing pipeline", || {
             ctx.device
@@ -423,6 +424,8 @@ struct PathTraceVariant {
     hybrid: bool,
     /// The denoiser's guide.
     guide: bool,
+    /// Forward-difference gradients (FORWARD_DIFF in lib/volume.wgsl).
+    forward_diff: bool,
 }
 
 /// Texels per face edge of the cube the environment is importance-sampled on (at most).
@@ -827,6 +830,7 @@ impl Renderer {
                 || pp.stochastic_blend > 0.0
                 || pp.scatter != ScatterRegions::Everywhere,
             guide: pp.denoise,
+            forward_diff: params.gradient == GradientMethod::Forward,
         };
         let pipeline = g.pipeline(&ctx, variant)?;
         g.ensure_accum(&ctx, view.width, view.height)?;

@@ -338,10 +338,11 @@ pub(crate) struct DvrVariant {
     lights: u32,
     volumetric: bool,
     precomputed_gradient: bool,
+    forward_diff: bool,
 }
 
 impl DvrVariant {
-    fn constants(&self) -> [(&'static str, f64); 13] {
+    fn constants(&self) -> [(&'static str, f64); 14] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         [
             ("BLEND", self.blend as f64),
@@ -357,6 +358,7 @@ impl DvrVariant {
             ("NUM_LIGHTS", self.lights as f64),
             ("VOLUMETRIC", b(self.volumetric)),
             ("PRECOMPUTED_GRADIENT", b(self.precomputed_gradient)),
+            ("FORWARD_DIFF", b(self.forward_diff)),
         ]
     }
 }
@@ -1173,9 +1175,6 @@ impl Renderer {
         if params.jitter {
             flags |= FLAG_JITTER;
         }
-        if params.gradient == GradientMethod::Forward {
-            flags |= FLAG_FORWARD_DIFF;
-        }
         if tf.independent {
             flags |= FLAG_INDEPENDENT;
         }
@@ -1255,6 +1254,7 @@ impl Renderer {
             lights: nl as u32,
             volumetric,
             precomputed_gradient: vol.gradients,
+            forward_diff: params.gradient == GradientMethod::Forward,
         };
         Ok((u, variant))
     }

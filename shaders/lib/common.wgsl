@@ -9,7 +9,6 @@ const BLEND_AVERAGE: u32 = 3u;
 const BLEND_ADDITIVE: u32 = 4u;
 
 const FLAG_JITTER: u32 = 2u;
-const FLAG_FORWARD_DIFF: u32 = 4u;
 const FLAG_TWO_SIDED: u32 = 16u;
 const FLAG_INDEPENDENT: u32 = 64u;
 const FLAG_DEPTH_INPUT: u32 = 128u;
