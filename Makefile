@@ -115,10 +115,12 @@ bench: build
 	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 20 --png-dir build/bench
 
 # vtkFerroVolumeMapper (zero-copy shared path and readback path) against
-# vtkGPUVolumeRayCastMapper in a VTK window, the same benchmark scene, alternating rounds.
+# vtkGPUVolumeRayCastMapper in a VTK window, the same benchmark scene, alternating rounds:
+# in VTK's default (multisampled) window, then in one without multisampling.
 bench-vtk: vtk
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 1 >/dev/null
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5 --multisamples 0
 
 # The README's pictures.
 pictures: build
