@@ -242,77 +242,114 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var t_prev = 0.0;
     var s_prev = 0.0;
     var done = false;
+    // Lavapipe runs the body of every branch for all lanes whenever it runs the code around
+    // it, so the surface work (bisection, exact gradient, occlusion, G-buffer writes) stays
+    // out of the sample loop: the inner loop only marches, one volume fetch per pass, until
+    // the lane's next crossing or the end of its segment; the outer loop handles that
+    // crossing once and marches on.
     loop {
         if (done) {
             break;
         }
-        var t: f32;
-        var k_here = k;
-        if (k < k_end) {
-            t = seg.x + (k + jit) * dt;
-        } else if (tail) {
-            tail = false;
-            t = seg.y;
-            k_here = k_end;
-            if (have_prev && t <= t_prev) {
-                break;
-            }
-        } else {
-            break;
-        }
-        let p = point_at(ray, t);
-        var skip_after = false;
-        if (SKIP && k_here < k_end && !block_occupied(p)) {
-            if (!have_prev) {
-                k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
-                continue;
-            }
-            // The interval from the last sample into this empty block is still checked.
-            skip_after = true;
-        }
-        if (CROP && !in_crop(p)) {
-            have_prev = false;
-            k = k + 1.0;
-            continue;
-        }
-        let s = sample_scalars(p).x;
-        if (!have_prev) {
-            t_prev = max(seg.x, seg.x + (k_here - 1.0 + jit) * dt);
-            s_prev = sample_scalars(point_at(ray, t_prev)).x;
-        }
+        var found = false;
+        var t = 0.0;
+        var s = 0.0;
         var crossed = 0u;
-        for (var i = 0u; i < n_iso; i = i + 1u) {
-            let v = iso_value(i);
-            if ((s_prev < v) != (s < v)) {
-                crossed = crossed | (1u << i);
-            }
-        }
-        if (crossed != 0u && t > t_prev) {
-            var th: array<f32, 8>;
-            for (var i = 0u; i < n_iso; i = i + 1u) {
-                if ((crossed & (1u << i)) != 0u) {
-                    th[i] = refine(ray, t_prev, t, iso_value(i), s_prev < iso_value(i));
-                }
-            }
-            // Several iso-values crossed between two samples: emit them nearest first.
-            loop {
-                if (crossed == 0u || done) {
+        var skip_after = false;
+        var p = vec3<f32>(0.0);
+        loop {
+            var k_here = k;
+            var at_tail = false;
+            if (k < k_end) {
+                t = seg.x + (k + jit) * dt;
+            } else if (tail) {
+                tail = false;
+                at_tail = true;
+                t = seg.y;
+                k_here = k_end;
+                if (have_prev && t <= t_prev) {
                     break;
                 }
-                var which = 0u;
-                var best = 3.4e38;
-                for (var i = 0u; i < n_iso; i = i + 1u) {
-                    if ((crossed & (1u << i)) != 0u && th[i] < best) {
-                        best = th[i];
-                        which = i;
-                    }
-                }
-                crossed = crossed & ~(1u << which);
-                write_hit(px, layers, ray, best, which, s_prev < iso_value(which));
-                layers = layers + 1u;
-                alpha = alpha + (1.0 - alpha) * iso.colors[which].a;
-                done = layers >= max_layers || alpha >= ert;
+            } else {
+                break;
             }
+            p = point_at(ray, t);
+            skip_after = false;
+            if (SKIP && k_here < k_end && !block_occupied(p)) {
+                if (!have_prev) {
+                    k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+                    continue;
+                }
+                // The interval from the last sample into this empty block is still checked.
+                skip_after = true;
+            }
+            if (CROP && !in_crop(p)) {
+                have_prev = false;
+                k = k + 1.0;
+                continue;
+            }
+            // One fetch per pass: without a previous sample, this pass takes it (one
+            // lattice step back) and the next pass comes back to t.
+            let t_back = max(seg.x, seg.x + (k_here - 1.0 + jit) * dt);
+            let take_prev = !have_prev;
+            let t_q = select(t, t_back, take_prev);
+            let s_q = sample_scalars(point_at(ray, t_q)).x;
+            if (take_prev) {
+                t_prev = t_q;
+                s_prev = s_q;
+                have_prev = true;
+                tail = tail || at_tail;
+                continue;
+            }
+            s = s_q;
+            crossed = 0u;
+            for (var i = 0u; i < n_iso; i = i + 1u) {
+                let v = iso_value(i);
+                if ((s_prev < v) != (s < v)) {
+                    crossed = crossed | (1u << i);
+                }
+            }
+            if (crossed != 0u && t > t_prev) {
+                found = true;
+                break;
+            }
+            have_prev = true;
+            t_prev = t;
+            s_prev = s;
+            if (skip_after) {
+                have_prev = false;
+                k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+            } else {
+                k = k + 1.0;
+            }
+        }
+        if (!found) {
+            break;
+        }
+        var th: array<f32, 8>;
+        for (var i = 0u; i < n_iso; i = i + 1u) {
+            if ((crossed & (1u << i)) != 0u) {
+                th[i] = refine(ray, t_prev, t, iso_value(i), s_prev < iso_value(i));
+            }
+        }
+        // Several iso-values crossed between two samples: emit them nearest first.
+        loop {
+            if (crossed == 0u || done) {
+                break;
+            }
+            var which = 0u;
+            var best = 3.4e38;
+            for (var i = 0u; i < n_iso; i = i + 1u) {
+                if ((crossed & (1u << i)) != 0u && th[i] < best) {
+                    best = th[i];
+                    which = i;
+                }
+            }
+            crossed = crossed & ~(1u << which);
+            write_hit(px, layers, ray, best, which, s_prev < iso_value(which));
+            layers = layers + 1u;
+            alpha = alpha + (1.0 - alpha) * iso.colors[which].a;
+            done = layers >= max_layers || alpha >= ert;
         }
         have_prev = true;
         t_prev = t;
