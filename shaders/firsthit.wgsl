@@ -242,6 +242,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var t_prev = 0.0;
     var s_prev = 0.0;
     var done = false;
+    // The last sample taken (t, s at p), and whether the march still has to step past it
+    // (it has once the sample was compared, or its crossing handled).
+    var t = 0.0;
+    var s = 0.0;
+    var p = vec3<f32>(0.0);
+    var skip_after = false;
+    var advance = false;
     // Lavapipe runs the body of every branch for all lanes whenever it runs the code around
     // it, so the surface work (bisection, exact gradient, occlusion, G-buffer writes) stays
     // out of the sample loop: the inner loop only marches, one volume fetch per pass, until
@@ -252,12 +259,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             break;
         }
         var found = false;
-        var t = 0.0;
-        var s = 0.0;
         var crossed = 0u;
-        var skip_after = false;
-        var p = vec3<f32>(0.0);
         loop {
+            if (advance) {
+                advance = false;
+                have_prev = true;
+                t_prev = t;
+                s_prev = s;
+                if (skip_after) {
+                    have_prev = false;
+                    k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+                } else {
+                    k = k + 1.0;
+                }
+            }
             var k_here = k;
             var at_tail = false;
             if (k < k_end) {
@@ -309,18 +324,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     crossed = crossed | (1u << i);
                 }
             }
+            advance = true;
             if (crossed != 0u && t > t_prev) {
                 found = true;
                 break;
-            }
-            have_prev = true;
-            t_prev = t;
-            s_prev = s;
-            if (skip_after) {
-                have_prev = false;
-                k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
-            } else {
-                k = k + 1.0;
             }
         }
         if (!found) {
@@ -350,15 +357,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             layers = layers + 1u;
             alpha = alpha + (1.0 - alpha) * iso.colors[which].a;
             done = layers >= max_layers || alpha >= ert;
-        }
-        have_prev = true;
-        t_prev = t;
-        s_prev = s;
-        if (skip_after) {
-            have_prev = false;
-            k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
-        } else {
-            k = k + 1.0;
         }
     }
     st.color.x = f32(layers);
