@@ -31,6 +31,8 @@ pub struct Context {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub info: DeviceInfo,
+    /// Set (with the driver's message) when the device is lost.
+    lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 /// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and
@@ -149,11 +151,21 @@ impl Context {
             norm16: required.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM),
             timestamps: required.contains(wgpu::Features::TIMESTAMP_QUERY),
         };
+        let lost = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            if reason != wgpu::DeviceLostReason::Destroyed {
+                if let Ok(mut l) = flag.lock() {
+                    *l = Some(message);
+                }
+            }
+        });
         Ok(Context {
             adapter,
             device,
             queue,
             info,
+            lost,
         })
     }
 
@@ -164,8 +176,9 @@ impl Context {
         let out = f();
         let v = pollster::block_on(val.pop());
         let o = pollster::block_on(oom.pop());
+        self.check_lost(what)?;
         if let Some(e) = o {
-            return Err(Error::Gpu(format!("{what}: out of GPU memory: {e}")));
+            return Err(Error::OutOfMemory(format!("{what}: {e}")));
         }
         if let Some(e) = v {
             return Err(Error::Gpu(format!("{what}: {e}")));
@@ -175,10 +188,20 @@ impl Context {
 
     /// Blocks until the GPU has finished all submitted work.
     pub fn wait_idle(&self) -> Result<()> {
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
+        let polled = self.device.poll(wgpu::PollType::wait_indefinitely());
+        self.check_lost("waiting for the GPU")?;
+        polled
             .map(|_| ())
             .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+    }
+
+    /// [`Error::DeviceLost`] once the driver has reported the device lost.
+    pub fn check_lost(&self, what: &str) -> Result<()> {
+        match self.lost.lock().map(|l| l.clone()) {
+            Ok(Some(message)) => Err(Error::DeviceLost(format!("{what}: {message}"))),
+            Ok(None) => Ok(()),
+            Err(_) => Err(Error::DeviceLost(format!("{what}: the device-lost flag is poisoned"))),
+        }
     }
 }
 

@@ -22,9 +22,15 @@ pub enum Error {
     /// The device lacks something this request needs.
     #[error("unsupported: {0}")]
     Unsupported(String),
-    /// The GPU reported an error (validation, out of memory, device lost).
+    /// The GPU reported an error other than the two below (validation, shader compilation).
     #[error("GPU error: {0}")]
     Gpu(String),
+    /// A GPU allocation failed: use a smaller volume, image or brick size.
+    #[error("out of GPU memory: {0}")]
+    OutOfMemory(String),
+    /// The device was lost (driver reset, GPU removed): create a new context.
+    #[error("GPU device lost: {0}; create a new context")]
+    DeviceLost(String),
     /// Writing an image failed.
     #[error("could not write image '{path}': {message}")]
     ImageWrite { path: String, message: String },

@@ -320,8 +320,9 @@ mod imp {
     fn vk_err(what: &str, e: vk::Result) -> Error {
         match e {
             vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
-                Error::Gpu(format!("{what}: out of memory ({e})"))
+                Error::OutOfMemory(format!("{what}: {e}"))
             }
+            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost(format!("{what}: {e}")),
             _ => Error::Gpu(format!("{what}: {e}")),
         }
     }

@@ -64,8 +64,8 @@ impl From<ferrovol_core::Error> for FfiError {
                 FvStatus::InvalidArgument
             }
             E::Unsupported(_) => FvStatus::Unsupported,
-            E::Gpu(m) if m.contains("out of GPU memory") => FvStatus::OutOfMemory,
-            E::Gpu(m) if m.to_ascii_lowercase().contains("lost") => FvStatus::DeviceLost,
+            E::OutOfMemory(_) => FvStatus::OutOfMemory,
+            E::DeviceLost(_) => FvStatus::DeviceLost,
             E::Gpu(_) => FvStatus::GpuError,
             E::ImageWrite { .. } => FvStatus::IoError,
         };
