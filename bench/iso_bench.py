@@ -25,7 +25,7 @@ import ferrovol
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "vtk_plugin",
                                 "tests"))
-import fvtest  # noqa: E402  (offscreen windows on one X connection: Xvfb drops new ones now and then)
+import fvtest  # noqa: E402  (offscreen windows on one X connection, transfer functions)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, ".."))
@@ -42,20 +42,10 @@ CONFIGS = [
 
 
 def skull_property():
-    ctf = vtk.vtkColorTransferFunction()
-    ctf.AddRGBPoint(-1000, 0.92, 0.68, 0.56)
-    ctf.AddRGBPoint(-500, 0.92, 0.68, 0.56)
-    ctf.AddRGBPoint(400, 0.95, 0.92, 0.84)
-    ctf.AddRGBPoint(3071, 1.0, 1.0, 1.0)
-    otf = vtk.vtkPiecewiseFunction()
-    otf.AddPoint(-1000, 0.3)
-    otf.AddPoint(-500, 0.3)
-    otf.AddPoint(400, 1.0)
-    otf.AddPoint(3071, 1.0)
-    p = vtk.vtkVolumeProperty()
-    p.SetColor(ctf)
-    p.SetScalarOpacity(otf)
-    p.SetInterpolationTypeToLinear()
+    p = fvtest.tf_property(
+        color=[(-1000, 0.92, 0.68, 0.56), (-500, 0.92, 0.68, 0.56), (400, 0.95, 0.92, 0.84),
+               (3071, 1.0, 1.0, 1.0)],
+        opacity=[(-1000, 0.3), (-500, 0.3), (400, 1.0), (3071, 1.0)], interpolation="linear")
     p.ShadeOn()
     p.GetIsoSurfaceValues().SetValue(0, -500.0)
     p.GetIsoSurfaceValues().SetValue(1, 400.0)

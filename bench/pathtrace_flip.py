@@ -5,7 +5,7 @@
    images of 1, 2, 4, ... paths per pixel (seed 0, independent of the reference) until the
    mean LDR-FLIP against the reference falls below --target. The time of each is the CLI's
    own path tracing time (its "N paths per pixel in T s": from the first frame to the last,
-   without start-up and upload). FLIP is tests/regression/flip.py (NVIDIA's LDR-FLIP,
+   without start-up and upload). FLIP is tests/ferrovol_testing/flip.py (NVIDIA's LDR-FLIP,
    checked against their implementation), averaged over the pixels where the reference is
    not black (the footprint) and over the whole frame.
 2. Preview cost: one path per pixel from a fresh accumulation (--repeat, as a moving camera
@@ -27,8 +27,8 @@ from PIL import Image
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, ".."))
-sys.path.insert(0, os.path.join(ROOT, "tests", "regression"))
-import flip  # noqa: E402
+sys.path.insert(0, os.path.join(ROOT, "tests"))
+from ferrovol_testing import flip  # noqa: E402
 
 CLI = os.path.join(ROOT, "target", "release", "ferrovol")
 

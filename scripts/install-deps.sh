@@ -12,7 +12,7 @@ PKGS=(mesa-vulkan-drivers libvulkan1 xvfb xauth cmake ninja-build pkg-config
 PKGS+=(libdouble-conversion-dev)
 PKGS+=(python3-scipy)
 # python3-scipy: image filtering for the FLIP metric of the regression suite
-# (tests/regression/flip.py).
+# (tests/ferrovol_testing/flip.py).
 # libdouble-conversion-dev: find_package(ParaView COMPONENTS RemotingViews ...) (paraview/)
 # pulls in VTK::IOCore, whose CMake package requires double-conversion's headers.
 missing=()

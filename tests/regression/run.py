@@ -27,6 +27,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "vtk_plugin", "tests"))
+sys.path.insert(0, os.path.join(ROOT, "tests"))
 sys.path.insert(0, HERE)
 
 import tomllib  # Python 3.11 (Debian bookworm's /usr/bin/python3)
@@ -64,8 +65,10 @@ import vtk  # noqa: E402
 
 import ferrovol  # noqa: E402
 import fvtest  # noqa: E402
-import flip  # noqa: E402
 import scenes as S  # noqa: E402
+from ferrovol_testing import flip  # noqa: E402
+from ferrovol_testing.metrics import (  # noqa: E402
+    coverage, difference_image, footprint, luminance, psnr, ssim)
 
 
 def log(*a):
@@ -159,29 +162,24 @@ def render(scene, kind):
 # ---------------------------------------------------------------------------------------
 # Metrics
 
-def footprint(a, b, tol=2.0):
-    """Pixels where either image shows something (differs from the black background)."""
-    return (a.max(axis=2) > tol) | (b.max(axis=2) > tol)
-
-
 def measure(img, ref):
     fmap = flip.flip_map(ref, img)
-    fp = footprint(img, ref)
+    fp = footprint(img, ref, tol=2.0)   # pixels where either image shows something
     d = np.abs(img - ref).mean(axis=2)
-    out = {"ssim": fvtest.ssim(img, ref), "psnr": fvtest.psnr(img, ref),
+    out = {"ssim": ssim(img, ref), "psnr": psnr(img, ref),
            "flip": float(fmap.mean()),
            "footprint": float(d[fp].mean()) if fp.any() else 0.0,
-           "dlum": float((fvtest.luminance(img) - fvtest.luminance(ref))[fp].mean())
+           "dlum": float((luminance(img) - luminance(ref))[fp].mean())
            if fp.any() else 0.0,
            "coverage": float(fp.mean()),
-           "silhouette": fvtest.ssim(silhouette(img), silhouette(ref))}
+           "silhouette": ssim(silhouette(img), silhouette(ref))}
     return out, fmap
 
 
 def silhouette(img):
     """The image's coverage mask (pixels that differ from the black background by more than
     8 levels) as a black and white image: SSIM of two of them compares outlines alone."""
-    mask = np.abs(img).max(axis=2) > 8.0
+    mask = footprint(img, tol=8.0)
     return np.repeat(mask[..., None] * 255.0, 3, axis=2)
 
 
@@ -257,15 +255,15 @@ def run_scene(scene, table):
     fv = res["renders"]["ferrovol"]
     why = table_problems(scene, t)
     pending = t is not None and "pending" in t
-    if fvtest.coverage(ref) < 0.01:
+    if coverage(ref) < 0.01:
         why.append("VTK's image is empty: bad scene")
     for kind in ("ferrovol", "vtk-fixed"):
         if kind not in imgs or (kind == "ferrovol" and pending and not fv["drew"]):
             continue
         m, fmap = measure(imgs[kind], ref)
         res["metrics"][kind] = m
-        diff = np.clip(np.abs(imgs[kind] - ref) * 4.0, 0, 255)
-        res["images"][kind + "-diff"] = save_png("%s-%s-diff" % (scene.name, kind), diff)
+        res["images"][kind + "-diff"] = save_png("%s-%s-diff" % (scene.name, kind),
+                                                 difference_image(imgs[kind], ref))
         res["images"][kind + "-flip"] = save_png("%s-%s-flip" % (scene.name, kind),
                                                  flip.heat(fmap))
     if pending:

@@ -13,8 +13,8 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 import vtk
 
-import fvtest  # vtk_plugin/tests/fvtest.py: windows, TF helpers, image_from_array
-from fvtest import WAVELET_COLOR, WAVELET_OPACITY, tf_property
+import fvtest  # vtk_plugin/tests/fvtest.py: windows, TF helpers, image_from_array, spheres
+from fvtest import WAVELET_OPACITY, tf_property
 
 # ---------------------------------------------------------------------------------------
 # Data (each loaded once per process)
@@ -40,11 +40,13 @@ class MissingData(Exception):
     pass
 
 
-def _read_xml(name):
+def _read(name, reader=vtk.vtkXMLImageDataReader):
+    """The image in DATA/name, read with a VTK reader class (VTK's XML image format by
+    default)."""
     p = _path(name)
     if not os.path.exists(p):
         raise MissingData("%s missing (scripts/fetch-data.sh makes it)" % p)
-    r = vtk.vtkXMLImageDataReader()
+    r = reader()
     r.SetFileName(p)
     r.Update()
     img = vtk.vtkImageData()
@@ -52,22 +54,24 @@ def _read_xml(name):
     return img
 
 
-@_cached
-def wavelet128():
-    """VTK's wavelet (vtkRTAnalyticSource), extent -64..63: 128^3 float32."""
+def _wavelet(lo, hi):
+    """VTK's wavelet (vtkRTAnalyticSource, float32) with the extent lo..hi on every axis."""
     src = vtk.vtkRTAnalyticSource()
-    src.SetWholeExtent(-64, 63, -64, 63, -64, 63)
+    src.SetWholeExtent(lo, hi, lo, hi, lo, hi)
     src.Update()
     return src.GetOutput()
+
+
+@_cached
+def wavelet128():
+    """VTK's wavelet, extent -64..63: 128^3 float32."""
+    return _wavelet(-64, 63)
 
 
 @_cached
 def wavelet21():
     """VTK's wavelet, extent -10..10: 21^3 float32."""
-    src = vtk.vtkRTAnalyticSource()
-    src.SetWholeExtent(-10, 10, -10, 10, -10, 10)
-    src.Update()
-    return src.GetOutput()
+    return _wavelet(-10, 10)
 
 
 @_cached
@@ -86,27 +90,19 @@ def marschner_lobb():
 @_cached
 def cranium():
     """InVesalius skull CT: 256x256x108 int16 HU, spacing 0.957 x 0.957 x 1.5 mm."""
-    return _read_xml("cranium.vti")
+    return _read("cranium.vti")
 
 
 @_cached
 def colin27():
     """Colin27 T1 MRI (mricron-data): 181x217x181 uint8, 1 mm."""
-    p = _path("colin27.nii.gz")
-    if not os.path.exists(p):
-        raise MissingData("%s missing (scripts/fetch-data.sh makes it)" % p)
-    r = vtk.vtkNIFTIImageReader()
-    r.SetFileName(p)
-    r.Update()
-    img = vtk.vtkImageData()
-    img.DeepCopy(r.GetOutput())
-    return img
+    return _read("colin27.nii.gz", vtk.vtkNIFTIImageReader)
 
 
 @_cached
 def heart():
     """mayavi2's heart.vti: CT of a heart, 32x32x12 float32, spacing 1 x 1 x 4."""
-    return _read_xml("heart.vti")
+    return _read("heart.vti")
 
 
 # Label map: the skull CT classified into 4 tissues (air 0, soft tissue 1, bone 2, dense
@@ -279,17 +275,7 @@ def inside_wavelet(cam):
 
 def sphere_actor(center, radius, color=(0.2, 0.9, 0.3)):
     def make():
-        s = vtk.vtkSphereSource()
-        s.SetCenter(*center)
-        s.SetRadius(radius)
-        s.SetThetaResolution(64)
-        s.SetPhiResolution(64)
-        m = vtk.vtkPolyDataMapper()
-        m.SetInputConnection(s.GetOutputPort())
-        a = vtk.vtkActor()
-        a.SetMapper(m)
-        a.GetProperty().SetColor(*color)
-        return [a]
+        return [fvtest.sphere_actor(center, radius, color, resolution=64)]
     return make
 
 

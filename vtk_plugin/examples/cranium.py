@@ -24,37 +24,35 @@ DEFAULT_INPUT = os.path.join(
     "cranium.vti")
 
 
-def ct_bone_property(spacing):
-    """CT bone in Hounsfield units: soft tissue transparent, bone ivory and opaque."""
+def volume_property(colors, opacities):
+    """A vtkVolumeProperty from (value, r, g, b) colour points and (value, opacity) points."""
     color = vtk.vtkColorTransferFunction()
-    color.AddRGBPoint(-3024, 0.0, 0.0, 0.0)
-    color.AddRGBPoint(-16.4458, 0.729412, 0.254902, 0.301961)
-    color.AddRGBPoint(641.385, 0.905882, 0.815686, 0.552941)
-    color.AddRGBPoint(3071, 1.0, 1.0, 1.0)
+    for x, r, g, b in colors:
+        color.AddRGBPoint(x, r, g, b)
     opacity = vtk.vtkPiecewiseFunction()
-    opacity.AddPoint(-3024, 0.0)
-    opacity.AddPoint(-16.4458, 0.0)
-    opacity.AddPoint(641.385, 0.715686)
-    opacity.AddPoint(3071, 0.705882)
+    for x, a in opacities:
+        opacity.AddPoint(x, a)
     prop = vtk.vtkVolumeProperty()
     prop.SetColor(color)
     prop.SetScalarOpacity(opacity)
+    return prop
+
+
+def ct_bone_property(spacing):
+    """CT bone in Hounsfield units: soft tissue transparent, bone ivory and opaque."""
+    prop = volume_property(
+        [(-3024, 0.0, 0.0, 0.0), (-16.4458, 0.729412, 0.254902, 0.301961),
+         (641.385, 0.905882, 0.815686, 0.552941), (3071, 1.0, 1.0, 1.0)],
+        [(-3024, 0.0), (-16.4458, 0.0), (641.385, 0.715686), (3071, 0.705882)])
     prop.SetScalarOpacityUnitDistance(sum(spacing) / 3.0)
     return prop
 
 
 def wavelet_property():
-    color = vtk.vtkColorTransferFunction()
-    color.AddRGBPoint(37.3531, 0.2, 0.29, 1.0)
-    color.AddRGBPoint(157.091, 0.87, 0.87, 0.87)
-    color.AddRGBPoint(276.829, 0.7, 0.015, 0.15)
-    opacity = vtk.vtkPiecewiseFunction()
-    opacity.AddPoint(37.3531, 0.0)
-    opacity.AddPoint(276.829, 1.0)
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
-    return prop
+    """VTK's GPU ray cast benchmark transfer function for its wavelet."""
+    return volume_property(
+        [(37.3531, 0.2, 0.29, 1.0), (157.091, 0.87, 0.87, 0.87), (276.829, 0.7, 0.015, 0.15)],
+        [(37.3531, 0.0), (276.829, 1.0)])
 
 
 def render(mapper, port, prop, have_ct, size, out):

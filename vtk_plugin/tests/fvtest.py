@@ -1,6 +1,7 @@
-"""Shared pieces of the vtkFerroVolumeMapper tests: scenes, image capture, SSIM/PSNR and
-the images written for people to look at (FERROVOL_TEST_OUTPUT, default
-build/vtk/test-images).
+"""Shared pieces of the vtkFerroVolumeMapper tests: scenes, image capture and the images
+written for people to look at (FERROVOL_TEST_OUTPUT, default build/vtk/test-images). The
+measures (SSIM, PSNR, coverage) come from tests/ferrovol_testing, shared with the ParaView
+tests and the regression suite, and are re-exported here.
 
 Run the suites with Debian's /usr/bin/python3 (VTK 9.2), after `. build/env.sh`, with an X
 display:  scripts/with-xvfb.sh /usr/bin/python3 -m unittest -v test_vtk_reference
@@ -16,6 +17,10 @@ import ferrovol
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "tests"))
+from ferrovol_testing.metrics import (  # noqa: E402,F401  (re-exported for the suites)
+    coverage, difference_image, luminance, psnr, ssim)
+from ferrovol_testing.png import write_png  # noqa: E402
 OUTPUT = os.environ.get("FERROVOL_TEST_OUTPUT", os.path.join(ROOT, "build", "vtk", "test-images"))
 DATA = os.environ.get("FERROVOL_DATA_DIR", os.path.join(ROOT, "build", "data"))
 os.makedirs(OUTPUT, exist_ok=True)
@@ -73,6 +78,44 @@ def tf_property(color=WAVELET_COLOR, opacity=WAVELET_OPACITY, interpolation="nea
     if interpolation == "linear":
         prop.SetInterpolationTypeToLinear()
     return prop
+
+
+def component_property(colors, max_opacity, top=200.0, interpolation="nearest"):
+    """A property with one flat colour per component (its index in colors) and opacity
+    rising linearly from 0 at 0 to max_opacity at top."""
+    p = vtk.vtkVolumeProperty()
+    for c, rgb in enumerate(colors):
+        ctf = vtk.vtkColorTransferFunction()
+        ctf.AddRGBPoint(0, *rgb)
+        ctf.AddRGBPoint(top, *rgb)
+        otf = vtk.vtkPiecewiseFunction()
+        otf.AddPoint(0, 0.0)
+        otf.AddPoint(top, max_opacity)
+        p.SetColor(c, ctf)
+        p.SetScalarOpacity(c, otf)
+    if interpolation == "linear":
+        p.SetInterpolationTypeToLinear()
+    return p
+
+
+def sphere_actor(center, radius, color, resolution=32, unlit=False):
+    """An opaque sphere (resolution segments around and along); unlit: its flat colour
+    everywhere (ambient only)."""
+    s = vtk.vtkSphereSource()
+    s.SetCenter(*center)
+    s.SetRadius(radius)
+    s.SetThetaResolution(resolution)
+    s.SetPhiResolution(resolution)
+    m = vtk.vtkPolyDataMapper()
+    m.SetInputConnection(s.GetOutputPort())
+    a = vtk.vtkActor()
+    a.SetMapper(m)
+    a.GetProperty().SetColor(*color)
+    if unlit:
+        a.GetProperty().SetAmbient(1.0)
+        a.GetProperty().SetDiffuse(0.0)
+        a.GetProperty().SetSpecular(0.0)
+    return a
 
 
 _DISPLAY_OWNER = []
@@ -153,6 +196,17 @@ class Scene:
         return grab(self.window, rerender=False)
 
 
+def ferrovol_scene(data, prop, *configure, **scene_args):
+    """A Scene around a new vtkFerroVolumeMapper, after each of configure (callables taking
+    the mapper; None skipped) has set it up; returns the scene and the mapper's Errors."""
+    mapper = ferrovol.vtkFerroVolumeMapper()
+    errors = Errors(mapper)
+    for c in configure:
+        if c:
+            c(mapper)
+    return Scene(mapper, data, prop, **scene_args), errors
+
+
 def grab(window, rerender=False):
     w2i = vtk.vtkWindowToImageFilter()
     w2i.SetInput(window)
@@ -182,62 +236,12 @@ def render_pair(data, prop_factory, size=(160, 160), camera=None, configure=None
     return images[0], images[1], mappers[0]
 
 
-# ---------------------------------------------------------------------------------------
-# Image comparison
-
-def _gauss_blur(x, sigma=1.5, radius=5):
-    k = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
-    k /= k.sum()
-    p = np.pad(x, radius, mode="reflect")
-    h, w = x.shape
-    rows = sum(k[i] * p[:, i:i + w] for i in range(2 * radius + 1))
-    return sum(k[i] * rows[i:i + h, :] for i in range(2 * radius + 1))
-
-
-def luminance(img):
-    return img[..., 0] * 0.299 + img[..., 1] * 0.587 + img[..., 2] * 0.114
-
-
-def ssim(a, b):
-    """Mean SSIM (Wang et al. 2004: 11x11 Gaussian window, sigma 1.5) of the luminance of two
-    8-bit RGB images."""
-    x, y = luminance(a), luminance(b)
-    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
-    mx, my = _gauss_blur(x), _gauss_blur(y)
-    sxx = _gauss_blur(x * x) - mx * mx
-    syy = _gauss_blur(y * y) - my * my
-    sxy = _gauss_blur(x * y) - mx * my
-    s = ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
-    return float(s.mean())
-
-
-def psnr(a, b):
-    mse = float(np.mean((a - b) ** 2))
-    return float("inf") if mse == 0 else 10.0 * np.log10(255.0 ** 2 / mse)
-
-
-def coverage(img, background=(0.0, 0.0, 0.0), tol=8.0):
-    """Fraction of pixels that differ from the background colour."""
-    bg = np.array(background) * 255.0
-    return float((np.abs(img - bg).max(axis=2) > tol).mean())
-
-
 def save(name, *images):
     """Writes the images side by side (and their difference, when two) as a PNG."""
     imgs = list(images)
     if len(imgs) == 2:
-        imgs.append(np.clip(np.abs(imgs[0] - imgs[1]) * 4.0, 0, 255))
-    row = np.concatenate(imgs, axis=1)
-    row = np.ascontiguousarray(row[::-1]).astype(np.uint8)
-    img = vtk.vtkImageData()
-    img.SetDimensions(row.shape[1], row.shape[0], 1)
-    img.GetPointData().SetScalars(numpy_to_vtk(row.reshape(-1, 3), deep=True))
-    w = vtk.vtkPNGWriter()
-    path = os.path.join(OUTPUT, name + ".png")
-    w.SetFileName(path)
-    w.SetInputData(img)
-    w.Write()
-    return path
+        imgs.append(difference_image(*imgs))
+    return write_png(os.path.join(OUTPUT, name + ".png"), np.concatenate(imgs, axis=1))
 
 
 def compare(name, ours, theirs):

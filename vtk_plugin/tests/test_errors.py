@@ -10,7 +10,7 @@ import vtk
 
 import ferrovol
 import fvtest
-from fvtest import Errors, Scene, coverage, image_from_array, tf_property, wavelet
+from fvtest import Errors, Scene, coverage, image_from_array, tf_property
 
 
 def ramp(n=12, dtype=np.float32):

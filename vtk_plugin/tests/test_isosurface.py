@@ -71,15 +71,12 @@ class Isosurface(unittest.TestCase):
         cls.src = wavelet(31)
 
     def render(self, configure=None, prop=None, size=(160, 160)):
-        mapper = ferrovol.vtkFerroVolumeMapper()
-        mapper.SetBlendModeToIsoSurface()
-        errors = Errors(mapper)
-        if configure:
-            configure(mapper)
-        scene = Scene(mapper, self.src, prop or wavelet_iso(), size=size, camera=view)
+        scene, errors = fvtest.ferrovol_scene(
+            self.src, prop or wavelet_iso(), lambda m: m.SetBlendModeToIsoSurface(), configure,
+            size=size, camera=view)
         img = scene.render()
         self.assertEqual(errors.messages, [], "unexpected error")
-        self.assertTrue(mapper.GetLastRenderDrew(), "nothing drawn")
+        self.assertTrue(scene.mapper.GetLastRenderDrew(), "nothing drawn")
         self._keep = scene
         return img
 

@@ -20,6 +20,18 @@ def mean_diff(a, b):
     return float(np.abs(a - b).mean())
 
 
+def parallel_camera(focal, distance, scale, clipping):
+    """A parallel projection looking down -z at focal from distance, y up."""
+    def camera(cam):
+        cam.SetFocalPoint(*focal)
+        cam.SetPosition(focal[0], focal[1], focal[2] + distance)
+        cam.SetViewUp(0, 1, 0)
+        cam.ParallelProjectionOn()
+        cam.SetParallelScale(scale)
+        cam.SetClippingRange(*clipping)
+    return camera
+
+
 class Settings(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -27,12 +39,10 @@ class Settings(unittest.TestCase):
 
     def render(self, configure=None, prop=None, data=None, size=(120, 120), camera=view,
                scene_hook=None):
-        mapper = ferrovol.vtkFerroVolumeMapper()
-        errors = Errors(mapper)
-        if configure:
-            configure(mapper)
-        scene = Scene(mapper, data if data is not None else self.src,
-                      prop if prop is not None else tf_property(), size=size, camera=camera)
+        scene, errors = fvtest.ferrovol_scene(
+            data if data is not None else self.src, prop if prop is not None else tf_property(),
+            configure, size=size, camera=camera)
+        mapper = scene.mapper
         if scene_hook:
             scene_hook(scene)
         img = scene.render()
@@ -188,13 +198,7 @@ class Settings(unittest.TestCase):
     def test_volume_matrix(self):
         # Parallel projection: moving the volume by 10 world units moves its image by
         # 10 / (2 * parallel scale) of the window height.
-        def camera(cam):
-            cam.SetFocalPoint(0, 0, 0)
-            cam.SetPosition(0, 0, 200)
-            cam.SetViewUp(0, 1, 0)
-            cam.ParallelProjectionOn()
-            cam.SetParallelScale(50.0)
-            cam.SetClippingRange(50, 400)
+        camera = parallel_camera((0, 0, 0), 200, 50.0, (50, 400))
 
         def centroid(img):
             m = img.max(axis=2) > 8
@@ -247,14 +251,7 @@ class Settings(unittest.TestCase):
         lit = lambda im: np.nonzero((im.max(axis=2) > 8).any(axis=0))[0][0]  # noqa: E731
         self.assertAlmostEqual(lit(shifted) - lit(point), 1.5, delta=1.0)
 
-    @staticmethod
-    def front(cam):
-        cam.SetPosition(11.5, 11.5, 150)
-        cam.SetFocalPoint(11.5, 11.5, 11.5)
-        cam.SetViewUp(0, 1, 0)
-        cam.ParallelProjectionOn()
-        cam.SetParallelScale(20.0)
-        cam.SetClippingRange(50, 300)
+    front = staticmethod(parallel_camera((11.5, 11.5, 11.5), 138.5, 20.0, (50, 300)))
 
     def test_scalar_types(self):
         n = 20
@@ -469,17 +466,8 @@ class Settings(unittest.TestCase):
         a = np.stack([x * 8, y * 8], axis=-1).astype(np.float32)
 
         def two(weight1=1.0, independent=True):
-            p = vtk.vtkVolumeProperty()
+            p = fvtest.component_property([(1.0, 0.3, 0.1), (0.1, 0.3, 1.0)], 0.4)
             p.SetIndependentComponents(independent)
-            for c, rgb in ((0, (1.0, 0.3, 0.1)), (1, (0.1, 0.3, 1.0))):
-                ctf = vtk.vtkColorTransferFunction()
-                ctf.AddRGBPoint(0, *rgb)
-                ctf.AddRGBPoint(200, *rgb)
-                otf = vtk.vtkPiecewiseFunction()
-                otf.AddPoint(0, 0.0)
-                otf.AddPoint(200, 0.4)
-                p.SetColor(c, ctf)
-                p.SetScalarOpacity(c, otf)
             p.SetComponentWeight(1, weight1)
             return p
         both, _ = self.render(data=image_from_array(a), prop=two(), camera=self.front)

@@ -9,7 +9,7 @@ import vtk
 
 import ferrovol
 import fvtest
-from fvtest import Errors, Scene, save, tf_property, wavelet
+from fvtest import Scene, save, tf_property, wavelet
 
 
 def view(cam):
@@ -19,17 +19,7 @@ def view(cam):
 
 
 def sphere():
-    s = vtk.vtkSphereSource()
-    s.SetCenter(8, -8, 18)
-    s.SetRadius(9)
-    s.SetThetaResolution(32)
-    s.SetPhiResolution(32)
-    m = vtk.vtkPolyDataMapper()
-    m.SetInputConnection(s.GetOutputPort())
-    a = vtk.vtkActor()
-    a.SetMapper(m)
-    a.GetProperty().SetColor(0.9, 0.8, 0.2)
-    return a
+    return fvtest.sphere_actor((8, -8, 18), 9, (0.9, 0.8, 0.2))
 
 
 def shared_available():
@@ -54,13 +44,10 @@ class OutputPaths(unittest.TestCase):
              actors=True):
         images = {}
         for path in ("Readback", "Shared"):
-            m = ferrovol.vtkFerroVolumeMapper()
-            getattr(m, "SetOutputPathTo" + path)()
-            errors = Errors(m)
-            if configure:
-                configure(m)
-            scene = Scene(m, self.src, tf_property(), size=size, camera=view,
-                          actors=[sphere()] if actors else ())
+            scene, errors = fvtest.ferrovol_scene(
+                self.src, tf_property(), lambda m: getattr(m, "SetOutputPathTo" + path)(),
+                configure, size=size, camera=view, actors=[sphere()] if actors else ())
+            m = scene.mapper
             if multisamples is not None:
                 scene.window.SetMultiSamples(multisamples)
             scene.renderer.ResetCameraClippingRange()

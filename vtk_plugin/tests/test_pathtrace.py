@@ -9,7 +9,7 @@ import vtk
 
 import ferrovol
 import fvtest
-from fvtest import Errors, Scene, coverage, log, save, wavelet
+from fvtest import coverage, log, save, wavelet
 
 
 def view(cam):
@@ -24,19 +24,20 @@ def medium(g=0.0):
     return p
 
 
+def path_tracing(mapper):
+    mapper.SetRenderModeToPathTrace()
+    mapper.SetSamplesPerPixel(16)
+
+
 class PathTrace(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.src = wavelet(15)
 
     def scene(self, prop=None, configure=None, size=(96, 96)):
-        mapper = ferrovol.vtkFerroVolumeMapper()
-        mapper.SetRenderModeToPathTrace()
-        mapper.SetSamplesPerPixel(16)
-        self.errors = Errors(mapper)
-        if configure:
-            configure(mapper)
-        return Scene(mapper, self.src, prop or medium(), size=size, camera=view)
+        scene, self.errors = fvtest.ferrovol_scene(self.src, prop or medium(), path_tracing,
+                                                   configure, size=size, camera=view)
+        return scene
 
     def test_still_renders_trace_the_budget_once(self):
         s = self.scene()

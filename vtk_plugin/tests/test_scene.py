@@ -17,21 +17,8 @@ def view(cam):
     cam.OrthogonalizeViewUp()
 
 
-def sphere_actor(center, radius, color=(0.1, 1.0, 0.1)):
-    s = vtk.vtkSphereSource()
-    s.SetCenter(*center)
-    s.SetRadius(radius)
-    s.SetThetaResolution(32)
-    s.SetPhiResolution(32)
-    m = vtk.vtkPolyDataMapper()
-    m.SetInputConnection(s.GetOutputPort())
-    a = vtk.vtkActor()
-    a.SetMapper(m)
-    a.GetProperty().SetColor(*color)
-    a.GetProperty().SetAmbient(1.0)
-    a.GetProperty().SetDiffuse(0.0)
-    a.GetProperty().SetSpecular(0.0)
-    return a
+def sphere_actor(center, radius):
+    return fvtest.sphere_actor(center, radius, (0.1, 1.0, 0.1), unlit=True)
 
 
 class SceneTests(unittest.TestCase):

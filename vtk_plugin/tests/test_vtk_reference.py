@@ -92,11 +92,9 @@ class VtkReference(unittest.TestCase):
         self.check("ref-mip", 0.97, 30.0, configure=lambda m: m.SetBlendModeToMaximumIntensity())
 
     def test_minimum_intensity(self):
-        def prop():
-            # MinIP needs opacity at low values to show anything
-            return tf_property(opacity=[(37.3531, 1.0), (276.829, 0.2)])
-        # measured SSIM 0.981, PSNR 32.1 dB
-        self.check("ref-minip", 0.95, 28.0, prop=prop,
+        # MinIP needs opacity at low values to show anything. Measured SSIM 0.981, PSNR 32.1 dB
+        self.check("ref-minip", 0.95, 28.0,
+                   prop=lambda: tf_property(opacity=[(37.3531, 1.0), (276.829, 0.2)]),
                    configure=lambda m: m.SetBlendModeToMinimumIntensity())
 
     def test_average_intensity(self):
@@ -107,10 +105,9 @@ class VtkReference(unittest.TestCase):
         self.check("ref-average", 0.95, 28.0, configure=configure)
 
     def test_additive(self):
-        def prop():
-            return tf_property(opacity=[(37.3531, 0.0), (276.829, 0.02)])
         # measured SSIM 0.998, PSNR 53.1 dB
-        self.check("ref-additive", 0.95, 28.0, prop=prop,
+        self.check("ref-additive", 0.95, 28.0,
+                   prop=lambda: tf_property(opacity=[(37.3531, 0.0), (276.829, 0.02)]),
                    configure=lambda m: m.SetBlendModeToAdditive())
 
     # -- property settings
@@ -290,18 +287,8 @@ class VtkReference(unittest.TestCase):
         img = fvtest.image_from_array(a.astype(np.float32))
 
         def prop():
-            p = vtk.vtkVolumeProperty()
-            for c, rgb in ((0, (1.0, 0.5, 0.1)), (1, (0.1, 0.5, 1.0))):
-                ctf = vtk.vtkColorTransferFunction()
-                ctf.AddRGBPoint(0, *rgb)
-                ctf.AddRGBPoint(200, *rgb)
-                otf = vtk.vtkPiecewiseFunction()
-                otf.AddPoint(0, 0.0)
-                otf.AddPoint(200, 0.3)
-                p.SetColor(c, ctf)
-                p.SetScalarOpacity(c, otf)
-            p.SetInterpolationTypeToLinear()
-            return p
+            return fvtest.component_property([(1.0, 0.5, 0.1), (0.1, 0.5, 1.0)], 0.3,
+                                             interpolation="linear")
         # measured SSIM 0.949, PSNR 23.0 dB. Where the components overlap VTK 9.2 adds their
         # premultiplied colours (sum of a_i w_i rgb_i, alpha sum a_i^2 / sum a_i w_i) while
         # ferrovol's core takes their opacity-weighted mean: VTK's overlap is brighter.
@@ -309,17 +296,7 @@ class VtkReference(unittest.TestCase):
 
     def test_opaque_sphere(self):
         def actors():
-            s = vtk.vtkSphereSource()
-            s.SetCenter(10, -10, 25)
-            s.SetRadius(12)
-            s.SetThetaResolution(48)
-            s.SetPhiResolution(48)
-            m = vtk.vtkPolyDataMapper()
-            m.SetInputConnection(s.GetOutputPort())
-            a = vtk.vtkActor()
-            a.SetMapper(m)
-            a.GetProperty().SetColor(0.2, 0.9, 0.3)
-            return (a,)
+            return (fvtest.sphere_actor((10, -10, 25), 12, (0.2, 0.9, 0.3), resolution=48),)
         # measured SSIM 0.989, PSNR 35.4 dB
         self.check("ref-sphere-in-volume", 0.95, 27.0, actors_factory=actors,
                    camera=view(0, 0), prop=lambda: tf_property(interpolation="linear"))
