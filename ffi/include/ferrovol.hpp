@@ -12,7 +12,12 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
+
+#ifndef _WIN32
+#include <unistd.h> // close (SharedImage)
+#endif
 
 namespace ferrovol {
 
@@ -21,11 +26,14 @@ class Error : public std::runtime_error {
 public:
   Error(FvStatus status, const std::string &message)
       : std::runtime_error(std::string(fv_status_name(status)) + ": " + message),
-        status_(status) {}
+        status_(status), message_(message) {}
   FvStatus status() const noexcept { return status_; }
+  /// The library's message alone (what() prefixes it with the status name).
+  const std::string &message() const noexcept { return message_; }
 
 private:
   FvStatus status_;
+  std::string message_;
 };
 
 /// Throws ferrovol::Error unless `status` is FV_STATUS_OK.
@@ -41,6 +49,10 @@ template <typename T, void (*Free)(T *)> struct Deleter {
 };
 template <typename T, void (*Free)(T *)>
 using Handle = std::unique_ptr<T, Deleter<T, Free>>;
+/// The C ABI takes NULL for an empty list.
+template <typename T> const T *data_or_null(const std::vector<T> &v) noexcept {
+  return v.empty() ? nullptr : v.data();
+}
 } // namespace detail
 
 /// The library version at run time ("MAJOR.MINOR.PATCH").
@@ -58,6 +70,19 @@ public:
     FvAdapterInfo i{};
     check(fv_context_info(h_.get(), &i));
     return i;
+  }
+  /// Whether renderers on this context can share their output (the reason in
+  /// fv_last_error() when not).
+  bool can_share() const noexcept { return fv_context_can_share(h_.get()); }
+  /// The Vulkan device and driver UUIDs, to compare with OpenGL's before sharing memory.
+  struct Uuids {
+    uint8_t device[16];
+    uint8_t driver[16];
+  };
+  Uuids uuids() const {
+    Uuids u{};
+    check(fv_context_uuids(h_.get(), &u.device, &u.driver));
+    return u;
   }
   FvContext *get() const noexcept { return h_.get(); }
 
@@ -94,16 +119,18 @@ public:
   }
   /// Flat (x, r, g, b) quadruples.
   void set_color(uint32_t component, const std::vector<double> &xrgb) {
-    check(fv_transfer_function_set_color(h_.get(), component, xrgb.data(), xrgb.size() / 4));
+    check(fv_transfer_function_set_color(h_.get(), component, detail::data_or_null(xrgb),
+                                         xrgb.size() / 4));
   }
   /// Flat (x, opacity) pairs.
   void set_opacity(uint32_t component, const std::vector<double> &xa) {
-    check(fv_transfer_function_set_opacity(h_.get(), component, xa.data(), xa.size() / 2));
+    check(fv_transfer_function_set_opacity(h_.get(), component, detail::data_or_null(xa),
+                                           xa.size() / 2));
   }
   /// Flat (|gradient|, opacity) pairs; empty turns gradient opacity off.
   void set_gradient_opacity(uint32_t component, const std::vector<double> &xa) {
-    check(fv_transfer_function_set_gradient_opacity(h_.get(), component, xa.data(),
-                                                    xa.size() / 2));
+    check(fv_transfer_function_set_gradient_opacity(h_.get(), component,
+                                                    detail::data_or_null(xa), xa.size() / 2));
   }
   void set_unit_distance(uint32_t component, double unit_distance, double weight = 1.0) {
     check(fv_transfer_function_set_unit_distance(h_.get(), component, unit_distance, weight));
@@ -135,6 +162,41 @@ private:
   uint32_t height_ = 0;
 };
 
+#ifndef _WIN32
+/// One exported image of the shared output path (see FvSharedImage). Owns its file
+/// descriptor, closed on destruction unless release() handed it over (glImportMemoryFdEXT
+/// takes it on success).
+class SharedImage {
+public:
+  SharedImage() = default;
+  explicit SharedImage(const FvSharedImage &image) : image_(image) {}
+  SharedImage(SharedImage &&o) noexcept : image_(o.image_) { o.image_.fd = -1; }
+  SharedImage &operator=(SharedImage &&o) noexcept {
+    if (this != &o) {
+      reset();
+      image_ = o.image_;
+      o.image_.fd = -1;
+    }
+    return *this;
+  }
+  SharedImage(const SharedImage &) = delete;
+  SharedImage &operator=(const SharedImage &) = delete;
+  ~SharedImage() { reset(); }
+  const FvSharedImage &info() const noexcept { return image_; }
+  /// The descriptor, no longer closed here.
+  int release() noexcept { return std::exchange(image_.fd, -1); }
+
+private:
+  void reset() noexcept {
+    if (image_.fd >= 0) {
+      close(image_.fd);
+      image_.fd = -1;
+    }
+  }
+  FvSharedImage image_{-1, 0, 0, 0, 0, false, 0};
+};
+#endif
+
 /// A renderer (see FvRenderer).
 class Renderer {
 public:
@@ -148,23 +210,67 @@ public:
     check(fv_render_params_default(&p));
     return p;
   }
+  static FvIsoParams default_iso_params() {
+    FvIsoParams p{};
+    check(fv_iso_params_default(&p));
+    return p;
+  }
+  static FvPathTraceParams default_path_trace_params() {
+    FvPathTraceParams p{};
+    check(fv_path_trace_params_default(&p));
+    return p;
+  }
   void set_volume(const Volume &v) { check(fv_renderer_set_volume(h_.get(), v.get())); }
   void set_transfer_function(const TransferFunction &tf) {
     check(fv_renderer_set_transfer_function(h_.get(), tf.get()));
   }
   void set_camera(const FvCamera &camera) { check(fv_renderer_set_camera(h_.get(), &camera)); }
   void set_lights(const std::vector<FvLight> &lights) {
-    check(fv_renderer_set_lights(h_.get(), lights.data(), lights.size()));
+    check(fv_renderer_set_lights(h_.get(), detail::data_or_null(lights), lights.size()));
   }
   void set_params(const FvRenderParams &p) { check(fv_renderer_set_params(h_.get(), &p)); }
+  void set_isosurface(const FvIsoParams &p) { check(fv_renderer_set_isosurface(h_.get(), &p)); }
+  void set_path_tracing(const FvPathTraceParams &p) {
+    check(fv_renderer_set_path_tracing(h_.get(), &p));
+  }
+  /// `path`: an equirectangular image, or nullptr for the built-in sky; `up`: 3 doubles or
+  /// nullptr for +Y.
+  void set_environment(const char *path, float intensity, const double *up,
+                       double azimuth_degrees) {
+    check(fv_renderer_set_environment(h_.get(), path, intensity, up, azimuth_degrees));
+  }
+  /// An FvOutputPath.
+  void set_output_path(uint32_t path) { check(fv_renderer_set_output_path(h_.get(), path)); }
   void set_max_brick_points(uint32_t points) {
     check(fv_renderer_set_max_brick_points(h_.get(), points));
   }
   /// `depth`: width·height window depths of opaque geometry (rows top to bottom), or empty.
   void render(uint32_t width, uint32_t height, const std::vector<float> &depth = {}) {
-    check(fv_renderer_render(h_.get(), width, height, depth.empty() ? nullptr : depth.data(),
-                             depth.size()));
+    check(fv_renderer_render(h_.get(), width, height, detail::data_or_null(depth), depth.size()));
   }
+  /// Paths per pixel the last path-traced frame shows.
+  uint32_t accumulated_samples() const {
+    uint32_t n = 0;
+    check(fv_renderer_accumulated_samples(h_.get(), &n));
+    return n;
+  }
+  void prepare_targets(uint32_t width, uint32_t height) {
+    check(fv_renderer_prepare_targets(h_.get(), width, height));
+  }
+#ifndef _WIN32
+  /// One image of the shared output path (an FvTarget).
+  SharedImage shared_image(uint32_t target) const {
+    FvSharedImage image{-1, 0, 0, 0, 0, false, 0};
+    check(fv_renderer_shared_image(h_.get(), target, &image));
+    return SharedImage(image);
+  }
+#endif
+  /// Renders with the opaque depth the host wrote into the shared depth input image.
+  void render_with_shared_depth(uint32_t width, uint32_t height) {
+    check(fv_renderer_render_with_shared_depth(h_.get(), width, height));
+  }
+  /// Waits until the last frame is finished on the GPU.
+  void finish() const { check(fv_renderer_finish(h_.get())); }
   Frame read_frame() const {
     FvFrame *f = nullptr;
     check(fv_renderer_read_frame(h_.get(), &f));

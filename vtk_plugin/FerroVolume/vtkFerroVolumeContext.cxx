@@ -1,0 +1,59 @@
+#include "vtkFerroVolumeContext.h"
+
+#include <sstream>
+
+vtkFerroVolumeContext& vtkFerroVolumeContext::Get()
+{
+  static vtkFerroVolumeContext instance;
+  return instance;
+}
+
+const ferrovol::Context* vtkFerroVolumeContext::Acquire(std::string& error)
+{
+  vtkFerroVolumeContext& self = Get();
+  std::lock_guard<std::mutex> lock(self.Mutex);
+  if (!self.Tried)
+  {
+    self.Tried = true;
+    try
+    {
+      // Never deleted: see Acquire's comment.
+      self.Context = new ferrovol::Context();
+    }
+    catch (const ferrovol::Error& e)
+    {
+      self.Error = std::string("no GPU device for ferrovol (") + fv_status_name(e.status()) +
+        "): " + e.message() +
+        ". Install Mesa's Vulkan drivers (mesa-vulkan-drivers) or check FERROVOL_ADAPTER / "
+        "FERROVOL_BACKEND.";
+    }
+    if (self.Context)
+    {
+      try
+      {
+        const FvAdapterInfo info = self.Context->info();
+        self.Desc = std::string(info.name) + " (" + info.backend + ", " + info.driver + ")";
+      }
+      catch (const ferrovol::Error&)
+      {
+        // no description: the device still renders
+      }
+    }
+  }
+  error = self.Error;
+  return self.Context;
+}
+
+const char* vtkFerroVolumeContext::Description()
+{
+  std::string error;
+  Acquire(error);
+  return Get().Desc.c_str();
+}
+
+std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e)
+{
+  std::ostringstream s;
+  s << "ferrovol could not " << what << " (" << fv_status_name(e.status()) << "): " << e.message();
+  return s.str();
+}

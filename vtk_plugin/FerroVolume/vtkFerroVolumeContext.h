@@ -1,0 +1,52 @@
+// vtkFerroVolumeContext: ferrovol's process-wide GPU device for every vtkFerroVolumeMapper,
+// and the wording of a failed ferrovol call. Internal to the FerroVolume module (not wrapped).
+#ifndef vtkFerroVolumeContext_h
+#define vtkFerroVolumeContext_h
+
+#include "ferrovol.hpp"
+
+#include <mutex>
+#include <string>
+
+class vtkFerroVolumeContext
+{
+public:
+  // Opens the device on first use and keeps it for the life of the process: renderers
+  // created from it keep the device alive, and tearing a Vulkan device down from static
+  // destructors at exit is fragile. nullptr, with the reason in `error`, when there is none.
+  static const ferrovol::Context* Acquire(std::string& error);
+
+  // "name (backend, driver)" of the device, "" when none could be opened.
+  static const char* Description();
+
+private:
+  static vtkFerroVolumeContext& Get();
+
+  std::mutex Mutex;
+  const ferrovol::Context* Context = nullptr;
+  bool Tried = false;
+  std::string Error;
+  std::string Desc;
+};
+
+// "ferrovol could not <what> (FV_STATUS_…): <the library's message>".
+std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e);
+
+// Runs `call` (ferrovol.hpp calls); when one fails, says so in `error` (see
+// vtkFerroVolumeFailure) and returns false.
+template <typename Call>
+bool vtkFerroVolumeCall(const char* what, std::string& error, Call&& call)
+{
+  try
+  {
+    call();
+    return true;
+  }
+  catch (const ferrovol::Error& e)
+  {
+    error = vtkFerroVolumeFailure(what, e);
+    return false;
+  }
+}
+
+#endif

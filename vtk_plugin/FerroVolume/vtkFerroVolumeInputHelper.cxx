@@ -1,0 +1,433 @@
+#include "vtkFerroVolumeInputHelper.h"
+
+#include "vtkAlgorithm.h"
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkFerroVolumeContext.h"
+#include "vtkFerroVolumeMapper.h"
+#include "vtkImageData.h"
+#include "vtkMatrix3x3.h"
+#include "vtkPointData.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <vector>
+
+namespace
+{
+// ferrovol's scalar type and the byte size of a VTK scalar type; false when ferrovol has none.
+bool ToFvScalarType(int vtkType, uint32_t& fvType, size_t& size)
+{
+  struct Entry
+  {
+    int Vtk;
+    FvScalarType Fv;
+    size_t Size;
+  };
+  static const Entry table[] = {
+    { VTK_CHAR, std::numeric_limits<char>::is_signed ? FV_SCALAR_TYPE_I8 : FV_SCALAR_TYPE_U8, 1 },
+    { VTK_SIGNED_CHAR, FV_SCALAR_TYPE_I8, 1 },
+    { VTK_UNSIGNED_CHAR, FV_SCALAR_TYPE_U8, 1 },
+    { VTK_BIT, FV_SCALAR_TYPE_U8, 1 }, // converted to one byte per value first
+    { VTK_SHORT, FV_SCALAR_TYPE_I16, 2 },
+    { VTK_UNSIGNED_SHORT, FV_SCALAR_TYPE_U16, 2 },
+    { VTK_INT, FV_SCALAR_TYPE_I32, 4 },
+    { VTK_UNSIGNED_INT, FV_SCALAR_TYPE_U32, 4 },
+    { VTK_LONG, sizeof(long) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32, sizeof(long) },
+    { VTK_UNSIGNED_LONG, sizeof(unsigned long) == 8 ? FV_SCALAR_TYPE_U64 : FV_SCALAR_TYPE_U32,
+      sizeof(unsigned long) },
+    { VTK_LONG_LONG, FV_SCALAR_TYPE_I64, 8 },
+    { VTK_UNSIGNED_LONG_LONG, FV_SCALAR_TYPE_U64, 8 },
+    { VTK_ID_TYPE, sizeof(vtkIdType) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32,
+      sizeof(vtkIdType) },
+    { VTK_FLOAT, FV_SCALAR_TYPE_F32, 4 },
+    { VTK_DOUBLE, FV_SCALAR_TYPE_F64, 8 },
+  };
+  for (const Entry& e : table)
+  {
+    if (e.Vtk == vtkType)
+    {
+      fvType = static_cast<uint32_t>(e.Fv);
+      size = e.Size;
+      return true;
+    }
+  }
+  return false;
+}
+
+// The scalars of the input as VTK's mappers pick them (ScalarMode, SelectScalarArray), or an
+// error saying why there are none.
+vtkDataArray* FindScalars(vtkFerroVolumeMapper* self, vtkImageData* image, int& cellFlag,
+  std::string& error)
+{
+  cellFlag = 0;
+  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(image, self->GetScalarMode(),
+    self->GetArrayAccessMode(), self->GetArrayId(), self->GetArrayName(), cellFlag);
+  if (scalars)
+  {
+    return scalars;
+  }
+  const int mode = self->GetScalarMode();
+  const bool byName = self->GetArrayAccessMode() == VTK_GET_ARRAY_BY_NAME;
+  std::string what = byName && self->GetArrayName()
+    ? std::string("array '") + self->GetArrayName() + "'"
+    : "array " + std::to_string(self->GetArrayId());
+  vtkAbstractArray* abstract = nullptr;
+  if (mode == VTK_SCALAR_MODE_USE_POINT_FIELD_DATA)
+  {
+    abstract = byName ? image->GetPointData()->GetAbstractArray(self->GetArrayName())
+                      : image->GetPointData()->GetAbstractArray(self->GetArrayId());
+  }
+  else if (mode == VTK_SCALAR_MODE_USE_CELL_FIELD_DATA)
+  {
+    abstract = byName ? image->GetCellData()->GetAbstractArray(self->GetArrayName())
+                      : image->GetCellData()->GetAbstractArray(self->GetArrayId());
+  }
+  if (abstract)
+  {
+    error = "the selected " + what + " (" + abstract->GetClassName() +
+      ") is not numeric: volume rendering needs numeric scalars";
+  }
+  else if (mode == VTK_SCALAR_MODE_USE_POINT_FIELD_DATA ||
+    mode == VTK_SCALAR_MODE_USE_CELL_FIELD_DATA)
+  {
+    error = std::string("the input has no ") +
+      (mode == VTK_SCALAR_MODE_USE_POINT_FIELD_DATA ? "point" : "cell") + " data " + what +
+      " (see SelectScalarArray)";
+  }
+  else
+  {
+    error = "the input has no scalars to render (set point or cell scalars, or select an "
+            "array with SetScalarModeToUsePointFieldData + SelectScalarArray)";
+  }
+  return nullptr;
+}
+
+// The volume to upload: geometry after cell centring and slab thickening, and the bytes.
+struct PreparedVolume
+{
+  FvVolumeDesc Desc;
+  const void* Data = nullptr;
+  size_t Bytes = 0;
+  std::vector<unsigned char> Storage;
+  double MeanSpacing = 1.0;
+};
+
+bool PrepareVolume(
+  vtkImageData* image, vtkDataArray* scalars, bool cells, PreparedVolume& out, std::string& error)
+{
+  int pointDims[3];
+  image->GetDimensions(pointDims);
+  double spacing[3], origin[3], dir[9];
+  image->GetSpacing(spacing);
+  image->GetOrigin(origin);
+  vtkMatrix3x3* dm = image->GetDirectionMatrix();
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      dir[3 * r + c] = dm ? dm->GetElement(r, c) : (r == c ? 1.0 : 0.0);
+    }
+  }
+  // The first point of the extent (which need not start at 0) is the volume's origin.
+  int extent[6];
+  image->GetExtent(extent);
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      origin[r] += dir[3 * r + a] * spacing[a] * extent[2 * a];
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (pointDims[a] < 1)
+    {
+      error = "the input image is empty (dimensions " + std::to_string(pointDims[0]) + "x" +
+        std::to_string(pointDims[1]) + "x" + std::to_string(pointDims[2]) + ")";
+      return false;
+    }
+  }
+
+  // Cell data: one value per cell, rendered as the grid of cell centres.
+  int dims[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    dims[a] = cells ? std::max(pointDims[a] - 1, 1) : pointDims[a];
+    if (cells && pointDims[a] > 1)
+    {
+      for (int r = 0; r < 3; ++r)
+      {
+        origin[r] += dir[3 * r + a] * 0.5 * spacing[a];
+      }
+    }
+  }
+
+  const int comps = scalars->GetNumberOfComponents();
+  if (comps < 1 || comps > 4)
+  {
+    error = "the scalars '" + std::string(scalars->GetName() ? scalars->GetName() : "") +
+      "' have " + std::to_string(comps) +
+      " components; ferrovol renders 1 to 4 (pick components with "
+      "vtkImageExtractComponents)";
+    return false;
+  }
+  const vtkIdType expected = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+  if (scalars->GetNumberOfTuples() != expected)
+  {
+    error = "the scalars have " + std::to_string(scalars->GetNumberOfTuples()) + " tuples but " +
+      std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]) +
+      (cells ? " cells" : " points") + " need " + std::to_string(expected);
+    return false;
+  }
+  uint32_t fvType = 0;
+  size_t typeSize = 0;
+  if (!ToFvScalarType(scalars->GetDataType(), fvType, typeSize))
+  {
+    error = std::string("scalars of type ") + scalars->GetDataTypeAsString() +
+      " cannot be volume rendered (cast them with vtkImageCast)";
+    return false;
+  }
+
+  // Spacing: positive along every axis (a negative one flips the direction column); an
+  // axis with one point may have any spacing (it is only the slab's thickness).
+  double positive[3] = { 0, 0, 0 };
+  double minPositive = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(spacing[a]))
+    {
+      error = "the input spacing is not finite";
+      return false;
+    }
+    if (spacing[a] != 0.0)
+    {
+      minPositive = std::min(minPositive, std::fabs(spacing[a]));
+    }
+  }
+  static const char* axisName[3] = { "x", "y", "z" };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (spacing[a] == 0.0)
+    {
+      if (dims[a] > 1)
+      {
+        std::ostringstream s;
+        s << "the input spacing (" << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
+          << ") is zero along " << axisName[a] << ", which has " << dims[a]
+          << " points: every spacing must be non-zero";
+        error = s.str();
+        return false;
+      }
+      positive[a] = std::isfinite(minPositive) ? minPositive : 1.0;
+    }
+    else
+    {
+      positive[a] = std::fabs(spacing[a]);
+      if (spacing[a] < 0.0)
+      {
+        for (int r = 0; r < 3; ++r)
+        {
+          dir[3 * r + a] = -dir[3 * r + a];
+        }
+      }
+    }
+  }
+
+  // The bytes: the array's own memory where possible.
+  const size_t elem = typeSize * comps;
+  const size_t count = static_cast<size_t>(expected);
+  const unsigned char* src = nullptr;
+  std::vector<unsigned char> bits;
+  if (scalars->GetDataType() == VTK_BIT)
+  {
+    bits.resize(count * comps);
+    for (size_t i = 0; i < count; ++i)
+    {
+      for (int c = 0; c < comps; ++c)
+      {
+        bits[i * comps + c] =
+          scalars->GetComponent(static_cast<vtkIdType>(i), c) != 0.0 ? 1 : 0;
+      }
+    }
+    src = bits.data();
+  }
+  else
+  {
+    src = static_cast<const unsigned char*>(scalars->GetVoidPointer(0));
+  }
+  if (!src)
+  {
+    error = "the scalars' memory could not be read";
+    return false;
+  }
+
+  // An axis with a single point becomes a slab one spacing thick, centred on the plane:
+  // the slice is duplicated and the origin moved back half a spacing.
+  int nd[3];
+  bool flat = false;
+  for (int a = 0; a < 3; ++a)
+  {
+    nd[a] = dims[a] == 1 ? 2 : dims[a];
+    if (dims[a] == 1)
+    {
+      flat = true;
+      for (int r = 0; r < 3; ++r)
+      {
+        origin[r] -= dir[3 * r + a] * 0.5 * positive[a];
+      }
+    }
+  }
+  if (flat)
+  {
+    out.Storage.resize(static_cast<size_t>(nd[0]) * nd[1] * nd[2] * elem);
+    for (int k = 0; k < nd[2]; ++k)
+    {
+      const int sk = std::min(k, dims[2] - 1);
+      for (int j = 0; j < nd[1]; ++j)
+      {
+        const int sj = std::min(j, dims[1] - 1);
+        const unsigned char* srow =
+          src + (static_cast<size_t>(sk) * dims[1] + sj) * dims[0] * elem;
+        unsigned char* drow =
+          out.Storage.data() + (static_cast<size_t>(k) * nd[1] + j) * nd[0] * elem;
+        if (dims[0] == 1)
+        {
+          std::memcpy(drow, srow, elem);
+          std::memcpy(drow + elem, srow, elem);
+        }
+        else
+        {
+          std::memcpy(drow, srow, dims[0] * elem);
+        }
+      }
+    }
+    out.Data = out.Storage.data();
+    out.Bytes = out.Storage.size();
+  }
+  else if (!bits.empty())
+  {
+    out.Storage.swap(bits);
+    out.Data = out.Storage.data();
+    out.Bytes = out.Storage.size();
+  }
+  else
+  {
+    out.Data = src;
+    out.Bytes = count * elem;
+  }
+
+  FvVolumeDesc& d = out.Desc;
+  std::memset(&d, 0, sizeof(d));
+  for (int a = 0; a < 3; ++a)
+  {
+    d.dims[a] = static_cast<uint32_t>(nd[a]);
+    d.spacing[a] = positive[a];
+    d.origin[a] = origin[a];
+  }
+  for (int i = 0; i < 9; ++i)
+  {
+    d.direction[i] = dir[i];
+  }
+  d.components = static_cast<uint32_t>(comps);
+  d.scalar_type = fvType;
+  // VTK's gradient magnitude unit (vtkVolumeShaderComposer.h, computeGradient) uses the mean
+  // spacing of the input.
+  out.MeanSpacing = (positive[0] + positive[1] + positive[2]) / 3.0;
+  return true;
+}
+} // namespace
+
+bool vtkFerroVolumeInputHelper::Key::operator==(const Key& o) const
+{
+  return this->Input == o.Input && this->InputMTime == o.InputMTime &&
+    this->Scalars == o.Scalars && this->ScalarsMTime == o.ScalarsMTime &&
+    this->CellFlag == o.CellFlag && this->Dims[0] == o.Dims[0] && this->Dims[1] == o.Dims[1] &&
+    this->Dims[2] == o.Dims[2] && this->DataType == o.DataType && this->Components == o.Components;
+}
+
+bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& error)
+{
+  this->Image = nullptr;
+  this->Scalars = nullptr;
+  vtkAlgorithm* alg = self->GetInputAlgorithm();
+  if (!alg || self->GetNumberOfInputConnections(0) < 1)
+  {
+    error = "no input: connect a vtkImageData (SetInputData / SetInputConnection)";
+    return false;
+  }
+  alg->Update();
+  vtkDataSet* dataset = self->GetInput();
+  vtkImageData* image = vtkImageData::SafeDownCast(dataset);
+  if (!image)
+  {
+    error = std::string("the input is ") + (dataset ? dataset->GetClassName() : "empty") +
+      ": vtkFerroVolumeMapper renders vtkImageData";
+    return false;
+  }
+  vtkDataArray* scalars = FindScalars(self, image, this->CellFlag, error);
+  if (!scalars)
+  {
+    return false;
+  }
+  if (this->CellFlag == 2)
+  {
+    error = "field data scalars cannot be volume rendered: select point or cell data";
+    return false;
+  }
+  this->Image = image;
+  this->Scalars = scalars;
+  return true;
+}
+
+bool vtkFerroVolumeInputHelper::Upload(ferrovol::Renderer& renderer, std::string& error)
+{
+  Key key;
+  key.Input = this->Image;
+  key.InputMTime = this->Image->GetMTime();
+  key.Scalars = this->Scalars;
+  key.ScalarsMTime = this->Scalars->GetMTime();
+  key.CellFlag = this->CellFlag;
+  this->Image->GetDimensions(key.Dims);
+  key.DataType = this->Scalars->GetDataType();
+  key.Components = this->Scalars->GetNumberOfComponents();
+  if (this->Uploaded && *this->Uploaded == key)
+  {
+    return true;
+  }
+  this->Uploaded.reset();
+  PreparedVolume pv;
+  if (!PrepareVolume(this->Image, this->Scalars, this->CellFlag == 1, pv, error))
+  {
+    return false;
+  }
+  std::unique_ptr<ferrovol::Volume> volume;
+  if (!vtkFerroVolumeCall("take the input volume", error,
+        [&] { volume.reset(new ferrovol::Volume(pv.Desc, pv.Data, pv.Bytes)); }) ||
+    !vtkFerroVolumeCall("upload the volume", error, [&] { renderer.set_volume(*volume); }))
+  {
+    return false;
+  }
+  this->Components = key.Components;
+  this->ComponentRanges = {};
+  for (int c = 0; c < this->Components; ++c)
+  {
+    double range[2] = { 0.0, 0.0 };
+    if (this->Scalars->GetDataType() == VTK_BIT)
+    {
+      this->Scalars->GetRange(range, c);
+    }
+    else
+    {
+      this->Scalars->GetFiniteRange(range, c);
+    }
+    this->ComponentRanges[c] = { range[0], range[1] };
+  }
+  this->MeanSpacing = pv.MeanSpacing;
+  this->Uploaded = key;
+  return true;
+}

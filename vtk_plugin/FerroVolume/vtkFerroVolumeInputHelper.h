@@ -1,0 +1,70 @@
+// vtkFerroVolumeInputHelper: the mapper's input (vtkImageData and the scalars VTK's mappers
+// would pick) → a ferrovol volume, uploaded only when the scalars (array, MTime, geometry)
+// changed; also each component's data range, which the tables span. Internal to the
+// FerroVolume module (not wrapped).
+#ifndef vtkFerroVolumeInputHelper_h
+#define vtkFerroVolumeInputHelper_h
+
+#include "vtkType.h"
+
+#include "ferrovol.hpp"
+
+#include <array>
+#include <optional>
+#include <string>
+
+class vtkDataArray;
+class vtkDataObject;
+class vtkFerroVolumeMapper;
+class vtkImageData;
+
+class vtkFerroVolumeInputHelper
+{
+public:
+  using Ranges = std::array<std::array<double, 2>, 4>;
+
+  // Updates the mapper's input and finds its image and scalars (ScalarMode,
+  // SelectScalarArray); false with the reason when there are none to render.
+  bool Select(vtkFerroVolumeMapper* self, std::string& error);
+
+  // Gives the renderer the selected scalars as a volume when they changed since the last
+  // upload.
+  bool Upload(ferrovol::Renderer& renderer, std::string& error);
+
+  // Forget the upload (the renderer is gone).
+  void Reset() { this->Uploaded.reset(); }
+
+  vtkImageData* GetImage() const { return this->Image; }
+  int GetComponents() const { return this->Components; }
+  // Each component's finite data range.
+  const Ranges& GetRanges() const { return this->ComponentRanges; }
+  // The mean voxel spacing, VTK's unit of gradient magnitude.
+  double GetMeanSpacing() const { return this->MeanSpacing; }
+
+private:
+  // What the uploaded volume was made from: anything here changing means a new upload.
+  struct Key
+  {
+    vtkDataObject* Input = nullptr;
+    vtkMTimeType InputMTime = 0;
+    vtkDataArray* Scalars = nullptr;
+    vtkMTimeType ScalarsMTime = 0;
+    int CellFlag = -1;
+    int Dims[3] = { 0, 0, 0 };
+    int DataType = -1;
+    int Components = 0;
+
+    bool operator==(const Key& o) const;
+  };
+
+  vtkImageData* Image = nullptr;
+  vtkDataArray* Scalars = nullptr;
+  int CellFlag = 0;
+
+  std::optional<Key> Uploaded;
+  int Components = 0;
+  Ranges ComponentRanges{};
+  double MeanSpacing = 1.0;
+};
+
+#endif

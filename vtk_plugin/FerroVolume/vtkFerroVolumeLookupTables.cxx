@@ -1,0 +1,296 @@
+#include "vtkFerroVolumeLookupTables.h"
+
+#include "vtkColorTransferFunction.h"
+#include "vtkFerroVolumeContext.h"
+#include "vtkMatrix4x4.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+namespace
+{
+// Entries of ferrovol's lookup tables (core's transfer table size). Colour and opacity are
+// sampled with VTK's own GetTable at exactly these positions over the range VTK's GPU mapper
+// uses, so ferrovol's tables equal VTK's (midpoints and sharpness included).
+constexpr int TableSize = 1024;
+
+// The x positions of a table over [lo, hi]: TableSize points, as VTK's GetTable places them.
+// A single-valued range (constant data) becomes two nodes [lo, lo + 1] holding the value at lo.
+void TablePositions(double lo, double hi, std::vector<double>& xs)
+{
+  if (!(hi > lo))
+  {
+    xs = { lo, lo + 1.0 };
+    return;
+  }
+  xs.resize(TableSize);
+  for (int i = 0; i < TableSize; ++i)
+  {
+    xs[i] = lo + (hi - lo) * i / (TableSize - 1);
+  }
+}
+
+void SampleScalar(vtkPiecewiseFunction* f, double lo, double hi, int m, double* out)
+{
+  if (hi > lo)
+  {
+    f->GetTable(lo, hi, m, out);
+    return;
+  }
+  std::fill(out, out + m, f->GetValue(lo));
+}
+
+void SampleColor(vtkColorTransferFunction* f, double lo, double hi, int m, double* out)
+{
+  if (hi > lo)
+  {
+    f->GetTable(lo, hi, m, out);
+    return;
+  }
+  double rgb[3];
+  f->GetColor(lo, rgb);
+  for (int i = 0; i < m; ++i)
+  {
+    std::copy(rgb, rgb + 3, out + 3 * i);
+  }
+}
+
+// A function with no nodes: VTK's GPU mapper puts a ramp over the range in its place, from 0
+// to `top` (black to white for colour, (min, 0) to (max, 0.5) for opacity).
+void Ramp(const std::vector<double>& xs, double lo, double hi, double top, double* out)
+{
+  for (size_t i = 0; i < xs.size(); ++i)
+  {
+    out[i] = (hi > lo) ? top * (xs[i] - lo) / (hi - lo) : 0.0;
+  }
+}
+
+double Clamp01(double v)
+{
+  return std::min(1.0, std::max(0.0, v));
+}
+
+// Colour of component `c` as (x, r, g, b) nodes at `xs`.
+void ColorNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
+  const std::vector<double>& xs, std::vector<double>& pts)
+{
+  const int m = static_cast<int>(xs.size());
+  std::vector<double> rgb(static_cast<size_t>(3) * m, 0.0);
+  if (prop->GetColorChannels(c) == 1)
+  {
+    std::vector<double> gray(m);
+    vtkPiecewiseFunction* g = prop->GetGrayTransferFunction(c);
+    if (g->GetSize() < 1)
+    {
+      Ramp(xs, lo, hi, 1.0, gray.data());
+    }
+    else
+    {
+      SampleScalar(g, lo, hi, m, gray.data());
+    }
+    for (int i = 0; i < m; ++i)
+    {
+      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = gray[i];
+    }
+  }
+  else
+  {
+    vtkColorTransferFunction* ctf = prop->GetRGBTransferFunction(c);
+    if (ctf->GetSize() < 1)
+    {
+      std::vector<double> ramp(m);
+      Ramp(xs, lo, hi, 1.0, ramp.data());
+      for (int i = 0; i < m; ++i)
+      {
+        rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = ramp[i];
+      }
+    }
+    else
+    {
+      SampleColor(ctf, lo, hi, m, rgb.data());
+    }
+  }
+  pts.resize(static_cast<size_t>(4) * m);
+  for (int i = 0; i < m; ++i)
+  {
+    pts[4 * i] = xs[i];
+    for (int k = 0; k < 3; ++k)
+    {
+      pts[4 * i + 1 + k] = Clamp01(rgb[3 * i + k]);
+    }
+  }
+}
+
+// Scalar opacity of component `c` as (x, opacity) nodes at `xs`.
+void OpacityNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
+  const std::vector<double>& xs, std::vector<double>& pts)
+{
+  const int m = static_cast<int>(xs.size());
+  std::vector<double> values(m, 0.0);
+  vtkPiecewiseFunction* sof = prop->GetScalarOpacity(c);
+  if (sof->GetSize() < 1)
+  {
+    Ramp(xs, lo, hi, 0.5, values.data());
+  }
+  else
+  {
+    SampleScalar(sof, lo, hi, m, values.data());
+  }
+  pts.resize(static_cast<size_t>(2) * m);
+  for (int i = 0; i < m; ++i)
+  {
+    pts[2 * i] = xs[i];
+    pts[2 * i + 1] = Clamp01(values[i]);
+  }
+}
+
+// Gradient opacity. VTK 9.2 (vtkVolumeShaderComposer.h computeGradient and
+// vtkOpenGLVolumeGradientOpacityTable) evaluates the function at
+//   g_vtk = meanSpacing · |∇s|   (central differences, ∇ in data coordinates)
+// clamped to [0, 0.25 · (max − min)] of the component's data range, the table spanning
+// exactly that. ferrovol's x axis is |∇s| in scalar units per world unit, so the nodes
+// move to x = g_vtk · gradientScale, gradientScale = 1 / (meanSpacing · volume matrix
+// scale); ferrovol clamps beyond the last node just as VTK clamps. A constant 1 (VTK's
+// default function) changes nothing: `pts` is then empty (gradient opacity off).
+void GradientOpacityNodes(vtkPiecewiseFunction* gof, const std::array<double, 2>& dataRange,
+  double gradientScale, std::vector<double>& pts)
+{
+  const double range = dataRange[1] - dataRange[0];
+  const double gmax = 0.25 * (range != 0.0 ? range : 1.0);
+  std::vector<double> values(TableSize, 1.0);
+  gof->GetTable(0.0, range != 0.0 ? gmax : 0.0, TableSize, values.data());
+  bool allOne = true;
+  pts.resize(static_cast<size_t>(2) * TableSize);
+  for (int i = 0; i < TableSize; ++i)
+  {
+    const double v = Clamp01(values[i]);
+    allOne = allOne && v == 1.0;
+    pts[2 * i] = gmax * i / (TableSize - 1) * gradientScale;
+    pts[2 * i + 1] = v;
+  }
+  if (allOne)
+  {
+    pts.clear();
+  }
+}
+
+bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
+  const vtkFerroVolumeInputHelper::Ranges& ranges, double gradientScale,
+  std::unique_ptr<ferrovol::TransferFunction>& tf, std::string& error)
+{
+  const bool independent = comps == 1 || prop->GetIndependentComponents();
+  if (!independent && comps != 2 && comps != 4)
+  {
+    error = "IndependentComponents is off with " + std::to_string(comps) +
+      " components: dependent components need 2 (colour scalar, opacity scalar) or 4 (RGB + "
+      "opacity scalar)";
+    return false;
+  }
+  const int n = independent ? comps : 1;
+  if (!vtkFerroVolumeCall("create a transfer function", error, [&] {
+        tf.reset(new ferrovol::TransferFunction(static_cast<uint32_t>(n), independent));
+      }))
+  {
+    return false;
+  }
+  std::vector<double> xs, pts;
+  for (int c = 0; c < n; ++c)
+  {
+    // Table ranges as vtkGPUVolumeRayCastMapper (SCALAR range type, its default): each
+    // component's data range; dependent components take colour from component 0 and
+    // opacity from the last one, and share one table here, spanning both ranges.
+    double lo = ranges[c][0], hi = ranges[c][1];
+    const int opacityComp = independent ? c : comps - 1;
+    if (!independent)
+    {
+      lo = std::min(ranges[0][0], ranges[comps - 1][0]);
+      hi = std::max(ranges[0][1], ranges[comps - 1][1]);
+    }
+    TablePositions(lo, hi, xs);
+    const uint32_t component = static_cast<uint32_t>(c);
+    ColorNodes(prop, c, lo, hi, xs, pts);
+    if (!vtkFerroVolumeCall(
+          "set the colour transfer function", error, [&] { tf->set_color(component, pts); }))
+    {
+      return false;
+    }
+    OpacityNodes(prop, c, lo, hi, xs, pts);
+    if (!vtkFerroVolumeCall(
+          "set the scalar opacity function", error, [&] { tf->set_opacity(component, pts); }) ||
+      !vtkFerroVolumeCall("set the scalar opacity unit distance", error, [&] {
+        tf->set_unit_distance(component, prop->GetScalarOpacityUnitDistance(opacityComp),
+          prop->GetComponentWeight(c));
+      }))
+    {
+      return false;
+    }
+    const int goIndex = independent ? c : 0;
+    if (prop->HasGradientOpacity(goIndex) && !prop->GetDisableGradientOpacity(goIndex))
+    {
+      GradientOpacityNodes(
+        prop->GetStoredGradientOpacity(goIndex), ranges[opacityComp], gradientScale, pts);
+      if (!vtkFerroVolumeCall("set the gradient opacity function", error,
+            [&] { tf->set_gradient_opacity(component, pts); }))
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+} // namespace
+
+bool vtkFerroVolumeLookupTables::Key::operator==(const Key& o) const
+{
+  return this->Property == o.Property && this->PropertyMTime == o.PropertyMTime &&
+    this->Components == o.Components && this->Ranges == o.Ranges &&
+    this->GradientScale == o.GradientScale;
+}
+
+double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
+{
+  return std::cbrt(std::fabs(volume->GetMatrix()->Determinant()));
+}
+
+bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
+  const vtkFerroVolumeInputHelper& input, ferrovol::Renderer& renderer, std::string& error)
+{
+  vtkVolumeProperty* prop = volume->GetProperty();
+  if (prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_1D)
+  {
+    error = "2D transfer functions (vtkVolumeProperty::TransferFunctionMode TF_2D) are not "
+            "supported by vtkFerroVolumeMapper: nothing is drawn";
+    return false;
+  }
+  const double matrixScale = MatrixScale(volume);
+  if (!(matrixScale > 0.0) || !std::isfinite(matrixScale))
+  {
+    error = "the vtkVolume's matrix is singular (zero scale?): nothing is drawn";
+    return false;
+  }
+  Key key;
+  key.Property = prop;
+  key.PropertyMTime = prop->GetMTime();
+  key.Components = input.GetComponents();
+  key.Ranges = input.GetRanges();
+  key.GradientScale = 1.0 / (input.GetMeanSpacing() * matrixScale);
+  if (this->Uploaded && *this->Uploaded == key)
+  {
+    return true;
+  }
+  this->Uploaded.reset();
+  std::unique_ptr<ferrovol::TransferFunction> tf;
+  if (!BuildTransferFunction(prop, key.Components, key.Ranges, key.GradientScale, tf, error) ||
+    !vtkFerroVolumeCall(
+      "set the transfer function", error, [&] { renderer.set_transfer_function(*tf); }))
+  {
+    return false;
+  }
+  this->Uploaded = key;
+  return true;
+}

@@ -1,0 +1,51 @@
+// vtkFerroVolumeLookupTables: vtkVolumeProperty → ferrovol's transfer function (colour,
+// scalar opacity, gradient opacity per component), sampled with VTK's own GetTable over the
+// ranges vtkGPUVolumeRayCastMapper uses so that ferrovol's tables equal VTK's; uploaded only
+// when the property (or its functions), the data ranges or the gradient scale changed.
+// Internal to the FerroVolume module (not wrapped).
+#ifndef vtkFerroVolumeLookupTables_h
+#define vtkFerroVolumeLookupTables_h
+
+#include "vtkFerroVolumeInputHelper.h"
+#include "vtkType.h"
+
+#include "ferrovol.hpp"
+
+#include <optional>
+#include <string>
+
+class vtkVolume;
+class vtkVolumeProperty;
+
+class vtkFerroVolumeLookupTables
+{
+public:
+  // The volume's matrix scale (cube root of |det|): world units per data unit.
+  static double MatrixScale(vtkVolume* volume);
+
+  // Gives the renderer the tables of the volume's property over the input's ranges when
+  // anything they are made from changed; false with the reason when the property or the
+  // volume's matrix cannot be rendered.
+  bool Update(vtkVolume* volume, const vtkFerroVolumeInputHelper& input,
+    ferrovol::Renderer& renderer, std::string& error);
+
+  // Forget the upload (the renderer is gone).
+  void Reset() { this->Uploaded.reset(); }
+
+private:
+  // What the uploaded tables were made from.
+  struct Key
+  {
+    vtkVolumeProperty* Property = nullptr;
+    vtkMTimeType PropertyMTime = 0;
+    int Components = 0;
+    vtkFerroVolumeInputHelper::Ranges Ranges{};
+    double GradientScale = 0.0;
+
+    bool operator==(const Key& o) const;
+  };
+
+  std::optional<Key> Uploaded;
+};
+
+#endif

@@ -1,0 +1,114 @@
+// vtkFerroVolumeOutput: how ferrovol's frames reach VTK's OpenGL framebuffer. A frame path
+// takes VTK's opaque depth for the viewport, has ferrovol render, and leaves the frame in two
+// textures: premultiplied RGBA and window depth, rows top to bottom. Two paths:
+//   readback (vtkFerroVolumeOutput.cxx): depth in with glReadPixels, the frame out with
+//     ferrovol's read_frame and glTexImage2D (a CPU copy each way);
+//   shared (vtkFerroVolumeSharedOutput): ferrovol's images imported with
+//     GL_EXT_memory_object_fd, no copy (when ferrovol.h has the shared output path).
+// vtkFerroVolumeOutput picks the path, falls back to the readback for good when the shared
+// one fails, and composites the frame: one full-screen quad, premultiplied blending,
+// gl_FragDepth from the volume's depth. Internal to the FerroVolume module (not wrapped).
+#ifndef vtkFerroVolumeOutput_h
+#define vtkFerroVolumeOutput_h
+
+#include "vtkWeakPointer.h"
+
+#include "ferrovol.hpp"
+
+#include <memory>
+#include <string>
+
+class vtkObject;
+class vtkOpenGLQuadHelper;
+class vtkOpenGLRenderWindow;
+class vtkRenderer;
+class vtkTextureObject;
+class vtkVolume;
+class vtkWindow;
+
+// One frame request: the viewport in the framebuffer and the size ferrovol renders at.
+struct vtkFerroVolumeFrameRequest
+{
+  vtkOpenGLRenderWindow* Window;
+  int ViewportX, ViewportY, ViewportW, ViewportH;
+  int RenderW, RenderH;
+  // Whether opaque geometry may be in VTK's depth buffer; without any, the buffer holds only
+  // its clear value and the frame is rendered without a depth input (no copy pass).
+  bool UseDepth;
+};
+
+// Linear (colour) or nearest (depth) filtering, clamped to the edges.
+void vtkFerroVolumeSetSampling(vtkTextureObject* texture, bool linear);
+
+// A way for frames to travel from ferrovol to OpenGL.
+class vtkFerroVolumeFramePath
+{
+public:
+  virtual ~vtkFerroVolumeFramePath() = default;
+  virtual const char* Name() const = 0;
+  // Renders the frame into the two textures; `warning`: something this frame lacks (it is
+  // still drawn).
+  virtual bool Render(ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
+    std::string& error, std::string& warning) = 0;
+  virtual vtkTextureObject* ColorTexture() = 0;
+  virtual vtkTextureObject* DepthTexture() = 0;
+  // nullptr: the context is gone, GL names are forgotten rather than deleted.
+  virtual void ReleaseGraphicsResources(vtkWindow* window) = 0;
+};
+
+class vtkFerroVolumeOutput
+{
+public:
+  vtkFerroVolumeOutput();
+  vtkFerroVolumeOutput(const vtkFerroVolumeOutput&) = delete;
+  vtkFerroVolumeOutput& operator=(const vtkFerroVolumeOutput&) = delete;
+  ~vtkFerroVolumeOutput();
+
+  // Renders the frame through the path for this window and `preference` (an
+  // vtkFerroVolumeMapper::OutputPaths value; the path is chosen again when either changed).
+  // `self` receives the warnings; `warning` is something this frame lacks.
+  bool Render(vtkObject* self, int preference, ferrovol::Renderer& renderer,
+    const vtkFerroVolumeFrameRequest& req, std::string& error, std::string& warning);
+
+  enum class Composited
+  {
+    Failed,
+    OffScreen, // the volume is entirely off screen: nothing to composite
+    Drawn
+  };
+  // Draws the last frame over the viewport, scissored to `rect` (x, y, w, h relative to the
+  // viewport).
+  Composited Composite(
+    const vtkFerroVolumeFrameRequest& req, const int rect[4], std::string& error);
+
+  // The viewport pixels (x, y, w, h relative to the viewport) the volume's world bounding
+  // box, grown by `pad` world units on every side, can cover (a volume one point thick
+  // renders as a slab one spacing thick, beyond VTK's flat bounds); the whole viewport when
+  // a corner is behind the camera. Outside them ferrovol's frame is empty, so the
+  // compositing pass is scissored to them (it is a full-viewport fragment pass otherwise).
+  static void ProjectedRect(
+    vtkRenderer* ren, vtkVolume* vol, double pad, int vw, int vh, int rect[4]);
+
+  // "shared", "readback", or "none" before the first frame.
+  const char* Name() const;
+  const std::string& Reason() const { return this->PathReason; }
+
+  // Frees the GL resources with `window`'s context current; a window other than the one
+  // drawn into, or nullptr, forgets the GL names instead.
+  void ReleaseGraphicsResources(vtkWindow* window);
+
+private:
+  void Choose(vtkObject* self, int preference, ferrovol::Renderer& renderer,
+    vtkOpenGLRenderWindow* win);
+  void UseReadback(ferrovol::Renderer& renderer);
+
+  std::unique_ptr<vtkFerroVolumeFramePath> Path;
+  int Preference = -1;
+  // weak: a window destroyed behind our back reads as null, and its GL names are forgotten
+  vtkWeakPointer<vtkOpenGLRenderWindow> PathWindow;
+  std::string PathReason;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  vtkWeakPointer<vtkOpenGLRenderWindow> QuadWindow;
+};
+
+#endif

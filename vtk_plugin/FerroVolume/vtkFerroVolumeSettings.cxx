@@ -1,0 +1,542 @@
+#include "vtkFerroVolumeSettings.h"
+
+#include "vtkCamera.h"
+#include "vtkContourValues.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkFerroVolumeContext.h"
+#include "vtkFerroVolumeMapper.h"
+#include "vtkLight.h"
+#include "vtkLightCollection.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMatrix4x4.h"
+#include "vtkOpenGLCamera.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
+#include "vtkPlaneCollection.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+namespace
+{
+// vtkMatrix4x4 (row-major, VTK's M·p) → column-major (OpenGL order), as ferrovol takes them.
+void ToColumnMajor(vtkMatrix4x4* m, double out[16])
+{
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      out[4 * c + r] = m->GetElement(r, c);
+    }
+  }
+}
+
+void ToFloat3(const double in[3], float out[3])
+{
+  for (int k = 0; k < 3; ++k)
+  {
+    out[k] = static_cast<float>(in[k]);
+  }
+}
+
+// A switched-on VTK light as ferrovol's; `defaultLighting`: VTK's default (one headlight of
+// intensity 1), whose ambient term is the material's ambient times the sample colour.
+FvLight ToFvLight(vtkLight* light, bool defaultLighting)
+{
+  FvLight l;
+  std::memset(&l, 0, sizeof(l));
+  if (light->LightTypeIsHeadlight())
+  {
+    l.space = FV_LIGHT_SPACE_HEADLIGHT;
+    light->GetPosition(l.position);
+    light->GetFocalPoint(l.focal_point);
+  }
+  else if (light->LightTypeIsCameraLight())
+  {
+    l.space = FV_LIGHT_SPACE_CAMERA;
+    light->GetPosition(l.position);
+    light->GetFocalPoint(l.focal_point);
+  }
+  else
+  {
+    l.space = FV_LIGHT_SPACE_WORLD;
+    light->GetTransformedPosition(l.position);
+    light->GetTransformedFocalPoint(l.focal_point);
+  }
+  l.positional = light->GetPositional() != 0;
+  double c[3];
+  light->GetAmbientColor(c);
+  ToFloat3(c, l.ambient);
+  if (defaultLighting)
+  {
+    l.ambient[0] = l.ambient[1] = l.ambient[2] = 1.0f;
+  }
+  light->GetDiffuseColor(c);
+  ToFloat3(c, l.diffuse);
+  light->GetSpecularColor(c);
+  ToFloat3(c, l.specular);
+  l.intensity = static_cast<float>(light->GetIntensity());
+  light->GetAttenuationValues(c);
+  ToFloat3(c, l.attenuation);
+  l.cone_angle = static_cast<float>(light->GetConeAngle());
+  l.exponent = static_cast<float>(light->GetExponent());
+  return l;
+}
+
+// The renderer's switched-on lights (at most FV_MAX_LIGHTS, warned once when more).
+std::vector<FvLight> SceneLights(vtkFerroVolumeMapper* self, vtkRenderer* ren,
+  std::set<std::string>& warned)
+{
+  std::vector<FvLight> lights;
+  vtkLightCollection* lc = ren->GetLights();
+  vtkCollectionSimpleIterator it;
+  int on = 0;
+  lc->InitTraversal(it);
+  while (vtkLight* light = lc->GetNextLight(it))
+  {
+    if (light->GetSwitch())
+    {
+      ++on;
+    }
+  }
+  if (on > FV_MAX_LIGHTS && warned.insert("lights").second)
+  {
+    vtkWarningWithObjectMacro(
+      self, << on << " lights are on: ferrovol uses the first " << FV_MAX_LIGHTS);
+  }
+  lc->InitTraversal(it);
+  while (vtkLight* light = lc->GetNextLight(it))
+  {
+    if (!light->GetSwitch() || static_cast<int>(lights.size()) >= FV_MAX_LIGHTS)
+    {
+      continue;
+    }
+    lights.push_back(ToFvLight(light,
+      on == 1 && light->LightTypeIsHeadlight() && light->GetIntensity() == 1.0));
+  }
+  return lights;
+}
+
+// The camera VTK draws the opaque geometry with.
+FvCamera ToFvCamera(vtkRenderer* ren, int vw, int vh)
+{
+  vtkCamera* cam = ren->GetActiveCamera();
+  FvCamera fcam;
+  std::memset(&fcam, 0, sizeof(fcam));
+  cam->GetPosition(fcam.position);
+  cam->GetFocalPoint(fcam.focal_point);
+  cam->GetViewUp(fcam.view_up);
+  fcam.view_angle = cam->GetViewAngle();
+  fcam.parallel = cam->GetParallelProjection() != 0;
+  fcam.parallel_scale = cam->GetParallelScale();
+  cam->GetClippingRange(fcam.clipping_range);
+  fcam.use_matrices = true;
+  if (vtkOpenGLCamera* glcam = vtkOpenGLCamera::SafeDownCast(cam))
+  {
+    // GL-ordered (transposed) copies: their storage is column-major already.
+    vtkMatrix4x4 *wcvc = nullptr, *vcdc = nullptr, *wcdc = nullptr;
+    vtkMatrix3x3* norms = nullptr;
+    glcam->GetKeyMatrices(ren, wcvc, norms, vcdc, wcdc);
+    std::memcpy(fcam.view_matrix, wcvc->GetData(), sizeof(fcam.view_matrix));
+    std::memcpy(fcam.projection_matrix, vcdc->GetData(), sizeof(fcam.projection_matrix));
+  }
+  else
+  {
+    ToColumnMajor(cam->GetModelViewTransformMatrix(), fcam.view_matrix);
+    ToColumnMajor(cam->GetProjectionTransformMatrix(static_cast<double>(vw) / vh, -1, 1),
+      fcam.projection_matrix);
+  }
+  return fcam;
+}
+} // namespace
+
+bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::string& error)
+{
+  static const std::pair<int, FvBlendMode> modes[] = {
+    { vtkVolumeMapper::COMPOSITE_BLEND, FV_BLEND_MODE_COMPOSITE },
+    { vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND, FV_BLEND_MODE_MAXIMUM },
+    { vtkVolumeMapper::MINIMUM_INTENSITY_BLEND, FV_BLEND_MODE_MINIMUM },
+    { vtkVolumeMapper::AVERAGE_INTENSITY_BLEND, FV_BLEND_MODE_AVERAGE },
+    { vtkVolumeMapper::ADDITIVE_BLEND, FV_BLEND_MODE_ADDITIVE },
+    { vtkVolumeMapper::ISOSURFACE_BLEND, FV_BLEND_MODE_ISOSURFACE },
+  };
+  const auto mode = std::find_if(std::begin(modes), std::end(modes),
+    [&](const std::pair<int, FvBlendMode>& m) { return m.first == self->GetBlendMode(); });
+  if (mode == std::end(modes))
+  {
+    error = "blend mode " + std::to_string(self->GetBlendMode()) +
+      " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
+      "additive and isosurface are): nothing is drawn";
+    return false;
+  }
+  this->Blend = self->GetRenderMode() == vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE
+    ? FV_BLEND_MODE_PATH_TRACE
+    : mode->second;
+  return true;
+}
+
+vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
+  vtkRenderer* ren, vtkVolume* vol, ferrovol::Renderer& renderer, std::set<std::string>& warned,
+  std::string& error)
+{
+  vtkVolumeProperty* prop = vol->GetProperty();
+  FvRenderParams& params = this->Params;
+  if (!vtkFerroVolumeCall("use the mapper's settings", error,
+        [&] { params = ferrovol::Renderer::default_params(); }))
+  {
+    return Result::Failed;
+  }
+  params.blend_mode = this->Blend;
+  switch (prop->GetInterpolationType())
+  {
+    case VTK_NEAREST_INTERPOLATION:
+      params.interpolation = FV_INTERPOLATION_NEAREST;
+      break;
+    case VTK_LINEAR_INTERPOLATION:
+      params.interpolation = FV_INTERPOLATION_LINEAR;
+      break;
+    default:
+      params.interpolation = FV_INTERPOLATION_LINEAR;
+      if (warned.insert("interpolation").second)
+      {
+        vtkWarningWithObjectMacro(self, << "interpolation type "
+                                        << prop->GetInterpolationTypeAsString()
+                                        << " is not supported by ferrovol: using linear "
+                                           "interpolation");
+      }
+      break;
+  }
+  if (!self->GetAutoAdjustSampleDistances())
+  {
+    const float distance = self->GetSampleDistance();
+    if (!(distance > 0.0f) || !std::isfinite(distance))
+    {
+      error = "SampleDistance " + std::to_string(distance) +
+        " must be positive (or turn AutoAdjustSampleDistances on)";
+      return Result::Failed;
+    }
+    params.sample_distance = distance;
+  }
+  params.jitter = self->GetUseJittering() != 0;
+  const bool isosurface = this->Blend == FV_BLEND_MODE_ISOSURFACE;
+  params.shade =
+    prop->GetShade(0) != 0 && (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface);
+  params.ambient = static_cast<float>(prop->GetAmbient(0));
+  params.diffuse = static_cast<float>(prop->GetDiffuse(0));
+  params.specular = static_cast<float>(prop->GetSpecular(0));
+  params.specular_power = static_cast<float>(prop->GetSpecularPower(0));
+  params.two_sided_lighting = ren->GetTwoSidedLighting() != 0;
+  if (!isosurface)
+  {
+    params.volumetric_scattering_blending =
+      static_cast<float>(self->GetVolumetricScatteringBlending());
+    params.global_illumination_reach = static_cast<float>(self->GetGlobalIlluminationReach());
+    params.scattering_anisotropy =
+      std::max(-1.0f, std::min(1.0f, prop->GetScatteringAnisotropy()));
+  }
+  params.cropping = self->GetCropping() != 0;
+  const double* crop = self->GetCroppingRegionPlanes();
+  std::copy(crop, crop + 6, params.cropping_planes);
+  params.cropping_regions = static_cast<uint32_t>(self->GetCroppingRegionFlags());
+  if (vtkPlaneCollection* planes = self->GetClippingPlanes())
+  {
+    int count = planes->GetNumberOfItems();
+    if (count > FV_MAX_CLIP_PLANES)
+    {
+      if (warned.insert("planes").second)
+      {
+        vtkWarningWithObjectMacro(
+          self, << count << " clipping planes: ferrovol uses the first " << FV_MAX_CLIP_PLANES);
+      }
+      count = FV_MAX_CLIP_PLANES;
+    }
+    for (int i = 0; i < count; ++i)
+    {
+      vtkPlane* plane = planes->GetItem(i);
+      plane->GetOrigin(params.clip_planes[i].origin);
+      plane->GetNormal(params.clip_planes[i].normal);
+    }
+    params.clip_plane_count = static_cast<uint32_t>(count);
+  }
+  params.average_range_enabled = this->Blend == FV_BLEND_MODE_AVERAGE;
+  const double* average = self->GetAverageIPScalarRange();
+  params.average_range[0] = average[0];
+  params.average_range[1] = average[1];
+  params.empty_space_skipping = self->GetEmptySpaceSkipping() != 0;
+  ToColumnMajor(vol->GetMatrix(), params.volume_matrix);
+  this->Background = false;
+  if (isosurface)
+  {
+    const Result iso = this->SetUpIsosurfaces(self, vol, renderer, warned, error);
+    if (iso != Result::Ready)
+    {
+      return iso;
+    }
+  }
+  if (this->Blend == FV_BLEND_MODE_PATH_TRACE &&
+    !this->SetUpPathTracing(self, ren, vol, renderer, error))
+  {
+    return Result::Failed;
+  }
+  if (!vtkFerroVolumeCall("use the mapper's settings", error, [&] { renderer.set_params(params); }))
+  {
+    return Result::Failed;
+  }
+  return Result::Ready;
+}
+
+bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw,
+  int vh, ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error)
+{
+  if (!vtkFerroVolumeCall(
+        "use the camera", error, [&] { renderer.set_camera(ToFvCamera(ren, vw, vh)); }))
+  {
+    return false;
+  }
+  std::vector<FvLight> lights;
+  if (this->Blend == FV_BLEND_MODE_ISOSURFACE && !this->Params.shade)
+  {
+    // Flat isosurfaces (Shade off), as vtkGPUVolumeRayCastMapper draws them: the surface
+    // colour alone, through one purely ambient light (SetUpIsosurfaces set the material).
+    FvLight l;
+    std::memset(&l, 0, sizeof(l));
+    l.space = FV_LIGHT_SPACE_HEADLIGHT;
+    l.ambient[0] = l.ambient[1] = l.ambient[2] = 1.0f;
+    l.intensity = 1.0f;
+    l.attenuation[0] = 1.0f;
+    lights.push_back(l);
+  }
+  else if (this->Params.shade || this->Blend == FV_BLEND_MODE_PATH_TRACE)
+  {
+    lights = SceneLights(self, ren, warned);
+  }
+  return vtkFerroVolumeCall(
+    "use the renderer's lights", error, [&] { renderer.set_lights(lights); });
+}
+
+void vtkFerroVolumeSettings::Reset()
+{
+  this->HaveEnvironment = false;
+  this->EnvironmentKey.clear();
+}
+
+//------------------------------------------------------------------------------------------
+// Gives the renderer the mapper's environment when the map or its placement changed since
+// the last frame; false (said once per setting with vtkErrorMacro) when it cannot be used.
+bool vtkFerroVolumeSettings::UseEnvironment(
+  vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer)
+{
+  const char* file = self->GetEnvironmentMap();
+  const bool sky = !file || !*file;
+  const double* up = self->GetEnvironmentUp();
+  std::ostringstream key;
+  key << (sky ? "" : file) << '|' << up[0] << ',' << up[1] << ',' << up[2] << '|'
+      << self->GetEnvironmentAzimuth() << '|' << self->GetEnvironmentIntensity();
+  if (!this->HaveEnvironment ||
+    (this->EnvironmentKey != key.str() && this->EnvironmentKey != "failed:" + key.str()))
+  {
+    this->HaveEnvironment = true;
+    this->EnvironmentKey = key.str();
+    std::string error;
+    if (!vtkFerroVolumeCall("use the environment map", error, [&] {
+          renderer.set_environment(sky ? nullptr : file,
+            static_cast<float>(self->GetEnvironmentIntensity()), up,
+            self->GetEnvironmentAzimuth());
+        }))
+    {
+      vtkErrorWithObjectMacro(self, << error << " (drawing without environment light)");
+      this->EnvironmentKey = "failed:" + key.str();
+    }
+  }
+  return this->EnvironmentKey.rfind("failed:", 0) != 0;
+}
+
+// Gives the renderer the path tracing settings: the property's ScatteringAnisotropy, the
+// mapper's budget (the still budget, or InteractiveSamplesPerPixel per frame while the
+// window renders interactively), bounces and environment (weight 1; background when
+// EnvironmentBackground is on).
+bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren,
+  vtkVolume* vol, ferrovol::Renderer& renderer, std::string& error)
+{
+  FvPathTraceParams pt;
+  if (!vtkFerroVolumeCall("use the path tracing settings", error,
+        [&] { pt = ferrovol::Renderer::default_path_trace_params(); }))
+  {
+    return false;
+  }
+  vtkRenderWindow* win = ren->GetRenderWindow();
+  const bool interactive = win && win->GetDesiredUpdateRate() > 1.0;
+  if (interactive)
+  {
+    pt.samples_per_frame = static_cast<uint32_t>(self->GetInteractiveSamplesPerPixel());
+    pt.max_samples = 0;
+  }
+  else
+  {
+    pt.samples_per_frame = static_cast<uint32_t>(std::min(self->GetSamplesPerPixel(), 4096));
+    pt.max_samples = static_cast<uint32_t>(self->GetSamplesPerPixel());
+    pt.secondary_rays = static_cast<uint32_t>(self->GetSecondaryRays());
+  }
+  pt.max_bounces = static_cast<uint32_t>(self->GetPathTracingBounces());
+  const double psi = self->GetGradientThreshold();
+  pt.gradient_threshold = psi >= static_cast<double>(FLT_MAX)
+    ? std::numeric_limits<float>::infinity()
+    : static_cast<float>(psi);
+  pt.stochastic_blend = static_cast<float>(std::min(self->GetStochasticBlend(), 1e30));
+  pt.scatter_regions = static_cast<uint32_t>(self->GetScatterRegions());
+  pt.attenuation = self->GetAttenuation() != 0;
+  pt.denoise = self->GetPathTracingDenoise() != 0;
+  pt.roughness = static_cast<float>(self->GetBsdfRoughness());
+  pt.fresnel = static_cast<float>(self->GetBsdfFresnel());
+  pt.transmission = static_cast<float>(self->GetTransmission());
+  pt.cone_angle = static_cast<float>(self->GetTransmissionConeAngle());
+  // (|g| = 1 is a delta, which a Monte Carlo estimate cannot sample: clamp inside)
+  pt.anisotropy =
+    std::max(-0.99f, std::min(0.99f, vol->GetProperty()->GetScatteringAnisotropy()));
+  pt.background = self->GetEnvironmentBackground() != 0;
+  if (!this->UseEnvironment(self, renderer))
+  {
+    pt.environment_light = 0.0f;
+    pt.background = false;
+  }
+  this->Background = pt.background;
+  return vtkFerroVolumeCall(
+    "use the path tracing settings", error, [&] { renderer.set_path_tracing(pt); });
+}
+
+// Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
+// environment when it changed. The surfaces' colours and opacities are the property's
+// colour and scalar opacity functions at the iso-values (first component), as
+// vtkGPUVolumeRayCastMapper's; Shade off draws flat colours (ambient 1, no diffuse or
+// specular light, no environment light).
+vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
+  vtkFerroVolumeMapper* self, vtkVolume* vol, ferrovol::Renderer& renderer,
+  std::set<std::string>& warned, std::string& error)
+{
+  vtkVolumeProperty* prop = vol->GetProperty();
+  FvRenderParams& params = this->Params;
+  vtkContourValues* contours = prop->GetIsoSurfaceValues();
+  const int n = contours ? contours->GetNumberOfContours() : 0;
+  if (n < 1)
+  {
+    error = "the isosurface blend mode needs iso-values: set them with "
+            "volumeProperty->GetIsoSurfaceValues()->SetValue(0, value)";
+    return Result::Failed;
+  }
+  if (n > FV_MAX_ISO_VALUES && warned.insert("iso-count").second)
+  {
+    vtkWarningWithObjectMacro(self, << n << " iso-values: ferrovol draws the first "
+                                    << FV_MAX_ISO_VALUES);
+  }
+  FvIsoParams iso;
+  if (!vtkFerroVolumeCall("use the isosurface settings", error,
+        [&] { iso = ferrovol::Renderer::default_iso_params(); }))
+  {
+    return Result::Failed;
+  }
+  // (Get{Gray,RGB}TransferFunction create a default function, and switch the property to
+  // it, when it has none: ask for the one the property uses.)
+  const bool grayColor = prop->GetColorChannels(0) == 1;
+  vtkColorTransferFunction* rgb = grayColor ? nullptr : prop->GetRGBTransferFunction(0);
+  vtkPiecewiseFunction* gray = grayColor ? prop->GetGrayTransferFunction(0) : nullptr;
+  vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(0);
+  uint32_t count = 0;
+  for (int i = 0; i < std::min(n, static_cast<int>(FV_MAX_ISO_VALUES)); ++i)
+  {
+    const double v = contours->GetValue(i);
+    const double a = std::min(1.0, opacity->GetValue(v));
+    if (!(a > 0.0))
+    {
+      if (warned.insert("iso-transparent-" + std::to_string(v)).second)
+      {
+        vtkWarningWithObjectMacro(self, << "iso-value " << v
+                                        << " has opacity 0 in the scalar opacity function: "
+                                           "it is not drawn");
+      }
+      continue;
+    }
+    FvIsoValue& iv = iso.values[count++];
+    iv.value = v;
+    double c[3];
+    if (grayColor)
+    {
+      c[0] = c[1] = c[2] = gray->GetValue(v);
+    }
+    else
+    {
+      rgb->GetColor(v, c);
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      iv.color[k] = static_cast<float>(std::min(1.0, std::max(0.0, c[k])));
+    }
+    iv.opacity = static_cast<float>(a);
+  }
+  if (count == 0)
+  {
+    return Result::NothingVisible;
+  }
+  iso.value_count = count;
+  iso.max_layers = static_cast<uint32_t>(self->GetIsosurfaceLayers());
+  iso.specular_mode = self->GetSpecularSampling() == vtkFerroVolumeMapper::SPECULAR_CONE
+    ? FV_SPECULAR_MODE_CONE
+    : FV_SPECULAR_MODE_IMPORTANCE;
+  iso.specular_samples = static_cast<uint32_t>(self->GetSpecularSamples());
+  if (self->GetShininessFromGradient())
+  {
+    const double* e = self->GetShininessRange();
+    const double* g = self->GetShininessGradientRange();
+    iso.shininess[0] = static_cast<float>(e[0]);
+    iso.shininess[1] = static_cast<float>(e[1]);
+    iso.shininess_range[0] = g[0];
+    iso.shininess_range[1] = g[1];
+  }
+  else
+  {
+    iso.shininess[0] = iso.shininess[1] = params.specular_power;
+  }
+  iso.fresnel = static_cast<float>(self->GetFresnel());
+  iso.scatter_mode = static_cast<uint32_t>(self->GetIsosurfaceScattering());
+  iso.scatter_samples = static_cast<uint32_t>(self->GetIsosurfaceScatteringSamples());
+  iso.scatter_absorption =
+    static_cast<float>(std::min(self->GetIsosurfaceScatteringAbsorption(), 1e30));
+  if (self->GetFresnel() >= 0.0)
+  {
+    iso.scatter_fresnel = static_cast<float>(self->GetFresnel());
+  }
+  iso.ao_samples = static_cast<uint32_t>(self->GetAmbientOcclusionSamples());
+  iso.ao_steps = static_cast<uint32_t>(self->GetAmbientOcclusionSteps());
+  iso.ao_radius = self->GetAmbientOcclusionRadius();
+  iso.background = self->GetEnvironmentBackground() != 0;
+  iso.environment_light = params.shade ? static_cast<float>(self->GetEnvironmentLighting()) : 0.0f;
+  if (!params.shade)
+  {
+    params.ambient = 1.0f;
+    params.diffuse = 0.0f;
+    params.specular = 0.0f;
+  }
+
+  if ((iso.environment_light > 0.0f || iso.background) && !this->UseEnvironment(self, renderer))
+  {
+    iso.environment_light = 0.0f;
+    iso.background = false;
+  }
+  this->Background = iso.background;
+  if (!vtkFerroVolumeCall(
+        "use the isosurface settings", error, [&] { renderer.set_isosurface(iso); }))
+  {
+    return Result::Failed;
+  }
+  return Result::Ready;
+}

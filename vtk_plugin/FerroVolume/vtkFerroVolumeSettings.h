@@ -1,0 +1,64 @@
+// vtkFerroVolumeSettings: what the mapper, its volume's property and the renderer ask of one
+// frame, in ferrovol's terms: blend mode, sampling, shading, cropping and clipping planes,
+// the isosurface, path tracing and environment parameters (given to the renderer every frame,
+// which uploads nothing), the camera and the lights. Internal to the FerroVolume module (not
+// wrapped).
+#ifndef vtkFerroVolumeSettings_h
+#define vtkFerroVolumeSettings_h
+
+#include "ferrovol.hpp"
+
+#include <set>
+#include <string>
+
+class vtkFerroVolumeMapper;
+class vtkRenderer;
+class vtkVolume;
+
+class vtkFerroVolumeSettings
+{
+public:
+  // The mapper's blend mode (or path tracing) in ferrovol's terms; false with the reason
+  // when ferrovol has no such mode.
+  bool SelectBlendMode(vtkFerroVolumeMapper* self, std::string& error);
+
+  enum class Result
+  {
+    Failed,
+    NothingVisible, // every iso-value is transparent (warned once)
+    Ready
+  };
+  // Gives the renderer the frame's parameters (and the isosurfaces, path tracing settings
+  // and environment in those modes). `warned`: the warnings said once per mapper.
+  Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
+    ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+
+  // Gives the renderer the camera VTK draws the opaque geometry with (for a vw × vh
+  // viewport) and the renderer's lights.
+  bool ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw, int vh,
+    ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+
+  // Whether the last frame shows the environment behind the volume: it then covers the
+  // whole viewport.
+  bool CoversViewport() const { return this->Background; }
+
+  // Forget the environment given to the renderer (the renderer is gone).
+  void Reset();
+
+private:
+  bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
+  bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
+    ferrovol::Renderer& renderer, std::string& error);
+  Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol,
+    ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+
+  uint32_t Blend = FV_BLEND_MODE_COMPOSITE;
+  FvRenderParams Params{};
+  bool Background = false;
+
+  // The environment last given to the renderer (isosurfaces, path tracing).
+  bool HaveEnvironment = false;
+  std::string EnvironmentKey;
+};
+
+#endif

@@ -1,0 +1,63 @@
+// vtkFerroVolumeSharedOutput: the zero-copy frame path. ferrovol renders into Vulkan memory
+// that OpenGL imports (ferrovol's shared images → glImportMemoryFdEXT →
+// glTexStorageMem2DEXT). VTK's depth goes into ferrovol's depth input image on the GPU (a
+// blit and one full-screen pass). No semaphores (llvmpipe has no GL_EXT_semaphore_fd):
+// glFinish before ferrovol reads what GL wrote, and ferrovol's finish before GL samples what
+// ferrovol wrote. Compiled when ferrovol.h has the shared output path
+// (FERROVOL_HAVE_SHARED_OUTPUT). Internal to the FerroVolume module (not wrapped).
+#ifndef vtkFerroVolumeSharedOutput_h
+#define vtkFerroVolumeSharedOutput_h
+
+#include "vtkFerroVolumeOutput.h"
+#include "vtkSmartPointer.h"
+#include "vtk_glew.h"
+
+#include <memory>
+#include <string>
+
+class vtkFerroVolumeSharedOutput : public vtkFerroVolumeFramePath
+{
+public:
+  // A shared output for this renderer, or nullptr with the reason (the window's OpenGL
+  // context is current). `anyDevice`: share with a GPU device too (only a CPU device,
+  // lavapipe, otherwise).
+  static std::unique_ptr<vtkFerroVolumeSharedOutput> Create(const ferrovol::Context& ctx,
+    ferrovol::Renderer& renderer, bool anyDevice, std::string& reason);
+
+  ~vtkFerroVolumeSharedOutput() override;
+
+  const char* Name() const override { return "shared"; }
+  bool Render(ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
+    std::string& error, std::string& warning) override;
+  vtkTextureObject* ColorTexture() override;
+  vtkTextureObject* DepthTexture() override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+
+private:
+  struct Imported
+  {
+    GLuint Memory = 0;
+    GLuint Texture = 0;
+    vtkSmartPointer<vtkTextureObject> Object;
+  };
+
+  vtkFerroVolumeSharedOutput() = default;
+  bool Import(ferrovol::Renderer& renderer, vtkOpenGLRenderWindow* win, std::string& error);
+  bool WriteDepthInput(const vtkFerroVolumeFrameRequest& req, std::string& error);
+  void ClearDepthInput();
+  void DeleteImports();
+  void Forget();
+
+  Imported Images[3];
+  uint64_t Generation = 0;
+  int InputW = 0, InputH = 0;
+  GLuint InputFbo = 0;
+  GLuint CopyFbo = 0;
+  GLuint CopyTex = 0;
+  GLenum CopyFormat = GL_NONE;
+  int CopyW = 0, CopyH = 0;
+  vtkSmartPointer<vtkTextureObject> CopyObject;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+};
+
+#endif
