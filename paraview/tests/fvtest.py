@@ -4,10 +4,11 @@
   (FERROVOL_PV_PLUGIN);
 - render helpers with a fixed camera and transfer functions, saving PNGs under OUT_DIR
   (build/paraview-test), read back as numpy arrays;
-- ssim()/psnr(): the measures the tests print and assert. SSIM is Wang et al. 2004 (Gaussian
-  window sigma 1.5, K1 0.01, K2 0.03) averaged over R, G and B; it is reported over the whole frame and
-  over the volume's screen box (pixels that differ from the background in either image),
-  the thresholds apply to the box, so an empty background cannot inflate them.
+- ssim()/psnr(): the measures the tests print and assert, from tests/ferrovol_testing (shared
+  with the VTK module's tests and the regression suite): SSIM of the luminance (Wang et al.
+  2004, Gaussian window sigma 1.5), PSNR over R, G and B. compare() reports them over the
+  whole frame and over the volume's screen box (pixels that differ from the background in
+  either image); the thresholds apply to the box, so an empty background cannot inflate them.
 """
 import os
 import sys
@@ -19,9 +20,14 @@ from paraview.simple import (  # noqa: F401  (re-exported for the tests)
     ColorBy, CreateRenderView, Delete, GetColorTransferFunction, GetOpacityTransferFunction,
     LoadDistributedPlugin, LoadPlugin, Render, SaveScreenshot, Show, servermanager)
 
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "tests"))
+from ferrovol_testing import metrics  # noqa: E402
+from ferrovol_testing.metrics import box, difference_image, footprint, psnr, ssim  # noqa: E402,F401
+from ferrovol_testing.png import read_png, write_png  # noqa: E402,F401
+
 OUT_DIR = os.environ.get("FERROVOL_PV_TEST_OUT", os.path.join(os.getcwd(), "build", "paraview-test"))
 BACKGROUND = (0.1, 0.1, 0.15)
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def rank():
@@ -139,99 +145,26 @@ def screenshot(view, name, size=None, transparent=False):
     return img, path, dt
 
 
-def read_png(path):
-    from vtkmodules.vtkIOImage import vtkPNGReader
-    from vtkmodules.util.numpy_support import vtk_to_numpy
-    r = vtkPNGReader()
-    r.SetFileName(path)
-    r.Update()
-    im = r.GetOutput()
-    w, h, _ = im.GetDimensions()
-    arr = vtk_to_numpy(im.GetPointData().GetScalars())
-    comps = arr.shape[1] if arr.ndim == 2 else 1
-    return arr.reshape(h, w, comps)[::-1].copy()  # top row first
-
-
-def write_png(path, img):
-    from vtkmodules.vtkIOImage import vtkPNGWriter
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    img = np.ascontiguousarray(img[::-1])
-    h, w, c = img.shape
-    data = vtkImageData()
-    data.SetDimensions(w, h, 1)
-    arr = numpy_to_vtk(img.reshape(h * w, c), deep=1)
-    data.GetPointData().SetScalars(arr)
-    wr = vtkPNGWriter()
-    wr.SetFileName(path)
-    wr.SetInputData(data)
-    wr.Write()
-
-
-def _blur(x, sigma=1.5, radius=5):
-    t = np.arange(-radius, radius + 1)
-    k = np.exp(-0.5 * (t / sigma) ** 2)
-    k /= k.sum()
-    x = np.pad(x, radius, mode="reflect")
-    x = np.apply_along_axis(lambda r: np.convolve(r, k, mode="valid"), 1, x)
-    x = np.apply_along_axis(lambda c: np.convolve(c, k, mode="valid"), 0, x)
-    return x
-
-
-def _ssim_channel(x, y):
-    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
-    mx, my = _blur(x), _blur(y)
-    sxx = _blur(x * x) - mx * mx
-    syy = _blur(y * y) - my * my
-    sxy = _blur(x * y) - mx * my
-    s = ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
-    return float(s.mean())
-
-
-def ssim(a, b):
-    """Mean SSIM of two uint8 RGB(A) images: the mean of the R, G and B channels' SSIM (so a
-    change of hue counts, which luminance alone would hide)."""
-    a = a[..., :3].astype(np.float64)
-    b = b[..., :3].astype(np.float64)
-    return float(np.mean([_ssim_channel(a[..., c], b[..., c]) for c in range(3)]))
-
-
-def psnr(a, b):
-    d = a[..., :3].astype(np.float64) - b[..., :3].astype(np.float64)
-    mse = float((d * d).mean())
-    return float("inf") if mse == 0 else 10 * np.log10(255.0 ** 2 / mse)
-
-
 def volume_box(*imgs, background=BACKGROUND, tol=3, pad=4):
     """Rows and columns (slices) covering every pixel that differs from the background in any
     of imgs."""
-    bg = np.round(np.asarray(background) * 255)
-    mask = np.zeros(imgs[0].shape[:2], bool)
-    for im in imgs:
-        mask |= np.abs(im[..., :3].astype(int) - bg).max(axis=2) > tol
-    if not mask.any():
-        return None
-    rows, cols = np.where(mask.any(axis=1))[0], np.where(mask.any(axis=0))[0]
-    h, w = mask.shape
-    return (slice(max(rows[0] - pad, 0), min(rows[-1] + pad + 1, h)),
-            slice(max(cols[0] - pad, 0), min(cols[-1] + pad + 1, w)))
+    return box(footprint(*imgs, background=np.round(np.asarray(background) * 255), tol=tol),
+               pad)
 
 
 def coverage(img, background=BACKGROUND, tol=3):
-    bg = np.round(np.asarray(background) * 255)
-    return float((np.abs(img[..., :3].astype(int) - bg).max(axis=2) > tol).mean())
+    return metrics.coverage(img, np.round(np.asarray(background) * 255), tol)
 
 
 def compare(name, a, b, min_ssim=None, min_psnr=None, failures=None, expect_fail=False):
     """Prints SSIM (frame and volume box) and PSNR of a against b, writes a diff image, and
     records a failure when the box SSIM or PSNR is under its threshold (or, with
     expect_fail, when neither is)."""
-    box = volume_box(a, b)
+    vb = volume_box(a, b)
     s_full, p = ssim(a, b), psnr(a, b)
-    s_box = ssim(a[box], b[box]) if box else s_full
-    p_box = psnr(a[box], b[box]) if box else p
-    diff = np.clip(np.abs(a[..., :3].astype(int) - b[..., :3].astype(int)) * 4, 0, 255)
-    write_png(os.path.join(OUT_DIR, name + "-diff.png"), diff.astype(np.uint8))
+    s_box = ssim(a[vb], b[vb]) if vb else s_full
+    p_box = psnr(a[vb], b[vb]) if vb else p
+    write_png(os.path.join(OUT_DIR, name + "-diff.png"), difference_image(a, b))
     ok = True
     why = []
     if min_ssim is not None and s_box < min_ssim:
@@ -251,6 +184,31 @@ def compare(name, a, b, min_ssim=None, min_psnr=None, failures=None, expect_fail
     if not ok and failures is not None:
         failures.append("%s: %s" % (name, "; ".join(why)))
     return s_box, p_box
+
+
+def render_both(view, disp, blend, tag, failures):
+    """Renders disp as ParaView's "Volume" and as "Ferrovol Volume" with one blend mode
+    (vtkVolumeMapper's enum) into OUT_DIR/<tag>-vtk.png and <tag>-ferrovol.png; records a
+    failure when the ferrovol mapper did not draw. Returns {representation: image}."""
+    imgs = {}
+    for rep in ("Volume", "Ferrovol Volume"):
+        disp.Representation = rep
+        if rep == "Volume":
+            # The stock BlendMode domain lists only Composite/Isosurface/Slice; the
+            # property itself passes any vtkVolumeMapper blend mode to the mapper.
+            disp.GetProperty("BlendMode").SetElement(0, blend)
+        else:
+            disp.FerrovolBlendMode = blend
+        disp.UpdateVTKObjects()
+        Render(view)
+        name = "%s-%s" % (tag, "ferrovol" if rep != "Volume" else "vtk")
+        imgs[rep], _, dt = screenshot(view, name)
+        log("  %-40s rendered + saved in %.2f s, %.1f%% of the frame covered" % (
+            name, dt, 100 * coverage(imgs[rep])))
+    info = ferrovol_info(disp)
+    if info["FerrovolLastRenderDrew"] != 1:
+        failures.append("%s: the ferrovol mapper did not draw (%s)" % (tag, info))
+    return imgs
 
 
 def finish(failures, what):
