@@ -238,6 +238,7 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
   }
 #else
   (void)self;
+  (void)renderer;
   this->PathReason = "this build's ferrovol.h has no shared output path (readback only)";
   this->Path.reset(new ReadbackOutput);
 #endif
