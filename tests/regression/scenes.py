@@ -252,16 +252,14 @@ def orbit(az=30.0, el=20.0, zoom=1.0, parallel=False):
 
 
 def ct_front(az=0.0, el=0.0, zoom=1.4, parallel=False):
+    """orbit() starting in front of the skull CT's face (its -y side), head up (+z)."""
+    then = orbit(az, el, zoom, parallel)
+
     def f(cam):
         cam.Elevation(-90.0)
         cam.SetViewUp(0, 0, 1)
         cam.OrthogonalizeViewUp()
-        cam.Azimuth(az)
-        cam.Elevation(el)
-        cam.OrthogonalizeViewUp()
-        cam.Zoom(zoom)
-        if parallel:
-            cam.ParallelProjectionOn()
+        then(cam)
     return f
 
 
