@@ -864,8 +864,8 @@ enum FvStatus fv_renderer_set_isosurface(struct FvRenderer *renderer,
                                          const struct FvIsoParams *params);
 
 /**
- * Sets the environment that lights isosurfaces and path-traced media and builds its maps now (an irradiance
- * cube and a mip-filtered environment cube; ~0.2 s on a CPU device). `path` (UTF-8) is an
+ * Sets the environment that lights isosurfaces and path-traced media and builds its maps
+ * now (an irradiance cube and a mip-filtered environment cube). `path` (UTF-8) is an
  * equirectangular .hdr, .exr, .png or .jpg image twice as wide as high, or NULL for the
  * built-in procedural sky. `up` (3 doubles, or NULL for +Y) is the world direction that
  * is up in the environment; `azimuth_degrees` turns it about that axis; `intensity`
@@ -1000,9 +1000,10 @@ enum FvStatus fv_frame_write_png(const struct FvFrame *frame,
 const char *fv_last_error(void);
 
 /**
- * A static name for a status ("FV_STATUS_OK", …); never NULL.
+ * A static name for a status value ("FV_STATUS_OK", …), "FV_STATUS_UNKNOWN" for a value
+ * that is not an FvStatus; never NULL. Takes an integer so that any value is safe to pass.
  */
-const char *fv_status_name(enum FvStatus status);
+const char *fv_status_name(int32_t status);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -3,6 +3,7 @@
 //! ([`FvPathTraceParams`]) and the environment map both are lit by.
 
 use crate::status::{FfiError, FfiResult};
+use crate::types::ToCore;
 use ferrovol_core::iso::MAX_ISO_VALUES;
 use ferrovol_core::{
     AmbientOcclusion, BsdfParams, IsoParams, IsoScatterMode, IsoScattering, IsoValue,
@@ -115,8 +116,11 @@ impl FvIsoParams {
             scatter_fresnel: IsoScattering::default().fresnel,
         }
     }
+}
 
-    pub fn to_core(&self) -> FfiResult<IsoParams> {
+impl ToCore for FvIsoParams {
+    type Core = IsoParams;
+    fn to_core(&self) -> FfiResult<IsoParams> {
         let n = self.value_count as usize;
         if n == 0 || n > FV_MAX_ISO_VALUES {
             return Err(FfiError::invalid(format!(
@@ -277,8 +281,11 @@ impl FvPathTraceParams {
             denoise: d.denoise,
         }
     }
+}
 
-    pub fn to_core(&self) -> FfiResult<PathTraceParams> {
+impl ToCore for FvPathTraceParams {
+    type Core = PathTraceParams;
+    fn to_core(&self) -> FfiResult<PathTraceParams> {
         let scatter = match self.scatter_regions {
             0 => ScatterRegions::Nowhere,
             1 => ScatterRegions::Surfaces,

@@ -346,7 +346,10 @@ impl FvTransferFunction {
             ))
         })
     }
+}
 
+impl ToCore for FvTransferFunction {
+    type Core = TransferFunction;
     fn to_core(&self) -> FfiResult<TransferFunction> {
         let mut components = Vec::with_capacity(self.components.len());
         for (i, c) in self.components.iter().enumerate() {
@@ -420,6 +423,28 @@ pub unsafe extern "C" fn fv_transfer_function_free(tf: *mut FvTransferFunction) 
     guard_value((), || free_handle(tf))
 }
 
+/// Replaces one of a component's piecewise functions (`field`) with `count` points of
+/// 1 + N doubles at `p`. `empty` is the refusal for count = 0, or None where no points
+/// turn the function off.
+fn set_component_points<const N: usize>(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    what: &str,
+    p: *const f64,
+    count: usize,
+    empty: Option<&str>,
+    field: fn(&mut PartialComponent) -> &mut Option<Piecewise<N>>,
+) -> FvStatus {
+    guard(|| {
+        let f = field(mut_ref(tf, "tf")?.component(component)?);
+        *f = points::<N>(what, p, count)?;
+        match empty {
+            Some(refusal) if f.is_none() => Err(FfiError::invalid(refusal)),
+            _ => Ok(()),
+        }
+    })
+}
+
 /// Colour points of one component: `count` quadruples (x, r, g, b), x increasing.
 #[no_mangle]
 pub unsafe extern "C" fn fv_transfer_function_set_color(
@@ -428,17 +453,15 @@ pub unsafe extern "C" fn fv_transfer_function_set_color(
     xrgb: *const f64,
     count: usize,
 ) -> FvStatus {
-    guard(|| {
-        let t = mut_ref(tf, "tf")?;
-        let c = t.component(component)?;
-        c.color = points::<3>("colour points", xrgb, count)?;
-        if c.color.is_none() {
-            return Err(FfiError::invalid(
-                "a colour function needs at least one point",
-            ));
-        }
-        Ok(())
-    })
+    set_component_points(
+        tf,
+        component,
+        "colour points",
+        xrgb,
+        count,
+        Some("a colour function needs at least one point"),
+        |c| &mut c.color,
+    )
 }
 
 /// Scalar opacity points of one component: `count` pairs (x, opacity), x increasing.
@@ -449,17 +472,15 @@ pub unsafe extern "C" fn fv_transfer_function_set_opacity(
     xa: *const f64,
     count: usize,
 ) -> FvStatus {
-    guard(|| {
-        let t = mut_ref(tf, "tf")?;
-        let c = t.component(component)?;
-        c.opacity = points::<1>("opacity points", xa, count)?;
-        if c.opacity.is_none() {
-            return Err(FfiError::invalid(
-                "an opacity function needs at least one point",
-            ));
-        }
-        Ok(())
-    })
+    set_component_points(
+        tf,
+        component,
+        "opacity points",
+        xa,
+        count,
+        Some("an opacity function needs at least one point"),
+        |c| &mut c.opacity,
+    )
 }
 
 /// Gradient-magnitude opacity points of one component: `count` pairs (|∇s| in scalar units
@@ -471,12 +492,15 @@ pub unsafe extern "C" fn fv_transfer_function_set_gradient_opacity(
     xa: *const f64,
     count: usize,
 ) -> FvStatus {
-    guard(|| {
-        let t = mut_ref(tf, "tf")?;
-        t.component(component)?.gradient_opacity =
-            points::<1>("gradient opacity points", xa, count)?;
-        Ok(())
-    })
+    set_component_points(
+        tf,
+        component,
+        "gradient opacity points",
+        xa,
+        count,
+        None,
+        |c| &mut c.gradient_opacity,
+    )
 }
 
 /// ScalarOpacityUnitDistance (> 0) and the component weight (≥ 0) of one component.
@@ -519,6 +543,36 @@ pub struct FvRenderer {
     upload: UploadOptions,
 }
 
+/// Runs `f` on the renderer behind `renderer` inside [`guard`] (NULL: FV_STATUS_NULL_ARGUMENT).
+fn with_renderer(
+    renderer: *mut FvRenderer,
+    f: impl FnOnce(&mut FvRenderer) -> FfiResult<()>,
+) -> FvStatus {
+    guard(|| f(mut_ref(renderer, "renderer")?))
+}
+
+/// [`with_renderer`] for the calls that only read the renderer.
+fn with_renderer_ref(
+    renderer: *const FvRenderer,
+    f: impl FnOnce(&FvRenderer) -> FfiResult<()>,
+) -> FvStatus {
+    guard(|| f(const_ref(renderer, "renderer")?))
+}
+
+/// Converts the C description at `value` (`what` names it when NULL) and hands it to `apply`.
+fn set_from<T: ToCore>(
+    renderer: *mut FvRenderer,
+    value: *const T,
+    what: &str,
+    apply: impl FnOnce(&mut FvRenderer, T::Core) -> ferrovol_core::Result<()>,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        let v = const_ref(value, what)?.to_core()?;
+        apply(r, v)?;
+        Ok(())
+    })
+}
+
 /// A renderer on `ctx` (which may be freed afterwards). `*out` receives it.
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_new(
@@ -552,8 +606,7 @@ pub unsafe extern "C" fn fv_renderer_set_max_brick_points(
     renderer: *mut FvRenderer,
     points: u32,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         if points == 1 || points == 2 {
             return Err(FfiError::invalid(format!(
                 "max brick points {points}: a brick needs at least 3 points per edge"
@@ -571,8 +624,7 @@ pub unsafe extern "C" fn fv_renderer_set_volume(
     renderer: *mut FvRenderer,
     volume: *const FvVolume,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         let v = const_ref(volume, "volume")?;
         r.r.set_volume_with(&v.data, r.upload)?;
         Ok(())
@@ -585,12 +637,7 @@ pub unsafe extern "C" fn fv_renderer_set_transfer_function(
     renderer: *mut FvRenderer,
     tf: *const FvTransferFunction,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
-        let t = const_ref(tf, "tf")?.to_core()?;
-        r.r.set_transfer_function(&t)?;
-        Ok(())
-    })
+    set_from(renderer, tf, "tf", |r, t| r.r.set_transfer_function(&t))
 }
 
 /// Sets the camera for the following frames.
@@ -599,9 +646,8 @@ pub unsafe extern "C" fn fv_renderer_set_camera(
     renderer: *mut FvRenderer,
     camera: *const FvCamera,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
-        r.view.camera = const_ref(camera, "camera")?.to_core()?;
+    set_from(renderer, camera, "camera", |r, c| {
+        r.view.camera = c;
         Ok(())
     })
 }
@@ -614,8 +660,7 @@ pub unsafe extern "C" fn fv_renderer_set_lights(
     lights: *const FvLight,
     count: usize,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         if count > FV_MAX_LIGHTS {
             return Err(FfiError::invalid(format!(
                 "{count} lights: at most {FV_MAX_LIGHTS}"
@@ -656,9 +701,8 @@ pub unsafe extern "C" fn fv_renderer_set_params(
     renderer: *mut FvRenderer,
     params: *const FvRenderParams,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
-        r.params = const_ref(params, "params")?.to_core()?;
+    set_from(renderer, params, "params", |r, p| {
+        r.params = p;
         Ok(())
     })
 }
@@ -682,16 +726,11 @@ pub unsafe extern "C" fn fv_renderer_set_isosurface(
     renderer: *mut FvRenderer,
     params: *const FvIsoParams,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
-        let p = const_ref(params, "params")?.to_core()?;
-        r.r.set_isosurface(&p)?;
-        Ok(())
-    })
+    set_from(renderer, params, "params", |r, p| r.r.set_isosurface(&p))
 }
 
-/// Sets the environment that lights isosurfaces and path-traced media and builds its maps now (an irradiance
-/// cube and a mip-filtered environment cube; ~0.2 s on a CPU device). `path` (UTF-8) is an
+/// Sets the environment that lights isosurfaces and path-traced media and builds its maps
+/// now (an irradiance cube and a mip-filtered environment cube). `path` (UTF-8) is an
 /// equirectangular .hdr, .exr, .png or .jpg image twice as wide as high, or NULL for the
 /// built-in procedural sky. `up` (3 doubles, or NULL for +Y) is the world direction that
 /// is up in the environment; `azimuth_degrees` turns it about that axis; `intensity`
@@ -704,8 +743,7 @@ pub unsafe extern "C" fn fv_renderer_set_environment(
     up: *const f64,
     azimuth_degrees: f64,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         let mut env = if path.is_null() {
             Environment::default()
         } else {
@@ -745,12 +783,7 @@ pub unsafe extern "C" fn fv_renderer_set_path_tracing(
     renderer: *mut FvRenderer,
     params: *const FvPathTraceParams,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
-        let p = const_ref(params, "params")?.to_core()?;
-        r.r.set_path_tracing(&p)?;
-        Ok(())
-    })
+    set_from(renderer, params, "params", |r, p| r.r.set_path_tracing(&p))
 }
 
 /// Paths per pixel the last path-traced frame shows into `*samples` (0 before the first);
@@ -760,8 +793,7 @@ pub unsafe extern "C" fn fv_renderer_accumulated_samples(
     renderer: *const FvRenderer,
     samples: *mut u32,
 ) -> FvStatus {
-    guard(|| {
-        let r = const_ref(renderer, "renderer")?;
+    with_renderer_ref(renderer, |r| {
         *mut_ref(samples, "samples")? = r.r.accumulated_samples();
         Ok(())
     })
@@ -779,8 +811,7 @@ pub unsafe extern "C" fn fv_renderer_render(
     depth: *const f32,
     depth_count: usize,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         r.view.width = width;
         r.view.height = height;
         let depth = if depth.is_null() {
@@ -802,8 +833,7 @@ pub unsafe extern "C" fn fv_renderer_set_output_path(
     renderer: *mut FvRenderer,
     path: u32,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         let p = match path {
             0 => OutputPath::Readback,
             1 => OutputPath::Shared,
@@ -824,8 +854,7 @@ pub unsafe extern "C" fn fv_renderer_output_path(
     renderer: *const FvRenderer,
     path: *mut u32,
 ) -> FvStatus {
-    guard(|| {
-        let r = const_ref(renderer, "renderer")?;
+    with_renderer_ref(renderer, |r| {
         *mut_ref(path, "path")? = match r.r.output_path() {
             OutputPath::Readback => FvOutputPath::Readback as u32,
             OutputPath::Shared => FvOutputPath::Shared as u32,
@@ -842,10 +871,8 @@ pub unsafe extern "C" fn fv_renderer_prepare_targets(
     width: u32,
     height: u32,
 ) -> FvStatus {
-    guard(|| {
-        mut_ref(renderer, "renderer")?
-            .r
-            .prepare_output(width, height)?;
+    with_renderer(renderer, |r| {
+        r.r.prepare_output(width, height)?;
         Ok(())
     })
 }
@@ -860,8 +887,7 @@ pub unsafe extern "C" fn fv_renderer_shared_image(
     target: u32,
     image: *mut FvSharedImage,
 ) -> FvStatus {
-    guard(|| {
-        let r = const_ref(renderer, "renderer")?;
+    with_renderer_ref(renderer, |r| {
         let out = mut_ref(image, "image")?;
         if target > FvTarget::DepthInput as u32 {
             return Err(FfiError::invalid(format!(
@@ -900,8 +926,7 @@ pub unsafe extern "C" fn fv_renderer_render_with_shared_depth(
     width: u32,
     height: u32,
 ) -> FvStatus {
-    guard(|| {
-        let r = mut_ref(renderer, "renderer")?;
+    with_renderer(renderer, |r| {
         r.view.width = width;
         r.view.height = height;
         r.r.render_with_shared_depth(&r.view, &r.params)?;
@@ -913,8 +938,8 @@ pub unsafe extern "C" fn fv_renderer_render_with_shared_depth(
 /// shared images. This CPU wait is the synchronisation of the shared path (no semaphores).
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_finish(renderer: *const FvRenderer) -> FvStatus {
-    guard(|| {
-        const_ref(renderer, "renderer")?.r.finish()?;
+    with_renderer_ref(renderer, |r| {
+        r.r.finish()?;
         Ok(())
     })
 }
@@ -925,8 +950,7 @@ pub unsafe extern "C" fn fv_renderer_stats(
     renderer: *const FvRenderer,
     stats: *mut FvStats,
 ) -> FvStatus {
-    guard(|| {
-        let r = const_ref(renderer, "renderer")?;
+    with_renderer_ref(renderer, |r| {
         let s = r.r.stats();
         *mut_ref(stats, "stats")? = FvStats {
             volume_uploads: s.volume_uploads,

@@ -1,7 +1,7 @@
 //! Status codes, the per-thread error message and the panic guard every export runs in.
 
 use std::cell::RefCell;
-use std::ffi::{c_char, CString};
+use std::ffi::{c_char, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// What a call did. Every function that can fail returns one; on anything but
@@ -121,20 +121,121 @@ pub extern "C" fn fv_last_error() -> *const c_char {
     LAST_ERROR.with(|e| e.borrow().as_ptr())
 }
 
-/// A static name for a status ("FV_STATUS_OK", …); never NULL.
+/// The names of the statuses, indexed by their value.
+const STATUS_NAMES: [&CStr; 10] = [
+    c"FV_STATUS_OK",
+    c"FV_STATUS_NULL_ARGUMENT",
+    c"FV_STATUS_INVALID_ARGUMENT",
+    c"FV_STATUS_UNSUPPORTED",
+    c"FV_STATUS_OUT_OF_MEMORY",
+    c"FV_STATUS_DEVICE_LOST",
+    c"FV_STATUS_NO_DEVICE",
+    c"FV_STATUS_GPU_ERROR",
+    c"FV_STATUS_IO_ERROR",
+    c"FV_STATUS_PANIC",
+];
+
+/// A static name for a status value ("FV_STATUS_OK", …), "FV_STATUS_UNKNOWN" for a value
+/// that is not an FvStatus; never NULL. Takes an integer so that any value is safe to pass.
 #[no_mangle]
-pub extern "C" fn fv_status_name(status: FvStatus) -> *const c_char {
-    let s: &'static [u8] = match status {
-        FvStatus::Ok => b"FV_STATUS_OK\0",
-        FvStatus::NullArgument => b"FV_STATUS_NULL_ARGUMENT\0",
-        FvStatus::InvalidArgument => b"FV_STATUS_INVALID_ARGUMENT\0",
-        FvStatus::Unsupported => b"FV_STATUS_UNSUPPORTED\0",
-        FvStatus::OutOfMemory => b"FV_STATUS_OUT_OF_MEMORY\0",
-        FvStatus::DeviceLost => b"FV_STATUS_DEVICE_LOST\0",
-        FvStatus::NoDevice => b"FV_STATUS_NO_DEVICE\0",
-        FvStatus::GpuError => b"FV_STATUS_GPU_ERROR\0",
-        FvStatus::IoError => b"FV_STATUS_IO_ERROR\0",
-        FvStatus::Panic => b"FV_STATUS_PANIC\0",
-    };
-    s.as_ptr().cast()
+pub extern "C" fn fv_status_name(status: i32) -> *const c_char {
+    usize::try_from(status)
+        .ok()
+        .and_then(|i| STATUS_NAMES.get(i))
+        .unwrap_or(&c"FV_STATUS_UNKNOWN")
+        .as_ptr()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ferrovol_core::Error as E;
+
+    const ALL: [FvStatus; 10] = [
+        FvStatus::Ok,
+        FvStatus::NullArgument,
+        FvStatus::InvalidArgument,
+        FvStatus::Unsupported,
+        FvStatus::OutOfMemory,
+        FvStatus::DeviceLost,
+        FvStatus::NoDevice,
+        FvStatus::GpuError,
+        FvStatus::IoError,
+        FvStatus::Panic,
+    ];
+
+    fn name(status: i32) -> &'static str {
+        // SAFETY: fv_status_name returns a static NUL-terminated string.
+        unsafe { CStr::from_ptr(fv_status_name(status)) }
+            .to_str()
+            .unwrap()
+    }
+
+    #[test]
+    fn every_core_error_maps_to_its_status() {
+        let s = || "x".to_string();
+        let cases = [
+            (E::NoAdapter(s()), FvStatus::NoDevice),
+            (
+                E::RequestDevice {
+                    adapter: s(),
+                    message: s(),
+                },
+                FvStatus::NoDevice,
+            ),
+            (E::InvalidVolume(s()), FvStatus::InvalidArgument),
+            (E::InvalidTransferFunction(s()), FvStatus::InvalidArgument),
+            (E::InvalidParameter(s()), FvStatus::InvalidArgument),
+            (E::Unsupported(s()), FvStatus::Unsupported),
+            (E::Gpu(s()), FvStatus::GpuError),
+            (E::OutOfMemory(s()), FvStatus::OutOfMemory),
+            (E::DeviceLost(s()), FvStatus::DeviceLost),
+            (
+                E::ImageWrite {
+                    path: s(),
+                    message: s(),
+                },
+                FvStatus::IoError,
+            ),
+        ];
+        for (error, want) in cases {
+            // A new core variant must get a row here: this match stops compiling without it.
+            match &error {
+                E::NoAdapter(_)
+                | E::RequestDevice { .. }
+                | E::InvalidVolume(_)
+                | E::InvalidTransferFunction(_)
+                | E::InvalidParameter(_)
+                | E::Unsupported(_)
+                | E::Gpu(_)
+                | E::OutOfMemory(_)
+                | E::DeviceLost(_)
+                | E::ImageWrite { .. } => {}
+            }
+            let text = error.to_string();
+            let e = FfiError::from(error);
+            println!("{text} -> {:?}", e.status);
+            assert_eq!(e.status, want, "{text}");
+            assert_eq!(e.message, text, "the message is the core error's text");
+        }
+    }
+
+    #[test]
+    fn status_names_answer_any_value() {
+        for (i, s) in ALL.into_iter().enumerate() {
+            assert_eq!(s as i32, i as i32, "FvStatus values are 0, 1, 2, …");
+            let debug = format!("{s:?}");
+            let mut want = String::from("FV_STATUS");
+            for c in debug.chars() {
+                if c.is_uppercase() {
+                    want.push('_');
+                }
+                want.push(c.to_ascii_uppercase());
+            }
+            assert_eq!(name(s as i32), want);
+        }
+        for v in [-1, 10, 42, i32::MIN, i32::MAX] {
+            assert_eq!(name(v), "FV_STATUS_UNKNOWN", "value {v}");
+        }
+    }
 }

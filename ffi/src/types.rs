@@ -255,6 +255,12 @@ pub struct FvStats {
     pub bricks: u32,
 }
 
+/// A C description that converts, validated, into its core type.
+pub trait ToCore {
+    type Core;
+    fn to_core(&self) -> FfiResult<Self::Core>;
+}
+
 fn enum_value<T: Copy>(what: &str, v: u32, table: &[T]) -> FfiResult<T> {
     table.get(v as usize).copied().ok_or_else(|| {
         FfiError::invalid(format!(
@@ -299,8 +305,11 @@ impl FvRenderParams {
             scattering_anisotropy: d.shading.scattering_anisotropy,
         }
     }
+}
 
-    pub fn to_core(&self) -> FfiResult<RenderParams> {
+impl ToCore for FvRenderParams {
+    type Core = RenderParams;
+    fn to_core(&self) -> FfiResult<RenderParams> {
         use BlendMode as B;
         let blend = enum_value(
             "blend_mode",
@@ -385,8 +394,9 @@ fn finite3(what: &str, v: [f64; 3]) -> FfiResult<DVec3> {
     }
 }
 
-impl FvCamera {
-    pub fn to_core(&self) -> FfiResult<Camera> {
+impl ToCore for FvCamera {
+    type Core = Camera;
+    fn to_core(&self) -> FfiResult<Camera> {
         let position = finite3("camera position", self.position)?;
         let focal_point = finite3("camera focal point", self.focal_point)?;
         let view_up = finite3("camera view up", self.view_up)?;

@@ -2,7 +2,11 @@
 //! NULL handles, bad sizes, unsupported types and out-of-range parameters each return the
 //! right status with a message naming the problem, and nothing panics across the boundary.
 
-use ferrovol::{FvCamera, FvLight, FvRenderParams, FvStatus, FvVolumeDesc};
+use ferrovol::FvStatus::{self, InvalidArgument as Invalid, NullArgument as Null};
+use ferrovol::{
+    FvBlendMode, FvCamera, FvIsoParams, FvLight, FvPathTraceParams, FvRenderParams, FvScalarType,
+    FvSharedImage, FvVolumeDesc,
+};
 use libloading::{Library, Symbol};
 use std::ffi::{c_char, c_void, CStr};
 use std::path::Path;
@@ -41,12 +45,17 @@ impl Lib {
             .to_string_lossy()
             .into_owned()
     }
-    /// Asserts `status` and that the message contains `needle`; prints both.
-    fn expect(&self, what: &str, status: FvStatus, want: FvStatus, needle: &str) {
+    /// Asserts that a call returned `want` and that its message contains `needle`; prints
+    /// both.
+    fn expect(&self, status: FvStatus, want: FvStatus, needle: &str) {
         let msg = self.last_error();
-        println!("{what}: {status:?}: {msg}");
-        assert_eq!(status, want, "{what}: {msg}");
-        assert!(msg.contains(needle), "{what}: '{msg}' lacks '{needle}'");
+        println!("{needle}: {status:?}: {msg}");
+        assert_eq!(status, want, "{needle}: {msg}");
+        assert!(msg.contains(needle), "'{msg}' lacks '{needle}'");
+    }
+    /// Asserts that a call succeeded (the message of its failure otherwise).
+    fn ok(&self, status: FvStatus) {
+        assert_eq!(status, FvStatus::Ok, "{}", self.last_error());
     }
 }
 
@@ -63,6 +72,10 @@ type SetParams = unsafe extern "C" fn(H, *const FvRenderParams) -> FvStatus;
 type ParamsDefault = unsafe extern "C" fn(*mut FvRenderParams) -> FvStatus;
 type SetCamera = unsafe extern "C" fn(H, *const FvCamera) -> FvStatus;
 type SetLights = unsafe extern "C" fn(H, *const FvLight, usize) -> FvStatus;
+type SetIso = unsafe extern "C" fn(H, *const FvIsoParams) -> FvStatus;
+type SetEnv = unsafe extern "C" fn(H, *const c_char, f32, *const f64, f64) -> FvStatus;
+type SetPt = unsafe extern "C" fn(H, *const FvPathTraceParams) -> FvStatus;
+type Accumulated = unsafe extern "C" fn(H, *mut u32) -> FvStatus;
 
 fn desc(dims: [u32; 3], components: u32, scalar_type: u32) -> FvVolumeDesc {
     FvVolumeDesc {
@@ -72,6 +85,140 @@ fn desc(dims: [u32; 3], components: u32, scalar_type: u32) -> FvVolumeDesc {
         spacing: [1.0; 3],
         origin: [0.0; 3],
         direction: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+    }
+}
+
+/// A perspective camera (30°, +y up).
+fn camera(position: [f64; 3], focal_point: [f64; 3], clipping_range: [f64; 2]) -> FvCamera {
+    // SAFETY: FvCamera is plain data; all zeros is a valid value.
+    let mut cam: FvCamera = unsafe { std::mem::zeroed() };
+    cam.position = position;
+    cam.focal_point = focal_point;
+    cam.view_up = [0.0, 1.0, 0.0];
+    cam.view_angle = 30.0;
+    cam.clipping_range = clipping_range;
+    cam
+}
+
+/// A context and a renderer, with the volume, transfer function and frame a test gives
+/// them; dropping it frees every handle (the fv_*_free functions accept NULL).
+struct Session<'a> {
+    lib: &'a Lib,
+    ctx: H,
+    r: H,
+    volume: H,
+    tf: H,
+    frame: H,
+}
+
+impl<'a> Session<'a> {
+    fn new(lib: &'a Lib) -> Self {
+        let mut s = Session {
+            lib,
+            ctx: null_mut(),
+            r: null_mut(),
+            volume: null_mut(),
+            tf: null_mut(),
+            frame: null_mut(),
+        };
+        // SAFETY: valid out-pointers.
+        unsafe {
+            lib.ok(lib.f::<NewCtx>("fv_context_new")(&mut s.ctx));
+            lib.ok(lib.f::<NewRenderer>("fv_renderer_new")(s.ctx, &mut s.r));
+        }
+        s
+    }
+
+    /// Uploads `data`, one component of `scalar_type` per point, as the renderer's volume.
+    fn set_volume<T>(&mut self, dims: [u32; 3], scalar_type: FvScalarType, data: &[T]) {
+        let d = desc(dims, 1, scalar_type as u32);
+        let bytes = std::mem::size_of_val(data);
+        let lib = self.lib;
+        // SAFETY: `data` holds `bytes` bytes; valid handles and out-pointer.
+        unsafe {
+            lib.ok(lib.f::<NewVolume>("fv_volume_new")(
+                &d,
+                data.as_ptr().cast(),
+                bytes,
+                &mut self.volume,
+            ));
+            lib.ok(lib.f::<SetH>("fv_renderer_set_volume")(self.r, self.volume));
+        }
+    }
+
+    /// Gives the renderer a one-component transfer function of colour (x, r, g, b) and
+    /// opacity (x, a) points (into the session's transfer function, made if there is none).
+    fn set_transfer_function(&mut self, xrgb: &[f64], xa: &[f64]) {
+        let lib = self.lib;
+        // SAFETY: the point arrays hold the counts given; valid handles.
+        unsafe {
+            if self.tf.is_null() {
+                lib.ok(lib.f::<NewTf>("fv_transfer_function_new")(
+                    1,
+                    true,
+                    &mut self.tf,
+                ));
+            }
+            let color = lib.f::<SetPoints>("fv_transfer_function_set_color");
+            lib.ok(color(self.tf, 0, xrgb.as_ptr(), xrgb.len() / 4));
+            let opacity = lib.f::<SetPoints>("fv_transfer_function_set_opacity");
+            lib.ok(opacity(self.tf, 0, xa.as_ptr(), xa.len() / 2));
+            lib.ok(lib.f::<SetH>("fv_renderer_set_transfer_function")(
+                self.r, self.tf,
+            ));
+        }
+    }
+
+    fn set_camera(&self, cam: &FvCamera) {
+        // SAFETY: a valid handle and camera.
+        self.lib
+            .ok(unsafe { self.lib.f::<SetCamera>("fv_renderer_set_camera")(self.r, cam) });
+    }
+
+    fn set_params(&self, p: &FvRenderParams) {
+        // SAFETY: a valid handle and parameters.
+        self.lib
+            .ok(unsafe { self.lib.f::<SetParams>("fv_renderer_set_params")(self.r, p) });
+    }
+
+    fn render(&self, width: u32, height: u32) {
+        // SAFETY: a valid handle, no depth input.
+        let render = self.lib.f::<Render>("fv_renderer_render");
+        self.lib
+            .ok(unsafe { render(self.r, width, height, null(), 0) });
+    }
+
+    /// Renders a `width × height` frame and reads it back: its premultiplied RGBA8 pixels.
+    fn frame(&mut self, width: u32, height: u32) -> &[u8] {
+        self.render(width, height);
+        let lib = self.lib;
+        // SAFETY: valid handles; the pixels live as long as the frame, which the session
+        // frees only on drop or on the next read.
+        unsafe {
+            lib.f::<Free>("fv_frame_free")(self.frame);
+            self.frame = null_mut();
+            let read =
+                lib.f::<unsafe extern "C" fn(H, *mut H) -> FvStatus>("fv_renderer_read_frame");
+            lib.ok(read(self.r, &mut self.frame));
+            let rgba = lib.f::<unsafe extern "C" fn(H) -> *const u8>("fv_frame_rgba")(self.frame);
+            std::slice::from_raw_parts(rgba, (4 * width * height) as usize)
+        }
+    }
+}
+
+impl Drop for Session<'_> {
+    fn drop(&mut self) {
+        let handles = [
+            ("fv_frame_free", self.frame),
+            ("fv_transfer_function_free", self.tf),
+            ("fv_volume_free", self.volume),
+            ("fv_renderer_free", self.r),
+            ("fv_context_free", self.ctx),
+        ];
+        for (free, h) in handles {
+            // SAFETY: each handle came from its fv_*_new (or is NULL) and is freed once.
+            unsafe { self.lib.f::<Free>(free)(h) };
+        }
     }
 }
 
@@ -97,80 +244,42 @@ fn volume_errors() {
     let data = vec![0f32; 8];
     let bytes = data.as_ptr().cast::<c_void>();
     let mut v: H = null_mut();
-    let d = desc([2, 2, 2], 1, ferrovol::FvScalarType::F32 as u32);
+    let f32_type = FvScalarType::F32 as u32;
+    let d = desc([2, 2, 2], 1, f32_type);
+    let mut zero_spacing = d;
+    zero_spacing.spacing[1] = 0.0;
+    let mut singular = d;
+    singular.direction = [0.0; 9];
+    let mut nan = data.clone();
+    nan[5] = f32::NAN;
     // SAFETY (all calls below): arguments follow the header; invalid ones are the test.
     unsafe {
-        lib.expect(
-            "NULL out",
-            new(&d, bytes, 32, null_mut()),
-            FvStatus::NullArgument,
-            "out is NULL",
-        );
-        lib.expect(
-            "NULL desc",
-            new(null(), bytes, 32, &mut v),
-            FvStatus::NullArgument,
-            "desc",
-        );
-        lib.expect(
-            "NULL data",
-            new(&d, null(), 32, &mut v),
-            FvStatus::NullArgument,
-            "data",
-        );
-        lib.expect(
-            "short data",
-            new(&d, bytes, 31, &mut v),
-            FvStatus::InvalidArgument,
-            "data_bytes is 31",
-        );
-        let t = desc([2, 2, 2], 1, 99);
-        lib.expect(
-            "scalar type 99",
-            new(&t, bytes, 32, &mut v),
-            FvStatus::Unsupported,
-            "scalar type 99",
-        );
-        let c = desc([2, 2, 1], 5, ferrovol::FvScalarType::U8 as u32);
-        lib.expect(
-            "5 components",
-            new(&c, bytes, 20, &mut v),
-            FvStatus::InvalidArgument,
-            "5 components",
-        );
-        let e = desc([0, 2, 2], 1, ferrovol::FvScalarType::F32 as u32);
-        lib.expect(
-            "empty",
-            new(&e, bytes, 0, &mut v),
-            FvStatus::InvalidArgument,
-            "empty volume",
-        );
-        let mut s = d;
-        s.spacing[1] = 0.0;
-        lib.expect(
-            "zero spacing",
-            new(&s, bytes, 32, &mut v),
-            FvStatus::InvalidArgument,
-            "spacing along y",
-        );
-        let mut m = d;
-        m.direction = [0.0; 9];
-        lib.expect(
-            "singular direction",
-            new(&m, bytes, 32, &mut v),
-            FvStatus::InvalidArgument,
-            "singular",
-        );
-        let mut nan = data.clone();
-        nan[5] = f32::NAN;
-        lib.expect(
-            "NaN",
-            new(&d, nan.as_ptr().cast(), 32, &mut v),
-            FvStatus::InvalidArgument,
-            "NaN",
-        );
+        lib.expect(new(&d, bytes, 32, null_mut()), Null, "out is NULL");
+        lib.expect(new(null(), bytes, 32, &mut v), Null, "desc");
+        lib.expect(new(&d, null(), 32, &mut v), Null, "data");
+        for (desc, len, want, needle) in [
+            (d, 31, Invalid, "data_bytes is 31"),
+            (
+                desc([2, 2, 2], 1, 99),
+                32,
+                FvStatus::Unsupported,
+                "scalar type 99",
+            ),
+            (
+                desc([2, 2, 1], 5, FvScalarType::U8 as u32),
+                20,
+                Invalid,
+                "5 components",
+            ),
+            (desc([0, 2, 2], 1, f32_type), 0, Invalid, "empty volume"),
+            (zero_spacing, 32, Invalid, "spacing along y"),
+            (singular, 32, Invalid, "singular"),
+        ] {
+            lib.expect(new(&desc, bytes, len, &mut v), want, needle);
+        }
+        lib.expect(new(&d, nan.as_ptr().cast(), 32, &mut v), Invalid, "NaN");
         assert!(v.is_null(), "a failed fv_volume_new must leave *out NULL");
-        assert_eq!(new(&d, bytes, 32, &mut v), FvStatus::Ok);
+        lib.ok(new(&d, bytes, 32, &mut v));
         assert!(!v.is_null());
         lib.f::<Free>("fv_volume_free")(v);
     }
@@ -182,63 +291,28 @@ fn transfer_function_errors() {
     let new = lib.f::<NewTf>("fv_transfer_function_new");
     let color = lib.f::<SetPoints>("fv_transfer_function_set_color");
     let opacity = lib.f::<SetPoints>("fv_transfer_function_set_opacity");
+    let gradient = lib.f::<SetPoints>("fv_transfer_function_set_gradient_opacity");
     let unit = lib.f::<unsafe extern "C" fn(H, u32, f64, f64) -> FvStatus>(
         "fv_transfer_function_set_unit_distance",
     );
     let mut tf: H = null_mut();
+    let pts = [0.0, 1.0, 1.0, 1.0];
+    let nan = [0.0, f64::NAN];
     // SAFETY: arguments follow the header; invalid ones are the test.
     unsafe {
-        lib.expect(
-            "0 components",
-            new(0, true, &mut tf),
-            FvStatus::InvalidArgument,
-            "0 components",
-        );
-        assert_eq!(new(1, true, &mut tf), FvStatus::Ok);
-        let pts = [0.0, 1.0, 1.0, 1.0];
-        lib.expect(
-            "component 3",
-            color(tf, 3, pts.as_ptr(), 1),
-            FvStatus::InvalidArgument,
-            "component 3",
-        );
-        lib.expect(
-            "NULL points",
-            color(tf, 0, null(), 2),
-            FvStatus::NullArgument,
-            "colour points",
-        );
-        lib.expect(
-            "no points",
-            opacity(tf, 0, pts.as_ptr(), 0),
-            FvStatus::InvalidArgument,
-            "at least one point",
-        );
-        let nan = [0.0, f64::NAN];
-        lib.expect(
-            "NaN opacity",
-            opacity(tf, 0, nan.as_ptr(), 1),
-            FvStatus::InvalidArgument,
-            "opacity points",
-        );
-        lib.expect(
-            "unit distance",
-            unit(tf, 0, 0.0, 1.0),
-            FvStatus::InvalidArgument,
-            "unit distance 0",
-        );
-        lib.expect(
-            "weight",
-            unit(tf, 0, 1.0, -1.0),
-            FvStatus::InvalidArgument,
-            "weight -1",
-        );
-        lib.expect(
-            "NULL tf",
-            unit(null_mut(), 0, 1.0, 1.0),
-            FvStatus::NullArgument,
-            "tf is NULL",
-        );
+        lib.expect(new(0, true, &mut tf), Invalid, "0 components");
+        lib.ok(new(1, true, &mut tf));
+        lib.expect(color(tf, 3, pts.as_ptr(), 1), Invalid, "component 3");
+        lib.expect(color(tf, 0, null(), 2), Null, "colour points");
+        lib.expect(color(tf, 0, pts.as_ptr(), 0), Invalid, "a colour function");
+        lib.expect(opacity(tf, 0, pts.as_ptr(), 0), Invalid, "opacity function");
+        lib.expect(opacity(tf, 0, nan.as_ptr(), 1), Invalid, "opacity points");
+        lib.expect(gradient(tf, 2, pts.as_ptr(), 1), Invalid, "component 2");
+        lib.expect(gradient(tf, 0, nan.as_ptr(), 1), Invalid, "gradient");
+        lib.ok(gradient(tf, 0, null(), 0));
+        lib.expect(unit(tf, 0, 0.0, 1.0), Invalid, "unit distance 0");
+        lib.expect(unit(tf, 0, 1.0, -1.0), Invalid, "weight -1");
+        lib.expect(unit(null_mut(), 0, 1.0, 1.0), Null, "tf is NULL");
         lib.f::<Free>("fv_transfer_function_free")(tf);
     }
 }
@@ -246,245 +320,106 @@ fn transfer_function_errors() {
 #[test]
 fn renderer_errors() {
     let lib = Lib::open();
-    let mut ctx: H = null_mut();
-    let mut r: H = null_mut();
     let render = lib.f::<Render>("fv_renderer_render");
     let set_params = lib.f::<SetParams>("fv_renderer_set_params");
     let mut p = FvRenderParams::defaults();
     // SAFETY: arguments follow the header; invalid ones are the test.
     unsafe {
-        lib.expect(
-            "NULL ctx",
-            lib.f::<NewCtx>("fv_context_new")(null_mut()),
-            FvStatus::NullArgument,
-            "out",
-        );
-        assert_eq!(
-            lib.f::<NewCtx>("fv_context_new")(&mut ctx),
-            FvStatus::Ok,
-            "{}",
-            lib.last_error()
-        );
+        lib.expect(lib.f::<NewCtx>("fv_context_new")(null_mut()), Null, "out");
+        let mut s = Session::new(&lib);
+        let mut r: H = null_mut();
         let new_r = lib.f::<NewRenderer>("fv_renderer_new");
-        lib.expect(
-            "NULL context",
-            new_r(null_mut(), &mut r),
-            FvStatus::NullArgument,
-            "ctx is NULL",
-        );
-        assert_eq!(new_r(ctx, &mut r), FvStatus::Ok);
-        lib.expect(
-            "NULL renderer",
-            render(null_mut(), 8, 8, null(), 0),
-            FvStatus::NullArgument,
-            "renderer",
-        );
-        lib.expect(
-            "no volume",
-            render(r, 8, 8, null(), 0),
-            FvStatus::InvalidArgument,
-            "volume",
-        );
+        lib.expect(new_r(null_mut(), &mut r), Null, "ctx is NULL");
+        lib.expect(render(null_mut(), 8, 8, null(), 0), Null, "renderer");
+        lib.expect(render(s.r, 8, 8, null(), 0), Invalid, "volume");
 
-        let data = [7u16; 4 * 4 * 4];
-        let d = desc([4, 4, 4], 1, ferrovol::FvScalarType::U16 as u32);
-        let mut v: H = null_mut();
-        assert_eq!(
-            lib.f::<NewVolume>("fv_volume_new")(&d, data.as_ptr().cast(), 128, &mut v),
-            FvStatus::Ok
-        );
-        assert_eq!(lib.f::<SetH>("fv_renderer_set_volume")(r, v), FvStatus::Ok);
-        let mut tf: H = null_mut();
-        assert_eq!(
-            lib.f::<NewTf>("fv_transfer_function_new")(1, true, &mut tf),
-            FvStatus::Ok
-        );
+        s.set_volume([4, 4, 4], FvScalarType::U16, &[7u16; 4 * 4 * 4]);
+        lib.ok(lib.f::<NewTf>("fv_transfer_function_new")(
+            1, true, &mut s.tf,
+        ));
         let set_tf = lib.f::<SetH>("fv_renderer_set_transfer_function");
         lib.expect(
-            "incomplete tf",
-            set_tf(r, tf),
-            FvStatus::InvalidArgument,
+            set_tf(s.r, s.tf),
+            Invalid,
             "needs both a colour and an opacity",
         );
-        let c = [0.0, 1.0, 1.0, 1.0, 10.0, 1.0, 1.0, 1.0];
-        let o = [0.0, 0.0, 10.0, 1.0];
-        assert_eq!(
-            lib.f::<SetPoints>("fv_transfer_function_set_color")(tf, 0, c.as_ptr(), 2),
-            FvStatus::Ok
+        s.set_transfer_function(
+            &[0.0, 1.0, 1.0, 1.0, 10.0, 1.0, 1.0, 1.0],
+            &[0.0, 0.0, 10.0, 1.0],
         );
-        assert_eq!(
-            lib.f::<SetPoints>("fv_transfer_function_set_opacity")(tf, 0, o.as_ptr(), 2),
-            FvStatus::Ok
-        );
-        assert_eq!(set_tf(r, tf), FvStatus::Ok);
 
+        lib.expect(render(s.r, 0, 0, null(), 0), Invalid, "image size 0x0");
         lib.expect(
-            "0x0 frame",
-            render(r, 0, 0, null(), 0),
-            FvStatus::InvalidArgument,
-            "image size 0x0",
-        );
-        lib.expect(
-            "huge frame",
-            render(r, 1 << 20, 4, null(), 0),
-            FvStatus::InvalidArgument,
+            render(s.r, 1 << 20, 4, null(), 0),
+            Invalid,
             "each side must be",
         );
         let depth = [1.0f32; 10];
-        lib.expect(
-            "depth size",
-            render(r, 8, 8, depth.as_ptr(), 10),
-            FvStatus::InvalidArgument,
-            "10 values",
-        );
+        lib.expect(render(s.r, 8, 8, depth.as_ptr(), 10), Invalid, "10 values");
 
-        for (what, edit, needle) in [
+        type Edit = fn(&mut FvRenderParams);
+        let cases: [(Edit, &str); 10] = [
+            (|p| p.blend_mode = 42, "blend_mode 42"),
+            (|p| p.interpolation = 2, "interpolation 2"),
+            (|p| p.gradient_method = 9, "gradient_method 9"),
+            (|p| p.sample_distance = -1.0, "sample_distance -1"),
+            (|p| p.termination_threshold = 0.0, "termination threshold 0"),
+            (|p| p.clip_plane_count = 7, "clip_plane_count 7"),
+            (|p| p.clip_plane_count = 1, "non-zero normal"),
             (
-                "blend",
-                (|p: &mut FvRenderParams| p.blend_mode = 42) as fn(&mut FvRenderParams),
-                "blend_mode 42",
-            ),
-            ("interp", |p| p.interpolation = 2, "interpolation 2"),
-            ("gradient", |p| p.gradient_method = 9, "gradient_method 9"),
-            (
-                "sample distance",
-                |p| p.sample_distance = -1.0,
-                "sample_distance -1",
-            ),
-            (
-                "termination",
-                |p| p.termination_threshold = 0.0,
-                "termination threshold 0",
-            ),
-            (
-                "clip count",
-                |p| p.clip_plane_count = 7,
-                "clip_plane_count 7",
-            ),
-            ("clip normal", |p| p.clip_plane_count = 1, "non-zero normal"),
-            (
-                "cropping",
                 |p| {
                     p.cropping = true;
                     p.cropping_planes = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0];
                 },
                 "min ≤ max",
             ),
-            ("matrix", |p| p.volume_matrix = [0.0; 16], "singular"),
-            (
-                "specular power",
-                |p| p.specular_power = f32::NAN,
-                "specular power",
-            ),
-        ] {
+            (|p| p.volume_matrix = [0.0; 16], "singular"),
+            (|p| p.specular_power = f32::NAN, "specular power"),
+        ];
+        for (edit, needle) in cases {
             let mut bad = p;
             edit(&mut bad);
-            lib.expect(what, set_params(r, &bad), FvStatus::InvalidArgument, needle);
+            lib.expect(set_params(s.r, &bad), Invalid, needle);
         }
 
         let defaults = lib.f::<ParamsDefault>("fv_render_params_default");
-        lib.expect(
-            "NULL params",
-            defaults(null_mut()),
-            FvStatus::NullArgument,
-            "params is NULL",
-        );
+        lib.expect(defaults(null_mut()), Null, "params is NULL");
         let mut from_c: FvRenderParams = std::mem::zeroed();
-        assert_eq!(defaults(&mut from_c), FvStatus::Ok);
+        lib.ok(defaults(&mut from_c));
         assert_eq!(from_c.termination_threshold, 1.0 - 1.0 / 255.0);
 
         let set_cam = lib.f::<SetCamera>("fv_renderer_set_camera");
-        let mut cam: FvCamera = std::mem::zeroed();
-        cam.view_up = [0.0, 1.0, 0.0];
-        cam.view_angle = 30.0;
-        cam.clipping_range = [0.1, 100.0];
-        lib.expect(
-            "camera at focal point",
-            set_cam(r, &cam),
-            FvStatus::InvalidArgument,
-            "equals its focal point",
-        );
-        cam.position = [2.0, 2.0, 30.0];
-        cam.focal_point = [2.0, 2.0, 2.0];
+        let mut cam = camera([0.0; 3], [0.0; 3], [0.1, 100.0]);
+        lib.expect(set_cam(s.r, &cam), Invalid, "equals its focal point");
+        cam = camera([2.0, 2.0, 30.0], [2.0, 2.0, 2.0], [0.1, 100.0]);
         cam.view_angle = 200.0;
-        lib.expect(
-            "view angle",
-            set_cam(r, &cam),
-            FvStatus::InvalidArgument,
-            "view angle 200",
-        );
+        lib.expect(set_cam(s.r, &cam), Invalid, "view angle 200");
         cam.view_angle = 30.0;
-        assert_eq!(set_cam(r, &cam), FvStatus::Ok);
+        s.set_camera(&cam);
 
         let set_lights = lib.f::<SetLights>("fv_renderer_set_lights");
         let mut light: FvLight = std::mem::zeroed();
         light.space = 7;
-        lib.expect(
-            "light space",
-            set_lights(r, &light, 1),
-            FvStatus::InvalidArgument,
-            "light 0 space 7",
-        );
-        lib.expect(
-            "9 lights",
-            set_lights(r, &light, 9),
-            FvStatus::InvalidArgument,
-            "9 lights",
-        );
-        lib.expect(
-            "NULL lights",
-            set_lights(r, null(), 2),
-            FvStatus::NullArgument,
-            "lights",
-        );
-        assert_eq!(set_lights(r, null(), 0), FvStatus::Ok);
+        lib.expect(set_lights(s.r, &light, 1), Invalid, "light 0 space 7");
+        lib.expect(set_lights(s.r, &light, 9), Invalid, "9 lights");
+        lib.expect(set_lights(s.r, null(), 2), Null, "lights");
+        lib.ok(set_lights(s.r, null(), 0));
 
         let set_path =
             lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_output_path");
-        lib.expect(
-            "output path 5",
-            set_path(r, 5),
-            FvStatus::InvalidArgument,
-            "output path 5",
+        lib.expect(set_path(s.r, 5), Invalid, "output path 5");
+        let shared = lib.f::<unsafe extern "C" fn(H, u32, *mut FvSharedImage) -> FvStatus>(
+            "fv_renderer_shared_image",
         );
-        let shared = lib
-            .f::<unsafe extern "C" fn(H, u32, *mut ferrovol::FvSharedImage) -> FvStatus>(
-                "fv_renderer_shared_image",
-            );
-        let mut img: ferrovol::FvSharedImage = std::mem::zeroed();
-        lib.expect(
-            "shared image while reading back",
-            shared(r, 0, &mut img),
-            FvStatus::InvalidArgument,
-            "shared",
-        );
-        lib.expect(
-            "target 9",
-            shared(r, 9, &mut img),
-            FvStatus::InvalidArgument,
-            "target 9",
-        );
-        lib.expect(
-            "NULL image",
-            shared(r, 0, null_mut()),
-            FvStatus::NullArgument,
-            "image is NULL",
-        );
+        let mut img: FvSharedImage = std::mem::zeroed();
+        lib.expect(shared(s.r, 0, &mut img), Invalid, "shared");
+        lib.expect(shared(s.r, 9, &mut img), Invalid, "target 9");
+        lib.expect(shared(s.r, 0, null_mut()), Null, "image is NULL");
 
         // A valid frame still renders after all those refusals.
         p.shade = true;
-        assert_eq!(set_params(r, &p), FvStatus::Ok);
-        assert_eq!(
-            render(r, 16, 16, null(), 0),
-            FvStatus::Ok,
-            "{}",
-            lib.last_error()
-        );
-        let mut frame: H = null_mut();
-        let read = lib.f::<unsafe extern "C" fn(H, *mut H) -> FvStatus>("fv_renderer_read_frame");
-        assert_eq!(read(r, &mut frame), FvStatus::Ok);
-        let rgba = lib.f::<unsafe extern "C" fn(H) -> *const u8>("fv_frame_rgba")(frame);
-        let centre = *rgba.add(4 * (8 * 16 + 8) + 3);
+        s.set_params(&p);
+        let centre = s.frame(16, 16)[4 * (8 * 16 + 8) + 3];
         println!("centre alpha after the refusals: {centre}");
         assert!(
             centre > 100,
@@ -493,29 +428,29 @@ fn renderer_errors() {
         let png = lib.f::<unsafe extern "C" fn(H, *const c_char, *const [f32; 3]) -> FvStatus>(
             "fv_frame_write_png",
         );
-        let bg = [0.0f32; 3];
+        let path = c"/nonexistent/dir/x.png";
         lib.expect(
-            "bad path",
-            png(frame, c"/nonexistent/dir/x.png".as_ptr(), &bg),
+            png(s.frame, path.as_ptr(), &[0.0; 3]),
             FvStatus::IoError,
             "/nonexistent/dir/x.png",
         );
-
-        lib.f::<Free>("fv_frame_free")(frame);
-        lib.f::<Free>("fv_transfer_function_free")(tf);
-        lib.f::<Free>("fv_volume_free")(v);
-        lib.f::<Free>("fv_renderer_free")(r);
-        lib.f::<Free>("fv_context_free")(ctx);
     }
 }
 
 #[test]
 fn last_error_is_per_thread_and_status_names_are_static() {
     let lib = Lib::open();
-    let name = lib.f::<extern "C" fn(FvStatus) -> *const c_char>("fv_status_name");
-    // SAFETY: fv_status_name returns static strings.
-    let s = unsafe { CStr::from_ptr(name(FvStatus::Panic)) };
-    assert_eq!(s.to_str().unwrap(), "FV_STATUS_PANIC");
+    let name = lib.f::<extern "C" fn(i32) -> *const c_char>("fv_status_name");
+    for (value, want) in [
+        (FvStatus::Panic as i32, "FV_STATUS_PANIC"),
+        (FvStatus::Ok as i32, "FV_STATUS_OK"),
+        (10, "FV_STATUS_UNKNOWN"),
+        (-1, "FV_STATUS_UNKNOWN"),
+    ] {
+        // SAFETY: fv_status_name returns static strings for any value.
+        let s = unsafe { CStr::from_ptr(name(value)) };
+        assert_eq!(s.to_str().unwrap(), want, "fv_status_name({value})");
+    }
     let new = lib.f::<NewTf>("fv_transfer_function_new");
     // SAFETY: NULL out is the error under test.
     unsafe { new(1, true, null_mut()) };
@@ -526,16 +461,11 @@ fn last_error_is_per_thread_and_status_names_are_static() {
     assert_eq!(other, "", "another thread must not see this thread's error");
 }
 
-type SetIso = unsafe extern "C" fn(H, *const ferrovol::FvIsoParams) -> FvStatus;
-type SetEnv = unsafe extern "C" fn(H, *const c_char, f32, *const f64, f64) -> FvStatus;
-
 /// The isosurface mode through the C ABI: every refusal names its problem, then a sphere
 /// renders opaque at the centre and empty in the corner.
 #[test]
 fn isosurface_errors_and_a_frame() {
     let lib = Lib::open();
-    let mut ctx: H = null_mut();
-    let mut r: H = null_mut();
     let n = 16usize;
     // Distance from the volume's centre: the iso-value 5 is a sphere of radius 5 voxels.
     let data: Vec<f32> = (0..n * n * n)
@@ -547,288 +477,136 @@ fn isosurface_errors_and_a_frame() {
         .collect();
     let set_iso = lib.f::<SetIso>("fv_renderer_set_isosurface");
     let set_env = lib.f::<SetEnv>("fv_renderer_set_environment");
-    let set_params = lib.f::<SetParams>("fv_renderer_set_params");
-    let render = lib.f::<Render>("fv_renderer_render");
+    let mut s = Session::new(&lib);
+    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
+    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    let mut p = FvRenderParams::defaults();
+    p.blend_mode = FvBlendMode::Isosurface as u32;
+    s.set_params(&p);
     // SAFETY: arguments follow the header; invalid ones are the test.
     unsafe {
-        assert_eq!(lib.f::<NewCtx>("fv_context_new")(&mut ctx), FvStatus::Ok);
-        assert_eq!(
-            lib.f::<NewRenderer>("fv_renderer_new")(ctx, &mut r),
-            FvStatus::Ok
-        );
-        let d = desc([16, 16, 16], 1, ferrovol::FvScalarType::F32 as u32);
-        let mut v: H = null_mut();
-        assert_eq!(
-            lib.f::<NewVolume>("fv_volume_new")(&d, data.as_ptr().cast(), 4 * n * n * n, &mut v),
-            FvStatus::Ok,
-            "{}",
-            lib.last_error()
-        );
-        assert_eq!(lib.f::<SetH>("fv_renderer_set_volume")(r, v), FvStatus::Ok);
-        let mut cam: FvCamera = std::mem::zeroed();
-        cam.position = [7.5, 7.5, 60.0];
-        cam.focal_point = [7.5, 7.5, 7.5];
-        cam.view_up = [0.0, 1.0, 0.0];
-        cam.view_angle = 30.0;
-        cam.clipping_range = [1.0, 200.0];
-        assert_eq!(
-            lib.f::<SetCamera>("fv_renderer_set_camera")(r, &cam),
-            FvStatus::Ok
-        );
-        let mut p = FvRenderParams::defaults();
-        p.blend_mode = ferrovol::FvBlendMode::Isosurface as u32;
-        assert_eq!(set_params(r, &p), FvStatus::Ok);
-        lib.expect(
-            "no iso-values",
-            render(r, 32, 32, null(), 0),
-            FvStatus::InvalidArgument,
-            "iso-values",
-        );
+        let render = lib.f::<Render>("fv_renderer_render");
+        lib.expect(render(s.r, 32, 32, null(), 0), Invalid, "iso-values");
 
-        let mut iso: ferrovol::FvIsoParams = std::mem::zeroed();
-        let defaults = lib.f::<unsafe extern "C" fn(*mut ferrovol::FvIsoParams) -> FvStatus>(
-            "fv_iso_params_default",
-        );
-        lib.expect(
-            "NULL iso defaults",
-            defaults(null_mut()),
-            FvStatus::NullArgument,
-            "params is NULL",
-        );
-        assert_eq!(defaults(&mut iso), FvStatus::Ok);
+        let mut iso: FvIsoParams = std::mem::zeroed();
+        let defaults =
+            lib.f::<unsafe extern "C" fn(*mut FvIsoParams) -> FvStatus>("fv_iso_params_default");
+        lib.expect(defaults(null_mut()), Null, "params is NULL");
+        lib.ok(defaults(&mut iso));
         assert_eq!(iso.bisection_steps, 8);
-        lib.expect(
-            "0 values",
-            set_iso(r, &iso),
-            FvStatus::InvalidArgument,
-            "value_count 0",
-        );
+        lib.expect(set_iso(s.r, &iso), Invalid, "value_count 0");
         iso.value_count = 1;
         iso.values[0] = ferrovol::FvIsoValue {
             value: 5.0,
             color: [0.9, 0.8, 0.7],
             opacity: 1.0,
         };
-        type Edit = fn(&mut ferrovol::FvIsoParams);
-        let cases: [(&str, Edit, &str); 7] = [
-            ("9 values", |i| i.value_count = 9, "value_count 9"),
-            ("opacity 0", |i| i.values[0].opacity = 0.0, "opacity 0"),
-            ("colour 2", |i| i.values[0].color[0] = 2.0, "colour"),
-            ("mode 7", |i| i.specular_mode = 7, "specular_mode 7"),
-            (
-                "0 samples",
-                |i| i.specular_samples = 0,
-                "0 specular samples",
-            ),
-            ("AO radius", |i| i.ao_radius = -1.0, "ao_radius -1"),
-            (
-                "40 bisections",
-                |i| i.bisection_steps = 40,
-                "40 bisection steps",
-            ),
+        type Edit = fn(&mut FvIsoParams);
+        let cases: [(Edit, &str); 7] = [
+            (|i| i.value_count = 9, "value_count 9"),
+            (|i| i.values[0].opacity = 0.0, "opacity 0"),
+            (|i| i.values[0].color[0] = 2.0, "colour"),
+            (|i| i.specular_mode = 7, "specular_mode 7"),
+            (|i| i.specular_samples = 0, "0 specular samples"),
+            (|i| i.ao_radius = -1.0, "ao_radius -1"),
+            (|i| i.bisection_steps = 40, "40 bisection steps"),
         ];
-        for (what, edit, needle) in cases {
+        for (edit, needle) in cases {
             let mut bad = iso;
             edit(&mut bad);
-            lib.expect(what, set_iso(r, &bad), FvStatus::InvalidArgument, needle);
+            lib.expect(set_iso(s.r, &bad), Invalid, needle);
         }
+        lib.expect(set_iso(null_mut(), &iso), Null, "renderer");
+        let missing = c"/nonexistent/sky.hdr";
         lib.expect(
-            "NULL renderer",
-            set_iso(null_mut(), &iso),
-            FvStatus::NullArgument,
-            "renderer",
-        );
-        lib.expect(
-            "missing map",
-            set_env(r, c"/nonexistent/sky.hdr".as_ptr(), 1.0, null(), 0.0),
-            FvStatus::InvalidArgument,
+            set_env(s.r, missing.as_ptr(), 1.0, null(), 0.0),
+            Invalid,
             "cannot be opened",
         );
+        let text = c"/etc/hostname.txt";
         lib.expect(
-            "text map",
-            set_env(r, c"/etc/hostname.txt".as_ptr(), 1.0, null(), 0.0),
-            FvStatus::InvalidArgument,
+            set_env(s.r, text.as_ptr(), 1.0, null(), 0.0),
+            Invalid,
             "unsupported file type",
         );
         let up = [0.0, 0.0, 1.0];
-        assert_eq!(
-            set_env(r, null(), 1.0, up.as_ptr(), 30.0),
-            FvStatus::Ok,
-            "{}",
-            lib.last_error()
-        );
+        lib.ok(set_env(s.r, null(), 1.0, up.as_ptr(), 30.0));
         iso.ao_samples = 8;
-        assert_eq!(set_iso(r, &iso), FvStatus::Ok, "{}", lib.last_error());
-        assert_eq!(
-            render(r, 32, 32, null(), 0),
-            FvStatus::Ok,
-            "{}",
-            lib.last_error()
-        );
-        let mut frame: H = null_mut();
-        let read = lib.f::<unsafe extern "C" fn(H, *mut H) -> FvStatus>("fv_renderer_read_frame");
-        assert_eq!(read(r, &mut frame), FvStatus::Ok);
-        let rgba = lib.f::<unsafe extern "C" fn(H) -> *const u8>("fv_frame_rgba")(frame);
-        let px = |x: usize, y: usize| std::slice::from_raw_parts(rgba.add(4 * (y * 32 + x)), 4);
-        println!("sphere centre {:?}, corner {:?}", px(16, 16), px(0, 0));
-        assert_eq!(px(16, 16)[3], 255, "the opaque sphere covers the centre");
-        assert!(px(16, 16)[0] > 100, "and it is lit");
-        assert_eq!(px(0, 0), [0, 0, 0, 0], "the corner misses it");
-        lib.f::<Free>("fv_frame_free")(frame);
-        lib.f::<Free>("fv_volume_free")(v);
-        lib.f::<Free>("fv_renderer_free")(r);
-        lib.f::<Free>("fv_context_free")(ctx);
+        lib.ok(set_iso(s.r, &iso));
     }
+    let rgba = s.frame(32, 32);
+    let px = |x: usize, y: usize| &rgba[4 * (y * 32 + x)..][..4];
+    println!("sphere centre {:?}, corner {:?}", px(16, 16), px(0, 0));
+    assert_eq!(px(16, 16)[3], 255, "the opaque sphere covers the centre");
+    assert!(px(16, 16)[0] > 100, "and it is lit");
+    assert_eq!(px(0, 0), [0, 0, 0, 0], "the corner misses it");
 }
-
-type SetPt = unsafe extern "C" fn(H, *const ferrovol::FvPathTraceParams) -> FvStatus;
-type Accumulated = unsafe extern "C" fn(H, *mut u32) -> FvStatus;
 
 /// Path tracing through the C ABI: refusals name their problem, frames accumulate and a
 /// camera change starts over.
 #[test]
 fn path_tracing_accumulates_and_refuses_bad_settings() {
     let lib = Lib::open();
-    let mut ctx: H = null_mut();
-    let mut r: H = null_mut();
     let data: Vec<f32> = (0..8 * 8 * 8).map(|i| (i % 8) as f32 / 7.0).collect();
+    let mut s = Session::new(&lib);
+    s.set_volume([8, 8, 8], FvScalarType::F32, &data);
+    s.set_transfer_function(
+        &[0.0, 0.9, 0.8, 0.7, 1.0, 0.9, 0.8, 0.7],
+        &[0.0, 0.0, 1.0, 0.6],
+    );
+    let mut cam = camera([3.5, 3.5, 40.0], [3.5; 3], [1.0, 100.0]);
+    s.set_camera(&cam);
+    let mut p = FvRenderParams::defaults();
+    p.blend_mode = FvBlendMode::PathTrace as u32;
+    s.set_params(&p);
+    let set_pt = lib.f::<SetPt>("fv_renderer_set_path_tracing");
+    let defaults = lib.f::<unsafe extern "C" fn(*mut FvPathTraceParams) -> FvStatus>(
+        "fv_path_trace_params_default",
+    );
     // SAFETY: arguments follow the header; invalid ones are the test.
     unsafe {
-        assert_eq!(lib.f::<NewCtx>("fv_context_new")(&mut ctx), FvStatus::Ok);
-        assert_eq!(
-            lib.f::<NewRenderer>("fv_renderer_new")(ctx, &mut r),
-            FvStatus::Ok
-        );
-        let d = desc([8, 8, 8], 1, ferrovol::FvScalarType::F32 as u32);
-        let mut v: H = null_mut();
-        assert_eq!(
-            lib.f::<NewVolume>("fv_volume_new")(&d, data.as_ptr().cast(), 4 * 512, &mut v),
-            FvStatus::Ok
-        );
-        assert_eq!(lib.f::<SetH>("fv_renderer_set_volume")(r, v), FvStatus::Ok);
-        let mut tf: H = null_mut();
-        assert_eq!(
-            lib.f::<NewTf>("fv_transfer_function_new")(1, true, &mut tf),
-            FvStatus::Ok
-        );
-        let c = [0.0, 0.9, 0.8, 0.7, 1.0, 0.9, 0.8, 0.7];
-        let o = [0.0, 0.0, 1.0, 0.6];
-        let set_points = lib.f::<SetPoints>("fv_transfer_function_set_color");
-        assert_eq!(set_points(tf, 0, c.as_ptr(), 2), FvStatus::Ok);
-        let set_points = lib.f::<SetPoints>("fv_transfer_function_set_opacity");
-        assert_eq!(set_points(tf, 0, o.as_ptr(), 2), FvStatus::Ok);
-        assert_eq!(
-            lib.f::<SetH>("fv_renderer_set_transfer_function")(r, tf),
-            FvStatus::Ok
-        );
-        let mut cam: FvCamera = std::mem::zeroed();
-        cam.position = [3.5, 3.5, 40.0];
-        cam.focal_point = [3.5, 3.5, 3.5];
-        cam.view_up = [0.0, 1.0, 0.0];
-        cam.view_angle = 30.0;
-        cam.clipping_range = [1.0, 100.0];
-        let set_cam = lib.f::<SetCamera>("fv_renderer_set_camera");
-        assert_eq!(set_cam(r, &cam), FvStatus::Ok);
-        let mut p = FvRenderParams::defaults();
-        p.blend_mode = ferrovol::FvBlendMode::PathTrace as u32;
-        assert_eq!(
-            lib.f::<SetParams>("fv_renderer_set_params")(r, &p),
-            FvStatus::Ok
-        );
-        let set_pt = lib.f::<SetPt>("fv_renderer_set_path_tracing");
-        let defaults = lib.f::<unsafe extern "C" fn(*mut ferrovol::FvPathTraceParams) -> FvStatus>(
-            "fv_path_trace_params_default",
-        );
-        let mut pt: ferrovol::FvPathTraceParams = std::mem::zeroed();
-        assert_eq!(defaults(&mut pt), FvStatus::Ok);
-        let mut bad = pt;
-        bad.anisotropy = 1.0;
-        lib.expect(
-            "g = 1",
-            set_pt(r, &bad),
-            FvStatus::InvalidArgument,
-            "anisotropy 1",
-        );
-        bad = pt;
-        bad.samples_per_frame = 0;
-        lib.expect(
-            "0 paths",
-            set_pt(r, &bad),
-            FvStatus::InvalidArgument,
-            "0 paths per pixel",
-        );
-        for (what, edit, words) in [
-            (
-                "scatter regions 7",
-                (|p: &mut ferrovol::FvPathTraceParams| p.scatter_regions = 7)
-                    as fn(&mut ferrovol::FvPathTraceParams),
-                "not an FvScatterRegions",
-            ),
-            ("roughness 0", |p| p.roughness = 0.0, "roughness 0"),
-            ("cone 90°", |p| p.cone_angle = 90.0, "cone angle 90"),
-            (
-                "ψ < 0",
-                |p| p.gradient_threshold = -1.0,
-                "gradient threshold",
-            ),
-            (
-                "k NaN",
-                |p| p.stochastic_blend = f32::NAN,
-                "stochastic blend",
-            ),
-            (
-                "0 secondary rays",
-                |p| p.secondary_rays = 0,
-                "secondary rays",
-            ),
-        ] {
-            bad = pt;
+        let mut pt: FvPathTraceParams = std::mem::zeroed();
+        lib.ok(defaults(&mut pt));
+        type Edit = fn(&mut FvPathTraceParams);
+        let cases: [(Edit, &str); 8] = [
+            (|p| p.anisotropy = 1.0, "anisotropy 1"),
+            (|p| p.samples_per_frame = 0, "0 paths per pixel"),
+            (|p| p.scatter_regions = 7, "not an FvScatterRegions"),
+            (|p| p.roughness = 0.0, "roughness 0"),
+            (|p| p.cone_angle = 90.0, "cone angle 90"),
+            (|p| p.gradient_threshold = -1.0, "gradient threshold"),
+            (|p| p.stochastic_blend = f32::NAN, "stochastic blend"),
+            (|p| p.secondary_rays = 0, "secondary rays"),
+        ];
+        for (edit, needle) in cases {
+            let mut bad = pt;
             edit(&mut bad);
-            lib.expect(what, set_pt(r, &bad), FvStatus::InvalidArgument, words);
+            lib.expect(set_pt(s.r, &bad), Invalid, needle);
         }
-        lib.expect(
-            "NULL params",
-            set_pt(r, null()),
-            FvStatus::NullArgument,
-            "params is NULL",
-        );
+        lib.expect(set_pt(s.r, null()), Null, "params is NULL");
         // the hybrid model with a 2×2 budget renders
-        bad = pt;
-        bad.gradient_threshold = 0.5;
-        bad.secondary_rays = 2;
-        bad.scatter_regions = ferrovol::FvScatterRegions::Surfaces as u32;
-        assert_eq!(set_pt(r, &bad), FvStatus::Ok);
-        assert_eq!(
-            lib.f::<Render>("fv_renderer_render")(r, 16, 16, null(), 0),
-            FvStatus::Ok,
-            "{}",
-            lib.last_error()
-        );
+        let mut hybrid = pt;
+        hybrid.gradient_threshold = 0.5;
+        hybrid.secondary_rays = 2;
+        hybrid.scatter_regions = ferrovol::FvScatterRegions::Surfaces as u32;
+        lib.ok(set_pt(s.r, &hybrid));
+        s.render(16, 16);
         pt.samples_per_frame = 2;
-        assert_eq!(set_pt(r, &pt), FvStatus::Ok);
-        let render = lib.f::<Render>("fv_renderer_render");
-        let accumulated = lib.f::<Accumulated>("fv_renderer_accumulated_samples");
-        let mut counts = vec![];
-        for i in 0..4 {
-            if i == 3 {
-                cam.position = [3.5, 10.0, 40.0];
-                assert_eq!(set_cam(r, &cam), FvStatus::Ok);
-            }
-            assert_eq!(
-                render(r, 16, 16, null(), 0),
-                FvStatus::Ok,
-                "{}",
-                lib.last_error()
-            );
-            let mut n = 0u32;
-            assert_eq!(accumulated(r, &mut n), FvStatus::Ok);
-            counts.push(n);
-        }
-        println!("accumulated paths per pixel: {counts:?} (camera moved before the last)");
-        assert_eq!(counts, vec![2, 4, 6, 2]);
-        lib.f::<Free>("fv_transfer_function_free")(tf);
-        lib.f::<Free>("fv_volume_free")(v);
-        lib.f::<Free>("fv_renderer_free")(r);
-        lib.f::<Free>("fv_context_free")(ctx);
+        lib.ok(set_pt(s.r, &pt));
     }
+    let accumulated = lib.f::<Accumulated>("fv_renderer_accumulated_samples");
+    let mut counts = vec![];
+    for i in 0..4 {
+        if i == 3 {
+            cam.position = [3.5, 10.0, 40.0];
+            s.set_camera(&cam);
+        }
+        s.render(16, 16);
+        let mut n = 0u32;
+        // SAFETY: a valid handle and out-pointer.
+        lib.ok(unsafe { accumulated(s.r, &mut n) });
+        counts.push(n);
+    }
+    println!("accumulated paths per pixel: {counts:?} (camera moved before the last)");
+    assert_eq!(counts, vec![2, 4, 6, 2]);
 }

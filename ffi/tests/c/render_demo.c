@@ -2,6 +2,7 @@
  * Built with -std=c11 -Wall -Wextra -Werror -pedantic by ffi/tests/c_program.rs.
  * Usage: render_demo OUT.png */
 #include "ferrovol.h"
+#include "fv_report.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -10,16 +11,11 @@
 
 #define N 41
 
-static int fail(const char *what, FvStatus s) {
-  fprintf(stderr, "%s failed: %s: %s\n", what, fv_status_name(s), fv_last_error());
-  return 1;
-}
-
 #define CHECK(call)                                                            \
   do {                                                                         \
     FvStatus s_ = (call);                                                      \
     if (s_ != FV_STATUS_OK) {                                                  \
-      code = fail(#call, s_);                                                  \
+      code = fv_report(#call, s_);                                             \
       goto done;                                                               \
     }                                                                          \
   } while (0)

@@ -12,6 +12,7 @@
 #include <GL/glext.h>
 
 #include "ferrovol.h"
+#include "fv_report.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,16 +23,11 @@
 #define H 61
 #define SKIP 77
 
-static int fv_fail(const char *what, FvStatus s) {
-  fprintf(stderr, "%s: %s: %s\n", what, fv_status_name(s), fv_last_error());
-  return 1;
-}
-
 #define FV(call)                                                               \
   do {                                                                         \
     FvStatus s_ = (call);                                                      \
     if (s_ != FV_STATUS_OK)                                                    \
-      return fv_fail(#call, s_);                                               \
+      return fv_report(#call, s_);                                             \
   } while (0)
 
 /* Loads a GL entry point through EGL (extension functions are not exported by libGL). */
