@@ -15,10 +15,9 @@ struct Denoise {
     params: vec4<f32>,
 }
 
-// The source holds sums over the paths (the accumulation): scale by params.x.
-const DENOISE_FROM_SUMS: u32 = 1u;
-// The last iteration: write the output image as well.
-const DENOISE_LAST: u32 = 2u;
+// Flags (size.w), declared from Rust (gpu::uniforms): DENOISE_FROM_SUMS, the source holds
+// sums over the paths (the accumulation): scale by params.x; DENOISE_LAST, the last
+// iteration: write the output image as well.
 
 @group(0) @binding(0) var<uniform> dn: Denoise;
 @group(0) @binding(1) var<storage, read> src: array<vec4<f32>>;

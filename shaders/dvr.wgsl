@@ -14,7 +14,7 @@
 #include "lib/output.wgsl"
 
 // Pipeline constants: each combination is its own pipeline, so the ray loop carries only
-// the code of the mode it runs (core/src/renderer.rs, DvrVariant).
+// the code of the mode it runs (core/src/passes/dvr.rs, DvrVariant).
 override BLEND: u32 = 0u;
 override NCOMP: u32 = 1u;
 override INDEPENDENT: bool = true;

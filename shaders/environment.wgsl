@@ -1,11 +1,11 @@
-// Environment lighting, computed once per environment map (core/src/environment.rs):
+// Environment lighting, computed once per environment map (core/src/resources/environment.rs):
 //   build       the source (procedural sky or equirectangular image) → level 0 of the cube
 //   downsample  level m − 1 → level m (2×2 box), the mip chain the specular lobe samples
 //   irradiance  Monte Carlo cosine-weighted filtering of the cube into the irradiance cube
 // Each dispatch covers one level of all six faces (global id z = face).
 #include "lib/envmap.wgsl"
 
-// Mirrored in core/src/gpu.rs (EnvUniforms).
+// Mirrored in core/src/gpu/uniforms.rs (EnvUniforms).
 struct EnvBuild {
     zenith: vec4<f32>,     // sky colour straight up (rgb)
     horizon: vec4<f32>,    // sky colour at the horizon
@@ -18,8 +18,7 @@ struct EnvBuild {
                            // written; z: samples per irradiance texel
 }
 
-const ENV_SKY: u32 = 0u;
-const ENV_EQUIRECT: u32 = 1u;
+// The source (params.x) is ENV_SKY or ENV_EQUIRECT (declared from Rust, gpu::uniforms).
 // Largest finite rgba16float value: brighter texels (a sun in an HDR photograph) are
 // clamped rather than becoming infinite.
 const HALF_MAX: f32 = 65504.0;

@@ -45,21 +45,14 @@ struct PathTrace {
 
 // Pipeline constants: the code of the BSDF and of the scattering regions (HYBRID) and of
 // the denoiser's guide (GUIDE) is compiled only into the pipelines that use it (on
-// lavapipe a path tracer carrying unused code ran 1.7x slower, measured on the skull).
+// lavapipe a path tracer carrying unused code runs markedly slower).
 override HYBRID: bool = true;
 override GUIDE: bool = true;
 
-const PT_FLAG_BACKGROUND: u32 = 1u;
-// Collisions that do not scatter absorb (otherwise they do not happen).
-const PT_FLAG_ATTENUATION: u32 = 2u;
-// Sum the denoiser's guide (the first collision's normal and distance) into `guide`.
-const PT_FLAG_GUIDE: u32 = 4u;
-const PT_SCATTER_NONE: u32 = 0u;
-const PT_SCATTER_SURFACES: u32 = 1u;
-const PT_SCATTER_BETWEEN: u32 = 2u;
-const PT_SCATTER_EVERYWHERE: u32 = 3u;
-// Opacity is clamped below 1 so that extinction stays finite (σ ≤ 9.2 / unit distance).
-const PT_MAX_OPACITY: f32 = 0.9999;
+// Declared from Rust (gpu::uniforms): PT_FLAG_BACKGROUND; PT_FLAG_ATTENUATION, collisions
+// that do not scatter absorb (otherwise they do not happen); PT_FLAG_GUIDE, sum the
+// denoiser's guide (the first collision's normal and distance) into `guide`; the
+// PT_SCATTER_* regions; PT_MAX_OPACITY, the clamp that keeps extinction finite.
 // Bound on the tentative collisions of one free flight or transmittance estimate (a
 // majorant of 9.2 per unit over thousands of units: never reached in practice).
 const PT_MAX_STEPS: u32 = 1000000u;
@@ -75,7 +68,7 @@ var<private> pt: PathTrace;
 @group(0) @binding(13) var env_sampler: sampler;
 // The environment's sampling distribution over the texels of a small cube (options.y² per
 // face, faces +X … −Z, rows top to bottom): the cumulative probabilities, last = 1
-// (core/src/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
+// (core/src/passes/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
 @group(0) @binding(14) var<storage, read> env_cdf: array<f32>;
 // Per min–max block (march.wgsl: block_coord): the largest extinction (per world unit) its
 // scalar range can take under the transfer function.

@@ -15,39 +15,17 @@
 //! # Ok::<(), ferrovol_core::Error>(())
 //! ```
 
-mod binding;
-pub mod camera;
-pub mod device;
-pub mod environment;
 pub mod error;
 pub mod gpu;
-pub mod interop;
-pub mod iso;
-pub mod light;
 pub mod params;
-pub mod pathtrace;
-mod readback;
+mod passes;
 pub mod renderer;
-pub mod shaders;
+mod resources;
 pub mod synth;
-pub mod transfer;
-pub mod upload;
-pub mod volume;
 
-pub use camera::Camera;
-pub use device::{Context, DeviceInfo};
-pub use environment::{CubeImage, Environment, EnvironmentSource, Sky};
 pub use error::{Error, Result};
-pub use interop::{DeviceUuids, OutputPath, SharedImage, SharedOutput};
-pub use iso::{
-    AmbientOcclusion, GBuffer, Hit, IsoParams, IsoScatterMode, IsoScattering, IsoValue, Shininess,
-    SpecularMode, MAX_SCATTER_SAMPLES,
-};
-pub use light::{Light, LightSpace};
-pub use params::{
-    BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
-};
-pub use pathtrace::{BsdfParams, PathTraceParams, ScatterRegions};
-pub use renderer::{Image, Renderer, Stats, UploadOptions, View};
-pub use transfer::{ComponentTransfer, Piecewise, TransferFunction};
-pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};
+pub use gpu::interop::{DeviceUuids, OutputPath, SharedImage, SharedOutput};
+pub use gpu::{Context, DeviceInfo};
+pub use params::environment::{cube_direction, cube_face_coords, FACE_NAMES};
+pub use params::*;
+pub use renderer::Renderer;

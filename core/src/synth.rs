@@ -3,7 +3,7 @@
 //!
 //! All generators return single-component `float32` volumes with identity direction.
 
-use crate::volume::{Scalars, VolumeData, IDENTITY_DIRECTION};
+use crate::params::{Scalars, VolumeData, IDENTITY_DIRECTION};
 
 /// `vtkRTAnalyticSource::Maximum` default.
 pub const WAVELET_MAXIMUM: f64 = 255.0;

@@ -1,29 +1,14 @@
 // Shared by every pass: the per-frame uniform block, its constants, the lookup tables and
-// small helpers. Mirrored in core/src/gpu.rs (FrameUniforms); a unit test checks the
-// layouts agree.
-
-const BLEND_COMPOSITE: u32 = 0u;
-const BLEND_MAXIMUM: u32 = 1u;
-const BLEND_MINIMUM: u32 = 2u;
-const BLEND_AVERAGE: u32 = 3u;
-const BLEND_ADDITIVE: u32 = 4u;
-
-const FLAG_JITTER: u32 = 2u;
-const FLAG_TWO_SIDED: u32 = 16u;
-const FLAG_INDEPENDENT: u32 = 64u;
-const FLAG_DEPTH_INPUT: u32 = 128u;
-const FLAG_AVERAGE_RANGE: u32 = 1024u;
-
-const MAX_LIGHTS: u32 = 8u;
-// Entries per lookup table (transfer::TABLE_SIZE).
-const TABLE_N: u32 = 1024u;
+// small helpers. Mirrored in core/src/gpu/uniforms.rs (FrameUniforms); a unit test checks
+// the layouts agree. The constants shared with Rust (BLEND_*, FLAG_*, MAX_LIGHTS, MAX_CLIP,
+// TABLE_N: entries per lookup table) are declared from gpu/uniforms.rs when a pass is
+// composed.
 
 // Nearest-neighbour interpolation, a pipeline constant: the transfer-function tables are
 // read at the nearest entry, as VTK's InterpolationType applies to the tables too (the
 // volume itself is read through the brick's nearest sampler; on lavapipe a sampler fetch
 // measured faster than textureLoad).
 override NEAREST: bool = false;
-const MAX_CLIP: u32 = 6u;
 
 struct Light {
     // xyz: world position (positional) or unit vector toward the light (directional);
@@ -75,8 +60,7 @@ struct Frame {
 // The passes read the frame's uniforms from this private copy, which each entry point
 // fills first (`frame = frame_ubo;`). Lavapipe reads a uniform inside a loop or a branch
 // with a masked per-lane gather and a bounds check per lane; the copy is read once per
-// invocation, outside all control flow, and what the loop needs stays in registers (with
-// the gradient method as a pipeline constant: benchmark frame unshaded 55–61 → 38–44 ms).
+// invocation, outside all control flow, and what the loop needs stays in registers.
 var<private> frame: Frame;
 // Per component c, two rows of N entries: row 2·c holds (r, g, b, alpha corrected for the
 // step), row 2·c + 1 holds (alpha as given, gradient opacity, 0, 0). Composite reads one

@@ -3,7 +3,7 @@
 // occlusion directions) and deferred shading (specular lobe sampling). No bindings here.
 //
 // Cube faces follow Vulkan's cube-map convention (the hardware's), in the layer order
-// +X, −X, +Y, −Y, +Z, −Z; core/src/environment.rs mirrors `cube_direction` for the CPU.
+// +X, −X, +Y, −Y, +Z, −Z; core/src/params/environment.rs mirrors `cube_direction` for the CPU.
 
 const PI: f32 = 3.14159265358979;
 

@@ -1,11 +1,7 @@
 // The isosurface uniforms shared by the first-hit pass (firsthit.wgsl) and deferred shading
-// (deferred.wgsl). Mirrored in core/src/gpu.rs (IsoUniforms); a unit test checks the layouts.
-
-const MAX_ISO: u32 = 8u;
-const SPECULAR_CONE: u32 = 0u;
-const SPECULAR_IMPORTANCE: u32 = 1u;
-// The environment fills the pixels the surfaces leave uncovered.
-const ISO_FLAG_BACKGROUND: u32 = 1u;
+// (deferred.wgsl). Mirrored in core/src/gpu/uniforms.rs (IsoUniforms); a unit test checks the
+// layouts. MAX_ISO, SPECULAR_CONE / SPECULAR_IMPORTANCE and ISO_FLAG_BACKGROUND (the
+// environment fills the pixels the surfaces leave uncovered) are declared from Rust.
 
 struct Iso {
     env_rotation: mat4x4<f32>,    // world direction → environment direction (+Y up)

@@ -12,7 +12,7 @@ struct Ray {
 // The camera's matrices, read at an index that is always 0 but not a constant to the
 // compiler: lavapipe (Mesa 22.3) inlines uniform values that feed branches into the
 // shader and recompiles it whenever one of them changes, and it picked the camera — a full
-// LLVM compile at every camera move (a 16×16 frame took 135 ms unshaded, 175 ms shaded).
+// LLVM compile at every camera move (docs/PERFORMANCE.md has the figures).
 fn inv_view_proj() -> mat4x4<f32> {
     return frame_ubo.camera[frame_ubo.viewport.z];
 }

@@ -11,6 +11,30 @@ override POSITIONAL_LIGHTS: bool = true;
 // Number of lights (a pipeline constant, so the light loop unrolls).
 override NUM_LIGHTS: u32 = 1u;
 
+// Unit vector from pos toward the light (xyz) and the light's attenuation there (w).
+// v: unit vector toward the eye (the headlight's direction). light.position.w: 0
+// directional, 1 positional, 2 headlight (from the camera along each ray).
+fn light_incidence(light: Light, pos: vec3<f32>, v: vec3<f32>) -> vec4<f32> {
+    var l = select(light.position.xyz, v, light.position.w > 1.5);
+    var atten = 1.0;
+    if (POSITIONAL_LIGHTS && light.position.w > 0.5 && light.position.w < 1.5) {
+        let lv = light.position.xyz - pos;
+        let d = length(lv);
+        l = lv / max(d, 1e-20);
+        let a = light.attenuation;
+        atten = 1.0 / max(a.x + a.y * d + a.z * d * d, 1e-20);
+        if (light.spot.w > -1.5) {
+            let cos_a = dot(-l, light.spot.xyz);
+            if (cos_a < light.spot.w) {
+                atten = 0.0;
+            } else {
+                atten = atten * pow(max(cos_a, 0.0), light.diffuse.w);
+            }
+        }
+    }
+    return vec4<f32>(l, atten);
+}
+
 fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec3<f32> {
     let glen = length(grad);
     var ambient = vec3<f32>(0.0);
@@ -28,24 +52,9 @@ fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>)
         if (!has_normal) {
             continue;
         }
-        // w: 0 directional, 1 positional, 2 headlight (from the camera along each ray)
-        var l = select(light.position.xyz, v, light.position.w > 1.5);
-        var atten = 1.0;
-        if (POSITIONAL_LIGHTS && light.position.w > 0.5 && light.position.w < 1.5) {
-            let lv = light.position.xyz - pos;
-            let d = length(lv);
-            l = lv / max(d, 1e-20);
-            let a = light.attenuation;
-            atten = 1.0 / max(a.x + a.y * d + a.z * d * d, 1e-20);
-            if (light.spot.w > -1.5) {
-                let cos_a = dot(-l, light.spot.xyz);
-                if (cos_a < light.spot.w) {
-                    atten = 0.0;
-                } else {
-                    atten = atten * pow(max(cos_a, 0.0), light.diffuse.w);
-                }
-            }
-        }
+        let li = light_incidence(light, pos, v);
+        let l = li.xyz;
+        let atten = li.w;
         var nl = n;
         var ndl = dot(nl, l);
         if (ndl < 0.0 && has_flag(FLAG_TWO_SIDED)) {

@@ -1,5 +1,5 @@
 // Blinn–Phong at a surface point (isosurfaces, deferred.wgsl) with the scene's lights and
-// VTK's light kinds as lib/shading.wgsl places them: directional, positional with
+// VTK's light kinds as lib/shading.wgsl places them (light_incidence): directional, positional with
 // attenuation and spotlight cone, and the headlight shining along each ray.
 #include "lib/shading.wgsl"
 
@@ -8,29 +8,6 @@ struct LightSum {
     ambient: vec3<f32>,
     diffuse: vec3<f32>,
     specular: vec3<f32>,
-}
-
-// Unit vector from pos toward the light (xyz) and the light's attenuation there (w).
-// v: unit vector toward the eye (the headlight's direction).
-fn light_incidence(light: Light, pos: vec3<f32>, v: vec3<f32>) -> vec4<f32> {
-    var l = select(light.position.xyz, v, light.position.w > 1.5);
-    var atten = 1.0;
-    if (POSITIONAL_LIGHTS && light.position.w > 0.5 && light.position.w < 1.5) {
-        let lv = light.position.xyz - pos;
-        let d = length(lv);
-        l = lv / max(d, 1e-20);
-        let a = light.attenuation;
-        atten = 1.0 / max(a.x + a.y * d + a.z * d * d, 1e-20);
-        if (light.spot.w > -1.5) {
-            let cos_a = dot(-l, light.spot.xyz);
-            if (cos_a < light.spot.w) {
-                atten = 0.0;
-            } else {
-                atten = atten * pow(max(cos_a, 0.0), light.diffuse.w);
-            }
-        }
-    }
-    return vec4<f32>(l, atten);
 }
 
 // Blinn–Phong sums for unit normal n (facing the viewer), unit vector v toward the eye and

@@ -26,7 +26,7 @@ var<private> brick: Brick;
 override PRECOMPUTED_GRADIENT: bool = false;
 // Forward differences (3 samples) instead of central ones (6). A pipeline constant, not a
 // flag: lavapipe runs both sides of a branch on a uniform value, so a flag would cost the
-// 6 samples and the 3 (shaded benchmark frame 94–98 → 73–82 ms).
+// 6 samples and the 3.
 override FORWARD_DIFF: bool = false;
 
 // Raw texel value (normalised storage) at index-space point p.

@@ -1,7 +1,13 @@
 //! Per-frame render parameters (the small things that change between frames without
 //! touching the volume or the tables).
 
+use super::check::{non_negative, within};
 use crate::error::{Error, Result};
+use crate::gpu::uniforms::{
+    BLEND_ADDITIVE, BLEND_AVERAGE, BLEND_COMPOSITE, BLEND_ISOSURFACE, BLEND_MAXIMUM, BLEND_MINIMUM,
+    BLEND_PATHTRACE,
+};
+pub use crate::gpu::uniforms::{MAX_CLIP_PLANES, MAX_LIGHTS};
 use glam::{DMat4, DVec3};
 
 /// How samples along a ray combine (VTK's vtkVolumeMapper blend modes).
@@ -19,23 +25,23 @@ pub enum BlendMode {
     Additive,
     /// Isosurfaces: first hit with bisection, deferred shading with environment lighting
     /// and ambient occlusion; the iso-values and their shading come from
-    /// [`crate::Renderer::set_isosurface`] (crate::iso), not the transfer function.
+    /// [`crate::Renderer::set_isosurface`] (crate::passes::iso), not the transfer function.
     Isosurface,
     /// Progressive Monte Carlo path tracing of the volume as a scattering medium
-    /// (crate::pathtrace; settings from [`crate::Renderer::set_path_tracing`]).
+    /// (crate::passes::pathtrace; settings from [`crate::Renderer::set_path_tracing`]).
     PathTrace,
 }
 
 impl BlendMode {
     pub(crate) fn code(self) -> u32 {
         match self {
-            BlendMode::Composite => 0,
-            BlendMode::Maximum => 1,
-            BlendMode::Minimum => 2,
-            BlendMode::Average => 3,
-            BlendMode::Additive => 4,
-            BlendMode::Isosurface => 5,
-            BlendMode::PathTrace => 6,
+            BlendMode::Composite => BLEND_COMPOSITE,
+            BlendMode::Maximum => BLEND_MAXIMUM,
+            BlendMode::Minimum => BLEND_MINIMUM,
+            BlendMode::Average => BLEND_AVERAGE,
+            BlendMode::Additive => BLEND_ADDITIVE,
+            BlendMode::Isosurface => BLEND_ISOSURFACE,
+            BlendMode::PathTrace => BLEND_PATHTRACE,
         }
     }
 }
@@ -120,9 +126,6 @@ pub struct ClipPlane {
     pub origin: DVec3,
     pub normal: DVec3,
 }
-
-pub const MAX_CLIP_PLANES: usize = 6;
-pub const MAX_LIGHTS: usize = 8;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderParams {
@@ -229,11 +232,7 @@ impl RenderParams {
             ("specular", s.specular),
             ("specular power", s.specular_power),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::InvalidParameter(format!(
-                    "shading {n} {v} must be finite and non-negative"
-                )));
-            }
+            non_negative(&format!("shading {n}"), v)?;
         }
         for (n, v, lo, hi) in [
             (
@@ -250,11 +249,7 @@ impl RenderParams {
             ),
             ("scattering anisotropy", s.scattering_anisotropy, -1.0, 1.0),
         ] {
-            if !(lo..=hi).contains(&v) {
-                return Err(Error::InvalidParameter(format!(
-                    "{n} {v} must be in [{lo}, {hi}]"
-                )));
-            }
+            within(n, v, lo, hi)?;
         }
         if self.volume_matrix.determinant().abs() < 1e-12 || !self.volume_matrix.is_finite() {
             return Err(Error::InvalidParameter(

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 
 /// Entries per lookup table. VTK's GPU mapper samples its tables at a similar resolution.
-pub const TABLE_SIZE: usize = 1024;
+pub use crate::gpu::uniforms::TABLE_SIZE;
 
 /// A piecewise-linear function of one variable (VTK's vtkPiecewiseFunction / the RGB
 /// channels of vtkColorTransferFunction): points sorted by x, clamped outside.

@@ -36,8 +36,8 @@
 //! dropped; memory imported elsewhere stays alive until that side deletes its memory object,
 //! so after a generation change the host deletes its old textures and memory objects.
 
-use crate::device::Context;
 use crate::error::{Error, Result};
+use crate::gpu::Context;
 
 /// Identifies a device across APIs: `VkPhysicalDeviceIDProperties::deviceUUID` and
 /// `driverUUID`, to compare with OpenGL's `GL_DEVICE_UUID_EXT` and `GL_DRIVER_UUID_EXT`.
@@ -184,8 +184,8 @@ pub(crate) fn create_exportable_texture(
 #[cfg(target_os = "linux")]
 mod imp {
     use super::{DeviceUuids, ExportableMemory};
-    use crate::device::Context;
     use crate::error::{Error, Result};
+    use crate::gpu::Context;
     use ash::vk;
     use std::os::fd::{FromRawFd, OwnedFd};
     use wgpu::hal::api::Vulkan;
@@ -506,8 +506,8 @@ mod imp {
 #[cfg(not(target_os = "linux"))]
 mod imp {
     use super::{DeviceUuids, ExportableMemory};
-    use crate::device::Context;
     use crate::error::{Error, Result};
+    use crate::gpu::Context;
 
     fn unsupported() -> Error {
         Error::Unsupported(

@@ -59,13 +59,6 @@ pub struct BrickUniforms {
 /// Per-pixel ray state (PixelState in WGSL), 48 bytes.
 pub const PIXEL_STATE_BYTES: u64 = 48;
 
-// Flag bits (FLAG_* in common.wgsl).
-pub const FLAG_JITTER: u32 = 2;
-pub const FLAG_TWO_SIDED: u32 = 16;
-pub const FLAG_INDEPENDENT: u32 = 64;
-pub const FLAG_DEPTH_INPUT: u32 = 128;
-pub const FLAG_AVERAGE_RANGE: u32 = 1024;
-
 /// The isosurface uniforms (`Iso` in shaders/lib/iso.wgsl), read by the first-hit and
 /// deferred passes.
 #[repr(C)]
@@ -106,9 +99,10 @@ pub struct PhaseTestUniforms {
     pub counts: [u32; 4],
 }
 
-pub const PT_FLAG_BACKGROUND: u32 = 1;
-pub const PT_FLAG_ATTENUATION: u32 = 2;
-pub const PT_FLAG_GUIDE: u32 = 4;
+/// Bytes between the uniform blocks of consecutive dispatches bound at dynamic offsets (the
+/// path tracer's paths, the denoiser's iterations): 256 is the largest dynamic-offset
+/// alignment a device may ask for.
+pub const UNIFORM_STRIDE: u64 = 256;
 
 /// The denoiser's uniforms (`Denoise` in shaders/denoise.wgsl), one block per iteration.
 #[repr(C)]
@@ -118,9 +112,6 @@ pub struct DenoiseUniforms {
     pub size: [u32; 4],
     pub params: [f32; 4],
 }
-
-pub const DENOISE_FROM_SUMS: u32 = 1;
-pub const DENOISE_LAST: u32 = 2;
 
 /// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
 #[repr(C)]
@@ -135,26 +126,131 @@ pub struct EnvUniforms {
     pub params: [u32; 4],
 }
 
-// Isosurface constants (lib/iso.wgsl, environment.wgsl).
+pub fn mat(m: glam::DMat4) -> [f32; 16] {
+    m.as_mat4().to_cols_array()
+}
+
+// ---------------------------------------------------------------------------------------
+// Constants shared with WGSL. Defined here only: `shaders::compose` prepends each as a WGSL
+// `const` declaration (WGSL_CONSTANTS) to every pass, so the shaders cannot disagree.
+// ---------------------------------------------------------------------------------------
+
+/// Blend mode codes (`frame.mode.x`; BlendMode::code).
+pub const BLEND_COMPOSITE: u32 = 0;
+pub const BLEND_MAXIMUM: u32 = 1;
+pub const BLEND_MINIMUM: u32 = 2;
+pub const BLEND_AVERAGE: u32 = 3;
+pub const BLEND_ADDITIVE: u32 = 4;
+pub const BLEND_ISOSURFACE: u32 = 5;
+pub const BLEND_PATHTRACE: u32 = 6;
+
+/// Frame flag bits (`frame.mode.y`).
+pub const FLAG_JITTER: u32 = 2;
+pub const FLAG_TWO_SIDED: u32 = 16;
+pub const FLAG_INDEPENDENT: u32 = 64;
+pub const FLAG_DEPTH_INPUT: u32 = 128;
+pub const FLAG_AVERAGE_RANGE: u32 = 1024;
+
+/// Most lights and clipping planes a frame takes (the sizes of Frame's arrays).
+pub const MAX_LIGHTS: usize = 8;
+pub const MAX_CLIP_PLANES: usize = 6;
+/// Entries per transfer-function table.
+pub const TABLE_SIZE: usize = 1024;
+
+/// Most iso-values per frame, and the isosurface options.
 pub const ISO_MAX_VALUES: usize = 8;
 pub const SPECULAR_CONE: u32 = 0;
 pub const SPECULAR_IMPORTANCE: u32 = 1;
 pub const ISO_FLAG_BACKGROUND: u32 = 1;
+
+/// Environment sources of the environment build pass.
 pub const ENV_SKY: u32 = 0;
 pub const ENV_EQUIRECT: u32 = 1;
 
-pub fn mat(m: glam::DMat4) -> [f32; 16] {
-    m.as_mat4().to_cols_array()
+/// Path tracing flags (`pt.options.x`) and scattering regions (`pt.counts.z`).
+pub const PT_FLAG_BACKGROUND: u32 = 1;
+pub const PT_FLAG_ATTENUATION: u32 = 2;
+pub const PT_FLAG_GUIDE: u32 = 4;
+pub const PT_SCATTER_NONE: u32 = 0;
+pub const PT_SCATTER_SURFACES: u32 = 1;
+pub const PT_SCATTER_BETWEEN: u32 = 2;
+pub const PT_SCATTER_EVERYWHERE: u32 = 3;
+/// Largest opacity the path tracer's medium takes, so that extinction stays finite
+/// (σ ≤ 9.2 per unit distance).
+pub const PT_MAX_OPACITY: f64 = 0.9999;
+
+/// Denoiser iteration flags.
+pub const DENOISE_FROM_SUMS: u32 = 1;
+pub const DENOISE_LAST: u32 = 2;
+
+/// The flag word with each `(on, bit)` pair's bit set where `on`.
+pub fn flag_bits(flags: &[(bool, u32)]) -> u32 {
+    flags
+        .iter()
+        .filter(|(on, _)| *on)
+        .fold(0, |w, (_, bit)| w | bit)
+}
+
+/// A constant's WGSL value.
+#[derive(Clone, Copy, Debug)]
+pub enum Wgsl {
+    U32(u32),
+    F32(f32),
+}
+
+/// Every constant above by its WGSL name.
+pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
+    ("BLEND_COMPOSITE", Wgsl::U32(BLEND_COMPOSITE)),
+    ("BLEND_MAXIMUM", Wgsl::U32(BLEND_MAXIMUM)),
+    ("BLEND_MINIMUM", Wgsl::U32(BLEND_MINIMUM)),
+    ("BLEND_AVERAGE", Wgsl::U32(BLEND_AVERAGE)),
+    ("BLEND_ADDITIVE", Wgsl::U32(BLEND_ADDITIVE)),
+    ("BLEND_ISOSURFACE", Wgsl::U32(BLEND_ISOSURFACE)),
+    ("BLEND_PATHTRACE", Wgsl::U32(BLEND_PATHTRACE)),
+    ("FLAG_JITTER", Wgsl::U32(FLAG_JITTER)),
+    ("FLAG_TWO_SIDED", Wgsl::U32(FLAG_TWO_SIDED)),
+    ("FLAG_INDEPENDENT", Wgsl::U32(FLAG_INDEPENDENT)),
+    ("FLAG_DEPTH_INPUT", Wgsl::U32(FLAG_DEPTH_INPUT)),
+    ("FLAG_AVERAGE_RANGE", Wgsl::U32(FLAG_AVERAGE_RANGE)),
+    ("MAX_LIGHTS", Wgsl::U32(MAX_LIGHTS as u32)),
+    ("MAX_CLIP", Wgsl::U32(MAX_CLIP_PLANES as u32)),
+    ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
+    ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),
+    ("SPECULAR_CONE", Wgsl::U32(SPECULAR_CONE)),
+    ("SPECULAR_IMPORTANCE", Wgsl::U32(SPECULAR_IMPORTANCE)),
+    ("ISO_FLAG_BACKGROUND", Wgsl::U32(ISO_FLAG_BACKGROUND)),
+    ("ENV_SKY", Wgsl::U32(ENV_SKY)),
+    ("ENV_EQUIRECT", Wgsl::U32(ENV_EQUIRECT)),
+    ("PT_FLAG_BACKGROUND", Wgsl::U32(PT_FLAG_BACKGROUND)),
+    ("PT_FLAG_ATTENUATION", Wgsl::U32(PT_FLAG_ATTENUATION)),
+    ("PT_FLAG_GUIDE", Wgsl::U32(PT_FLAG_GUIDE)),
+    ("PT_SCATTER_NONE", Wgsl::U32(PT_SCATTER_NONE)),
+    ("PT_SCATTER_SURFACES", Wgsl::U32(PT_SCATTER_SURFACES)),
+    ("PT_SCATTER_BETWEEN", Wgsl::U32(PT_SCATTER_BETWEEN)),
+    ("PT_SCATTER_EVERYWHERE", Wgsl::U32(PT_SCATTER_EVERYWHERE)),
+    ("PT_MAX_OPACITY", Wgsl::F32(PT_MAX_OPACITY as f32)),
+    ("DENOISE_FROM_SUMS", Wgsl::U32(DENOISE_FROM_SUMS)),
+    ("DENOISE_LAST", Wgsl::U32(DENOISE_LAST)),
+];
+
+/// The WGSL declarations of [`WGSL_CONSTANTS`], one line each.
+pub fn wgsl_constants() -> String {
+    WGSL_CONSTANTS
+        .iter()
+        .map(|(name, v)| match v {
+            Wgsl::U32(x) => format!("const {name}: u32 = {x}u;\n"),
+            Wgsl::F32(x) => format!("const {name}: f32 = {x:?};\n"),
+        })
+        .collect()
 }
 
 #[cfg(test)]
 mod layout_tests {
     use super::*;
-    use crate::pathtrace::ScatterRegions;
     use std::mem::{offset_of, size_of};
 
     fn module(pass: &str) -> naga::Module {
-        naga::front::wgsl::parse_str(&crate::shaders::compose(pass)).expect("WGSL parses")
+        naga::front::wgsl::parse_str(&crate::gpu::shaders::compose(pass)).expect("WGSL parses")
     }
 
     /// (member name, offset) of a WGSL struct, and its size.
@@ -296,45 +392,12 @@ mod layout_tests {
     }
 
     #[test]
-    fn iso_constants_match_wgsl() {
-        let iso = crate::shaders::compose("deferred.wgsl");
-        let env = crate::shaders::compose("environment.wgsl");
-        let pt = crate::shaders::compose("pathtrace.wgsl");
-        let dn = crate::shaders::compose("denoise.wgsl");
-        for (src, name, v) in [
-            (&iso, "MAX_ISO", ISO_MAX_VALUES as u32),
-            (&iso, "SPECULAR_CONE", SPECULAR_CONE),
-            (&iso, "SPECULAR_IMPORTANCE", SPECULAR_IMPORTANCE),
-            (&iso, "ISO_FLAG_BACKGROUND", ISO_FLAG_BACKGROUND),
-            (&env, "ENV_SKY", ENV_SKY),
-            (&env, "ENV_EQUIRECT", ENV_EQUIRECT),
-            (&pt, "PT_FLAG_BACKGROUND", PT_FLAG_BACKGROUND),
-            (&pt, "PT_FLAG_ATTENUATION", PT_FLAG_ATTENUATION),
-            (&pt, "PT_FLAG_GUIDE", PT_FLAG_GUIDE),
-            (&dn, "DENOISE_FROM_SUMS", DENOISE_FROM_SUMS),
-            (&dn, "DENOISE_LAST", DENOISE_LAST),
-            (&pt, "PT_SCATTER_NONE", ScatterRegions::Nowhere.code()),
-            (&pt, "PT_SCATTER_SURFACES", ScatterRegions::Surfaces.code()),
-            (&pt, "PT_SCATTER_BETWEEN", ScatterRegions::Between.code()),
-            (
-                &pt,
-                "PT_SCATTER_EVERYWHERE",
-                ScatterRegions::Everywhere.code(),
-            ),
-        ] {
-            let decl = format!("const {name}: u32 = {v}u;");
-            assert!(src.contains(&decl), "WGSL lacks `{decl}`");
-        }
-    }
-
-    /// Every WGSL file is part of some pass, so the naga test above validates all of them.
-    #[test]
     fn every_file_is_part_of_a_pass() {
-        let used: Vec<String> = crate::shaders::PASSES
+        let used: Vec<String> = crate::gpu::shaders::PASSES
             .iter()
-            .flat_map(|p| crate::shaders::files_of(p))
+            .flat_map(|p| crate::gpu::shaders::files_of(p))
             .collect();
-        for (path, _) in crate::shaders::FILES {
+        for (path, _) in crate::gpu::shaders::FILES {
             assert!(
                 used.iter().any(|u| u == path),
                 "{path} is listed in shaders::FILES but no pass includes it"
@@ -343,25 +406,8 @@ mod layout_tests {
     }
 
     #[test]
-    fn flags_match_wgsl() {
-        let src = crate::shaders::compose("dvr.wgsl");
-        let table = format!("const TABLE_N: u32 = {}u;", crate::transfer::TABLE_SIZE);
-        assert!(src.contains(&table), "WGSL lacks `{table}`");
-        for (name, v) in [
-            ("FLAG_JITTER", FLAG_JITTER),
-            ("FLAG_TWO_SIDED", FLAG_TWO_SIDED),
-            ("FLAG_INDEPENDENT", FLAG_INDEPENDENT),
-            ("FLAG_DEPTH_INPUT", FLAG_DEPTH_INPUT),
-            ("FLAG_AVERAGE_RANGE", FLAG_AVERAGE_RANGE),
-        ] {
-            let decl = format!("const {name}: u32 = {v}u;");
-            assert!(src.contains(&decl), "WGSL lacks `{decl}`");
-        }
-    }
-
-    #[test]
     fn every_pass_validates_with_naga() {
-        for pass in crate::shaders::PASSES {
+        for pass in crate::gpu::shaders::PASSES {
             let m = module(pass);
             naga::valid::Validator::new(
                 naga::valid::ValidationFlags::all(),

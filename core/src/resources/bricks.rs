@@ -7,8 +7,8 @@
 //! device filters it, otherwise as float16 normalised to the data range. The shader turns a
 //! texel back into a scalar with a per-component `scale · texel + shift`.
 
-use crate::device::DeviceInfo;
-use crate::volume::{ScalarType, VolumeData};
+use crate::gpu::DeviceInfo;
+use crate::params::{ScalarType, VolumeData};
 
 /// Points of overlap kept on each side of a brick: one for trilinear interpolation, one
 /// more for central-difference gradients, so bricks meet without seams.
@@ -228,7 +228,6 @@ pub fn brick_texels(v: &VolumeData, layout: &Layout, b: &BrickExtent) -> Vec<u8>
 /// the points b·S … b·S + S (inclusive), all a sample inside the block interpolates from.
 pub struct MinMaxGrid {
     pub dims: [u32; 3],
-    pub components: u32,
     /// Per block, per component: (min, max).
     pub ranges: Vec<[f32; 2]>,
 }
@@ -271,11 +270,7 @@ impl MinMaxGrid {
                 }
             }
         }
-        MinMaxGrid {
-            dims,
-            components: nc,
-            ranges,
-        }
+        MinMaxGrid { dims, ranges }
     }
 }
 

@@ -200,7 +200,9 @@ impl Context {
         match self.lost.lock().map(|l| l.clone()) {
             Ok(Some(message)) => Err(Error::DeviceLost(format!("{what}: {message}"))),
             Ok(None) => Ok(()),
-            Err(_) => Err(Error::DeviceLost(format!("{what}: the device-lost flag is poisoned"))),
+            Err(_) => Err(Error::DeviceLost(format!(
+                "{what}: the device-lost flag is poisoned"
+            ))),
         }
     }
 }

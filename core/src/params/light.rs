@@ -4,7 +4,7 @@
 //! `position` toward `focal_point`; positional lights attenuate with distance and may be
 //! spotlights with a cone angle.
 
-use crate::camera::Camera;
+use super::camera::Camera;
 use glam::{DMat4, DVec3};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,8 +1,8 @@
 //! Copies of GPU textures and buffers to the CPU (tests, G-buffer and environment
 //! inspection, the output image), each waiting for the device.
 
+use super::Context;
 use crate::error::{Error, Result};
-use crate::Context;
 
 /// Copies one mip level / array layer of a texture to the CPU (rows tightly packed).
 pub(crate) fn read_texture_layer(

@@ -1,0 +1,15 @@
+//! The GPU layer: the device context, binding helpers, shader composition, pipelines and
+//! their cache, the Rust mirrors of the WGSL uniforms and constants, texture uploads,
+//! readback and the memory export that shares the output with OpenGL. It knows nothing of
+//! volumes or passes.
+
+pub(crate) mod binding;
+pub mod context;
+pub mod interop;
+pub(crate) mod pipeline;
+pub(crate) mod readback;
+pub mod shaders;
+pub(crate) mod texture;
+pub(crate) mod uniforms;
+
+pub use context::{Context, DeviceInfo};

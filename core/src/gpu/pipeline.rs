@@ -1,0 +1,140 @@
+//! Shader modules and compute pipelines: the one way ferrovol creates them, and one cache of
+//! pipelines specialised by pipeline-overridable constants.
+
+use super::Context;
+use crate::error::Result;
+use std::collections::HashMap;
+use std::hash::Hash;
+
+/// The shader module of pass `file` (composed by [`super::shaders::compose`]), created
+/// without wgpu's injected bounds checks and loop counters: those cost a clamp per access
+/// and a counter per loop iteration, a large share of the frame time on lavapipe.
+///
+/// SAFETY of that, for every pass: the shaders index only within bounds they establish
+/// themselves (pixel indices behind the viewport or rectangle test, table indices from a
+/// clamped coordinate, occupancy and texel coordinates clamped to their grids, iso indices
+/// clamped to MAX_ISO, G-buffer layers below the layer count the textures were made with,
+/// the cone table indexed modulo its length), and every loop advances toward a bound (ray
+/// steps, bisection steps, samples, lights, components, bounces).
+pub(crate) fn shader_module(ctx: &Context, file: &str) -> Result<wgpu::ShaderModule> {
+    ctx.checked(&format!("compiling shader {file}"), || {
+        let desc = wgpu::ShaderModuleDescriptor {
+            label: Some(file),
+            source: wgpu::ShaderSource::Wgsl(super::shaders::compose(file).into()),
+        };
+        // SAFETY: see the function's documentation.
+        unsafe {
+            ctx.device
+                .create_shader_module_trusted(desc, wgpu::ShaderRuntimeChecks::unchecked())
+        }
+    })
+}
+
+/// A pipeline layout of `groups` bind group layouts.
+pub(crate) fn pipeline_layout(
+    ctx: &Context,
+    label: &str,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    ctx.device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &groups,
+            immediate_size: 0,
+        })
+}
+
+/// The compute pipeline of `module`'s `main` with these override constants.
+pub(crate) fn compute_pipeline(
+    ctx: &Context,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::ComputePipeline> {
+    ctx.checked(&format!("creating the {label} pipeline"), || {
+        ctx.device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(layout),
+                module,
+                entry_point: Some("main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    // no pass uses workgroup memory
+                    zero_initialize_workgroup_memory: false,
+                },
+                cache: None,
+            })
+    })
+}
+
+/// The override constants of one specialisation of a pass (its `override` declarations).
+pub(crate) trait Variant: Copy + Eq + Hash {
+    fn constants(&self) -> Vec<(&'static str, f64)>;
+}
+
+/// 1.0 or 0.0: a boolean override constant's value.
+pub(crate) fn flag(on: bool) -> f64 {
+    if on {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// A pass's shader module and pipeline layout with its pipelines, one per variant, created
+/// on first use.
+pub(crate) struct PipelineCache<K> {
+    label: &'static str,
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    pipelines: HashMap<K, wgpu::ComputePipeline>,
+}
+
+impl<K: Variant> PipelineCache<K> {
+    pub fn new(
+        ctx: &Context,
+        file: &'static str,
+        label: &'static str,
+        groups: &[&wgpu::BindGroupLayout],
+    ) -> Result<PipelineCache<K>> {
+        Ok(PipelineCache {
+            label,
+            module: shader_module(ctx, file)?,
+            layout: pipeline_layout(ctx, file, groups),
+            pipelines: HashMap::new(),
+        })
+    }
+
+    /// The pipeline of variant `v`.
+    pub fn get(&mut self, ctx: &Context, v: K) -> Result<wgpu::ComputePipeline> {
+        if let Some(p) = self.pipelines.get(&v) {
+            return Ok(p.clone());
+        }
+        let p = compute_pipeline(ctx, self.label, &self.layout, &self.module, &v.constants())?;
+        self.pipelines.insert(v, p.clone());
+        Ok(p)
+    }
+}
+
+/// A pass of one bind group (`entries`) running `file`'s `main`: its bind group layout and
+/// compute pipeline (the small passes: resolve, gradient build, denoiser, sampling checks).
+pub(crate) fn single_group_pipeline(
+    ctx: &Context,
+    file: &str,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
+    let bgl = ctx
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries,
+        });
+    let layout = pipeline_layout(ctx, file, &[&bgl]);
+    let module = shader_module(ctx, file)?;
+    let pipeline = compute_pipeline(ctx, label, &layout, &module, &[])?;
+    Ok((bgl, pipeline))
+}

@@ -1,0 +1,31 @@
+//! The public parameter and data types: the volume, the transfer function, the view
+//! (camera, lights), per-frame render parameters, isosurfaces, path tracing, the
+//! environment. Plain data with validation; nothing here touches the GPU.
+
+pub mod camera;
+mod check;
+pub mod environment;
+pub mod iso;
+pub mod light;
+pub mod pathtrace;
+pub mod render;
+pub mod transfer;
+pub mod view;
+pub mod volume;
+
+pub use camera::Camera;
+pub use environment::{CubeImage, Environment, EnvironmentSource, Sky};
+pub use iso::{
+    AmbientOcclusion, GBuffer, Hit, IsoParams, IsoScatterMode, IsoScattering, IsoValue, Shininess,
+    SpecularMode, MAX_ISO_VALUES, MAX_SCATTER_SAMPLES,
+};
+pub use light::{Light, LightSpace};
+pub use pathtrace::{BsdfParams, PathTraceParams, ScatterRegions};
+pub use render::{
+    BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
+    MAX_CLIP_PLANES, MAX_LIGHTS,
+};
+pub(crate) use transfer::build_tables;
+pub use transfer::{ComponentTransfer, Piecewise, TransferFunction, TABLE_SIZE};
+pub use view::{Image, Stats, UploadOptions, View};
+pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

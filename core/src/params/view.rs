@@ -1,0 +1,92 @@
+//! What a frame is seen through ([`View`]), how a volume is uploaded ([`UploadOptions`]),
+//! and what comes back ([`Image`], [`Stats`]).
+
+use super::camera::Camera;
+use super::light::Light;
+use crate::error::{Error, Result};
+
+/// What the frame is seen through: camera, lights and image size.
+#[derive(Clone, Debug)]
+pub struct View {
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl View {
+    /// A view of `width × height` with a reset camera on `bounds` and VTK's headlight.
+    pub fn fit(bounds: [f64; 6], width: u32, height: u32) -> View {
+        let mut camera = Camera::default();
+        camera.reset(bounds);
+        View {
+            camera,
+            lights: vec![Light::headlight()],
+            width,
+            height,
+        }
+    }
+    pub fn aspect(&self) -> f64 {
+        self.width as f64 / self.height as f64
+    }
+}
+
+/// Options for uploading a volume.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct UploadOptions {
+    /// Largest brick edge in points (overlap included); `None` = the device limit.
+    pub max_brick_points: Option<u32>,
+    /// Largest brick texture in bytes; `None` = the device's buffer limit, at most 1 GiB.
+    pub max_brick_bytes: Option<u64>,
+    /// Store the first component's central-difference gradients in a texture beside each
+    /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
+    /// gradients: see shaders/gradient.wgsl); single-component volumes only. `None`: off
+    /// (measured slower on lavapipe, the one device this was measured on; a GPU's texture
+    /// units may well reverse that).
+    pub precompute_gradients: Option<bool>,
+}
+
+/// Counters that show what a frame re-uploaded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    pub volume_uploads: u32,
+    pub table_uploads: u32,
+    pub occupancy_updates: u32,
+    pub frames: u32,
+}
+
+/// A finished frame read back to the CPU.
+#[derive(Clone, Debug)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    /// Premultiplied RGBA8, rows top to bottom.
+    pub rgba: Vec<u8>,
+    /// Window depth per pixel (0 near … 1 far; 1 where no sample passed the threshold).
+    pub depth: Vec<f32>,
+}
+
+impl Image {
+    /// Composites over an opaque background colour and writes a PNG.
+    pub fn save_png(&self, path: &std::path::Path, background: [f32; 3]) -> Result<()> {
+        let mut out = image::RgbImage::new(self.width, self.height);
+        for (i, px) in out.pixels_mut().enumerate() {
+            let p = &self.rgba[4 * i..4 * i + 4];
+            let a = p[3] as f32 / 255.0;
+            for c in 0..3 {
+                let v = p[c] as f32 + (1.0 - a) * background[c] * 255.0;
+                px.0[c] = v.round().clamp(0.0, 255.0) as u8;
+            }
+        }
+        out.save(path).map_err(|e| Error::ImageWrite {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Pixel (x, y) as premultiplied RGBA in [0, 1].
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        let i = 4 * (y * self.width + x) as usize;
+        [0, 1, 2, 3].map(|c| self.rgba[i + c] as f32 / 255.0)
+    }
+}

@@ -1,0 +1,157 @@
+//! The path tracer's denoiser.
+
+use super::frame::groups;
+use crate::error::Result;
+use crate::gpu::binding::{bind, buffer_entry, entry, storage_texture_entry};
+use crate::gpu::pipeline::single_group_pipeline;
+use crate::gpu::uniforms::{DenoiseUniforms, DENOISE_FROM_SUMS, DENOISE_LAST, UNIFORM_STRIDE};
+use crate::gpu::Context;
+
+/// Iterations of the à-trous denoiser (taps 1, 2 and 4 pixels apart).
+const DENOISE_ITERATIONS: u32 = 3;
+/// Edge-stopping scales of the denoiser: colour (radiance units, shrinking by √2 each
+/// iteration), the power of the normals' cosine (low: a medium's first-collision normals are
+/// noisy), depth (sample distances per pixel of tap spacing).
+const DENOISE_COLOR_SIGMA: f32 = 1.0;
+const DENOISE_NORMAL_POWER: f32 = 1.0;
+const DENOISE_DEPTH_SIGMA: f32 = 16.0;
+
+/// What the denoiser reads and writes.
+pub(crate) struct DenoiseOutputs<'a> {
+    pub accum: &'a wgpu::Buffer,
+    pub guide: &'a wgpu::Buffer,
+    pub images: [&'a wgpu::Buffer; 2],
+    pub color: &'a wgpu::TextureView,
+}
+
+/// The denoiser (shaders/denoise.wgsl): an edge-avoiding à-trous filter of the path
+/// tracer's accumulation guided by the first collisions' normals and depths.
+pub(crate) struct DenoisePass {
+    bgl: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    uniforms: wgpu::Buffer,
+}
+
+impl DenoisePass {
+    pub fn new(ctx: &Context) -> Result<DenoisePass> {
+        use wgpu::BufferBindingType as B;
+        let (bgl, pipeline) = single_group_pipeline(
+            ctx,
+            "denoise.wgsl",
+            "denoise",
+            &[
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: B::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<
+                            DenoiseUniforms,
+                        >()
+                            as u64),
+                    },
+                ),
+                buffer_entry(1, B::Storage { read_only: true }),
+                buffer_entry(2, B::Storage { read_only: false }),
+                buffer_entry(3, B::Storage { read_only: true }),
+                buffer_entry(4, B::Storage { read_only: true }),
+                storage_texture_entry(
+                    5,
+                    wgpu::TextureFormat::Rgba8Unorm,
+                    wgpu::TextureViewDimension::D2,
+                ),
+            ],
+        )?;
+        let d = &ctx.device;
+        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("denoiser uniforms"),
+            size: UNIFORM_STRIDE * DENOISE_ITERATIONS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(DenoisePass {
+            bgl,
+            pipeline,
+            uniforms,
+        })
+    }
+
+    /// Records the denoiser's iterations over `rect`: the accumulation's means (scale[0] = 1 /
+    /// paths) filtered into the ping-pong images, the last also into the output colour. The
+    /// colour edge-stopping scale shrinks each iteration (Dammertz et al. halve it); depths are
+    /// compared per `scale[1]` (the sample distance) times the tap spacing.
+    pub fn encode(
+        &self,
+        ctx: &Context,
+        enc: &mut wgpu::CommandEncoder,
+        out: &DenoiseOutputs<'_>,
+        rect: [u32; 4],
+        width: u32,
+        scale: [f32; 2],
+    ) {
+        let mut blocks = vec![0u8; (UNIFORM_STRIDE * DENOISE_ITERATIONS as u64) as usize];
+        for i in 0..DENOISE_ITERATIONS {
+            let mut flags = 0;
+            if i == 0 {
+                flags |= DENOISE_FROM_SUMS;
+            }
+            if i + 1 == DENOISE_ITERATIONS {
+                flags |= DENOISE_LAST;
+            }
+            let u = DenoiseUniforms {
+                rect,
+                size: [width, 0, 1 << i, flags],
+                params: [
+                    scale[0],
+                    DENOISE_COLOR_SIGMA * 0.5f32.powf(i as f32 * 0.5),
+                    DENOISE_NORMAL_POWER,
+                    DENOISE_DEPTH_SIGMA * scale[1],
+                ],
+            };
+            let at = (UNIFORM_STRIDE * i as u64) as usize;
+            blocks[at..at + std::mem::size_of::<DenoiseUniforms>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        ctx.queue.write_buffer(&self.uniforms, 0, &blocks);
+        let bind = |src: &wgpu::Buffer, dst: &wgpu::Buffer| {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("denoise"),
+                layout: &self.bgl,
+                entries: &[
+                    bind(
+                        0,
+                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.uniforms,
+                            offset: 0,
+                            size: std::num::NonZeroU64::new(
+                                std::mem::size_of::<DenoiseUniforms>() as u64
+                            ),
+                        }),
+                    ),
+                    bind(1, src.as_entire_binding()),
+                    bind(2, dst.as_entire_binding()),
+                    bind(3, out.guide.as_entire_binding()),
+                    bind(4, out.accum.as_entire_binding()),
+                    bind(5, wgpu::BindingResource::TextureView(out.color)),
+                ],
+            })
+        };
+        let [a, b] = out.images;
+        let gr = groups(rect);
+        let bind_groups = [bind(out.accum, a), bind(a, b), bind(b, a)];
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("denoise"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        for i in 0..DENOISE_ITERATIONS {
+            let g = if i == 0 {
+                &bind_groups[0]
+            } else {
+                &bind_groups[1 + (i as usize + 1) % 2]
+            };
+            pass.set_bind_group(0, g, &[(UNIFORM_STRIDE * i as u64) as u32]);
+            pass.dispatch_workgroups(gr[0], gr[1], 1);
+        }
+    }
+}

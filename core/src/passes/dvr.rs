@@ -1,0 +1,219 @@
+//! Ray casting (shaders/dvr.wgsl) in the blend modes of VTK's mappers (composite with early
+//! ray termination, maximum, minimum, average, additive), one dispatch per brick in
+//! visibility order; with several bricks a resolve pass (shaders/resolve.wgsl) turns the
+//! per-pixel ray state into the output images.
+
+use super::frame::{self, brick_order, groups, SKIP_MAX_OCCUPANCY};
+use crate::error::Result;
+use crate::gpu::binding::{
+    bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
+};
+use crate::gpu::pipeline::{flag, single_group_pipeline, PipelineCache, Variant};
+use crate::gpu::Context;
+use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, View};
+use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::Resources;
+
+/// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct DvrVariant {
+    blend: u32,
+    components: u32,
+    independent: bool,
+    shade: bool,
+    gradient_opacity: bool,
+    skip: bool,
+    crop: bool,
+    nearest: bool,
+    single_brick: bool,
+    positional_lights: bool,
+    lights: u32,
+    volumetric: bool,
+    precomputed_gradient: bool,
+    forward_diff: bool,
+}
+
+impl Variant for DvrVariant {
+    fn constants(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("BLEND", self.blend as f64),
+            ("NCOMP", self.components as f64),
+            ("INDEPENDENT", flag(self.independent)),
+            ("SHADE", flag(self.shade)),
+            ("GRAD_OPACITY", flag(self.gradient_opacity)),
+            ("SKIP", flag(self.skip)),
+            ("CROP", flag(self.crop)),
+            ("NEAREST", flag(self.nearest)),
+            ("SINGLE_BRICK", flag(self.single_brick)),
+            ("POSITIONAL_LIGHTS", flag(self.positional_lights)),
+            ("NUM_LIGHTS", self.lights as f64),
+            ("VOLUMETRIC", flag(self.volumetric)),
+            ("PRECOMPUTED_GRADIENT", flag(self.precomputed_gradient)),
+            ("FORWARD_DIFF", flag(self.forward_diff)),
+        ]
+    }
+}
+
+/// The ray-casting pass: its pipelines (one per variant) and the resolve pass.
+pub(crate) struct DvrPass {
+    bgl: wgpu::BindGroupLayout,
+    pipelines: PipelineCache<DvrVariant>,
+    resolve_bgl: wgpu::BindGroupLayout,
+    resolve: wgpu::ComputePipeline,
+}
+
+impl DvrPass {
+    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        let color_out = storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2);
+        let depth_out = storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2);
+        let bgl = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("dvr frame"),
+                entries: &[
+                    buffer_entry(0, B::Uniform),
+                    texture_entry(1, false, V::D2),
+                    buffer_entry(2, B::Storage { read_only: false }),
+                    sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
+                    texture_entry(4, false, V::D2),
+                    color_out,
+                    depth_out,
+                ],
+            });
+        let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
+        let (resolve_bgl, resolve) = single_group_pipeline(
+            ctx,
+            "resolve.wgsl",
+            "resolve",
+            &[
+                buffer_entry(0, B::Uniform),
+                texture_entry(1, false, V::D2),
+                buffer_entry(2, B::Storage { read_only: true }),
+                color_out,
+                depth_out,
+            ],
+        )?;
+        Ok(DvrPass {
+            bgl,
+            pipelines,
+            resolve_bgl,
+            resolve,
+        })
+    }
+
+    /// One ray-cast frame.
+    pub fn render(
+        &mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        view: &View,
+        params: &RenderParams,
+        depth: DepthSource<'_>,
+    ) -> Result<()> {
+        params.validate()?;
+        if params.shading.enabled {
+            frame::check_light_count(view)?;
+        }
+        let step = res.sample_distance(params)?;
+        res.ensure_tables(ctx, step)?;
+        res.ensure_occupancy(ctx, step)?;
+        let occupied = res.occupancy.as_ref().map_or(1.0, |o| o.fraction);
+        let skip = params.empty_space_skipping
+            && params.blend == BlendMode::Composite
+            && occupied < SKIP_MAX_OCCUPANCY;
+        res.ensure_targets(ctx, view.width, view.height)?;
+        res.write_depth_input(ctx, view, depth)?;
+        let depth_input = !matches!(depth, DepthSource::None);
+        let f = frame::frame(res, view, params, step, depth_input)?;
+        let vol = res.volume()?;
+        let variant = DvrVariant {
+            blend: params.blend.code(),
+            components: vol.components,
+            independent: f.independent,
+            shade: params.shading.enabled,
+            gradient_opacity: f.gradient_opacity,
+            skip,
+            crop: params.cropping.is_some(),
+            nearest: params.interpolation == Interpolation::Nearest,
+            single_brick: vol.bricks.len() == 1,
+            positional_lights: f.positional_lights(),
+            lights: f.lights(),
+            volumetric: f.volumetric,
+            precomputed_gradient: vol.gradients,
+            forward_diff: params.gradient == GradientMethod::Forward,
+        };
+        let dvr = self.pipelines.get(ctx, variant)?;
+        let order = brick_order(res, view, params);
+        let t = res.targets.as_ref().expect("targets allocated above");
+        let (_, tables) = res.tables.as_ref().expect("tables built above");
+        let occupancy = &res.occupancy.as_ref().expect("occupancy built above").grid;
+        let q = &ctx.queue;
+        let d = &ctx.device;
+        let u = f.uniforms;
+        q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
+        let depth_in_view = t.depth_in.create_view(&Default::default());
+        let color_view = t.color.create_view(&Default::default());
+        let depth_view = t.depth.create_view(&Default::default());
+        let common = [
+            bind(0, res.frame_buf.as_entire_binding()),
+            bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+            bind(2, t.state.as_entire_binding()),
+            bind(5, wgpu::BindingResource::TextureView(&color_view)),
+            bind(6, wgpu::BindingResource::TextureView(&depth_view)),
+        ];
+        let mut dvr_entries = common.to_vec();
+        dvr_entries.push(bind(3, wgpu::BindingResource::TextureView(occupancy)));
+        dvr_entries.push(bind(4, wgpu::BindingResource::TextureView(&depth_in_view)));
+        let dvr_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dvr frame"),
+            layout: &self.bgl,
+            entries: &dvr_entries,
+        });
+        let resolve_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("resolve"),
+            layout: &self.resolve_bgl,
+            entries: &common,
+        });
+        let rect = u.rect;
+        let gr = groups(rect);
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame"),
+        });
+        if rect != [0, 0, view.width, view.height] {
+            clear_outputs(&mut enc, &color_view, &depth_view);
+        }
+        if !variant.single_brick {
+            enc.clear_buffer(&t.state, 0, None);
+        }
+        for i in order {
+            let b = &vol.bricks[i];
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dvr"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&dvr);
+            pass.set_bind_group(0, &dvr_bg, &[]);
+            let bg = if params.interpolation == Interpolation::Nearest {
+                &b.bind_nearest
+            } else {
+                &b.bind_linear
+            };
+            pass.set_bind_group(1, bg, &[]);
+            pass.dispatch_workgroups(gr[0], gr[1], 1);
+        }
+        if !variant.single_brick {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("resolve"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.resolve);
+            pass.set_bind_group(0, &resolve_bg, &[]);
+            pass.dispatch_workgroups(gr[0], gr[1], 1);
+        }
+        q.submit([enc.finish()]);
+        res.stats.frames += 1;
+        Ok(())
+    }
+}

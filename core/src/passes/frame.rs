@@ -1,0 +1,367 @@
+//! What every pass of a frame shares: the frame uniforms (camera, volume transform, tables'
+//! ranges, material, lights, clipping, the screen rectangle the volume covers), the bricks'
+//! visibility order and the workgroup size.
+
+use crate::error::{Error, Result};
+use crate::gpu::uniforms::{
+    flag_bits, mat, FrameUniforms, FLAG_AVERAGE_RANGE, FLAG_DEPTH_INPUT, FLAG_INDEPENDENT,
+    FLAG_JITTER, FLAG_TWO_SIDED,
+};
+use crate::params::{BlendMode, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS};
+use crate::resources::bricks::{BrickExtent, BLOCK_SIZE};
+use crate::resources::Resources;
+use bytemuck::Zeroable;
+use glam::{DMat4, DVec3};
+
+/// Edge of the square compute workgroups (`@workgroup_size` of the screen-space passes).
+/// 8×8 keeps rays in a workgroup coherent; 16×16 measured slower on lavapipe.
+pub(crate) const WORKGROUP: u32 = 8;
+
+/// Empty-space skipping is used only when fewer blocks than this fraction are occupied:
+/// skipping costs a block lookup per sample, which cannot pay for itself where nearly every
+/// block is occupied.
+pub(crate) const SKIP_MAX_OCCUPANCY: f64 = 0.9;
+
+/// An error unless the view has at most [`MAX_LIGHTS`] lights.
+pub(crate) fn check_light_count(view: &View) -> Result<()> {
+    if view.lights.len() > MAX_LIGHTS {
+        return Err(Error::InvalidParameter(format!(
+            "{} lights; at most {MAX_LIGHTS} are supported",
+            view.lights.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Workgroups covering the pixel rectangle `r` ([x0, y0, x1, y1)).
+pub(crate) fn groups(r: [u32; 4]) -> [u32; 2] {
+    [
+        (r[2] - r[0]).div_ceil(WORKGROUP),
+        (r[3] - r[1]).div_ceil(WORKGROUP),
+    ]
+}
+
+/// One frame's uniforms and the facts about it the passes specialise their pipelines on.
+pub(crate) struct Frame {
+    pub uniforms: FrameUniforms,
+    /// Some component has a gradient opacity function.
+    pub gradient_opacity: bool,
+    /// The components are classified independently.
+    pub independent: bool,
+    /// VTK's volumetric shadows are on.
+    pub volumetric: bool,
+}
+
+impl Frame {
+    /// Lights the frame carries.
+    pub fn lights(&self) -> u32 {
+        self.uniforms.counts[1]
+    }
+
+    /// Whether any of them is positional.
+    pub fn positional_lights(&self) -> bool {
+        self.uniforms.lights[..self.lights() as usize]
+            .iter()
+            .any(|l| l.position[3] == 1.0)
+    }
+}
+
+/// The pixels the volume's box can cover: the bounding rectangle of its projected corners
+/// widened by a pixel, as [x0, y0, x1, y1) — or the whole image when a corner lies behind
+/// the camera (the camera is inside or beside the volume).
+fn screen_rect(
+    vp: DMat4,
+    index_to_world: DMat4,
+    dims: [u32; 3],
+    width: u32,
+    height: u32,
+) -> [u32; 4] {
+    let full = [0, 0, width, height];
+    let (mut x0, mut y0, mut x1, mut y1) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for c in 0..8u32 {
+        let ijk = DVec3::new(
+            if c & 1 != 0 {
+                (dims[0] - 1) as f64
+            } else {
+                0.0
+            },
+            if c & 2 != 0 {
+                (dims[1] - 1) as f64
+            } else {
+                0.0
+            },
+            if c & 4 != 0 {
+                (dims[2] - 1) as f64
+            } else {
+                0.0
+            },
+        );
+        let clip = vp * index_to_world.transform_point3(ijk).extend(1.0);
+        if clip.w <= 1e-9 || !clip.is_finite() {
+            return full;
+        }
+        let x = (clip.x / clip.w + 1.0) * 0.5 * width as f64;
+        let y = (1.0 - clip.y / clip.w) * 0.5 * height as f64;
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let clamp = |v: f64, hi: u32| v.clamp(0.0, hi as f64) as u32;
+    let r = [
+        clamp(x0.floor() - 1.0, width),
+        clamp(y0.floor() - 1.0, height),
+        clamp(x1.ceil() + 1.0, width),
+        clamp(y1.ceil() + 1.0, height),
+    ];
+    if r[0] >= r[2] || r[1] >= r[3] {
+        return [0, 0, 0, 0];
+    }
+    r
+}
+
+/// The frame uniforms of a frame of `view` with `params` at sample distance `step`, with
+/// what the passes specialise on.
+pub(crate) fn frame(
+    res: &Resources,
+    view: &View,
+    params: &RenderParams,
+    step: f64,
+    depth_input: bool,
+) -> Result<Frame> {
+    let vol = res.volume()?;
+    // Isosurfaces need no transfer function: a placeholder fills its uniforms.
+    let placeholder;
+    let tf = match res.tf.as_ref() {
+        Some(tf) => tf,
+        None if params.blend == BlendMode::Isosurface => {
+            placeholder = TransferFunction::ramp([0.0, 1.0], 1.0);
+            &placeholder
+        }
+        None => {
+            return Err(Error::InvalidParameter(
+                "no transfer function has been set".into(),
+            ))
+        }
+    };
+    let aspect = view.aspect();
+    let vp = view.camera.view_projection(aspect);
+    if !vp.is_finite() || vp.determinant().abs() < 1e-300 {
+        return Err(Error::InvalidParameter("the camera gives a singular projection (check position, focal point, view up and clipping range)".into()));
+    }
+    let index_to_world = params.volume_matrix * vol.index_to_data;
+    let world_to_index = index_to_world.inverse();
+    let mut u = FrameUniforms::zeroed();
+    u.camera = [mat(vp.inverse()), mat(vp)];
+    u.world_to_index = mat(world_to_index);
+    u.index_to_data = mat(vol.index_to_data);
+    u.gradient_to_world = mat(world_to_index.transpose());
+    let dd = vol.data_dims;
+    u.dims = [
+        dd[0] as f32,
+        dd[1] as f32,
+        dd[2] as f32,
+        vol.components as f32,
+    ];
+    u.scalar_scale = vol.layout.scale;
+    u.scalar_shift = vol.layout.shift;
+    let mut any_go = false;
+    for c in 0..4 {
+        let ct = tf.component(c);
+        let [lo, hi] = ct.table_range();
+        u.tf_lo[c] = lo as f32;
+        u.tf_inv_width[c] = (1.0 / (hi - lo)) as f32;
+        let [glo, ghi] = ct.gradient_range();
+        u.go_lo[c] = glo as f32;
+        u.go_inv_width[c] = (1.0 / (ghi - glo)) as f32;
+        u.weights[c] = ct.weight;
+        u.additive_scale[c] = (step / ct.unit_distance) as f32;
+        any_go |= ct.gradient_opacity.is_some() && (c as u32) < vol.components;
+    }
+    let s = &params.shading;
+    u.material = [s.ambient, s.diffuse, s.specular, s.specular_power];
+    let mut flags = 0;
+    if let Some(c) = &params.cropping {
+        u.crop_lo = [
+            c.planes[0] as f32,
+            c.planes[2] as f32,
+            c.planes[4] as f32,
+            0.0,
+        ];
+        u.crop_hi = [
+            c.planes[1] as f32,
+            c.planes[3] as f32,
+            c.planes[5] as f32,
+            0.0,
+        ];
+        u.mode[2] = c.regions;
+    }
+    u.misc = [
+        step as f32,
+        params.termination_threshold,
+        params.depth_threshold,
+        0.0,
+    ];
+    if let Some(r) = params.average_range {
+        flags |= FLAG_AVERAGE_RANGE;
+        u.average_range = [r[0] as f32, r[1] as f32, 0.0, 0.0];
+    }
+    // clipping planes, world → index space: keep dot(n_i, p) + w >= 0
+    for (i, p) in params.clip_planes.iter().enumerate() {
+        let n = p.normal.normalize();
+        let ni = index_to_world.transpose().transform_vector3(n);
+        let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
+        u.clip[i] = [ni.x as f32, ni.y as f32, ni.z as f32, w as f32];
+    }
+    let mut nl = 0;
+    if s.enabled {
+        for l in view.lights.iter().take(MAX_LIGHTS) {
+            let (pos, focal) = l.world_placement(&view.camera);
+            let k = l.intensity;
+            let g = &mut u.lights[nl];
+            if l.positional {
+                g.position = [pos.x as f32, pos.y as f32, pos.z as f32, 1.0];
+                let axis = (focal - pos).try_normalize().unwrap_or(DVec3::NEG_Z);
+                let cone = if l.cone_angle < 90.0 {
+                    (l.cone_angle as f64).to_radians().cos() as f32
+                } else {
+                    -2.0
+                };
+                g.spot = [axis.x as f32, axis.y as f32, axis.z as f32, cone];
+            } else {
+                let dir = (pos - focal).try_normalize().unwrap_or(DVec3::Z);
+                // A headlight shines along each ray (w = 2), as VTK's headlight path
+                // lights every sample from the camera.
+                let w = if l.space == LightSpace::Headlight {
+                    2.0
+                } else {
+                    0.0
+                };
+                g.position = [dir.x as f32, dir.y as f32, dir.z as f32, w];
+                g.spot = [0.0, 0.0, 0.0, -2.0];
+            }
+            g.diffuse = [
+                l.diffuse[0] * k,
+                l.diffuse[1] * k,
+                l.diffuse[2] * k,
+                l.exponent,
+            ];
+            g.specular = [l.specular[0] * k, l.specular[1] * k, l.specular[2] * k, 0.0];
+            g.ambient = [l.ambient[0] * k, l.ambient[1] * k, l.ambient[2] * k, 0.0];
+            g.attenuation = [l.attenuation[0], l.attenuation[1], l.attenuation[2], 0.0];
+            nl += 1;
+        }
+        if s.two_sided {
+            flags |= FLAG_TWO_SIDED;
+        }
+    }
+    flags |= flag_bits(&[
+        (params.jitter, FLAG_JITTER),
+        (tf.independent, FLAG_INDEPENDENT),
+        (depth_input, FLAG_DEPTH_INPUT),
+    ]);
+    // VTK's volumetric shadows: composite, shaded, lit; one component in one brick (the
+    // shadow rays read the whole volume from one texture).
+    let volumetric =
+        s.enabled && s.volumetric_blending > 0.0 && nl > 0 && params.blend == BlendMode::Composite;
+    if volumetric {
+        if vol.bricks.len() != 1 || vol.components != 1 {
+            return Err(Error::Unsupported(format!(
+                "volumetric scattering needs a one-component volume in one brick (this one \
+                 has {} component(s) in {} brick(s)): turn the scattering blending off",
+                vol.components,
+                vol.bricks.len()
+            )));
+        }
+        let extent = [DVec3::X, DVec3::Y, DVec3::Z]
+            .iter()
+            .zip(vol.data_dims)
+            .map(|(axis, n)| {
+                index_to_world.transform_vector3(*axis).length() * (n.max(2) - 1) as f64
+            })
+            .fold(0.0, f64::max);
+        // VTK: reach = √3 + (m − √3)(1 − R)^0.33 texture units, m the sample distance
+        // over the largest extent
+        let m = step / extent;
+        let root3 = 3f64.sqrt();
+        let reach = root3 + (m - root3) * (1.0 - s.global_illumination_reach as f64).powf(0.33);
+        let (lo, hi) = vol
+            .minmax
+            .ranges
+            .iter()
+            .step_by(vol.components as usize)
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), r| {
+                (lo.min(r[0]), hi.max(r[1]))
+            });
+        let range = if hi > lo { (hi - lo) as f64 } else { 1.0 };
+        u.scatter = [
+            s.volumetric_blending,
+            s.scattering_anisotropy,
+            reach as f32,
+            (2.0 / range) as f32,
+        ];
+    }
+    u.viewport = [view.width, view.height, 0, 0x9e37_79b9];
+    u.rect = screen_rect(vp, index_to_world, vol.data_dims, view.width, view.height);
+    u.mode[0] = params.blend.code();
+    u.mode[1] = flags;
+    u.counts = [
+        params.clip_planes.len() as u32,
+        nl as u32,
+        BLOCK_SIZE,
+        vol.components,
+    ];
+    u.occupancy_dims = [
+        vol.minmax.dims[0],
+        vol.minmax.dims[1],
+        vol.minmax.dims[2],
+        0,
+    ];
+    Ok(Frame {
+        uniforms: u,
+        gradient_opacity: any_go,
+        independent: tf.independent,
+        volumetric,
+    })
+}
+
+/// Bricks in front-to-back order for this camera: along each axis, bricks on the
+/// camera's side of a brick boundary come first. For a grid of boxes this order is a
+/// valid visibility order for perspective and parallel projection alike.
+pub(crate) fn brick_order(res: &Resources, view: &View, params: &RenderParams) -> Vec<usize> {
+    let Some(vol) = res.volume.as_ref() else {
+        return vec![];
+    };
+    let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
+    let cam = world_to_index.transform_point3(view.camera.position);
+    let dir = world_to_index.transform_vector3(view.camera.direction());
+    let bc = vol.layout.brick_cells as f64;
+    let mut order: Vec<usize> = (0..vol.bricks.len()).collect();
+    // Per axis, how many brick steps separate a brick from the camera's brick (perspective:
+    // a ray's successive bricks have non-decreasing steps on every axis and a strictly
+    // larger sum) or how far it lies along the view direction (parallel).
+    let key = |e: &BrickExtent| -> [i64; 3] {
+        [0, 1, 2].map(|a| {
+            let cell = e.cell[a] as i64;
+            if view.camera.parallel {
+                if dir[a] >= 0.0 {
+                    cell
+                } else {
+                    -cell
+                }
+            } else {
+                (cell - (cam[a] / bc).floor() as i64).abs()
+            }
+        })
+    };
+    order.sort_by_key(|&i| {
+        let k = key(&vol.bricks[i].extent);
+        k[0] + k[1] + k[2]
+    });
+    order
+}

@@ -1,0 +1,91 @@
+//! The gradient build (shaders/gradient.wgsl): central-difference gradients of a brick's
+//! first component into an rgba16float texture beside it, for
+//! [`UploadOptions::precompute_gradients`](crate::UploadOptions::precompute_gradients).
+
+use crate::error::Result;
+use crate::gpu::binding::{bind, buffer_entry, storage_texture_entry, texture_entry};
+use crate::gpu::pipeline::single_group_pipeline;
+use crate::gpu::Context;
+use crate::resources::bricks::Layout;
+
+pub(crate) struct GradientPass {
+    bgl: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl GradientPass {
+    pub fn new(ctx: &Context) -> Result<GradientPass> {
+        let (bgl, pipeline) = single_group_pipeline(
+            ctx,
+            "gradient.wgsl",
+            "gradient build",
+            &[
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                texture_entry(1, false, wgpu::TextureViewDimension::D3),
+                storage_texture_entry(
+                    2,
+                    wgpu::TextureFormat::Rgba16Float,
+                    wgpu::TextureViewDimension::D3,
+                ),
+            ],
+        )?;
+        Ok(GradientPass { bgl, pipeline })
+    }
+
+    /// A brick's gradient texture, computed from its volume texture on the GPU.
+    pub fn build(
+        &self,
+        ctx: &Context,
+        volume: &wgpu::TextureView,
+        size: wgpu::Extent3d,
+        layout: &Layout,
+    ) -> Result<wgpu::Texture> {
+        let d = &ctx.device;
+        let texture = ctx.checked("allocating the gradient texture", || {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some("gradients"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+                view_formats: &[],
+            })
+        })?;
+        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gradient build uniforms"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let scale = [layout.scale[0], layout.shift[0], 0.0f32, 0.0];
+        ctx.queue
+            .write_buffer(&uniforms, 0, bytemuck::bytes_of(&scale));
+        let out = texture.create_view(&Default::default());
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gradient build"),
+            layout: &self.bgl,
+            entries: &[
+                bind(0, uniforms.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(volume)),
+                bind(2, wgpu::BindingResource::TextureView(&out)),
+            ],
+        });
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(
+                size.width.div_ceil(4),
+                size.height.div_ceil(4),
+                size.depth_or_array_layers.div_ceil(4),
+            );
+        }
+        ctx.checked("computing the gradients", || {
+            ctx.queue.submit([enc.finish()]);
+        })?;
+        Ok(texture)
+    }
+}

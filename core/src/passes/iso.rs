@@ -1,0 +1,604 @@
+//! High-quality isosurfaces: first hit with interval bisection, deferred shading with
+//! environment maps, ambient occlusion.
+//!
+//! With [`BlendMode::Isosurface`](crate::BlendMode::Isosurface) a frame is two passes:
+//!
+//! 1. **First hit** (shaders/firsthit.wgsl): each pixel's ray is marched as the DVR pass
+//!    marches it (bricks, clipping planes, cropping, the host's depth, the sample lattice,
+//!    empty-space skipping against the iso-values); between two samples on opposite sides of
+//!    an iso-value the crossing is refined by interval bisection on the field interpolated
+//!    in f32 from the texels (not through the sampler, whose filter weights have 8 bits) and
+//!    written to a layered G-buffer: position, normal (central differences at the refined
+//!    hit), gradient magnitude, iso index, window depth and ambient accessibility. Marching
+//!    goes on behind translucent surfaces until the accumulated opacity reaches the
+//!    termination threshold or [`IsoParams::max_layers`] layers are filled, so nested
+//!    translucent isosurfaces (skin over bone) keep every layer.
+//! 2. **Deferred shading** (shaders/deferred.wgsl): every layer is lit (Blinn–Phong with the
+//!    view's lights, irradiance-cube diffuse, environment specular on the Phong lobe,
+//!    Fresnel, AO) and the layers are composited front to back with their opacities.
+//!
+//! Ambient occlusion is computed in the first pass, where the volume is bound, and stored
+//! per layer. The environment's maps are built once by
+//! [`Renderer::set_environment`](crate::Renderer::set_environment)
+//! (see [`crate::params::environment`]).
+
+use super::frame::{self, brick_order, groups, SKIP_MAX_OCCUPANCY};
+use crate::error::{Error, Result};
+use crate::gpu::binding::{
+    bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
+};
+use crate::gpu::pipeline::{flag, PipelineCache, Variant};
+use crate::gpu::readback::{read_buffer, read_texture_layer};
+use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND};
+use crate::gpu::Context;
+use crate::params::iso::MAX_SPECULAR_SAMPLES;
+use crate::params::{
+    BlendMode, GBuffer, IsoParams, IsoScatterMode, RenderParams, Shading, Shininess, View,
+};
+use crate::resources::environment::texel_solid_angle;
+use crate::resources::tables::{Occupancy, Tables};
+use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::Resources;
+use bytemuck::Zeroable;
+use glam::DMat4;
+
+/// The pipeline constants of one specialisation of the first-hit pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct FirstHitVariant {
+    skip: bool,
+    crop: bool,
+    single_brick: bool,
+}
+
+impl Variant for FirstHitVariant {
+    fn constants(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("SKIP", flag(self.skip)),
+            ("CROP", flag(self.crop)),
+            ("SINGLE_BRICK", flag(self.single_brick)),
+        ]
+    }
+}
+
+/// The pipeline constants of one specialisation of the deferred pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct DeferredVariant {
+    lights: u32,
+    positional_lights: bool,
+    /// 0 none, 1 preview, 2 traced (IsoScattering).
+    scatter: u32,
+}
+
+impl Variant for DeferredVariant {
+    fn constants(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("NUM_LIGHTS", self.lights as f64),
+            ("POSITIONAL_LIGHTS", flag(self.positional_lights)),
+            ("SCATTER", self.scatter as f64),
+        ]
+    }
+}
+
+struct GBufferTargets {
+    width: u32,
+    height: u32,
+    layers: u32,
+    position: wgpu::Texture,
+    normal: wgpu::Texture,
+    extra: wgpu::Texture,
+}
+
+/// The occupancy of the min–max blocks for a set of iso-values: a block is occupied when
+/// one of the values lies within its range.
+#[derive(PartialEq)]
+struct OccupancyKey {
+    values: Vec<u64>,
+    volume_upload: u32,
+}
+
+/// The isosurface passes (first hit, deferred shading) with their state, created on first
+/// use.
+pub(crate) struct IsoPass {
+    firsthit_bgl: wgpu::BindGroupLayout,
+    deferred_bgl: wgpu::BindGroupLayout,
+    firsthit: PipelineCache<FirstHitVariant>,
+    deferred: PipelineCache<DeferredVariant>,
+    iso_buf: wgpu::Buffer,
+    lobe_dirs: wgpu::Buffer,
+    // fills the tables' slot when no transfer function is needed (scattering off)
+    no_tables: Tables,
+    gbuffer: Option<GBufferTargets>,
+    occupancy: Option<Occupancy<OccupancyKey>>,
+    /// The pixels the last frame's first-hit pass covered.
+    last_rect: [u32; 4],
+}
+
+/// `n` unit vectors uniform over the sphere from a fixed seed (PCG), as vec4s.
+fn random_unit_vectors(n: usize) -> Vec<[f32; 4]> {
+    let mut state: u64 = 0x853c_49e6_748f_ea9b;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let x = (((state >> 18) ^ state) >> 27) as u32;
+        let r = (state >> 59) as u32;
+        x.rotate_right(r) as f64 / 4_294_967_296.0
+    };
+    (0..n)
+        .map(|_| {
+            let z = 1.0 - 2.0 * next();
+            let phi = 2.0 * std::f64::consts::PI * next();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            [
+                (r * phi.cos()) as f32,
+                (r * phi.sin()) as f32,
+                z as f32,
+                0.0,
+            ]
+        })
+        .collect()
+}
+
+const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+impl IsoPass {
+    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<IsoPass> {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        let d = &ctx.device;
+        let gb_write = |b| storage_texture_entry(b, GBUFFER_FORMAT, V::D2Array);
+        let firsthit_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("first hit"),
+            entries: &[
+                buffer_entry(0, B::Uniform),
+                buffer_entry(2, B::Storage { read_only: false }),
+                sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
+                texture_entry(4, false, V::D2),
+                buffer_entry(7, B::Uniform),
+                gb_write(8),
+                gb_write(9),
+                gb_write(10),
+                sampler_entry(11),
+            ],
+        });
+        let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("deferred"),
+            entries: &[
+                buffer_entry(0, B::Uniform),
+                buffer_entry(2, B::Storage { read_only: true }),
+                storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+                storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
+                buffer_entry(7, B::Uniform),
+                texture_entry(8, false, V::D2Array),
+                texture_entry(9, false, V::D2Array),
+                texture_entry(10, false, V::D2Array),
+                texture_entry(11, true, V::Cube),
+                texture_entry(12, true, V::Cube),
+                sampler_entry(13),
+                buffer_entry(14, B::Storage { read_only: true }),
+                texture_entry(1, false, V::D2),
+            ],
+        });
+        let firsthit = PipelineCache::new(
+            ctx,
+            "firsthit.wgsl",
+            "first hit",
+            &[&firsthit_bgl, brick_bgl],
+        )?;
+        let deferred = PipelineCache::new(
+            ctx,
+            "deferred.wgsl",
+            "deferred shading",
+            &[&deferred_bgl, brick_bgl],
+        )?;
+        let iso_buf = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("iso uniforms"),
+            size: std::mem::size_of::<IsoUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let dirs = random_unit_vectors(MAX_SPECULAR_SAMPLES as usize);
+        let lobe_dirs = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("specular cone directions"),
+            size: (dirs.len() * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue
+            .write_buffer(&lobe_dirs, 0, bytemuck::cast_slice(&dirs));
+        Ok(IsoPass {
+            firsthit_bgl,
+            deferred_bgl,
+            firsthit,
+            deferred,
+            iso_buf,
+            lobe_dirs,
+            no_tables: Tables::new(
+                d,
+                wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+            ),
+            gbuffer: None,
+            occupancy: None,
+            last_rect: [0; 4],
+        })
+    }
+
+    fn ensure_gbuffer(
+        &mut self,
+        ctx: &Context,
+        width: u32,
+        height: u32,
+        layers: u32,
+    ) -> Result<()> {
+        if self
+            .gbuffer
+            .as_ref()
+            .is_some_and(|g| g.width == width && g.height == height && g.layers == layers)
+        {
+            return Ok(());
+        }
+        self.gbuffer = None;
+        let tex = |label| {
+            ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: GBUFFER_FORMAT,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let g = ctx.checked("allocating the G-buffer", || GBufferTargets {
+            width,
+            height,
+            layers,
+            position: tex("g-buffer position"),
+            normal: tex("g-buffer normal"),
+            extra: tex("g-buffer extra"),
+        })?;
+        self.gbuffer = Some(g);
+        Ok(())
+    }
+}
+
+impl IsoPass {
+    /// Waits for the last isosurface frame and copies its G-buffer to the CPU.
+    pub fn read_gbuffer(&self, ctx: &Context, res: &Resources) -> Result<GBuffer> {
+        let (Some(gb), Some(t)) = (self.gbuffer.as_ref(), res.targets.as_ref()) else {
+            return Err(Error::InvalidParameter(
+                "no isosurface frame has been rendered yet".into(),
+            ));
+        };
+        let state = read_buffer(ctx, &t.state)?;
+        let states: &[[f32; 12]] = bytemuck::cast_slice(&state);
+        let r = self.last_rect;
+        let counts = (0..gb.width * gb.height)
+            .map(|i| {
+                let (x, y) = (i % gb.width, i / gb.width);
+                if x >= r[0] && x < r[2] && y >= r[1] && y < r[3] {
+                    (states[i as usize][0] as u32).min(gb.layers)
+                } else {
+                    0
+                }
+            })
+            .collect();
+        let read = |tex: &wgpu::Texture| -> Result<Vec<[f32; 4]>> {
+            let mut out = Vec::new();
+            for l in 0..gb.layers {
+                let bytes = read_texture_layer(ctx, tex, 0, l, 16)?;
+                out.extend_from_slice(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes));
+            }
+            Ok(out)
+        };
+        Ok(GBuffer {
+            width: gb.width,
+            height: gb.height,
+            layers: gb.layers,
+            counts,
+            position: read(&gb.position)?,
+            normal: read(&gb.normal)?,
+            extra: read(&gb.extra)?,
+        })
+    }
+
+    /// The occupancy grid (a texture) for these iso-values: blocks whose min–max range holds one.
+    fn ensure_occupancy(&mut self, ctx: &Context, res: &Resources, values: &[f32]) -> Result<()> {
+        let vol = res.volume()?;
+        let key = OccupancyKey {
+            values: values.iter().map(|v| v.to_bits() as u64).collect(),
+            volume_upload: res.stats.volume_uploads,
+        };
+        if Occupancy::current(&self.occupancy, &key) {
+            return Ok(());
+        }
+        let nc = vol.components as usize;
+        let occ: Vec<u32> = vol
+            .minmax
+            .ranges
+            .chunks(nc)
+            .map(|r| {
+                let [lo, hi] = r[0];
+                values.iter().any(|&v| v >= lo && v <= hi) as u32
+            })
+            .collect();
+        self.occupancy = Some(Occupancy::new(
+            ctx,
+            "iso occupancy",
+            key,
+            vol.minmax.dims,
+            &occ,
+        ));
+        Ok(())
+    }
+
+    /// One isosurface frame: first hit per brick in visibility order, then deferred shading.
+    pub fn render(
+        &mut self,
+        ctx: &Context,
+        res: &mut Resources,
+        view: &View,
+        params: &RenderParams,
+        iso: &IsoParams,
+        depth: DepthSource<'_>,
+    ) -> Result<()> {
+        params.validate()?;
+        iso.validate()?;
+        frame::check_light_count(view)?;
+        res.volume()?;
+        res.ensure_environment(ctx)?;
+        let step = res.sample_distance(params)?;
+        if iso.scattering.is_some() {
+            if res.tf.is_none() {
+                return Err(Error::InvalidParameter(
+                    "scattering between isosurfaces reads the transfer function's opacity: \
+                     set a transfer function"
+                        .into(),
+                ));
+            }
+            res.ensure_tables(ctx, step)?;
+        }
+        let spacing = res.sample_distance(&RenderParams {
+            sample_distance: None,
+            ..params.clone()
+        })?;
+        let values: Vec<f32> = iso.values.iter().map(|v| v.value as f32).collect();
+        self.ensure_occupancy(ctx, res, &values)?;
+        res.ensure_targets(ctx, view.width, view.height)?;
+        res.write_depth_input(ctx, view, depth)?;
+        let depth_input = !matches!(depth, DepthSource::None);
+        // Lighting is the point of this mode: the material applies whatever `enabled` says.
+        let lit = RenderParams {
+            blend: BlendMode::Isosurface,
+            shading: Shading {
+                enabled: true,
+                ..params.shading
+            },
+            ..params.clone()
+        };
+        let f = frame::frame(res, view, &lit, step, depth_input)?;
+        let order = brick_order(res, view, params);
+        let vol = res.volume()?;
+        let data_range = vol
+            .minmax
+            .ranges
+            .chunks(vol.components as usize)
+            .fold([f32::INFINITY, f32::NEG_INFINITY], |a, r| {
+                [a[0].min(r[0][0]), a[1].max(r[0][1])]
+            });
+        let single_brick = vol.bricks.len() == 1;
+        if iso.scattering.is_some() && !single_brick {
+            return Err(Error::Unsupported(format!(
+                "scattering between isosurfaces needs the volume in one brick; it is split \
+                 into {} (it exceeds the device's 3D texture or allocation limits)",
+                vol.bricks.len()
+            )));
+        }
+        let unit = res
+            .tf
+            .as_ref()
+            .map_or(1.0, |tf| tf.component(0).unit_distance);
+        let full = [0, 0, view.width, view.height];
+        let occupied = self.occupancy.as_ref().map_or(1.0, |o| o.fraction);
+        let fh = FirstHitVariant {
+            skip: params.empty_space_skipping && occupied < SKIP_MAX_OCCUPANCY,
+            crop: params.cropping.is_some(),
+            single_brick,
+        };
+        let df = DeferredVariant {
+            lights: f.lights(),
+            positional_lights: f.positional_lights(),
+            scatter: match iso.scattering.map(|s| s.mode) {
+                None => 0,
+                Some(IsoScatterMode::Preview) => 1,
+                Some(IsoScatterMode::Traced) => 2,
+            },
+        };
+        let firsthit = self.firsthit.get(ctx, fh)?;
+        let deferred = self.deferred.get(ctx, df)?;
+        // With scattering the surfaces are interfaces: the first-hit pass keeps the first two
+        // crossings whatever their opacities (the deferred pass makes the first opaque).
+        let layers = if iso.scattering.is_some() {
+            2
+        } else {
+            iso.max_layers
+        };
+        self.ensure_gbuffer(ctx, view.width, view.height, layers)?;
+        let frame = f.uniforms;
+        self.last_rect = frame.rect;
+        let env = res.current_environment()?;
+        let cube_sampler = res.cube_sampler()?;
+        // The uniforms.
+        let mut u = IsoUniforms::zeroed();
+        u.env_rotation = mat(DMat4::from_mat3(env.rotation));
+        for (i, v) in iso.values.iter().enumerate() {
+            u.values[i / 4][i % 4] = v.value as f32;
+            let opacity = if iso.scattering.is_some() {
+                0.0
+            } else {
+                v.opacity
+            };
+            u.colors[i] = [v.color[0], v.color[1], v.color[2], opacity];
+        }
+        u.shininess = match iso.shininess {
+            Shininess::Constant(s) => [0.0, 0.0, s, s],
+            Shininess::GradientMagnitude { range, exponents } => {
+                let [lo, hi] = range.unwrap_or_else(|| {
+                    let w = (data_range[1] - data_range[0]).max(0.0) as f64;
+                    [0.0, (w / (4.0 * spacing)).max(1e-30)]
+                });
+                [
+                    lo as f32,
+                    (1.0 / (hi - lo)) as f32,
+                    exponents[0],
+                    exponents[1],
+                ]
+            }
+        };
+        let ao = iso.ambient_occlusion;
+        u.ao = [
+            ao.map_or(0.0, |a| a.radius.unwrap_or(8.0 * spacing) as f32),
+            0.0,
+            0.0,
+            0.0,
+        ];
+        u.env = [
+            iso.environment_light,
+            iso.fresnel.unwrap_or(-1.0),
+            texel_solid_angle(env.size) as f32,
+            (env.mips - 1) as f32,
+        ];
+        u.counts = [
+            iso.values.len() as u32,
+            iso.bisection_steps,
+            layers,
+            ao.map_or(0, |a| a.samples),
+        ];
+        u.options = [
+            ao.map_or(1, |a| a.steps),
+            iso.specular_samples,
+            iso.specular.code(),
+            if iso.background {
+                ISO_FLAG_BACKGROUND
+            } else {
+                0
+            },
+        ];
+        if let Some(sc) = &iso.scattering {
+            u.scatter = [
+                (sc.absorption as f64 / unit) as f32,
+                sc.samples as f32,
+                sc.fresnel,
+                0.0,
+            ];
+        }
+        let rect = frame.rect;
+        u.shade_rect = if iso.background { full } else { rect };
+        let shade_rect = u.shade_rect;
+        let q = &ctx.queue;
+        q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
+        q.write_buffer(&self.iso_buf, 0, bytemuck::bytes_of(&u));
+        let t = res.targets.as_ref().expect("allocated above");
+        let occupancy = &self.occupancy.as_ref().expect("built above").grid;
+        // (the tables only matter with scattering; otherwise a one-texel table fills the slot)
+        let tables = res.tables.as_ref().map_or(&self.no_tables, |(_, t)| t);
+        let gb = self.gbuffer.as_ref().expect("allocated above");
+        let array_view = |tex: &wgpu::Texture| {
+            tex.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let (gp, gn, ge) = (
+            array_view(&gb.position),
+            array_view(&gb.normal),
+            array_view(&gb.extra),
+        );
+        let depth_in_view = t.depth_in.create_view(&Default::default());
+        let color_view = t.color.create_view(&Default::default());
+        let depth_view = t.depth.create_view(&Default::default());
+        let d = &ctx.device;
+        let firsthit_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("first hit"),
+            layout: &self.firsthit_bgl,
+            entries: &[
+                bind(0, res.frame_buf.as_entire_binding()),
+                bind(2, t.state.as_entire_binding()),
+                bind(3, wgpu::BindingResource::TextureView(occupancy)),
+                bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
+                bind(7, self.iso_buf.as_entire_binding()),
+                bind(8, wgpu::BindingResource::TextureView(&gp)),
+                bind(9, wgpu::BindingResource::TextureView(&gn)),
+                bind(10, wgpu::BindingResource::TextureView(&ge)),
+                bind(11, wgpu::BindingResource::Sampler(&res.nearest)),
+            ],
+        });
+        let deferred_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("deferred"),
+            layout: &self.deferred_bgl,
+            entries: &[
+                bind(0, res.frame_buf.as_entire_binding()),
+                bind(2, t.state.as_entire_binding()),
+                bind(5, wgpu::BindingResource::TextureView(&color_view)),
+                bind(6, wgpu::BindingResource::TextureView(&depth_view)),
+                bind(7, self.iso_buf.as_entire_binding()),
+                bind(8, wgpu::BindingResource::TextureView(&gp)),
+                bind(9, wgpu::BindingResource::TextureView(&gn)),
+                bind(10, wgpu::BindingResource::TextureView(&ge)),
+                bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
+                bind(12, wgpu::BindingResource::TextureView(&env.irradiance_view)),
+                bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
+                bind(14, self.lobe_dirs.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("isosurface frame"),
+        });
+        if shade_rect != full {
+            clear_outputs(&mut enc, &color_view, &depth_view);
+        }
+        if !single_brick {
+            enc.clear_buffer(&t.state, 0, None);
+        }
+        let gr = groups(rect);
+        for i in order {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("first hit"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&firsthit);
+            pass.set_bind_group(0, &firsthit_bg, &[]);
+            pass.set_bind_group(1, &vol.bricks[i].bind_linear, &[]);
+            pass.dispatch_workgroups(gr[0], gr[1], 1);
+        }
+        {
+            let gs = groups(shade_rect);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("deferred shading"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&deferred);
+            pass.set_bind_group(0, &deferred_bg, &[]);
+            // (the scattering pass samples the volume: one brick)
+            pass.set_bind_group(1, &vol.bricks[0].bind_linear, &[]);
+            pass.dispatch_workgroups(gs[0], gs[1], 1);
+        }
+        ctx.checked("rendering the isosurface frame", || {
+            q.submit([enc.finish()]);
+        })?;
+        res.stats.frames += 1;
+        Ok(())
+    }
+}

@@ -1,0 +1,11 @@
+//! The passes of a frame. Each owns its pipelines (and any state of its own, such as the
+//! path tracer's accumulation) and borrows the renderer's resources for the frame; none
+//! reaches back into the renderer.
+
+pub(crate) mod denoise;
+pub(crate) mod dvr;
+pub(crate) mod frame;
+pub(crate) mod gradient;
+pub(crate) mod iso;
+pub(crate) mod pathtrace;
+pub(crate) mod scatter_check;

@@ -1,0 +1,120 @@
+//! Checks of the path tracer's sampling code on the device (shaders/phase_test.wgsl): the
+//! Henyey–Greenstein phase function and the BSDF, for the tests.
+
+use crate::error::{Error, Result};
+use crate::gpu::binding::{bind, buffer_entry};
+use crate::gpu::pipeline::single_group_pipeline;
+use crate::gpu::readback::read_buffer;
+use crate::gpu::uniforms::PhaseTestUniforms;
+use crate::gpu::Context;
+use crate::params::BsdfParams;
+
+/// Draws `n` Henyey–Greenstein scattering directions with anisotropy `g` by the path
+/// tracer's own sampling code (shaders/lib/phase.wgsl) and returns the cosine of each
+/// to the propagation direction: for checking the sampler against the density.
+pub(crate) fn sample_phase_cosines(ctx: &Context, g: f32, n: u32, seed: u32) -> Result<Vec<f32>> {
+    if g.is_nan() || g.abs() >= 1.0 {
+        return Err(Error::InvalidParameter(format!(
+            "phase sampling check: anisotropy {g} must be in (−1, 1)"
+        )));
+    }
+    let dir = glam::Vec3::new(0.3, -0.5, 0.8).normalize();
+    let u = PhaseTestUniforms {
+        params: [g, dir.x, dir.y, dir.z],
+        counts: [n, seed, 0, 0],
+        ..Default::default()
+    };
+    Ok(run_phase_check(ctx, &u)?.iter().map(|v| v[0]).collect())
+}
+
+/// Checks the path tracer's BSDF (shaders/lib/bsdf.wgsl, colour 1) at a surface with
+/// gradient direction `normal` for a path arriving along `dir` (both unit vectors):
+/// per sample, [value / density of a direction drawn by its sampler, 4π × value and 4π ×
+/// density of a uniformly drawn direction]. The means of the first two estimate the
+/// albedo (≤ 1 when energy is conserved; equal when sampler and density agree), the
+/// mean of the third is 1 when the density is normalised.
+pub(crate) fn sample_bsdf(
+    ctx: &Context,
+    bsdf: &BsdfParams,
+    normal: [f32; 3],
+    dir: [f32; 3],
+    n: u32,
+    seed: u32,
+) -> Result<Vec<[f32; 3]>> {
+    bsdf.validate()?;
+    let unit = |v: [f32; 3]| (glam::Vec3::from(v).length() - 1.0).abs() < 1e-3;
+    if !unit(normal) || !unit(dir) {
+        return Err(Error::InvalidParameter(format!(
+            "BSDF check: normal {normal:?} and direction {dir:?} must be unit vectors"
+        )));
+    }
+    let u = PhaseTestUniforms {
+        params: [0.0, dir[0], dir[1], dir[2]],
+        bsdf: [
+            bsdf.roughness,
+            bsdf.fresnel,
+            bsdf.transmission,
+            bsdf.lobe_exponent(),
+        ],
+        normal: [normal[0], normal[1], normal[2], 0.0],
+        counts: [n, seed, 1, 0],
+    };
+    Ok(run_phase_check(ctx, &u)?
+        .iter()
+        .map(|v| [v[0], v[1], v[2]])
+        .collect())
+}
+
+/// Runs shaders/phase_test.wgsl: `u.counts[0]` samples.
+fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>> {
+    let n = u.counts[0];
+    if n == 0 || n > 1 << 24 {
+        return Err(Error::InvalidParameter(format!(
+            "scattering check: the sample count {n} must be in 1 to 2^24"
+        )));
+    }
+    use wgpu::BufferBindingType as B;
+    let d = &ctx.device;
+    let (bgl, pipeline) = single_group_pipeline(
+        ctx,
+        "phase_test.wgsl",
+        "phase test",
+        &[
+            buffer_entry(0, B::Uniform),
+            buffer_entry(1, B::Storage { read_only: false }),
+        ],
+    )?;
+    let ubuf = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("phase test uniforms"),
+        size: std::mem::size_of::<PhaseTestUniforms>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    ctx.queue.write_buffer(&ubuf, 0, bytemuck::bytes_of(u));
+    let out = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("phase test results"),
+        size: 16 * n as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("phase test"),
+        layout: &bgl,
+        entries: &[
+            bind(0, ubuf.as_entire_binding()),
+            bind(1, out.as_entire_binding()),
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(n.div_ceil(64), 1, 1);
+    }
+    ctx.checked("running the scattering check", || {
+        ctx.queue.submit([enc.finish()]);
+    })?;
+    let bytes = read_buffer(ctx, &out)?;
+    Ok(bytemuck::cast_slice(&bytes).to_vec())
+}

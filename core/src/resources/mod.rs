@@ -1,0 +1,123 @@
+//! What the passes read and write, owned by the renderer and borrowed by each pass for a
+//! frame: the volume (bricks, min–max grid, optional gradients), the transfer tables and the
+//! occupancy they give, the output images (with their interop export) and the environment.
+
+pub(crate) mod bricks;
+pub(crate) mod environment;
+pub(crate) mod tables;
+pub(crate) mod targets;
+pub(crate) mod volume;
+
+use crate::error::{Error, Result};
+use crate::gpu::binding::{buffer_entry, entry, texture_entry};
+use crate::gpu::interop::OutputPath;
+use crate::gpu::uniforms::FrameUniforms;
+use crate::gpu::Context;
+use crate::params::{RenderParams, Stats, TransferFunction};
+use environment::EnvironmentState;
+use tables::{Occupancy, TableKey, Tables};
+use targets::Targets;
+use volume::GpuVolume;
+
+/// The renderer's resources. Passes get `&mut Resources` for a frame; each resource is built
+/// or rebuilt on demand by its `ensure_*` function when what decides its contents changed.
+pub(crate) struct Resources {
+    /// Layout of a brick's bind group (group 1 of every pass that samples the volume).
+    pub brick_bgl: wgpu::BindGroupLayout,
+    pub nearest: wgpu::Sampler,
+    linear: wgpu::Sampler,
+    /// The frame uniforms (lib/common.wgsl's Frame), written by each pass.
+    pub frame_buf: wgpu::Buffer,
+    pub volume: Option<GpuVolume>,
+    pub tf: Option<TransferFunction>,
+    pub tables: Option<(TableKey, Tables)>,
+    /// Occupancy of the min–max blocks under the transfer function.
+    pub occupancy: Option<Occupancy<TableKey>>,
+    pub targets: Option<Targets>,
+    pub output_path: OutputPath,
+    /// Counts allocations of the output images.
+    pub generation: u64,
+    pub environment: EnvironmentState,
+    pub stats: Stats,
+}
+
+impl Resources {
+    pub fn new(ctx: &Context) -> Resources {
+        let d = &ctx.device;
+        let brick_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("brick"),
+            entries: &[
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                texture_entry(1, true, wgpu::TextureViewDimension::D3),
+                entry(
+                    2,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+                texture_entry(3, true, wgpu::TextureViewDimension::D3),
+            ],
+        });
+        let sampler = |f: wgpu::FilterMode| {
+            d.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("volume"),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: f,
+                min_filter: f,
+                ..Default::default()
+            })
+        };
+        let frame_buf = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniforms"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Resources {
+            brick_bgl,
+            linear: sampler(wgpu::FilterMode::Linear),
+            nearest: sampler(wgpu::FilterMode::Nearest),
+            frame_buf,
+            volume: None,
+            tf: None,
+            tables: None,
+            occupancy: None,
+            targets: None,
+            output_path: OutputPath::Readback,
+            generation: 0,
+            environment: EnvironmentState::default(),
+            stats: Stats::default(),
+        }
+    }
+
+    /// The volume, or the error every pass gives without one.
+    pub fn volume(&self) -> Result<&GpuVolume> {
+        self.volume
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))
+    }
+
+    /// The transfer function, or the error every pass that classifies gives without one.
+    pub fn transfer_function(&self) -> Result<&TransferFunction> {
+        self.tf
+            .as_ref()
+            .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))
+    }
+
+    /// The world distance between samples these parameters give for the current volume.
+    pub fn sample_distance(&self, params: &RenderParams) -> Result<f64> {
+        let vol = self.volume()?;
+        Ok(match params.sample_distance {
+            Some(d) => d,
+            None => {
+                let m = params.volume_matrix * vol.index_to_data;
+                let s = [
+                    m.x_axis.truncate().length(),
+                    m.y_axis.truncate().length(),
+                    m.z_axis.truncate().length(),
+                ];
+                s.iter().cloned().fold(f64::INFINITY, f64::min)
+            }
+        })
+    }
+}

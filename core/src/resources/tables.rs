@@ -1,0 +1,161 @@
+//! The transfer-function tables and the occupancy of the min–max blocks they give.
+
+use super::Resources;
+use crate::error::{Error, Result};
+use crate::gpu::texture::{block_grid, upload_texture};
+use crate::gpu::uniforms::TABLE_SIZE;
+use crate::gpu::Context;
+use crate::params::{build_tables, TransferFunction};
+
+/// Everything that decides the tables' contents; tables are rebuilt only when it changes.
+#[derive(PartialEq)]
+pub(crate) struct TableKey {
+    tf: TransferFunction,
+    step_bits: u64,
+}
+
+impl TableKey {
+    fn new(tf: &TransferFunction, step: f64) -> TableKey {
+        TableKey {
+            tf: tf.clone(),
+            step_bits: step.to_bits(),
+        }
+    }
+}
+
+/// The transfer-function tables as the shaders read them (lib/common.wgsl): one row of
+/// `TABLE_SIZE` texels per table, two tables per component. A texture, not a storage
+/// buffer: lavapipe reads a storage buffer at per-lane indices one lane at a time, a
+/// texture with one gather.
+pub(crate) struct Tables {
+    texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+impl Tables {
+    pub fn new(d: &wgpu::Device, size: wgpu::Extent3d) -> Tables {
+        let texture = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("transfer tables"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Tables { texture, view }
+    }
+}
+
+/// Which min–max blocks hold something to draw (1) and which can be skipped (0), as the
+/// passes read it (lib/march.wgsl), for the contents `key` names.
+pub(crate) struct Occupancy<K> {
+    pub key: K,
+    pub grid: wgpu::TextureView,
+    /// The fraction of blocks occupied.
+    pub fraction: f64,
+}
+
+impl<K: PartialEq> Occupancy<K> {
+    /// Whether `slot` already holds the occupancy for `key`.
+    pub fn current(slot: &Option<Occupancy<K>>, key: &K) -> bool {
+        slot.as_ref().is_some_and(|o| o.key == *key)
+    }
+
+    pub fn new(ctx: &Context, label: &str, key: K, dims: [u32; 3], occ: &[u32]) -> Self {
+        let grid = block_grid(ctx, label, dims, occ);
+        let fraction = occ.iter().filter(|&&o| o != 0).count() as f64 / occ.len().max(1) as f64;
+        Occupancy {
+            key,
+            grid,
+            fraction,
+        }
+    }
+}
+
+impl Resources {
+    /// Builds the tables for the transfer function at sample distance `step`, unless they are
+    /// current.
+    pub fn ensure_tables(&mut self, ctx: &Context, step: f64) -> Result<()> {
+        let tf = self.transfer_function()?;
+        let key = TableKey::new(tf, step);
+        if self.tables.as_ref().is_some_and(|(k, _)| *k == key) {
+            return Ok(());
+        }
+        let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
+        let mut data: Vec<[f32; 4]> = Vec::with_capacity(comps * 2 * TABLE_SIZE);
+        for c in 0..comps {
+            data.extend(build_tables(tf.component(c), step));
+        }
+        let size = wgpu::Extent3d {
+            width: TABLE_SIZE as u32,
+            height: 2 * comps as u32,
+            depth_or_array_layers: 1,
+        };
+        let tables = match self.tables.take() {
+            Some((_, t)) if t.texture.size() == size => t,
+            _ => Tables::new(&ctx.device, size),
+        };
+        upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 16);
+        self.tables = Some((key, tables));
+        self.stats.table_uploads += 1;
+        Ok(())
+    }
+
+    /// Classifies the min–max grid against the transfer function: 1 for blocks where some
+    /// value in the block's range has non-zero opacity.
+    pub fn ensure_occupancy(&mut self, ctx: &Context, step: f64) -> Result<()> {
+        let (Some(tf), Some(vol)) = (self.tf.as_ref(), self.volume.as_ref()) else {
+            return Err(Error::InvalidParameter(
+                "a volume and a transfer function are needed".into(),
+            ));
+        };
+        let key = TableKey::new(tf, step);
+        if Occupancy::current(&self.occupancy, &key) {
+            return Ok(());
+        }
+        let nc = vol.components as usize;
+        // Which components drive opacity, and prefix counts of non-zero table entries.
+        let opacity_comps: Vec<usize> = if tf.independent {
+            (0..nc).collect()
+        } else {
+            vec![nc - 1]
+        };
+        let prefix: Vec<(usize, [f64; 2], Vec<u32>)> = opacity_comps
+            .iter()
+            .map(|&c| {
+                let ct = tf.component(if tf.independent { c } else { 0 });
+                let tables = build_tables(ct, step);
+                let mut p = vec![0u32; TABLE_SIZE + 1];
+                for i in 0..TABLE_SIZE {
+                    let nz = tables[i][3] > 0.0 && (!tf.independent || ct.weight > 0.0);
+                    p[i + 1] = p[i] + nz as u32;
+                }
+                (c, ct.table_range(), p)
+            })
+            .collect();
+        let nblocks = vol.minmax.ranges.len() / nc;
+        let mut occ = vec![0u32; nblocks];
+        let last = (TABLE_SIZE - 1) as f64;
+        for (b, o) in occ.iter_mut().enumerate() {
+            for (c, [lo, hi], p) in &prefix {
+                let [mn, mx] = vol.minmax.ranges[b * nc + c];
+                let x0 = ((mn as f64 - lo) / (hi - lo) * last)
+                    .floor()
+                    .clamp(0.0, last) as usize;
+                let x1 = ((mx as f64 - lo) / (hi - lo) * last)
+                    .ceil()
+                    .clamp(0.0, last) as usize;
+                if p[x1 + 1] > p[x0] {
+                    *o = 1;
+                    break;
+                }
+            }
+        }
+        self.occupancy = Some(Occupancy::new(ctx, "occupancy", key, vol.minmax.dims, &occ));
+        self.stats.occupancy_updates += 1;
+        Ok(())
+    }
+}
