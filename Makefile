@@ -81,6 +81,7 @@ demo: build
 lint: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
+	python3 scripts/check-core-layers.py
 
 # The C ABI tests load and link target/debug/libferrovol.so, which `cargo test` alone does
 # not build (it links tests against the rlib).
