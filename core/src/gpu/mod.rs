@@ -4,6 +4,7 @@
 //! volumes or passes.
 
 pub(crate) mod binding;
+pub(crate) mod buffers;
 pub mod context;
 pub mod interop;
 pub(crate) mod pipeline;

@@ -1,6 +1,7 @@
 //! Copies of GPU textures and buffers to the CPU (tests, G-buffer and environment
 //! inspection, the output image), each waiting for the device.
 
+use super::buffers::buffer;
 use super::Context;
 use crate::error::{Error, Result};
 
@@ -17,12 +18,12 @@ pub(crate) fn read_texture_layer(
     let row = w * bytes_per_texel;
     let padded =
         row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: padded as u64 * h as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let buf = buffer(
+        ctx,
+        "readback",
+        padded as u64 * h as u64,
+        wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+    );
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     enc.copy_texture_to_buffer(
         wgpu::TexelCopyTextureInfo {
@@ -60,12 +61,12 @@ pub(crate) fn read_texture_layer(
 
 /// Copies a storage buffer to the CPU.
 pub(crate) fn read_buffer(ctx: &Context, src: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: src.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let buf = buffer(
+        ctx,
+        "readback",
+        src.size(),
+        wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+    );
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(src, 0, &buf, 0, src.size());
     ctx.queue.submit([enc.finish()]);

@@ -3,6 +3,7 @@
 use super::frame::groups;
 use crate::error::Result;
 use crate::gpu::binding::{bind, buffer_entry, entry, storage_texture_entry};
+use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::single_group_pipeline;
 use crate::gpu::uniforms::{DenoiseUniforms, DENOISE_FROM_SUMS, DENOISE_LAST, UNIFORM_STRIDE};
 use crate::gpu::Context;
@@ -62,13 +63,11 @@ impl DenoisePass {
                 ),
             ],
         )?;
-        let d = &ctx.device;
-        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("denoiser uniforms"),
-            size: UNIFORM_STRIDE * DENOISE_ITERATIONS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniforms = uniform_buffer(
+            ctx,
+            "denoiser uniforms",
+            UNIFORM_STRIDE * DENOISE_ITERATIONS as u64,
+        );
         Ok(DenoisePass {
             bgl,
             pipeline,

@@ -4,6 +4,7 @@
 
 use crate::error::Result;
 use crate::gpu::binding::{bind, buffer_entry, storage_texture_entry, texture_entry};
+use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::single_group_pipeline;
 use crate::gpu::Context;
 use crate::resources::bricks::Layout;
@@ -53,12 +54,7 @@ impl GradientPass {
                 view_formats: &[],
             })
         })?;
-        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("gradient build uniforms"),
-            size: 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniforms = uniform_buffer(ctx, "gradient build uniforms", 16);
         let scale = [layout.scale[0], layout.shift[0], 0.0f32, 0.0];
         ctx.queue
             .write_buffer(&uniforms, 0, bytemuck::bytes_of(&scale));

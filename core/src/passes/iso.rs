@@ -27,6 +27,7 @@ use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
+use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::{flag, PipelineCache, Variant};
 use crate::gpu::readback::{read_buffer, read_texture_layer};
 use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND};
@@ -191,19 +192,18 @@ impl IsoPass {
             "deferred shading",
             &[&deferred_bgl, brick_bgl],
         )?;
-        let iso_buf = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("iso uniforms"),
-            size: std::mem::size_of::<IsoUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let iso_buf = uniform_buffer(
+            ctx,
+            "iso uniforms",
+            std::mem::size_of::<IsoUniforms>() as u64,
+        );
         let dirs = random_unit_vectors(MAX_SPECULAR_SAMPLES as usize);
-        let lobe_dirs = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("specular cone directions"),
-            size: (dirs.len() * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let lobe_dirs = buffer(
+            ctx,
+            "specular cone directions",
+            (dirs.len() * 16) as u64,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         ctx.queue
             .write_buffer(&lobe_dirs, 0, bytemuck::cast_slice(&dirs));
         Ok(IsoPass {

@@ -31,6 +31,7 @@ use crate::gpu::binding::{
     bind, buffer_entry, entry, sampled_texture_entry, sampler_entry, storage_texture_entry,
     texture_entry,
 };
+use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::{flag, PipelineCache, Variant};
 use crate::gpu::readback::read_buffer;
 use crate::gpu::texture::block_grid;
@@ -110,12 +111,11 @@ impl PathTracePass {
         });
         let pipelines =
             PipelineCache::new(ctx, "pathtrace.wgsl", "path tracing", &[&bgl, brick_bgl])?;
-        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("path tracing uniforms"),
-            size: UNIFORM_STRIDE * MAX_SAMPLES_PER_FRAME as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniforms = uniform_buffer(
+            ctx,
+            "path tracing uniforms",
+            UNIFORM_STRIDE * MAX_SAMPLES_PER_FRAME as u64,
+        );
         Ok(PathTracePass {
             bgl,
             pipelines,
@@ -140,23 +140,23 @@ impl PathTracePass {
         }
         self.accum = None;
         self.denoise_buffers = None;
-        let buffer = |label| {
+        let pixel_buffer = |label| {
             ctx.checked("allocating the path tracing accumulation", || {
-                ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size: 16 * width as u64 * height as u64,
-                    usage: wgpu::BufferUsages::STORAGE
+                buffer(
+                    ctx,
+                    label,
+                    16 * width as u64 * height as u64,
+                    wgpu::BufferUsages::STORAGE
                         | wgpu::BufferUsages::COPY_SRC
                         | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
+                )
             })
         };
-        let buf = buffer("path tracing accumulation")?;
+        let buf = pixel_buffer("path tracing accumulation")?;
         self.denoise_buffers = Some([
-            buffer("denoiser guide")?,
-            buffer("denoiser image A")?,
-            buffer("denoiser image B")?,
+            pixel_buffer("denoiser guide")?,
+            pixel_buffer("denoiser image A")?,
+            pixel_buffer("denoiser image B")?,
         ]);
         self.accum = Some((width, height, buf));
         self.samples = 0;
@@ -254,12 +254,12 @@ impl PathTracePass {
         }
         let cube = res.read_environment(ctx, level)?;
         let cdf = environment_cdf(&cube);
-        let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("environment sampling distribution"),
-            size: (4 * cdf.len()) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let buf = buffer(
+            ctx,
+            "environment sampling distribution",
+            (4 * cdf.len()) as u64,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         ctx.queue.write_buffer(&buf, 0, bytemuck::cast_slice(&cdf));
         self.env_dist = Some((generation, cube.size, buf));
         Ok(())

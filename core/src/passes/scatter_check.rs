@@ -3,6 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, buffer_entry};
+use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::single_group_pipeline;
 use crate::gpu::readback::read_buffer;
 use crate::gpu::uniforms::PhaseTestUniforms;
@@ -84,19 +85,18 @@ fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>
             buffer_entry(1, B::Storage { read_only: false }),
         ],
     )?;
-    let ubuf = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("phase test uniforms"),
-        size: std::mem::size_of::<PhaseTestUniforms>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let ubuf = uniform_buffer(
+        ctx,
+        "phase test uniforms",
+        std::mem::size_of::<PhaseTestUniforms>() as u64,
+    );
     ctx.queue.write_buffer(&ubuf, 0, bytemuck::bytes_of(u));
-    let out = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("phase test results"),
-        size: 16 * n as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
+    let out = buffer(
+        ctx,
+        "phase test results",
+        16 * n as u64,
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+    );
     let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("phase test"),
         layout: &bgl,

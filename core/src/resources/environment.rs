@@ -6,6 +6,7 @@ use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
+use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::shader_module;
 use crate::gpu::readback::read_texture_layer;
 use crate::gpu::uniforms::{EnvUniforms, ENV_EQUIRECT, ENV_SKY};
@@ -195,12 +196,11 @@ impl GpuEnvironment {
             (cube, irradiance)
         })?;
         let uniform = |u: &EnvUniforms| {
-            let b = d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("environment uniforms"),
-                size: std::mem::size_of::<EnvUniforms>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let b = uniform_buffer(
+                ctx,
+                "environment uniforms",
+                std::mem::size_of::<EnvUniforms>() as u64,
+            );
             q.write_buffer(&b, 0, bytemuck::bytes_of(u));
             b
         };

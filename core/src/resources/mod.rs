@@ -10,6 +10,7 @@ pub(crate) mod volume;
 
 use crate::error::{Error, Result};
 use crate::gpu::binding::{buffer_entry, entry, texture_entry};
+use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::interop::OutputPath;
 use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Context;
@@ -67,12 +68,11 @@ impl Resources {
                 ..Default::default()
             })
         };
-        let frame_buf = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("frame uniforms"),
-            size: std::mem::size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let frame_buf = uniform_buffer(
+            ctx,
+            "frame uniforms",
+            std::mem::size_of::<FrameUniforms>() as u64,
+        );
         Resources {
             brick_bgl,
             linear: sampler(wgpu::FilterMode::Linear),

@@ -4,6 +4,7 @@ use super::bricks::{self, BrickExtent, Layout, MinMaxGrid};
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::bind;
+use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::texture::upload_texture;
 use crate::gpu::uniforms::BrickUniforms;
 use crate::gpu::Context;
@@ -110,12 +111,11 @@ impl Resources {
                     tex_lo: v4(e.tex_lo),
                     tex_inv_size: [1.0 / tex_size[0], 1.0 / tex_size[1], 1.0 / tex_size[2], 0.0],
                 };
-                let uniform = d.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("brick uniforms"),
-                    size: std::mem::size_of::<BrickUniforms>() as u64,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
+                let uniform = uniform_buffer(
+                    ctx,
+                    "brick uniforms",
+                    std::mem::size_of::<BrickUniforms>() as u64,
+                );
                 ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&bu));
                 (texture, uniform)
             })?;
