@@ -175,7 +175,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     let e = a.extent;
     let (vol, tf, name) = match &a.input {
         Some(p) => {
-            let v = crate::readers::read_volume(p)?;
+            let v = ferrovol_io::read_volume(p)?;
             let tf = presets::transfer_function(&a.tf, &v)?;
             (v, tf, p.display().to_string())
         }

@@ -2,7 +2,6 @@
 
 mod bench;
 mod presets;
-mod readers;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
@@ -560,7 +559,7 @@ fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     #[error(transparent)]
-    Read(#[from] readers::ReadError),
+    Read(#[from] ferrovol_io::ReadError),
     #[error("{0}")]
     Core(#[from] ferrovol_core::Error),
     #[error("{0}")]
@@ -594,7 +593,7 @@ fn demo_volume(d: Demo) -> VolumeData {
 fn render(a: RenderArgs) -> Result<(), CliError> {
     let pb = spinner("loading volume");
     let (vol, default_tf) = match &a.input {
-        Some(p) => (readers::read_volume(p)?, "auto"),
+        Some(p) => (ferrovol_io::read_volume(p)?, "auto"),
         None => (
             demo_volume(a.demo),
             match a.demo {

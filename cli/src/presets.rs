@@ -1,8 +1,5 @@
-//! Transfer-function presets and JSON transfer-function files.
-//!
-//! JSON: `{"color": [[x, r, g, b], …], "opacity": [[x, a], …],
-//! "gradient_opacity": [[g, a], …], "unit_distance": 1.0}`; x in scalar units, g in
-//! scalar units per world unit; gradient_opacity and unit_distance are optional.
+//! Transfer-function presets, and JSON transfer-function files (the format:
+//! [`ferrovol_io::transfer`]).
 
 use crate::CliError;
 use ferrovol_core::{ComponentTransfer, Piecewise, TransferFunction, VolumeData};
@@ -114,78 +111,8 @@ pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunctio
     Ok(t)
 }
 
-fn points<const N: usize>(
-    path: &Path,
-    v: &serde_json::Value,
-    key: &str,
-) -> Result<Option<Piecewise<N>>, CliError> {
-    let bad = |m: String| {
-        CliError::Usage(format!(
-            "{}: transfer function '{key}': {m}",
-            path.display()
-        ))
-    };
-    let Some(arr) = v.get(key) else {
-        return Ok(None);
-    };
-    let arr = arr
-        .as_array()
-        .ok_or_else(|| bad("must be an array of points".into()))?;
-    let mut pts = Vec::new();
-    for (i, p) in arr.iter().enumerate() {
-        let nums: Vec<f64> = p
-            .as_array()
-            .ok_or_else(|| bad(format!("point {i} must be an array")))?
-            .iter()
-            .map(|x| {
-                x.as_f64()
-                    .ok_or_else(|| bad(format!("point {i} has a non-number")))
-            })
-            .collect::<Result<_, _>>()?;
-        if nums.len() != N + 1 {
-            return Err(bad(format!(
-                "point {i} has {} numbers, expected {}",
-                nums.len(),
-                N + 1
-            )));
-        }
-        let mut val = [0f32; N];
-        for c in 0..N {
-            val[c] = nums[c + 1] as f32;
-        }
-        pts.push((nums[0], val));
-    }
-    Piecewise::new(pts)
-        .map(Some)
-        .map_err(|e| bad(e.to_string()))
-}
-
 fn from_json(path: &Path) -> Result<TransferFunction, CliError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| CliError::Usage(format!("{}: cannot read: {e}", path.display())))?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| CliError::Usage(format!("{}: not valid JSON: {e}", path.display())))?;
-    let color = points::<3>(path, &v, "color")?.ok_or_else(|| {
-        CliError::Usage(format!(
-            "{}: a 'color' array of [x, r, g, b] points is required",
-            path.display()
-        ))
-    })?;
-    let opacity = points::<1>(path, &v, "opacity")?.ok_or_else(|| {
-        CliError::Usage(format!(
-            "{}: an 'opacity' array of [x, a] points is required",
-            path.display()
-        ))
-    })?;
-    let mut c = ComponentTransfer::new(color, opacity);
-    c.gradient_opacity = points::<1>(path, &v, "gradient_opacity")?;
-    if let Some(u) = v.get("unit_distance") {
-        c.unit_distance = u.as_f64().filter(|u| *u > 0.0).ok_or_else(|| {
-            CliError::Usage(format!(
-                "{}: 'unit_distance' must be a positive number",
-                path.display()
-            ))
-        })?;
-    }
-    Ok(TransferFunction::single(c))
+    Ok(ferrovol_io::transfer::parse_json(&text).map_err(|e| e.in_file(path))?)
 }

@@ -15,37 +15,28 @@
 //!   data is at the end of the file" and needs raw encoding). A `data file` is relative to
 //!   the header's folder; `LIST` and numbered file patterns are not supported.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use ferrovol_core::{ScalarType, VolumeData, IDENTITY_DIRECTION};
+use ferrovol_core::{Direction, ScalarType, Scalars, VolumeData};
 
-use super::{decode_binary, next_line, parse_ascii, read_file, value_count, ReadError};
+use crate::decode::{
+    decode_binary, inflate, lookup_type, next_line, numbers, parse_ascii, Fields, Geometry, Layout,
+    TypeNames,
+};
+use crate::ReadError;
 
 const FORMAT: &str = "NRRD";
 const SUPPORTED_TYPES: &str =
     "int8, uint8, int16, uint16, int32, uint32, float and double (in any NRRD spelling, e.g. uchar, short, unsigned int)";
 
-fn bad(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError::bad_header(path, FORMAT, message)
+fn bad(message: impl Into<String>) -> ReadError {
+    ReadError::bad_header(FORMAT, message)
 }
 
+/// The scalar type of a `type` field's value (any case and spacing).
 fn nrrd_type(name: &str) -> Option<ScalarType> {
-    let n = name.split_ascii_whitespace().collect::<Vec<_>>().join(" ");
-    Some(match n.as_str() {
-        "signed char" | "int8" | "int8_t" => ScalarType::I8,
-        "uchar" | "unsigned char" | "uint8" | "uint8_t" => ScalarType::U8,
-        "short" | "short int" | "signed short" | "signed short int" | "int16" | "int16_t" => {
-            ScalarType::I16
-        }
-        "ushort" | "unsigned short" | "unsigned short int" | "uint16" | "uint16_t" => {
-            ScalarType::U16
-        }
-        "int" | "signed int" | "int32" | "int32_t" => ScalarType::I32,
-        "uint" | "unsigned int" | "uint32" | "uint32_t" => ScalarType::U32,
-        "float" => ScalarType::F32,
-        "double" => ScalarType::F64,
-        _ => return None,
-    })
+    let words: Vec<&str> = name.split_ascii_whitespace().collect();
+    lookup_type(TypeNames::Nrrd, &words.join(" ").to_ascii_lowercase())
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -58,25 +49,20 @@ enum Encoding {
 
 struct Header {
     /// Field name (lower case, spaces collapsed) and value.
-    fields: Vec<(String, String)>,
+    fields: Fields,
     /// Where attached data starts (after the blank line), if the header ended with one.
     data_start: Option<usize>,
 }
 
 impl Header {
     fn get(&self, keys: &[&str]) -> Option<&str> {
-        keys.iter().find_map(|k| {
-            self.fields
-                .iter()
-                .find(|(key, _)| key == k)
-                .map(|(_, v)| v.as_str())
-        })
+        self.fields.get(keys).map(|(_, v)| v)
     }
 }
 
-fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, ReadError> {
+fn parse_header(bytes: &[u8]) -> Result<Header, ReadError> {
     let Some((magic, mut pos)) = next_line(bytes, 0) else {
-        return Err(bad(path, "the file is empty"));
+        return Err(bad("the file is empty"));
     };
     let version_ok = magic.len() == 8
         && magic.starts_with(b"NRRD000")
@@ -84,7 +70,6 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, ReadError> {
     if !version_ok {
         let shown: String = String::from_utf8_lossy(magic).chars().take(40).collect();
         return Err(bad(
-            path,
             format!("the first line is {shown:?}, not NRRD0001 to NRRD0005; this is not a NRRD file (or a newer version)"),
         ));
     }
@@ -95,7 +80,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, ReadError> {
         line_no += 1;
         if line.iter().all(|b| b.is_ascii_whitespace()) {
             return Ok(Header {
-                fields,
+                fields: Fields(fields),
                 data_start: Some(pos),
             });
         }
@@ -118,21 +103,20 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, ReadError> {
             _ => {
                 let shown: String = text.chars().take(60).collect();
                 return Err(bad(
-                    path,
                     format!("line {line_no} ({shown:?}) is not 'field: value' (attached data must follow a blank line)"),
                 ));
             }
         }
     }
     Ok(Header {
-        fields,
+        fields: Fields(fields),
         data_start: None,
     })
 }
 
 /// Parses a list like `(1,0,0) (0, 2,0) none` into vectors (None for "none").
-fn parse_vectors(path: &Path, field: &str, v: &str) -> Result<Vec<Option<Vec<f64>>>, ReadError> {
-    let err = |why: &str| bad(path, format!("{field}: {v:?}: {why}"));
+fn parse_vectors(field: &str, v: &str) -> Result<Vec<Option<Vec<f64>>>, ReadError> {
+    let err = |why: &str| bad(format!("{field}: {v:?}: {why}"));
     let mut out = Vec::new();
     let mut rest = v.trim_start();
     while !rest.is_empty() {
@@ -157,67 +141,57 @@ fn parse_vectors(path: &Path, field: &str, v: &str) -> Result<Vec<Option<Vec<f64
     Ok(out)
 }
 
-pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
-    let bytes = read_file(path)?;
-    let h = parse_header(path, &bytes)?;
+/// Parses a NRRD file (`.nrrd`) or a detached header (`.nhdr`) with its data: attached
+/// data follows the header in `bytes`; a `data file` field's name is passed to
+/// `data_file`, which returns that file's bytes (see [`crate::Format::parse`]).
+pub fn parse(
+    bytes: &[u8],
+    data_file: impl FnOnce(&str) -> Result<Vec<u8>, ReadError>,
+) -> Result<VolumeData, ReadError> {
+    let h = parse_header(bytes)?;
     let need = |keys: &[&str], what: &str| {
         h.get(keys)
-            .ok_or_else(|| bad(path, format!("no '{}' field ({what})", keys[0])))
+            .ok_or_else(|| bad(format!("no '{}' field ({what})", keys[0])))
     };
 
     let type_name = need(&["type"], "the scalar type")?;
-    let ty =
-        nrrd_type(&type_name.to_ascii_lowercase()).ok_or_else(|| ReadError::UnsupportedType {
-            path: path.to_path_buf(),
-            type_name: type_name.to_string(),
-            supported: SUPPORTED_TYPES,
-        })?;
+    let ty = nrrd_type(type_name)
+        .ok_or_else(|| ReadError::unsupported_type(type_name, SUPPORTED_TYPES))?;
     let dim_text = need(&["dimension"], "the number of axes")?;
-    let dimension: usize = dim_text.parse().map_err(|_| {
-        bad(
-            path,
-            format!("dimension: {dim_text:?} is not a whole number"),
-        )
-    })?;
+    let dimension: usize = dim_text
+        .parse()
+        .map_err(|_| bad(format!("dimension: {dim_text:?} is not a whole number")))?;
     if !(1..=4).contains(&dimension) {
         return Err(ReadError::unsupported(
-            path,
             format!("dimension {dimension}; ferrovol reads 1 to 3 spatial axes plus an optional first axis of 1-4 components"),
         ));
     }
     let sizes_text = need(&["sizes"], "the axis sizes")?;
-    let sizes: Vec<u64> = sizes_text
-        .split_ascii_whitespace()
-        .map(|t| t.parse::<u64>())
-        .collect::<Result<_, _>>()
-        .ok()
-        .filter(|s: &Vec<u64>| s.len() == dimension)
-        .ok_or_else(|| {
-            bad(
-                path,
-                format!("sizes: {sizes_text:?} is not {dimension} whole numbers"),
-            )
-        })?;
+    let sizes: Vec<u64> = numbers(sizes_text, dimension).ok_or_else(|| {
+        bad(format!(
+            "sizes: {sizes_text:?} is not {dimension} whole numbers"
+        ))
+    })?;
 
     let kinds: Option<Vec<String>> = h
         .get(&["kinds"])
         .map(|k| k.split_ascii_whitespace().map(str::to_string).collect());
     if let Some(k) = &kinds {
         if k.len() != dimension {
-            return Err(bad(
-                path,
-                format!("kinds: {} entries for {dimension} axes", k.len()),
-            ));
+            return Err(bad(format!(
+                "kinds: {} entries for {dimension} axes",
+                k.len()
+            )));
         }
     }
     let directions = match h.get(&["space directions"]) {
         Some(v) => {
-            let d = parse_vectors(path, "space directions", v)?;
+            let d = parse_vectors("space directions", v)?;
             if d.len() != dimension {
-                return Err(bad(
-                    path,
-                    format!("space directions: {} entries for {dimension} axes", d.len()),
-                ));
+                return Err(bad(format!(
+                    "space directions: {} entries for {dimension} axes",
+                    d.len()
+                )));
             }
             Some(d)
         }
@@ -240,7 +214,6 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
     let comp_axis = if dimension == 4 {
         if first_is_domain {
             return Err(ReadError::unsupported(
-                path,
                 "a 4D image whose first axis is spatial (a time series?); extract one 3D volume first (e.g. with unu slice)",
             ));
         }
@@ -250,10 +223,9 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
     };
     let components = if comp_axis { sizes[0] } else { 1 };
     if !(1..=4).contains(&components) {
-        return Err(ReadError::unsupported(
-            path,
-            format!("{components} components per voxel on the first axis; ferrovol renders 1 to 4"),
-        ));
+        return Err(ReadError::unsupported(format!(
+            "{components} components per voxel on the first axis; ferrovol renders 1 to 4"
+        )));
     }
     let first_spatial = usize::from(comp_axis);
     let spatial: Vec<usize> = (first_spatial..dimension).collect();
@@ -263,27 +235,28 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
     }
 
     // Geometry.
-    let mut spacing = [1.0f64; 3];
-    let mut direction = IDENTITY_DIRECTION;
+    let mut geometry = Geometry::default();
+    let Geometry {
+        spacing,
+        origin,
+        direction,
+    } = &mut geometry;
     if let Some(dirs) = &directions {
         let mut have = [false; 3];
         for (i, &a) in spatial.iter().enumerate() {
-            let v = dirs.get(a).cloned().flatten().ok_or_else(|| {
-                bad(
-                    path,
-                    format!("space directions: spatial axis {a} is 'none'"),
-                )
-            })?;
+            let v = dirs
+                .get(a)
+                .cloned()
+                .flatten()
+                .ok_or_else(|| bad(format!("space directions: spatial axis {a} is 'none'")))?;
             if v.len() > 3 {
                 return Err(ReadError::unsupported(
-                    path,
                     format!("a {}-dimensional space (space directions); ferrovol places volumes in 3D space", v.len()),
                 ));
             }
             let len = v.iter().map(|x| x * x).sum::<f64>().sqrt();
             if !len.is_finite() || len <= 0.0 {
                 return Err(bad(
-                    path,
                     format!("space directions: axis {a} has the zero or invalid vector {v:?}, so its spacing would be {len}"),
                 ));
             }
@@ -293,29 +266,22 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
             }
             have[i] = true;
         }
-        complete_direction(&mut direction, have);
+        complete_direction(direction, have);
     } else if let Some(v) = h.get(&["spacings"]) {
-        let s: Vec<f64> = v
-            .split_ascii_whitespace()
-            .map(|t| t.parse::<f64>())
-            .collect::<Result<_, _>>()
-            .ok()
-            .filter(|s: &Vec<f64>| s.len() == dimension)
-            .ok_or_else(|| bad(path, format!("spacings: {v:?} is not {dimension} numbers")))?;
+        let s: Vec<f64> = numbers(v, dimension)
+            .ok_or_else(|| bad(format!("spacings: {v:?} is not {dimension} numbers")))?;
         for (i, &a) in spatial.iter().enumerate() {
             spacing[i] = if s[a].is_nan() { 1.0 } else { s[a] };
         }
     }
-    let mut origin = [0.0f64; 3];
     if let Some(v) = h.get(&["space origin"]) {
-        let o = parse_vectors(path, "space origin", v)?;
+        let o = parse_vectors("space origin", v)?;
         match o.as_slice() {
             [Some(o)] if o.len() <= 3 => origin[..o.len()].copy_from_slice(o),
             _ => {
-                return Err(bad(
-                    path,
-                    format!("space origin: {v:?} is not one vector like (0,0,0)"),
-                ))
+                return Err(bad(format!(
+                    "space origin: {v:?} is not one vector like (0,0,0)"
+                )))
             }
         }
     }
@@ -329,19 +295,17 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
         "hex" => Encoding::Hex,
         "bzip2" | "bz2" | "zstd" => {
             return Err(ReadError::unsupported(
-                path,
                 format!("encoding {enc_text}; re-save with raw or gzip encoding (e.g. unu save -f nrrd -e gzip)"),
             ))
         }
-        other => return Err(bad(path, format!("encoding: unknown encoding {other:?}"))),
+        other => return Err(bad(format!("encoding: unknown encoding {other:?}"))),
     };
     let big_endian = match h.get(&["endian"]).map(|e| e.to_ascii_lowercase()) {
         Some(e) if e == "little" => false,
         Some(e) if e == "big" => true,
-        Some(e) => return Err(bad(path, format!("endian: {e:?}; expected little or big"))),
+        Some(e) => return Err(bad(format!("endian: {e:?}; expected little or big"))),
         None if ty.size_bytes() > 1 && encoding != Encoding::Ascii => {
             return Err(bad(
-                path,
                 "no 'endian' field, which multi-byte binary data needs (add 'endian: little' or 'endian: big')",
             ))
         }
@@ -350,76 +314,87 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
     let line_skip: usize = match h.get(&["line skip", "lineskip"]) {
         Some(v) => v
             .parse()
-            .map_err(|_| bad(path, format!("line skip: {v:?} is not a whole number")))?,
+            .map_err(|_| bad(format!("line skip: {v:?} is not a whole number")))?,
         None => 0,
     };
     let byte_skip: i64 = match h.get(&["byte skip", "byteskip"]) {
         Some(v) => v
             .parse()
-            .map_err(|_| bad(path, format!("byte skip: {v:?} is not a whole number")))?,
+            .map_err(|_| bad(format!("byte skip: {v:?} is not a whole number")))?,
         None => 0,
     };
     if byte_skip < -1 || (byte_skip == -1 && encoding != Encoding::Raw) {
-        return Err(bad(
-            path,
-            format!(
-                "byte skip {byte_skip}: only -1 (with raw encoding) or a byte count is allowed"
-            ),
-        ));
+        return Err(bad(format!(
+            "byte skip {byte_skip}: only -1 (with raw encoding) or a byte count is allowed"
+        )));
     }
-    let (count, nbytes) = value_count(path, FORMAT, &dims, components, ty)?;
+    let layout = Layout::new(FORMAT, dims, components, ty)?;
 
     // Where the data is.
-    let external;
-    let (data_path, mut data): (PathBuf, &[u8]) = match h.get(&["data file", "datafile"]) {
+    let stored = Stored {
+        encoding,
+        big_endian,
+        line_skip,
+        byte_skip,
+    };
+    let scalars = match h.get(&["data file", "datafile"]) {
         Some(f) => {
             let first = f.split_ascii_whitespace().next().unwrap_or("");
             if first == "LIST" || f.contains('%') {
-                return Err(ReadError::unsupported(
-                    path,
-                    format!("data file: {f}: data split over several files; join them into one file (e.g. with unu join, then unu save)"),
-                ));
+                return Err(ReadError::unsupported(format!(
+                    "data file: {f}: data split over several files; join them into one file (e.g. with unu join, then unu save)"
+                )));
             }
-            let p = path
-                .parent()
-                .map(|d| d.join(f))
-                .unwrap_or_else(|| PathBuf::from(f));
-            external = read_file(&p)?;
-            (p, &external[..])
+            let external = data_file(f)?;
+            decode(&external, layout, stored).map_err(|e| e.in_file(Path::new(f)))?
         }
         None => match h.data_start {
-            Some(s) => (path.to_path_buf(), bytes.get(s..).unwrap_or(&[])),
+            Some(s) => decode(bytes.get(s..).unwrap_or(&[]), layout, stored)?,
             None => {
                 return Err(bad(
-                    path,
                     "no 'data file' field and no blank line followed by data; a detached header (.nhdr) must name its data file",
                 ))
             }
         },
     };
+    layout.volume(geometry, scalars)
+}
+
+/// How the data is stored: the header's `encoding`, `endian`, `line skip` and
+/// `byte skip` fields.
+#[derive(Clone, Copy)]
+struct Stored {
+    encoding: Encoding,
+    big_endian: bool,
+    line_skip: usize,
+    byte_skip: i64,
+}
+
+/// The values in `data`: skips lines, then bytes (after decompression for gzip), then
+/// converts.
+fn decode(mut data: &[u8], layout: Layout, stored: Stored) -> Result<Scalars, ReadError> {
+    let Stored {
+        encoding,
+        big_endian,
+        line_skip,
+        byte_skip,
+    } = stored;
     for _ in 0..line_skip {
         data = match data.iter().position(|&b| b == b'\n') {
             Some(i) => data.get(i + 1..).unwrap_or(&[]),
             None => {
-                return Err(ReadError::Truncated {
-                    path: data_path,
-                    what: format!("NRRD data (line skip {line_skip})"),
-                    expected: line_skip as u64,
-                    found: 0,
-                })
+                return Err(ReadError::truncated(
+                    format!("NRRD data (line skip {line_skip})"),
+                    line_skip,
+                    0,
+                ))
             }
         };
     }
-
-    // Decode: skip bytes (after decompression for gzip), then convert.
-    let truncated = |found: usize| ReadError::Truncated {
-        path: data_path.clone(),
-        what: "NRRD data".into(),
-        expected: nbytes as u64,
-        found: found as u64,
-    };
+    let nbytes = layout.nbytes;
+    let truncated = |found: usize| ReadError::truncated("NRRD data", nbytes, found);
     let skip = usize::try_from(byte_skip.max(0)).unwrap_or(usize::MAX);
-    let scalars = match encoding {
+    Ok(match encoding {
         Encoding::Raw => {
             let start = if byte_skip == -1 {
                 data.len()
@@ -430,41 +405,32 @@ pub(crate) fn read(path: &Path) -> Result<VolumeData, ReadError> {
             };
             let d = data.get(start..).unwrap_or(&[]);
             let d = d.get(..nbytes).ok_or_else(|| truncated(d.len()))?;
-            decode_binary(d, ty, big_endian)
+            decode_binary(d, layout.ty, big_endian)
         }
         Encoding::Gzip => {
             let limit = nbytes.saturating_add(skip);
-            let out = super::inflate(&data_path, "gzip NRRD data", data, limit)?;
+            let out = inflate("gzip NRRD data", data, limit)?;
             let d = out.get(skip..).unwrap_or(&[]);
             let d = d.get(..nbytes).ok_or_else(|| truncated(d.len()))?;
-            decode_binary(d, ty, big_endian)
+            decode_binary(d, layout.ty, big_endian)
         }
         Encoding::Ascii => {
             let d = data.get(skip..).unwrap_or(&[]);
             let text = String::from_utf8_lossy(d);
-            parse_ascii(&data_path, "ASCII NRRD data", &text, ty, count)?
+            parse_ascii("ASCII NRRD data", &text, layout.ty, layout.count)?
         }
         Encoding::Hex => {
             let d = data.get(skip..).unwrap_or(&[]);
-            let raw = decode_hex(&data_path, d, nbytes)?;
-            decode_binary(&raw, ty, big_endian)
+            let raw = decode_hex(d, nbytes)?;
+            decode_binary(&raw, layout.ty, big_endian)
         }
-    };
-
-    Ok(VolumeData {
-        dims: [dims[0] as u32, dims[1] as u32, dims[2] as u32],
-        spacing,
-        origin,
-        direction,
-        components: components as u32,
-        scalars,
     })
 }
 
 /// Fills the direction columns of axes that have none (images with fewer than 3 spatial
 /// axes) so that the matrix stays non-singular: the cross product of the other two
 /// columns, or a unit axis.
-fn complete_direction(d: &mut [[f64; 3]; 3], have: [bool; 3]) {
+fn complete_direction(d: &mut Direction, have: [bool; 3]) {
     let col = |d: &[[f64; 3]; 3], j: usize| [d[0][j], d[1][j], d[2][j]];
     for j in 0..3 {
         if have[j] {
@@ -499,7 +465,7 @@ fn complete_direction(d: &mut [[f64; 3]; 3], have: [bool; 3]) {
 }
 
 /// Decodes hex text (two digits per byte, whitespace ignored) into `nbytes` bytes.
-fn decode_hex(path: &Path, text: &[u8], nbytes: usize) -> Result<Vec<u8>, ReadError> {
+fn decode_hex(text: &[u8], nbytes: usize) -> Result<Vec<u8>, ReadError> {
     let mut out = Vec::with_capacity(nbytes.min(text.len() / 2 + 1));
     let mut hi: Option<u8> = None;
     for (i, &c) in text.iter().enumerate() {
@@ -509,38 +475,36 @@ fn decode_hex(path: &Path, text: &[u8], nbytes: usize) -> Result<Vec<u8>, ReadEr
         if c.is_ascii_whitespace() {
             continue;
         }
-        let v = (c as char)
-            .to_digit(16)
-            .ok_or_else(|| ReadError::CorruptData {
-                path: path.to_path_buf(),
-                what: "hex NRRD data".into(),
-                message: format!(
+        let v = (c as char).to_digit(16).ok_or_else(|| {
+            ReadError::corrupt(
+                "hex NRRD data",
+                format!(
                     "{:?} at byte {i} is not a hex digit (fix or re-export the data)",
                     c as char
                 ),
-            })? as u8;
+            )
+        })? as u8;
         match hi.take() {
             None => hi = Some(v),
             Some(h) => out.push(h << 4 | v),
         }
     }
     if out.len() < nbytes {
-        return Err(ReadError::Truncated {
-            path: path.to_path_buf(),
-            what: "hex NRRD data".into(),
-            expected: nbytes as u64,
-            found: out.len() as u64,
-        });
+        return Err(ReadError::truncated("hex NRRD data", nbytes, out.len()));
     }
     Ok(out)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::read_volume;
-    use super::super::test_util::{gzip, msg, TempDir};
     use super::nrrd_type;
-    use ferrovol_core::{ScalarType, Scalars};
+    use crate::test_util::{check_errors, gzip, never_panics};
+    use crate::{no_data_file, ReadError};
+    use ferrovol_core::{ScalarType, Scalars, VolumeData};
+
+    fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
+        super::parse(bytes, no_data_file)
+    }
 
     fn nrrd(header: &str, data: &[u8]) -> Vec<u8> {
         let mut f = header.trim_end_matches('\n').as_bytes().to_vec();
@@ -562,9 +526,8 @@ mod tests {
 
     #[test]
     fn readers_nrrd_raw_short_space_directions() {
-        let dir = TempDir::new("nrrd");
         let (vals, bytes) = short_data(false);
-        let v = read_volume(&dir.write("a.nrrd", &nrrd(SHORT, &bytes))).unwrap();
+        let v = parse(&nrrd(SHORT, &bytes)).unwrap();
         assert_eq!(v.dims, [3, 2, 2]);
         assert_eq!(v.spacing, [0.5, 1.0, 2.0]);
         assert_eq!(v.origin, [10.0, 20.0, 30.0]);
@@ -577,11 +540,10 @@ mod tests {
 
     #[test]
     fn readers_nrrd_gzip_big_endian_float_spacings() {
-        let dir = TempDir::new("nrrd");
         let vals: Vec<f32> = (0..12).map(|i| i as f32 * 0.75).collect();
         let bytes: Vec<u8> = vals.iter().flat_map(|v| v.to_be_bytes()).collect();
         let header = "NRRD0005\ntype: float\ndimension: 3\nsizes: 3 2 2\nspacings: 0.5 1.5 3\nendian: big\nencoding: gz";
-        let v = read_volume(&dir.write("b.nrrd", &nrrd(header, &gzip(&bytes)))).unwrap();
+        let v = parse(&nrrd(header, &gzip(&bytes))).unwrap();
         assert_eq!(v.spacing, [0.5, 1.5, 3.0]);
         assert_eq!(v.origin, [0.0; 3]);
         assert_eq!(v.scalars, Scalars::F32(vals));
@@ -589,61 +551,71 @@ mod tests {
 
     #[test]
     fn readers_nrrd_ascii_and_hex() {
-        let dir = TempDir::new("nrrd");
         let header = "NRRD0001\ntype: unsigned char\ndimension: 3\nsizes: 2 2 1\nencoding: ascii";
-        let v = read_volume(&dir.write("c.nrrd", &nrrd(header, b"0 1\n254 255\n"))).unwrap();
+        let v = parse(&nrrd(header, b"0 1\n254 255\n")).unwrap();
         assert_eq!(v.dims, [2, 2, 1]);
         assert_eq!(v.scalars, Scalars::U8(vec![0, 1, 254, 255]));
 
         let header =
             "NRRD0004\ntype: uint16_t\ndimension: 2\nsizes: 2 1\nendian: big\nencoding: hex";
-        let v = read_volume(&dir.write("d.nrrd", &nrrd(header, b"0102\nFFfe\n"))).unwrap();
+        let v = parse(&nrrd(header, b"0102\nFFfe\n")).unwrap();
         assert_eq!(v.dims, [2, 1, 1]);
         assert_eq!(v.scalars, Scalars::U16(vec![0x0102, 0xfffe]));
     }
 
     #[test]
     fn readers_nhdr_detached_with_skips() {
-        let dir = TempDir::new("nrrd");
         let (vals, bytes) = short_data(true);
         let mut raw = b"first line\nsecond line\nXYZ".to_vec();
         raw.extend(&bytes);
-        std::fs::create_dir_all(dir.path().join("sub")).unwrap();
-        dir.write("sub/vol.raw", &raw);
+        let mut z = vec![0u8; 5];
+        z.extend(short_data(false).1);
+        let z = gzip(&z);
+        let files = |name: &str| match name {
+            "sub/vol.raw" => Ok(raw.clone()),
+            "vol.raw.gz" => Ok(z.clone()),
+            _ => no_data_file(name),
+        };
         let header = SHORT.replace("endian: little", "endian: big")
             + "data file: sub/vol.raw\nline skip: 2\nbyte skip: 3\n";
-        let v = read_volume(&dir.write("e.nhdr", header.as_bytes())).unwrap();
+        let v = super::parse(header.as_bytes(), files).unwrap();
         assert_eq!(v.scalars, Scalars::I16(vals.clone()));
 
         // byte skip -1: the data is at the end of the file; old "datafile" spelling.
         let header = SHORT.replace("endian: little", "endian: big")
             + "datafile: sub/vol.raw\nbyteskip: -1\n";
-        let v = read_volume(&dir.write("f.nhdr", header.as_bytes())).unwrap();
+        let v = super::parse(header.as_bytes(), files).unwrap();
         assert_eq!(v.scalars, Scalars::I16(vals.clone()));
 
         // gzip data file; byte skip applies after decompression.
-        let mut z = vec![0u8; 5];
-        z.extend(short_data(false).1);
-        dir.write("vol.raw.gz", &gzip(&z));
         let header = SHORT.replace("encoding: raw", "encoding: gzip")
             + "data file: vol.raw.gz\nbyte skip: 5\n";
-        let v = read_volume(&dir.write("g.nhdr", header.as_bytes())).unwrap();
+        let v = super::parse(header.as_bytes(), files).unwrap();
         assert_eq!(v.scalars, Scalars::I16(vals));
+
+        // A problem in the data file names it as the header does.
+        let header = SHORT.to_string() + "data file: sub/vol.raw\nbyte skip: 30\n";
+        let m = super::parse(header.as_bytes(), files)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            m.starts_with("sub/vol.raw: truncated NRRD data: expected 24 bytes, found 20"),
+            "{m}"
+        );
     }
 
     #[test]
     fn readers_nrrd_components() {
-        let dir = TempDir::new("nrrd");
         let rgb: Vec<u8> = (0..36).collect();
         let header = "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 3 3 2 2\nkinds: RGB-color domain domain domain\nspace directions: none (1,0,0) (0,1,0) (0,0,1)\nspacings: nan 1 1 1\nencoding: raw";
-        let v = read_volume(&dir.write("rgb.nrrd", &nrrd(header, &rgb))).unwrap();
+        let v = parse(&nrrd(header, &rgb)).unwrap();
         assert_eq!(v.dims, [3, 2, 2]);
         assert_eq!(v.components, 3);
         assert_eq!(v.scalars, Scalars::U8(rgb.clone()));
 
         // dimension 3 with a non-spatial first axis: a 2D image with components.
         let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 4 3\nspace dimension: 3\nspace directions: none (0,2,0) (2,0,0)\nspace origin: (1,2,3)\nencoding: raw";
-        let v = read_volume(&dir.write("rgb2d.nrrd", &nrrd(header, &rgb))).unwrap();
+        let v = parse(&nrrd(header, &rgb)).unwrap();
         assert_eq!(v.dims, [4, 3, 1]);
         assert_eq!(v.components, 3);
         assert_eq!(v.spacing, [2.0, 2.0, 1.0]);
@@ -715,7 +687,6 @@ mod tests {
 
     #[test]
     fn readers_nrrd_errors() {
-        let dir = TempDir::new("nrrd");
         let (_, bytes) = short_data(false);
         let s = |from: &str, to: &str| SHORT.replace(from, to);
         let cases: Vec<(&str, Vec<u8>, &str)> = vec![
@@ -733,7 +704,7 @@ mod tests {
             ("bz.nrrd", nrrd(&s("raw", "bzip2"), &bytes), "bzip2"),
             ("list.nhdr", (s("encoding", "data file: LIST\nencoding")).into_bytes(), "several files"),
             ("nodata.nhdr", SHORT.trim_end().as_bytes().to_vec(), "no 'data file' field"),
-            ("missing.nhdr", (SHORT.to_string() + "data file: nothere.raw\n").into_bytes(), "nothere.raw: cannot read the file"),
+            ("missing.nhdr", (SHORT.to_string() + "data file: nothere.raw\n").into_bytes(), "\"nothere.raw\", which was not given"),
             ("time.nrrd", nrrd("NRRD0004\ntype: uchar\ndimension: 4\nsizes: 2 2 2 2\nkinds: domain domain domain time\nencoding: raw", &[0; 16]), "time series"),
             ("comp5.nrrd", nrrd("NRRD0004\ntype: uchar\ndimension: 4\nsizes: 5 1 1 1\nencoding: raw", &[0; 5]), "5 components"),
             ("vec.nrrd", nrrd(&s("(0,0,2)", "(0,0,2"), &bytes), "no matching ')'"),
@@ -744,36 +715,47 @@ mod tests {
             ("skip.nrrd", nrrd(&(SHORT.to_string() + "byte skip: -1\n").replace("raw", "gzip"), &gzip(&bytes)), "byte skip -1"),
             ("empty.nrrd", Vec::new(), "empty"),
         ];
-        for (name, bytes, want) in cases {
-            let p = dir.write(name, &bytes);
-            let m = msg(read_volume(&p));
-            assert!(
-                m.starts_with(&dir.path().display().to_string()),
-                "{name}: {m}"
-            );
-            assert!(m.contains(want), "{name}: wanted {want:?} in {m}");
-        }
+        check_errors(parse, &cases);
+    }
+
+    /// 10^12 voxels of double (8 TB) in a few bytes: an error, not an allocation.
+    #[test]
+    fn readers_nrrd_absurd_size_fails_before_allocating() {
+        let header =
+            "NRRD0004\ntype: double\ndimension: 3\nsizes: 10000 10000 10000\nendian: little";
+        let cases = [
+            (
+                "raw",
+                nrrd(&format!("{header}\nencoding: raw"), &[0; 16]),
+                "expected 8000000000000 bytes, found 16",
+            ),
+            (
+                "gzip",
+                nrrd(&format!("{header}\nencoding: gzip"), &gzip(&[0; 16])),
+                "expected 8000000000000 bytes, found 16",
+            ),
+            (
+                "ascii",
+                nrrd(&format!("{header}\nencoding: ascii"), b"1 2"),
+                "found 2 values, expected 1000000000000",
+            ),
+            (
+                "hex",
+                nrrd(&format!("{header}\nencoding: hex"), b"0102"),
+                "expected 8000000000000 bytes, found 2",
+            ),
+        ];
+        check_errors(parse, &cases);
     }
 
     #[test]
     fn readers_nrrd_never_panics_on_damaged_files() {
-        let dir = TempDir::new("nrrd");
         let (_, bytes) = short_data(false);
         let f = nrrd(&SHORT.replace("raw", "gzip"), &gzip(&bytes));
-        let p = dir.path().join("x.nrrd");
-        for cut in 0..f.len() {
-            std::fs::write(&p, &f[..cut]).unwrap();
-            let _ = read_volume(&p);
-        }
-        for i in 0..f.len() {
-            for x in [0u8, b'9', b'-', b' ', b'\n', b'(', b')', b',', 0xff] {
-                let mut g = f.clone();
-                g[i] = x;
-                std::fs::write(&p, &g).unwrap();
-                if let Ok(v) = read_volume(&p) {
-                    v.validate().unwrap();
-                }
-            }
-        }
+        never_panics(
+            parse,
+            &f,
+            &[0, b'9', b'-', b' ', b'\n', b'(', b')', b',', 0xff],
+        );
     }
 }

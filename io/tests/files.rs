@@ -1,0 +1,116 @@
+//! The path API on real files: detached data files next to their headers, and messages
+//! that start with the path of the file that was wrong.
+
+use std::path::PathBuf;
+
+use ferrovol_core::Scalars;
+use ferrovol_io::{read_volume, Format, ReadError};
+
+/// A fresh folder under the system temp folder, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        let dir = std::env::temp_dir().join(format!("ferrovol-io-{}-{tag}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        TempDir(dir)
+    }
+
+    /// Writes `bytes` to `name` in the folder and returns the full path.
+    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
+        let p = self.0.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn message(r: Result<ferrovol_core::VolumeData, ReadError>) -> String {
+    let m = r.expect_err("an error").to_string();
+    println!("{m}");
+    m
+}
+
+const MHD: &str = "NDims = 3\nDimSize = 3 2 2\nElementType = MET_UCHAR\nElementDataFile = ";
+const NHDR: &str = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 2 2\nencoding: raw\ndata file: ";
+
+#[test]
+fn detached_data_files_are_read_next_to_the_header() {
+    let dir = TempDir::new("detached");
+    let vals: Vec<u8> = (0..12).map(|i| i * 20).collect();
+    dir.write("sub/vol data.raw", &vals);
+    for (name, header) in [
+        ("a.mhd", format!("{MHD}sub/vol data.raw\n")),
+        ("a.nhdr", format!("{NHDR}sub/vol data.raw\n")),
+    ] {
+        let v = read_volume(&dir.write(name, header.as_bytes())).unwrap();
+        assert_eq!(v.dims, [3, 2, 2], "{name}");
+        assert_eq!(v.scalars, Scalars::U8(vals.clone()), "{name}");
+    }
+}
+
+#[test]
+fn messages_name_the_file_that_was_wrong() {
+    let dir = TempDir::new("messages");
+    dir.write("short.raw", &[1, 2, 3]);
+    for (name, header, what) in [
+        ("s.mhd", format!("{MHD}short.raw\n"), "MetaImage voxel data"),
+        ("s.nhdr", format!("{NHDR}short.raw\n"), "NRRD data"),
+    ] {
+        let header_path = dir.write(name, header.as_bytes());
+        // A short data file: its own path.
+        let m = message(read_volume(&header_path));
+        let short = dir.0.join("short.raw");
+        let want = format!(
+            "{}: truncated {what}: expected 12 bytes, found 3",
+            short.display()
+        );
+        assert!(m.starts_with(&want), "{m}");
+        // A missing data file: its path.
+        let header_path = dir.write(name, header.replace("short.raw", "gone.raw").as_bytes());
+        let m = message(read_volume(&header_path));
+        let gone = dir.0.join("gone.raw");
+        assert!(
+            m.starts_with(&format!("{}: cannot read the file", gone.display())),
+            "{m}"
+        );
+        // A bad header: the header's path.
+        let header_path = dir.write(name, header.replace("3 2 2", "3 0 2").as_bytes());
+        let m = message(read_volume(&header_path));
+        assert!(
+            m.starts_with(&format!("{}: bad ", header_path.display())),
+            "{m}"
+        );
+    }
+    let p = dir.write("bad.vti", b"hello");
+    let m = message(read_volume(&p));
+    assert!(
+        m.starts_with(&format!("{}: bad VTK ImageData (.vti) header", p.display())),
+        "{m}"
+    );
+}
+
+#[test]
+fn the_byte_api_reads_what_the_path_api_reads() {
+    let dir = TempDir::new("bytes");
+    let vals: Vec<u8> = (0..12).collect();
+    dir.write("d.raw", &vals);
+    let header = format!("{NHDR}d.raw\n");
+    let p = dir.write("h.nhdr", header.as_bytes());
+    let from_file = read_volume(&p).unwrap();
+    let format = Format::from_path(&p).unwrap();
+    let from_bytes = format
+        .parse(header.as_bytes(), |name| {
+            assert_eq!(name, "d.raw");
+            Ok(vals.clone())
+        })
+        .unwrap();
+    assert_eq!(from_file.dims, from_bytes.dims);
+    assert_eq!(from_file.scalars, from_bytes.scalars);
+}
