@@ -276,7 +276,12 @@ impl FvPathTraceParams {
             fresnel: d.bsdf.fresnel,
             transmission: d.bsdf.transmission,
             cone_angle: d.bsdf.cone_angle,
-            scatter_regions: d.scatter.code(),
+            scatter_regions: match d.scatter {
+                ScatterRegions::Nowhere => FvScatterRegions::Nowhere,
+                ScatterRegions::Surfaces => FvScatterRegions::Surfaces,
+                ScatterRegions::Between => FvScatterRegions::Between,
+                ScatterRegions::Everywhere => FvScatterRegions::Everywhere,
+            } as u32,
             attenuation: d.attenuation,
             denoise: d.denoise,
         }

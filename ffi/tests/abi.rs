@@ -288,6 +288,9 @@ fn volume_errors() {
 #[test]
 fn transfer_function_errors() {
     let lib = Lib::open();
+    let mut tf: H = null_mut();
+    let pts = [0.0, 1.0, 1.0, 1.0];
+    let nan = [0.0, f64::NAN];
     let new = lib.f::<NewTf>("fv_transfer_function_new");
     let color = lib.f::<SetPoints>("fv_transfer_function_set_color");
     let opacity = lib.f::<SetPoints>("fv_transfer_function_set_opacity");
@@ -295,9 +298,6 @@ fn transfer_function_errors() {
     let unit = lib.f::<unsafe extern "C" fn(H, u32, f64, f64) -> FvStatus>(
         "fv_transfer_function_set_unit_distance",
     );
-    let mut tf: H = null_mut();
-    let pts = [0.0, 1.0, 1.0, 1.0];
-    let nan = [0.0, f64::NAN];
     // SAFETY: arguments follow the header; invalid ones are the test.
     unsafe {
         lib.expect(new(0, true, &mut tf), Invalid, "0 components");
