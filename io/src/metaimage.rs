@@ -254,7 +254,7 @@ fn decode(
 
 #[cfg(test)]
 mod tests {
-    use crate::test_util::{check_errors, gzip, msg, never_panics, zlib};
+    use crate::test_util::{assert_geometry, check_errors, gzip, msg, never_panics, zlib};
     use crate::{no_data_file, ReadError};
     use ferrovol_core::{Scalars, VolumeData};
 
@@ -285,9 +285,7 @@ mod tests {
         let data: Vec<u8> = vals.iter().flat_map(|v| v.to_le_bytes()).collect();
         let header = "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\nCompressedData = False\nTransformMatrix = 0 1 0 -1 0 0 0 0 1\nOffset = 1 2 3\nCenterOfRotation = 0 0 0\nElementSpacing = 0.5 1 2\nDimSize = 3 2 2\nAnatomicalOrientation = RAI\nElementType = MET_SHORT\nElementDataFile = LOCAL\n";
         let v = parse(&mha(header, &data)).unwrap();
-        assert_eq!(v.dims, [3, 2, 2]);
-        assert_eq!(v.spacing, [0.5, 1.0, 2.0]);
-        assert_eq!(v.origin, [1.0, 2.0, 3.0]);
+        assert_geometry(&v, [3, 2, 2], [0.5, 1.0, 2.0], [1.0, 2.0, 3.0]);
         // ITK: the first three numbers are the direction of index axis 0 (a column).
         assert_eq!(
             v.direction,

@@ -477,7 +477,7 @@ fn interleave(s: Scalars, nvox: usize, vector: usize, per: usize) -> Scalars {
 #[cfg(test)]
 mod tests {
     use super::parse;
-    use crate::test_util::{check_errors, gzip, never_panics};
+    use crate::test_util::{assert_geometry, check_errors, gzip, never_panics};
     use ferrovol_core::Scalars;
 
     /// Fields of a test header; written as NIfTI-1 or NIfTI-2.
@@ -599,9 +599,7 @@ mod tests {
         let mut f = h.nifti1();
         f.extend(&vals);
         let v = parse(&f).unwrap();
-        assert_eq!(v.dims, [3, 2, 2]);
-        assert_eq!(v.spacing, [0.5, 1.0, 2.0]);
-        assert_eq!(v.origin, [5.0, 6.0, 7.0]);
+        assert_geometry(&v, [3, 2, 2], [0.5, 1.0, 2.0], [5.0, 6.0, 7.0]);
         let want = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
         for (got, want) in v.direction.iter().flatten().zip(want.iter().flatten()) {
             assert!((got - want).abs() < 1e-6, "{:?}", v.direction);
@@ -718,9 +716,7 @@ mod tests {
         let mut f = h.nifti2();
         f.extend(le_or_be(vals.iter().map(|v| v.to_le_bytes()), false));
         let v = parse(&f).unwrap();
-        assert_eq!(v.dims, [3, 2, 2]);
-        assert_eq!(v.spacing, [0.5, 1.0, 2.0]);
-        assert_eq!(v.origin, [-1.0, -2.0, -3.0]);
+        assert_geometry(&v, [3, 2, 2], [0.5, 1.0, 2.0], [-1.0, -2.0, -3.0]);
         assert_eq!(v.scalars, Scalars::U16(vals.clone()));
 
         h.be = true;

@@ -498,7 +498,7 @@ fn decode_hex(text: &[u8], nbytes: usize) -> Result<Vec<u8>, ReadError> {
 #[cfg(test)]
 mod tests {
     use super::nrrd_type;
-    use crate::test_util::{check_errors, gzip, never_panics};
+    use crate::test_util::{assert_geometry, check_errors, gzip, never_panics};
     use crate::{no_data_file, ReadError};
     use ferrovol_core::{ScalarType, Scalars, VolumeData};
 
@@ -528,9 +528,7 @@ mod tests {
     fn readers_nrrd_raw_short_space_directions() {
         let (vals, bytes) = short_data(false);
         let v = parse(&nrrd(SHORT, &bytes)).unwrap();
-        assert_eq!(v.dims, [3, 2, 2]);
-        assert_eq!(v.spacing, [0.5, 1.0, 2.0]);
-        assert_eq!(v.origin, [10.0, 20.0, 30.0]);
+        assert_geometry(&v, [3, 2, 2], [0.5, 1.0, 2.0], [10.0, 20.0, 30.0]);
         assert_eq!(
             v.direction,
             [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]

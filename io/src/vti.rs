@@ -162,18 +162,8 @@ pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
         }
         None => return Err(bad("the <VTKFile> element has no type attribute")),
     }
-    let big_endian = choose(
-        "byte_order",
-        h.byte_order.as_deref(),
-        false,
-        &[("LittleEndian", false), ("BigEndian", true)],
-    )?;
-    let header_u64 = choose(
-        "header_type",
-        h.header_type.as_deref(),
-        false,
-        &[("UInt32", false), ("UInt64", true)],
-    )?;
+    let big_endian = flag("byte_order", &h.byte_order, ["LittleEndian", "BigEndian"])?;
+    let header_u64 = flag("header_type", &h.header_type, ["UInt32", "UInt64"])?;
     let compressed = match h.compressor.as_deref() {
         None | Some("") => false,
         Some("vtkZLibDataCompressor") => true,
@@ -351,28 +341,15 @@ pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
     layout.volume(geometry, scalars)
 }
 
-/// The value of attribute `attr` among `options`, `default` where the attribute is
-/// missing.
-fn choose<T: Copy>(
-    attr: &str,
-    value: Option<&str>,
-    default: T,
-    options: &[(&str, T)],
-) -> Result<T, ReadError> {
-    let Some(value) = value else {
-        return Ok(default);
-    };
-    options
-        .iter()
-        .find(|(name, _)| *name == value)
-        .map(|&(_, v)| v)
-        .ok_or_else(|| {
-            let names: Vec<&str> = options.iter().map(|(name, _)| *name).collect();
-            bad(format!(
-                "{attr}=\"{value}\"; expected {}",
-                names.join(" or ")
-            ))
-        })
+/// An attribute with two values: false for `off` (also where the attribute is missing),
+/// true for `on`.
+fn flag(attr: &str, value: &Option<String>, [off, on]: [&str; 2]) -> Result<bool, ReadError> {
+    match value.as_deref() {
+        None => Ok(false),
+        Some(v) if v == off => Ok(false),
+        Some(v) if v == on => Ok(true),
+        Some(v) => Err(bad(format!("{attr}=\"{v}\"; expected {off} or {on}"))),
+    }
 }
 
 /// How binary arrays are stored (attributes of `<VTKFile>`).
@@ -686,7 +663,7 @@ fn read_binary(
 #[cfg(test)]
 mod tests {
     use super::parse;
-    use crate::test_util::{check_errors, msg, never_panics, zlib};
+    use crate::test_util::{assert_geometry, check_errors, msg, never_panics, zlib};
     use base64::Engine;
     use ferrovol_core::{Scalars, VolumeData};
 
@@ -759,9 +736,7 @@ mod tests {
     }
 
     fn check_geom(v: &VolumeData) {
-        assert_eq!(v.dims, [3, 2, 2]);
-        assert_eq!(v.spacing, [0.5, 1.0, 2.0]);
-        assert_eq!(v.origin, [1.0, 2.0, 3.0]);
+        assert_geometry(v, [3, 2, 2], [0.5, 1.0, 2.0], [1.0, 2.0, 3.0]);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The path API on real files: detached data files next to their headers, and messages
 //! that start with the path of the file that was wrong.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use ferrovol_core::Scalars;
 use ferrovol_io::{read_volume, Format, ReadError};
@@ -31,10 +31,12 @@ impl Drop for TempDir {
     }
 }
 
-fn message(r: Result<ferrovol_core::VolumeData, ReadError>) -> String {
+/// Checks that reading fails with a message that starts with `path` and `words`.
+fn assert_fails(r: Result<ferrovol_core::VolumeData, ReadError>, path: &Path, words: &str) {
     let m = r.expect_err("an error").to_string();
     println!("{m}");
-    m
+    let want = format!("{}: {words}", path.display());
+    assert!(m.starts_with(&want), "wanted {want:?} in {m}");
 }
 
 const MHD: &str = "NDims = 3\nDimSize = 3 2 2\nElementType = MET_UCHAR\nElementDataFile = ";
@@ -63,37 +65,31 @@ fn messages_name_the_file_that_was_wrong() {
         ("s.mhd", format!("{MHD}short.raw\n"), "MetaImage voxel data"),
         ("s.nhdr", format!("{NHDR}short.raw\n"), "NRRD data"),
     ] {
-        let header_path = dir.write(name, header.as_bytes());
         // A short data file: its own path.
-        let m = message(read_volume(&header_path));
         let short = dir.0.join("short.raw");
-        let want = format!(
-            "{}: truncated {what}: expected 12 bytes, found 3",
-            short.display()
+        let words = format!("truncated {what}: expected 12 bytes, found 3");
+        assert_fails(
+            read_volume(&dir.write(name, header.as_bytes())),
+            &short,
+            &words,
         );
-        assert!(m.starts_with(&want), "{m}");
         // A missing data file: its path.
-        let header_path = dir.write(name, header.replace("short.raw", "gone.raw").as_bytes());
-        let m = message(read_volume(&header_path));
-        let gone = dir.0.join("gone.raw");
-        assert!(
-            m.starts_with(&format!("{}: cannot read the file", gone.display())),
-            "{m}"
+        let p = dir.write(name, header.replace("short.raw", "gone.raw").as_bytes());
+        assert_fails(
+            read_volume(&p),
+            &dir.0.join("gone.raw"),
+            "cannot read the file",
         );
         // A bad header: the header's path.
-        let header_path = dir.write(name, header.replace("3 2 2", "3 0 2").as_bytes());
-        let m = message(read_volume(&header_path));
-        assert!(
-            m.starts_with(&format!("{}: bad ", header_path.display())),
-            "{m}"
-        );
+        let p = dir.write(name, header.replace("3 2 2", "3 0 2").as_bytes());
+        assert_fails(read_volume(&p), &p, "bad ");
     }
     let p = dir.write("bad.vti", b"hello");
-    let m = message(read_volume(&p));
-    assert!(
-        m.starts_with(&format!("{}: bad VTK ImageData (.vti) header", p.display())),
-        "{m}"
-    );
+    assert_fails(read_volume(&p), &p, "bad VTK ImageData (.vti) header");
+    for name in ["a.vti", "a.nii", "a.nii.gz", "a.mha", "a.nrrd"] {
+        let p = dir.0.join("nothere").join(name);
+        assert_fails(read_volume(&p), &p, "cannot read the file");
+    }
 }
 
 #[test]
