@@ -331,9 +331,7 @@ mod tests {
     fn readers_mha_ascii_2d_and_other_types() {
         let header = "ObjectType = Image\nNDims = 2\nDimSize = 3 2\nElementSpacing = 2 3\nOffset = 5 6\nBinaryData = False\nElementType = MET_INT\nElementDataFile = LOCAL\n";
         let v = parse(&mha(header, b"1 -2 3\n4 5 -600000\n")).unwrap();
-        assert_eq!(v.dims, [3, 2, 1]);
-        assert_eq!(v.spacing, [2.0, 3.0, 1.0]);
-        assert_eq!(v.origin, [5.0, 6.0, 0.0]);
+        assert_geometry(&v, [3, 2, 1], [2.0, 3.0, 1.0], [5.0, 6.0, 0.0]);
         assert_eq!(v.scalars, Scalars::I32(vec![1, -2, 3, 4, 5, -600000]));
 
         for (ty, want) in [

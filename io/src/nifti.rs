@@ -97,8 +97,73 @@ impl Header {
     }
 }
 
-/// Reads fixed-size fields; the caller has checked the slice is long enough (missing
-/// bytes read as zero rather than panic).
+/// How a header field's number is stored.
+#[derive(Clone, Copy)]
+enum Num {
+    I16,
+    I32,
+    I64,
+    F32,
+    F64,
+}
+
+/// A field: how it is stored and its byte offset.
+type Field = (Num, usize);
+
+/// Element `i` of the array that starts at `field`.
+fn nth((num, off): Field, i: usize) -> Field {
+    let width = match num {
+        Num::I16 => 2,
+        Num::I32 | Num::F32 => 4,
+        Num::I64 | Num::F64 => 8,
+    };
+    (num, off + width * i)
+}
+
+/// Where a NIfTI version keeps the fields the reader uses. `scl` is scl_slope (then
+/// scl_inter), `codes` qform_code (then sform_code), `quatern` quatern_b (then c, d and
+/// qoffset_x, y, z), `srow` srow_x\[0\] (the 3x4 sform, row by row).
+struct Version {
+    size: usize,
+    magic: usize,
+    datatype: Field,
+    dim: Field,
+    pixdim: Field,
+    vox_offset: Field,
+    scl: Field,
+    codes: Field,
+    quatern: Field,
+    srow: Field,
+}
+
+const NIFTI1: Version = Version {
+    size: 348,
+    magic: 344,
+    datatype: (Num::I16, 70),
+    dim: (Num::I16, 40),
+    pixdim: (Num::F32, 76),
+    vox_offset: (Num::F32, 108),
+    scl: (Num::F32, 112),
+    codes: (Num::I16, 252),
+    quatern: (Num::F32, 256),
+    srow: (Num::F32, 280),
+};
+
+const NIFTI2: Version = Version {
+    size: 540,
+    magic: 4,
+    datatype: (Num::I16, 12),
+    dim: (Num::I64, 16),
+    pixdim: (Num::F64, 104),
+    vox_offset: (Num::I64, 168),
+    scl: (Num::F64, 176),
+    codes: (Num::I32, 344),
+    quatern: (Num::F64, 352),
+    srow: (Num::F64, 400),
+};
+
+/// Reads header fields; the caller has checked the slice is long enough (missing bytes
+/// read as zero rather than panic).
 struct Fields<'a> {
     b: &'a [u8],
     be: bool,
@@ -114,20 +179,22 @@ impl Fields<'_> {
     fn num<T: FromBytes<N>, const N: usize>(&self, off: usize) -> T {
         T::from_bytes(self.arr(off), self.be)
     }
-    fn i16(&self, off: usize) -> i64 {
-        self.num::<i16, 2>(off).into()
+    /// An integer field (a float field is truncated toward zero).
+    fn int(&self, field: Field) -> i64 {
+        match field {
+            (Num::I16, off) => self.num::<i16, 2>(off).into(),
+            (Num::I32, off) => self.num::<i32, 4>(off).into(),
+            (Num::I64, off) => self.num(off),
+            (Num::F32 | Num::F64, _) => self.float(field) as i64,
+        }
     }
-    fn i32(&self, off: usize) -> i64 {
-        self.num::<i32, 4>(off).into()
-    }
-    fn i64(&self, off: usize) -> i64 {
-        self.num(off)
-    }
-    fn f32(&self, off: usize) -> f64 {
-        self.num::<f32, 4>(off).into()
-    }
-    fn f64(&self, off: usize) -> f64 {
-        self.num(off)
+    /// A field as a float.
+    fn float(&self, field: Field) -> f64 {
+        match field {
+            (Num::F32, off) => self.num::<f32, 4>(off).into(),
+            (Num::F64, off) => self.num(off),
+            (Num::I16 | Num::I32 | Num::I64, _) => self.int(field) as f64,
+        }
     }
 }
 
@@ -171,12 +238,13 @@ fn parse_header(b: &[u8]) -> Result<Header, ReadError> {
         )))
         }
     };
-    let header_size = if nifti2 { 540 } else { 348 };
+    let v = if nifti2 { &NIFTI2 } else { &NIFTI1 };
+    let header_size = v.size;
     if b.len() < header_size {
         return Err(ReadError::truncated("NIfTI header", header_size, b.len()));
     }
     let f = Fields { b, be };
-    let magic: [u8; 4] = if nifti2 { f.arr(4) } else { f.arr(344) };
+    let magic: [u8; 4] = f.arr(v.magic);
     let magic_text = String::from_utf8_lossy(&magic[..3]).into_owned();
     match &magic[..3] {
         b"n+1" | b"n+2" => {}
@@ -192,51 +260,19 @@ fn parse_header(b: &[u8]) -> Result<Header, ReadError> {
         }
     }
 
-    let mut dim = [0i64; 8];
-    let mut pixdim = [0f64; 8];
-    let mut srow = [[0f64; 4]; 3];
-    let h = if nifti2 {
-        for i in 0..8 {
-            dim[i] = f.i64(16 + 8 * i);
-            pixdim[i] = f.f64(104 + 8 * i);
-        }
-        for (r, row) in srow.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v = f.f64(400 + 32 * r + 8 * c);
-            }
-        }
-        (
-            f.i16(12) as i32,
-            f.i64(168) as f64,
-            f.f64(176),
-            f.f64(184),
-            f.i32(344) as i32,
-            f.i32(348) as i32,
-            [f.f64(352), f.f64(360), f.f64(368)],
-            [f.f64(376), f.f64(384), f.f64(392)],
-        )
-    } else {
-        for i in 0..8 {
-            dim[i] = f.i16(40 + 2 * i);
-            pixdim[i] = f.f32(76 + 4 * i);
-        }
-        for (r, row) in srow.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v = f.f32(280 + 16 * r + 4 * c);
-            }
-        }
-        (
-            f.i16(70) as i32,
-            f.f32(108),
-            f.f32(112),
-            f.f32(116),
-            f.i16(252) as i32,
-            f.i16(254) as i32,
-            [f.f32(256), f.f32(260), f.f32(264)],
-            [f.f32(268), f.f32(272), f.f32(276)],
-        )
-    };
-    let (datatype, vox_offset, scl_slope, scl_inter, qform_code, sform_code, quatern, qoffset) = h;
+    let dim: [i64; 8] = std::array::from_fn(|i| f.int(nth(v.dim, i)));
+    let pixdim: [f64; 8] = std::array::from_fn(|i| f.float(nth(v.pixdim, i)));
+    let srow: [[f64; 4]; 3] =
+        std::array::from_fn(|r| std::array::from_fn(|c| f.float(nth(v.srow, 4 * r + c))));
+    let quatern: [f64; 6] = std::array::from_fn(|i| f.float(nth(v.quatern, i)));
+    let datatype = f.int(v.datatype) as i32;
+    let vox_offset = f.float(v.vox_offset);
+    let (scl_slope, scl_inter) = (f.float(v.scl), f.float(nth(v.scl, 1)));
+    let (qform_code, sform_code) = (f.int(v.codes) as i32, f.int(nth(v.codes, 1)) as i32);
+    let (quatern, qoffset) = (
+        [quatern[0], quatern[1], quatern[2]],
+        [quatern[3], quatern[4], quatern[5]],
+    );
 
     let (ty, type_components) =
         type_of(datatype).map_err(|name| ReadError::unsupported_type(name, SUPPORTED_TYPES))?;

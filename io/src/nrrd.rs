@@ -542,8 +542,7 @@ mod tests {
         let bytes: Vec<u8> = vals.iter().flat_map(|v| v.to_be_bytes()).collect();
         let header = "NRRD0005\ntype: float\ndimension: 3\nsizes: 3 2 2\nspacings: 0.5 1.5 3\nendian: big\nencoding: gz";
         let v = parse(&nrrd(header, &gzip(&bytes))).unwrap();
-        assert_eq!(v.spacing, [0.5, 1.5, 3.0]);
-        assert_eq!(v.origin, [0.0; 3]);
+        assert_geometry(&v, [3, 2, 2], [0.5, 1.5, 3.0], [0.0; 3]);
         assert_eq!(v.scalars, Scalars::F32(vals));
     }
 
