@@ -74,12 +74,12 @@ struct Header {
     big_endian: bool,
     dim: [i64; 8],
     pixdim: [f64; 8],
-    scl_slope: f64,
-    scl_inter: f64,
-    qform_code: i32,
-    sform_code: i32,
-    quatern: [f64; 3],
-    qoffset: [f64; 3],
+    /// scl_slope, scl_inter.
+    scl: [f64; 2],
+    /// qform_code, sform_code.
+    codes: [i32; 2],
+    /// quatern_b, c, d, qoffset_x, y, z.
+    quatern: [f64; 6],
     srow: [[f64; 4]; 3],
     /// Dimensions x, y, z; `datatype`'s scalar type; components per voxel:
     /// `type_components` (RGB24: 3) times `vector` (dim[5]).
@@ -267,12 +267,8 @@ fn parse_header(b: &[u8]) -> Result<Header, ReadError> {
     let quatern: [f64; 6] = std::array::from_fn(|i| f.float(nth(v.quatern, i)));
     let datatype = f.int(v.datatype) as i32;
     let vox_offset = f.float(v.vox_offset);
-    let (scl_slope, scl_inter) = (f.float(v.scl), f.float(nth(v.scl, 1)));
-    let (qform_code, sform_code) = (f.int(v.codes) as i32, f.int(nth(v.codes, 1)) as i32);
-    let (quatern, qoffset) = (
-        [quatern[0], quatern[1], quatern[2]],
-        [quatern[3], quatern[4], quatern[5]],
-    );
+    let scl: [f64; 2] = std::array::from_fn(|i| f.float(nth(v.scl, i)));
+    let codes: [i32; 2] = std::array::from_fn(|i| f.int(nth(v.codes, i)) as i32);
 
     let (ty, type_components) =
         type_of(datatype).map_err(|name| ReadError::unsupported_type(name, SUPPORTED_TYPES))?;
@@ -331,12 +327,9 @@ fn parse_header(b: &[u8]) -> Result<Header, ReadError> {
         big_endian: be,
         dim,
         pixdim,
-        scl_slope,
-        scl_inter,
-        qform_code,
-        sform_code,
+        scl,
+        codes,
         quatern,
-        qoffset,
         srow,
         layout,
         type_components,
@@ -362,7 +355,7 @@ fn build(h: &Header, file: &[u8]) -> Result<VolumeData, ReadError> {
     }
 
     // Intensity scaling.
-    let (slope, inter) = (h.scl_slope, h.scl_inter);
+    let [slope, inter] = h.scl;
     if h.type_components == 1
         && slope.is_finite()
         && inter.is_finite()
@@ -392,7 +385,8 @@ fn build(h: &Header, file: &[u8]) -> Result<VolumeData, ReadError> {
 
 /// Origin and direction from the sform or qform (see the module documentation).
 fn orientation(h: &Header) -> ([f64; 3], Direction) {
-    if h.sform_code > 0 {
+    let [qform_code, sform_code] = h.codes;
+    if sform_code > 0 {
         let m = [
             [h.srow[0][0], h.srow[0][1], h.srow[0][2]],
             [h.srow[1][0], h.srow[1][1], h.srow[1][2]],
@@ -405,8 +399,8 @@ fn orientation(h: &Header) -> ([f64; 3], Direction) {
         };
         return (origin, direction);
     }
-    if h.qform_code > 0 {
-        let [mut b, mut c, mut d] = h.quatern;
+    if qform_code > 0 {
+        let [mut b, mut c, mut d, x, y, z] = h.quatern;
         let s = b * b + c * c + d * d;
         let a = if s > 1.0 {
             // Not a unit quaternion: normalize (b, c, d) and use a = 0, as nifti1_io does.
@@ -444,7 +438,7 @@ fn orientation(h: &Header) -> ([f64; 3], Direction) {
         } else {
             IDENTITY_DIRECTION
         };
-        return (h.qoffset, direction);
+        return ([x, y, z], direction);
     }
     ([0.0; 3], IDENTITY_DIRECTION)
 }
