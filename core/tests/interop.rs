@@ -1,22 +1,24 @@
-//! The shared output (Vulkan external memory, opaque fd) on a real device: lavapipe on CI,
-//! with OpenGL from Mesa's llvmpipe through EGL's surfaceless platform as the importing host.
+//! The shared output (Vulkan external memory, opaque fd) on a real device, with OpenGL
+//! through EGL's surfaceless platform as the importing host (on lavapipe, the CI device,
+//! Mesa's llvmpipe).
 //!
 //! Every test prints what it measured. The sharing tests need a Vulkan device that can export
-//! memory; they fail (they do not skip) when the device cannot, because lavapipe can. The
-//! OpenGL tests skip, saying why, only when libEGL cannot be loaded or its GL lacks
-//! GL_EXT_memory_object_fd; everything after that point is asserted.
+//! memory, as every device class is expected to (common/gpu.rs); they fail (they do not skip)
+//! when the device cannot. The OpenGL tests skip, saying why, only when libEGL cannot be
+//! loaded, its GL lacks GL_EXT_memory_object_fd, or it runs on another device than Vulkan
+//! where that is not expected of the device class; everything after that point is asserted.
 
 use ferrovol_core::*;
-use std::sync::{Mutex, MutexGuard, OnceLock};
+use std::sync::{MutexGuard, OnceLock};
+mod common;
 
-/// One GPU context per test binary; tests take turns on it (the fd and mapping counts below
-/// also need the process to themselves).
+use common::gpu::{expected, shared_renderer};
+use common::metrics::{count_diff, footprint};
+
+/// The test binary's renderer, the test volume and a transfer function set (the fd and
+/// mapping counts below also need the process to themselves).
 fn renderer() -> MutexGuard<'static, Renderer> {
-    static R: OnceLock<Mutex<Renderer>> = OnceLock::new();
-    R.get_or_init(|| {
-        let ctx = Context::new().expect("a wgpu device (lavapipe: mesa-vulkan-drivers)");
-        println!("{}", ctx.info);
-        let mut r = Renderer::new(ctx).expect("creating the renderer");
+    shared_renderer(|r| {
         r.set_volume_with(
             &test_volume(),
             UploadOptions {
@@ -30,11 +32,7 @@ fn renderer() -> MutexGuard<'static, Renderer> {
             Piecewise::new(vec![(0.0, [0.1, 0.3, 0.9]), (1.0, [1.0, 0.8, 0.3])]).expect("finite");
         r.set_transfer_function(&tf)
             .expect("a valid transfer function");
-        Mutex::new(r)
     })
-    .lock()
-    // a failed test must not take the others down with a poisoned lock
-    .unwrap_or_else(|e| e.into_inner())
 }
 
 fn params() -> RenderParams {
@@ -64,15 +62,6 @@ fn view(width: u32, height: u32) -> View {
     v
 }
 
-fn footprint(img: &Image) -> usize {
-    img.rgba.chunks(4).filter(|p| p[3] > 0).count()
-}
-
-fn count_diff<T: PartialEq>(a: &[T], b: &[T]) -> usize {
-    assert_eq!(a.len(), b.len());
-    a.iter().zip(b).filter(|(x, y)| x != y).count()
-}
-
 /// Open file descriptors of this process.
 fn open_fds() -> usize {
     std::fs::read_dir("/proc/self/fd")
@@ -80,7 +69,8 @@ fn open_fds() -> usize {
         .count()
 }
 
-/// Mappings of memfd files in this process: lavapipe maps each exportable allocation.
+/// Mappings of memfd files in this process: a driver keeping exportable allocations in host
+/// memory (lavapipe) maps each (`Expected::exports_as_memfd`).
 fn memfd_mappings() -> usize {
     std::fs::read_to_string("/proc/self/maps")
         .expect("reading /proc/self/maps")
@@ -93,9 +83,14 @@ fn memfd_mappings() -> usize {
 fn device_can_export_and_has_uuids() {
     let r = renderer();
     let ctx = r.context();
+    let exp = expected(&ctx.info);
     let support = ctx.external_memory_support();
     println!("external memory: {support:?}");
-    support.expect("lavapipe exports opaque fds (VK_KHR_external_memory_fd)");
+    assert!(
+        exp.exports_memory,
+        "the sharing tests need a device expected to export memory: {exp:?}"
+    );
+    support.expect("opaque fds (VK_KHR_external_memory_fd), expected of this device class");
     assert!(ctx.can_export_memory());
     let ids = ctx.device_uuids().expect("Vulkan 1.1 device UUIDs");
     println!("device UUID {:02x?}", ids.device);
@@ -124,7 +119,8 @@ fn sharing_does_not_change_the_image() {
         .expect("rendering with depth");
     let plain_cut = r.read_image().expect("reading back");
 
-    r.set_output_sharing(true).expect("sharing on lavapipe");
+    r.set_output_sharing(true)
+        .expect("sharing (expected of this device class)");
     assert_eq!(r.output_path(), OutputPath::Shared);
     r.render(&v, &p, None)
         .expect("rendering into shared memory");
@@ -167,7 +163,7 @@ fn exported_fds_and_generations() {
     assert!(matches!(err, Error::Unsupported(_)));
 
     r.set_output_path(OutputPath::Shared)
-        .expect("sharing on lavapipe");
+        .expect("sharing (expected of this device class)");
     r.prepare_output(64, 40).expect("allocating");
     let g0 = r.output_generation();
     r.render(&view(64, 40), &p, None).expect("rendering");
@@ -235,9 +231,10 @@ fn exported_fds_and_generations() {
 #[test]
 fn replaced_shared_memory_is_freed() {
     let mut r = renderer();
+    let memfd = expected(&r.context().info).exports_as_memfd;
     let p = params();
     r.set_output_path(OutputPath::Shared)
-        .expect("sharing on lavapipe");
+        .expect("sharing (expected of this device class)");
     r.render(&view(40, 30), &p, None).expect("rendering");
     r.finish().expect("waiting");
     let (maps0, fds0) = (memfd_mappings(), open_fds());
@@ -260,6 +257,11 @@ fn replaced_shared_memory_is_freed() {
         "memfd mappings / open fds: {maps0} / {fds0} at start, {maps1} / {fds1} after 13 \
          reallocations, {maps2} / {fds2} back on readback"
     );
+    if !memfd {
+        // device memory: only the fds can be counted
+        assert_eq!(fds1, fds0, "reallocation leaks fds");
+        return;
+    }
     assert!(maps0 >= 3, "lavapipe maps each of the 3 shared allocations");
     assert_eq!((maps1, fds1), (maps0, fds0), "reallocation leaks nothing");
     assert_eq!(
@@ -679,9 +681,10 @@ impl Drop for Imported<'_> {
     }
 }
 
-/// A GL host that can import opaque fds, or why not (then the caller skips).
+/// A GL host that can import the opaque fds of `ctx`'s device, or why not (then the caller
+/// skips).
 #[cfg(target_os = "linux")]
-fn gl_host() -> Option<gl::Host> {
+fn gl_host(ctx: &Context) -> Option<gl::Host> {
     let host = match gl::Host::new() {
         Ok(h) => h,
         Err(e) => {
@@ -704,6 +707,28 @@ fn gl_host() -> Option<gl::Host> {
             "no (the CPU wait Renderer::finish is the sync)"
         }
     );
+    let ids = ctx.device_uuids().expect("UUIDs");
+    let (gl_device, gl_driver) = host.uuids();
+    println!(
+        "Vulkan device {:02x?} driver {:02x?}",
+        ids.device, ids.driver
+    );
+    println!("GL     device {gl_device:02x?} driver {gl_driver:02x?}");
+    let exp = expected(&ctx.info);
+    if exp.surfaceless_gl_same_device {
+        assert_eq!(
+            (gl_device, gl_driver),
+            (ids.device, ids.driver),
+            "lavapipe and llvmpipe report the same device and driver"
+        );
+    } else if (gl_device, gl_driver) != (ids.device, ids.driver) {
+        println!(
+            "SKIPPED: this GL runs on another device than Vulkan (not expected otherwise of a \
+             {:?} device): memory cannot be shared between them",
+            exp.class
+        );
+        return None;
+    }
     Some(host)
 }
 
@@ -712,19 +737,9 @@ fn gl_host() -> Option<gl::Host> {
 #[test]
 fn opengl_sees_the_frame() {
     let mut r = renderer();
-    let Some(host) = gl_host() else { return };
-    let ids = r.context().device_uuids().expect("UUIDs");
-    let (gl_device, gl_driver) = host.uuids();
-    println!(
-        "Vulkan device {:02x?} driver {:02x?}",
-        ids.device, ids.driver
-    );
-    println!("GL     device {gl_device:02x?} driver {gl_driver:02x?}");
-    assert_eq!(
-        (gl_device, gl_driver),
-        (ids.device, ids.driver),
-        "lavapipe and llvmpipe report the same device and driver"
-    );
+    let Some(host) = gl_host(r.context()) else {
+        return;
+    };
 
     let (w, h) = (97, 61);
     r.set_output_path(OutputPath::Shared).expect("sharing");
@@ -776,7 +791,9 @@ fn opengl_sees_the_frame() {
 #[test]
 fn opengl_writes_the_depth_input() {
     let mut r = renderer();
-    let Some(host) = gl_host() else { return };
+    let Some(host) = gl_host(r.context()) else {
+        return;
+    };
     let (w, h) = (80, 56);
     let v = view(w, h);
     let p = params();

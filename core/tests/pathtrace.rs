@@ -1,4 +1,5 @@
-//! The path tracer on a real wgpu device (lavapipe on CI): its Henyey–Greenstein sampler
+//! The path tracer on a real wgpu device (common/gpu.rs: what each device class is expected
+//! to do): its Henyey–Greenstein sampler
 //! against the density (chi-square), the white furnace, delta tracking against the ray
 //! marcher's transmittance on a heterogeneous slab, convergence like 1/√spp, accumulation
 //! and the errors of the API.
@@ -9,41 +10,26 @@
 use ferrovol_core::*;
 mod common;
 
-use common::{renderer, volume};
+use common::gpu::{assert_error, pt_params, renderer, set_bricked, trace};
+use common::images::save;
+use common::scenes::{ball, component_transfer, volume};
 
 /// Colour `rgb` everywhere, opacity ramping linearly over [0, 1] from `a0` to `a1`.
 fn medium(rgb: [f32; 3], a0: f32, a1: f32, unit: f64) -> TransferFunction {
-    let color = Piecewise::new(vec![(0.0, rgb), (1.0, rgb)]).expect("colour");
-    let opacity = Piecewise::new(vec![(0.0, [a0]), (1.0, [a1])]).expect("opacity");
-    let mut c = ComponentTransfer::new(color, opacity);
-    c.unit_distance = unit;
-    TransferFunction::single(c)
+    TransferFunction::single(component_transfer(
+        &[(0.0, rgb), (1.0, rgb)],
+        &[(0.0, a0), (1.0, a1)],
+        unit,
+    ))
 }
 
-fn save(img: &Image, name: &str) {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-images");
-    std::fs::create_dir_all(&dir).expect("creating target/test-images");
-    img.save_png(&dir.join(format!("pathtrace-{name}.png")), [0.0; 3])
-        .expect("writing a test image");
-}
-
-fn pt_params() -> RenderParams {
-    RenderParams {
-        blend: BlendMode::PathTrace,
-        ..Default::default()
+/// Sets the volume, its transfer function and, where given, the environment.
+fn set_scene(r: &mut Renderer, vol: &VolumeData, tf: TransferFunction, env: Option<Environment>) {
+    r.set_volume(vol).unwrap();
+    r.set_transfer_function(&tf).unwrap();
+    if let Some(env) = env {
+        r.set_environment(&env).unwrap();
     }
-}
-
-/// Renders frames until `spp` paths per pixel are accumulated; returns the mean per pixel.
-fn trace(r: &mut Renderer, view: &View, p: &PathTraceParams, spp: u32) -> Vec<[f32; 4]> {
-    r.set_path_tracing(p).expect("valid path tracing settings");
-    r.reset_accumulation();
-    while r.accumulated_samples() < spp {
-        r.render(view, &pt_params(), None)
-            .expect("a path-traced frame");
-    }
-    assert_eq!(r.accumulated_samples(), spp);
-    r.read_accumulation().expect("the accumulation")
 }
 
 /// The Henyey–Greenstein CDF of the cosine μ between propagation directions.
@@ -98,10 +84,12 @@ fn white_furnace_returns_the_environment() {
     // environment of radiance 1: every path must bring back exactly 1 on average, however
     // often it scatters (and the environment behind is 1 too).
     let vol = volume([16, 16, 16], |_, _, _| 0.5);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([1.0; 3], 0.3, 0.3, 1.0))
-        .unwrap();
-    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    set_scene(
+        &mut r,
+        &vol,
+        medium([1.0; 3], 0.3, 0.3, 1.0),
+        Some(Environment::constant([1.0; 3])),
+    );
     let mut view = View::fit(vol.bounds(), 24, 24);
     view.lights.clear();
     for g in [0.0f32, 0.6] {
@@ -141,7 +129,7 @@ fn white_furnace_returns_the_environment() {
         sum / cov
     );
     assert!((sum / cov - 1.0).abs() < 0.01);
-    save(&r.read_image().unwrap(), "furnace");
+    save(&r.read_image().unwrap(), "pathtrace-furnace");
 }
 
 /// Enough scattering events that the furnace is not cut short (Russian roulette never
@@ -156,10 +144,12 @@ fn delta_tracking_agrees_with_ray_marching() {
     // by delta tracking; the composite ray caster's 1 − alpha is the same T by ray
     // marching (sample distance 0.25).
     let vol = volume([32, 32, 8], |x, _, _| x / 31.0);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.0; 3], 0.0, 0.25, 1.0))
-        .unwrap();
-    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    set_scene(
+        &mut r,
+        &vol,
+        medium([0.0; 3], 0.0, 0.25, 1.0),
+        Some(Environment::constant([1.0; 3])),
+    );
     let mut view = View::fit(vol.bounds(), 40, 40);
     view.camera.parallel = true;
     view.lights.clear();
@@ -214,15 +204,13 @@ fn error_falls_like_one_over_root_spp() {
     // the default sky, whose sun the uniform next-event directions rarely find, single
     // paths that hit the sun dominate the error at these counts: the environment is not
     // importance-sampled yet.)
-    let vol = volume([20, 20, 20], |x, y, z| {
-        let d = ((x - 9.5).powi(2) + (y - 9.5).powi(2) + (z - 9.5).powi(2)).sqrt();
-        (1.0 - d / 9.0).clamp(0.0, 1.0)
-    });
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0))
-        .unwrap();
-    r.set_environment(&Environment::hemisphere([0.9, 0.95, 1.0], [0.3, 0.25, 0.2]))
-        .unwrap();
+    let vol = ball(20, 9.0);
+    set_scene(
+        &mut r,
+        &vol,
+        medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0),
+        Some(Environment::hemisphere([0.9, 0.95, 1.0], [0.3, 0.25, 0.2])),
+    );
     let view = View::fit(vol.bounds(), 24, 24);
     let p = |spp: u32, seed: u32| PathTraceParams {
         samples_per_frame: spp.min(256),
@@ -257,16 +245,14 @@ fn error_falls_like_one_over_root_spp() {
     println!("fitted slope of log RMSE over log spp: {slope:.3} (Monte Carlo: -0.5)");
     // The reference's own noise (1/√32 of the 64-spp error) flattens the slope slightly.
     assert!((-0.6..=-0.4).contains(&slope), "slope {slope}");
-    save(&r.read_image().unwrap(), "blob-64spp");
+    save(&r.read_image().unwrap(), "pathtrace-blob-64spp");
 }
 
 #[test]
 fn accumulation_restarts_on_changes() {
     let mut r = renderer();
     let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.8; 3], 0.0, 0.5, 1.0))
-        .unwrap();
+    set_scene(&mut r, &vol, medium([0.8; 3], 0.0, 0.5, 1.0), None);
     let mut view = View::fit(vol.bounds(), 16, 16);
     let p = PathTraceParams {
         samples_per_frame: 3,
@@ -324,14 +310,10 @@ fn accumulation_restarts_on_changes() {
 fn errors_say_what_is_wrong() {
     let mut r = renderer();
     let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.8; 3], 0.0, 0.5, 1.0))
-        .unwrap();
+    set_scene(&mut r, &vol, medium([0.8; 3], 0.0, 0.5, 1.0), None);
     let view = View::fit(vol.bounds(), 16, 16);
     let bad = |p: PathTraceParams, words: &str| {
-        let e = PathTraceParams::validate(&p).expect_err("refused");
-        println!("{e}");
-        assert!(e.to_string().contains(words), "'{e}' lacks '{words}'");
+        assert_error(PathTraceParams::validate(&p), "", &[words]);
     };
     let d = PathTraceParams::default();
     bad(
@@ -366,31 +348,14 @@ fn errors_say_what_is_wrong() {
         planes: [0.0, 4.0, 0.0, 4.0, 0.0, 4.0],
         regions: Cropping::SUBVOLUME,
     });
-    let e = r.render(&view, &crop, None).expect_err("cropping refused");
-    println!("{e}");
-    assert!(e.to_string().contains("crop"));
+    assert_error(r.render(&view, &crop, None), "", &["crop"]);
     let mut lit = view.clone();
     let mut l = Light::headlight();
     l.positional = true;
     lit.lights = vec![l];
-    let e = r
-        .render(&lit, &pt_params(), None)
-        .expect_err("positional refused");
-    println!("{e}");
-    assert!(e.to_string().contains("positional"));
-    r.set_volume_with(
-        &vol,
-        UploadOptions {
-            max_brick_points: Some(6),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let e = r
-        .render(&view, &pt_params(), None)
-        .expect_err("bricks refused");
-    println!("{e}");
-    assert!(e.to_string().contains("one brick"));
+    assert_error(r.render(&lit, &pt_params(), None), "", &["positional"]);
+    set_bricked(&mut r, &vol, 6);
+    assert_error(r.render(&view, &pt_params(), None), "", &["one brick"]);
 }
 
 #[test]
@@ -401,21 +366,13 @@ fn every_path_is_counted_in_a_dense_volume() {
     // must count with coverage 1 (64 paths per pixel per frame once lost paths on lavapipe,
     // whose loop limiter stops all loops of an invocation after 65535 iterations: coverage
     // fell to 0.6 at the ball's rim).
-    let vol = volume([48, 48, 48], |x, y, z| {
-        let d = ((x - 23.5).powi(2) + (y - 23.5).powi(2) + (z - 23.5).powi(2)).sqrt();
-        (1.0 - d / 20.0).clamp(0.0, 1.0)
-    });
+    let vol = ball(48, 20.0);
     r.set_volume(&vol).unwrap();
-    let color = Piecewise::new(vec![(0.0, [1.0; 3]), (1.0, [1.0; 3])]).unwrap();
-    let opacity = Piecewise::new(vec![
-        (0.0, [0.0]),
-        (0.01, [0.0]),
-        (0.05, [0.999]),
-        (1.0, [0.999]),
-    ])
-    .unwrap();
-    let mut c = ComponentTransfer::new(color, opacity);
-    c.unit_distance = 0.2;
+    let c = component_transfer(
+        &[(0.0, [1.0; 3]), (1.0, [1.0; 3])],
+        &[(0.0, 0.0), (0.01, 0.0), (0.05, 0.999), (1.0, 0.999)],
+        0.2,
+    );
     r.set_transfer_function(&TransferFunction::single(c))
         .unwrap();
     r.set_environment(&Environment::hemisphere([1.0; 3], [0.0; 3]))
@@ -496,14 +453,13 @@ fn bsdf_conserves_energy_and_samples_its_density() {
 #[test]
 fn white_furnace_with_the_bsdf() {
     let mut r = renderer();
-    let vol = volume([16, 16, 16], |x, y, z| {
-        let d = ((x - 7.5).powi(2) + (y - 7.5).powi(2) + (z - 7.5).powi(2)).sqrt();
-        (1.0 - d / 10.0).clamp(0.0, 1.0)
-    });
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([1.0; 3], 0.0, 0.6, 1.0))
-        .unwrap();
-    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    let vol = ball(16, 10.0);
+    set_scene(
+        &mut r,
+        &vol,
+        medium([1.0; 3], 0.0, 0.6, 1.0),
+        Some(Environment::constant([1.0; 3])),
+    );
     let mut view = View::fit(vol.bounds(), 24, 24);
     view.lights.clear();
     for (name, psi, k) in [("switch", 0.0f32, 0.0f32), ("stochastic", 0.0, 20.0)] {
@@ -533,10 +489,12 @@ fn white_furnace_with_the_bsdf() {
 fn scattering_regions_and_attenuation() {
     let mut r = renderer();
     let vol = volume([16, 16, 16], |x, _, _| x / 15.0);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.8, 0.7, 0.6], 0.2, 0.6, 1.0))
-        .unwrap();
-    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    set_scene(
+        &mut r,
+        &vol,
+        medium([0.8, 0.7, 0.6], 0.2, 0.6, 1.0),
+        Some(Environment::constant([1.0; 3])),
+    );
     let view = View::fit(vol.bounds(), 24, 24);
     let base = PathTraceParams {
         samples_per_frame: 16,
@@ -590,14 +548,13 @@ fn scattering_regions_and_attenuation() {
 #[test]
 fn ray_budgets_share_primary_rays() {
     let mut r = renderer();
-    let vol = volume([16, 16, 16], |x, y, z| {
-        let d = ((x - 7.5).powi(2) + (y - 7.5).powi(2) + (z - 7.5).powi(2)).sqrt();
-        (1.0 - d / 8.0).clamp(0.0, 1.0)
-    });
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.9, 0.8, 0.7], 0.0, 0.5, 1.0))
-        .unwrap();
-    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    let vol = ball(16, 8.0);
+    set_scene(
+        &mut r,
+        &vol,
+        medium([0.9, 0.8, 0.7], 0.0, 0.5, 1.0),
+        Some(Environment::constant([1.0; 3])),
+    );
     let view = View::fit(vol.bounds(), 32, 32);
     let mut means = vec![];
     for (p, s) in [(64u32, 1u32), (8, 8), (1, 64)] {
@@ -629,7 +586,10 @@ fn ray_budgets_share_primary_rays() {
             assert!(fractional > 0, "{p} primary rays antialias the edge");
         }
         means.push(mean);
-        save(&r.read_image().unwrap(), &format!("budget-{p}x{s}"));
+        save(
+            &r.read_image().unwrap(),
+            &format!("pathtrace-budget-{p}x{s}"),
+        );
     }
     // Every budget estimates the same image (the 1×64 mean has the least independent
     // samples: 1024 pixels × 1 primary ray).
@@ -644,14 +604,13 @@ fn ray_budgets_share_primary_rays() {
 #[test]
 fn denoiser_lowers_the_error_and_keeps_the_accumulation() {
     let mut r = renderer();
-    let vol = volume([24, 24, 24], |x, y, z| {
-        let d = ((x - 11.5).powi(2) + (y - 11.5).powi(2) + (z - 11.5).powi(2)).sqrt();
-        (1.0 - d / 11.0).clamp(0.0, 1.0)
-    });
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&medium([0.9, 0.7, 0.5], 0.0, 0.8, 1.0))
-        .unwrap();
-    r.set_environment(&Environment::constant([1.0; 3])).unwrap();
+    let vol = ball(24, 11.0);
+    set_scene(
+        &mut r,
+        &vol,
+        medium([0.9, 0.7, 0.5], 0.0, 0.8, 1.0),
+        Some(Environment::constant([1.0; 3])),
+    );
     let view = View::fit(vol.bounds(), 96, 96);
     let p = PathTraceParams {
         samples_per_frame: 64,
@@ -686,9 +645,9 @@ fn denoiser_lowers_the_error_and_keeps_the_accumulation() {
         4,
     );
     let denoised = r.read_image().unwrap();
-    save(&plain, "denoise-off");
-    save(&denoised, "denoise-on");
-    save(&reference, "denoise-reference");
+    save(&plain, "pathtrace-denoise-off");
+    save(&denoised, "pathtrace-denoise-on");
+    save(&reference, "pathtrace-denoise-reference");
     let (e_plain, e_denoised) = (rmse(&plain), rmse(&denoised));
     println!(
         "4 paths per pixel against 1024: RMSE {e_plain:.2} levels unfiltered, {e_denoised:.2} \

@@ -1,0 +1,86 @@
+//! Test volumes, transfer functions and render settings.
+
+use ferrovol_core::*;
+
+/// A single-component float volume with unit spacing, `f` evaluated at index coordinates.
+pub fn volume(dims: [u32; 3], f: impl Fn(f64, f64, f64) -> f64) -> VolumeData {
+    let mut data = Vec::with_capacity(dims.iter().map(|&d| d as usize).product());
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                data.push(f(i as f64, j as f64, k as f64) as f32);
+            }
+        }
+    }
+    VolumeData::new(dims, 1, Scalars::F32(data)).expect("valid volume")
+}
+
+/// An n³ volume of `f` of the distance (in voxels) to the grid's centre.
+pub fn radial(n: u32, f: impl Fn(f64) -> f64) -> VolumeData {
+    let c = (n - 1) as f64 / 2.0;
+    volume([n; 3], |x, y, z| {
+        f(((x - c).powi(2) + (y - c).powi(2) + (z - c).powi(2)).sqrt())
+    })
+}
+
+/// A ball of radius `r` voxels in an n³ volume: 1 at the centre falling linearly to 0 at r.
+pub fn ball(n: u32, r: f64) -> VolumeData {
+    radial(n, |d| (1.0 - d / r).clamp(0.0, 1.0))
+}
+
+/// Two overlapping Gaussian blobs, smooth, values in [0, 1]: a volume with gradients in
+/// every direction and both soft and steep parts of the transfer function.
+pub fn blob_volume(n: u32) -> VolumeData {
+    let m = (n - 1) as f64;
+    volume([n; 3], |x, y, z| {
+        let g = |c: [f64; 3], s: f64| {
+            let r2 = (x - c[0] * m).powi(2) + (y - c[1] * m).powi(2) + (z - c[2] * m).powi(2);
+            (-r2 / (2.0 * (s * m).powi(2))).exp()
+        };
+        (0.95 * g([0.45, 0.5, 0.55], 0.22) + 0.7 * g([0.72, 0.35, 0.4], 0.1)).min(1.0)
+    })
+}
+
+pub fn piecewise3(points: &[(f64, [f32; 3])]) -> Piecewise<3> {
+    Piecewise::new(points.to_vec()).expect("finite points")
+}
+
+pub fn piecewise1(points: &[(f64, f32)]) -> Piecewise<1> {
+    Piecewise::new(points.iter().map(|&(x, a)| (x, [a])).collect()).expect("finite points")
+}
+
+/// A transfer function component: colour and opacity points, the opacity per
+/// `unit_distance`.
+pub fn component_transfer(
+    color: &[(f64, [f32; 3])],
+    opacity: &[(f64, f32)],
+    unit_distance: f64,
+) -> ComponentTransfer {
+    let mut c = ComponentTransfer::new(piecewise3(color), piecewise1(opacity));
+    c.unit_distance = unit_distance;
+    c
+}
+
+/// The colourful, semi-transparent transfer function used with [`blob_volume`].
+pub fn blob_transfer() -> ComponentTransfer {
+    component_transfer(
+        &[
+            (0.05, [0.2, 0.3, 0.9]),
+            (0.5, [0.9, 0.6, 0.2]),
+            (1.0, [1.0, 1.0, 0.9]),
+        ],
+        &[(0.05, 0.0), (0.5, 0.25), (1.0, 0.7)],
+        3.0,
+    )
+}
+
+/// Composite frames with shading on.
+pub fn shaded() -> RenderParams {
+    RenderParams {
+        shading: Shading {
+            enabled: true,
+            ..Shading::default()
+        },
+        ..RenderParams::default()
+    }
+}
