@@ -17,49 +17,69 @@ fn ferrovol(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-#[test]
-fn missing_file_names_the_file_and_fails() {
-    let (code, _, err) = ferrovol(&["render", "/no/such/volume.vti", "--out", "/tmp/never.png"]);
-    println!("exit {code}: {err}");
-    assert_ne!(code, 0);
-    assert!(err.contains("/no/such/volume.vti"), "{err}");
-    assert!(!err.contains("panicked"), "{err}");
+/// Runs `ferrovol render ARGS --out PNG` (PNG a temp file named after `name`) and
+/// checks that it succeeded; returns the PNG's path, stdout and stderr.
+fn render_ok(name: &str, args: &[&str]) -> (std::path::PathBuf, String, String) {
+    let out = std::env::temp_dir().join(format!("ferrovol-cli-test-{name}.png"));
+    let path = out.to_str().expect("utf-8 temp path");
+    let all: Vec<&str> = ["render"]
+        .iter()
+        .chain(args)
+        .chain(&["--out", path])
+        .copied()
+        .collect();
+    let (code, stdout, err) = ferrovol(&all);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains(path), "{stdout}");
+    (out, stdout, err)
 }
 
-#[test]
-fn bad_parameters_fail_with_a_message() {
-    for args in [
-        vec!["render", "--size", "0x10"],
-        vec!["render", "--tf", "no-such-preset"],
-        vec!["render", "--sample-distance", "0"],
-    ] {
-        let (code, _, err) = ferrovol(&args);
+/// Runs `ferrovol render BASE ARGS` for each case's ARGS (with an output that is never
+/// written); each must fail without a panic, with the case's words in its message.
+fn check_rejected(base: &[&str], cases: &[(Vec<&str>, &str)]) {
+    for (args, words) in cases {
+        let mut all = vec!["render"];
+        all.extend(base);
+        all.extend(args);
+        all.extend(["--out", "/tmp/ferrovol-cli-never.png"]);
+        let (code, _, err) = ferrovol(&all);
         println!(
             "{args:?}: exit {code}: {}",
             err.lines().next().unwrap_or("")
         );
         assert_ne!(code, 0, "{args:?}");
         assert!(!err.contains("panicked"), "{err}");
-        assert!(!err.trim().is_empty());
+        assert!(err.contains(words), "{args:?}: '{err}' lacks '{words}'");
     }
 }
 
 #[test]
+fn missing_file_names_the_file_and_fails() {
+    check_rejected(&[], &[(vec!["/no/such/volume.vti"], "/no/such/volume.vti")]);
+}
+
+#[test]
+fn bad_parameters_fail_with_a_message() {
+    check_rejected(
+        &[],
+        &[
+            (vec!["--size", "0x10"], "each side must be 1 to 16384"),
+            (
+                vec!["--size", "8x8", "--tf", "no-such-preset"],
+                "neither a preset",
+            ),
+            (
+                vec!["--size", "8x8", "--sample-distance", "0"],
+                "sample distance 0",
+            ),
+        ],
+    );
+}
+
+#[test]
 fn demo_render_writes_a_picture_of_the_volume() {
-    let out = std::env::temp_dir().join("ferrovol-cli-test-demo.png");
-    let path = out.to_str().expect("utf-8 temp path");
-    let (code, stdout, err) = ferrovol(&[
-        "render",
-        "--demo",
-        "marschner-lobb",
-        "--shade",
-        "--size",
-        "96x80",
-        "--out",
-        path,
-    ]);
-    assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains(path), "{stdout}");
+    let args = ["--demo", "marschner-lobb", "--shade", "--size", "96x80"];
+    let (out, _, _) = render_ok("demo", &args);
     let img = image::open(&out).expect("a PNG").to_rgb8();
     assert_eq!(img.dimensions(), (96, 80));
     // The volume covers the middle of the picture and leaves the black background around it.
@@ -72,84 +92,54 @@ fn demo_render_writes_a_picture_of_the_volume() {
 
 #[test]
 fn iso_flags_reject_bad_values_with_a_message() {
-    for (args, words) in [
-        (vec!["--iso", "abc"], "not a finite number"),
-        (vec!["--iso", "0.5:0"], "(0, 1]"),
-        (vec!["--iso", "0.5:1.5"], "(0, 1]"),
-        (vec!["--iso", "0.5:1:2,0,0"], "[0, 1]"),
-        (
-            vec!["--iso", "0.5", "--env", "/no/such/sky.hdr"],
-            "/no/such/sky.hdr",
-        ),
-        (
-            vec!["--iso", "0.5", "--env", "sky.txt"],
-            "unsupported file type",
-        ),
-        (vec!["--iso", "0.5", "--env-cube", "a.png,b.png"], "six"),
-        (vec!["--iso", "0.5", "--env-up", "w"], "x, y, z"),
-        (vec!["--iso", "0.5", "--view-up", "up"], "x, y, z"),
-        (vec!["--iso", "0.5", "--view-up", "z"], "parallel"),
-        (
-            vec!["--iso", "0.5", "--specular-samples", "0"],
-            "specular samples",
-        ),
-        (vec!["--iso", "0.5", "--ao", "0"], "ambient-occlusion"),
-        (vec!["--iso", "0.5", "--layers", "9"], "layers"),
-        (vec!["--iso", "0.5", "--shininess", "-1"], "non-negative"),
-        (vec!["--iso", "0.5", "--fresnel", "2"], "Fresnel"),
-        (
-            vec![
-                "--iso",
-                "0.5",
-                "--scatter-inside",
-                "traced",
-                "--scatter-samples",
-                "0",
-            ],
-            "scattering directions",
-        ),
-        (
-            vec![
-                "--iso",
-                "0.5",
-                "--scatter-inside",
-                "preview",
-                "--absorption",
-                "-1",
-            ],
-            "absorption",
-        ),
-        (
-            vec!["--iso", "0.5", "--scatter-inside", "sometimes"],
-            "invalid value",
-        ),
-    ] {
-        let mut all = vec!["render", "--demo", "marschner-lobb", "--mode", "iso"];
-        all.extend(&args);
-        all.extend(["--size", "16x16", "--out", "/tmp/ferrovol-cli-never.png"]);
-        let (code, _, err) = ferrovol(&all);
-        println!(
-            "{args:?}: exit {code}: {}",
-            err.lines().next().unwrap_or("")
-        );
-        assert_ne!(code, 0, "{args:?}");
-        assert!(!err.contains("panicked"), "{err}");
-        assert!(err.contains(words), "{args:?}: '{err}' lacks '{words}'");
-    }
-}
-
-#[test]
-fn iso_render_of_nested_surfaces_with_ao() {
-    let out = std::env::temp_dir().join("ferrovol-cli-test-iso.png");
-    let path = out.to_str().expect("utf-8 temp path");
-    let (code, stdout, err) = ferrovol(&[
-        "render",
+    let iso = [
         "--demo",
         "marschner-lobb",
         "--mode",
         "iso",
-        "--iso",
-        "0.7",
+        "--size",
+        "16x16",
+    ];
+    check_rejected(
+        &iso,
+        &[
+            (vec!["--iso", "abc"], "not a finite number"),
+            (vec!["--iso", "0.5:0"], "(0, 1]"),
+            (vec!["--iso", "0.5:1.5"], "(0, 1]"),
+            (vec!["--iso", "0.5:1:2,0,0"], "[0, 1]"),
+        ],
+    );
+    check_rejected(
+        &[&iso[..], &["--iso", "0.5"]].concat(),
+        &[
+            (vec!["--env", "/no/such/sky.hdr"], "/no/such/sky.hdr"),
+            (vec!["--env", "sky.txt"], "unsupported file type"),
+            (vec!["--env-cube", "a.png,b.png"], "six"),
+            (vec!["--env-up", "w"], "x, y, z"),
+            (vec!["--view-up", "up"], "x, y, z"),
+            (vec!["--view-up", "z"], "parallel"),
+            (vec!["--specular-samples", "0"], "specular samples"),
+            (vec!["--ao", "0"], "ambient-occlusion"),
+            (vec!["--layers", "9"], "layers"),
+            (vec!["--shininess", "-1"], "non-negative"),
+            (vec!["--fresnel", "2"], "Fresnel"),
+            (
+                vec!["--scatter-inside", "traced", "--scatter-samples", "0"],
+                "scattering directions",
+            ),
+            (
+                vec!["--scatter-inside", "preview", "--absorption", "-1"],
+                "absorption",
+            ),
+            (vec!["--scatter-inside", "sometimes"], "invalid value"),
+        ],
+    );
+}
+
+#[test]
+fn iso_render_of_nested_surfaces_with_ao() {
+    let iso = ["--demo", "marschner-lobb", "--mode", "iso", "--iso", "0.7"];
+    let args = [
         "--iso",
         "0.3:0.4:1,0.6,0.5",
         "--ao",
@@ -157,61 +147,42 @@ fn iso_render_of_nested_surfaces_with_ao() {
         "--env-background",
         "--size",
         "64x64",
-        "--out",
-        path,
-    ]);
-    assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains(path), "{stdout}");
+    ];
+    let (out, _, _) = render_ok("iso", &[&iso[..], &args].concat());
     let img = image::open(&out).expect("a PNG").to_rgb8();
     // the environment fills the background: no black pixel is left
     let black = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
     println!("black pixels: {black}");
     assert_eq!(black, 0);
     // light scattered between the surfaces, traced
-    let (code, _, err) = ferrovol(&[
-        "render",
-        "--demo",
-        "marschner-lobb",
-        "--mode",
-        "iso",
-        "--iso",
-        "0.7",
+    let args = [
         "--iso",
         "0.3",
         "--scatter-inside",
         "traced",
         "--scatter-samples",
         "4",
-        "--absorption",
-        "0.5",
-        "--size",
-        "32x32",
-        "--out",
-        path,
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ];
+    render_ok(
+        "iso",
+        &[&iso[..], &args, &["--absorption", "0.5", "--size", "32x32"]].concat(),
+    );
 }
 
 #[test]
 fn pathtrace_render_and_bad_settings() {
-    let out = std::env::temp_dir().join("ferrovol-cli-test-pathtrace.png");
-    let path = out.to_str().expect("utf-8 temp path");
-    let (code, _, err) = ferrovol(&[
-        "render",
+    let pt = [
         "--demo",
         "marschner-lobb",
         "--mode",
         "pathtrace",
-        "--spp",
-        "70",
-        "--g",
-        "0.3",
         "--size",
         "24x24",
-        "--out",
-        path,
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ];
+    let (out, _, err) = render_ok(
+        "pathtrace",
+        &[&pt[..], &["--spp", "70", "--g", "0.3"]].concat(),
+    );
     // 64 paths in the first frame, 6 in the second: one accumulation, not a restart
     assert!(err.contains("70 paths per pixel"), "{err}");
     let img = image::open(&out).expect("a PNG").to_rgba8();
@@ -219,12 +190,7 @@ fn pathtrace_render_and_bad_settings() {
     println!("{lit} of {} pixels met the medium", 24 * 24);
     assert!(lit > 100);
     // The hybrid model, scattering at surfaces only, with a 2x4 ray budget.
-    let (code, _, err) = ferrovol(&[
-        "render",
-        "--demo",
-        "marschner-lobb",
-        "--mode",
-        "pathtrace",
+    let args = [
         "--budget",
         "2x4",
         "--psi",
@@ -233,38 +199,26 @@ fn pathtrace_render_and_bad_settings() {
         "iso",
         "--transmission",
         "0.5",
-        "--size",
-        "24x24",
-        "--out",
-        path,
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ];
+    let (_, _, err) = render_ok("pathtrace", &[&pt[..], &args].concat());
     assert!(err.contains("8 paths per pixel"), "{err}");
-    for (args, words) in [
-        (vec!["--g", "1.5"], "anisotropy"),
-        (vec!["--spp", "0"], "spp"),
-        (vec!["--env-light", "-1"], "environment light"),
-        (vec!["--budget", "8"], "PxS"),
-        (vec!["--budget", "0x8"], "at least 1"),
-        (vec!["--budget", "8x8", "--spp", "4"], "cannot be used with"),
-        (vec!["--psi", "-1"], "gradient threshold"),
-        (vec!["--psi", "1", "--blend-k", "2"], "cannot be used with"),
-        (vec!["--blend-k", "inf"], "stochastic blend"),
-        (vec!["--roughness", "0"], "roughness"),
-        (vec!["--bsdf-fresnel", "2"], "Fresnel"),
-        (vec!["--transmission", "1.5"], "transmission"),
-        (vec!["--cone-angle", "90"], "cone angle"),
-        (vec!["--scatter", "sometimes"], "invalid value"),
-    ] {
-        let mut all = vec!["render", "--demo", "sphere", "--mode", "pathtrace"];
-        all.extend(&args);
-        all.extend(["--size", "8x8", "--out", "/tmp/ferrovol-cli-never.png"]);
-        let (code, _, err) = ferrovol(&all);
-        println!(
-            "{args:?}: exit {code}: {}",
-            err.lines().next().unwrap_or("")
-        );
-        assert_ne!(code, 0, "{args:?}");
-        assert!(err.contains(words), "{args:?}: '{err}' lacks '{words}'");
-    }
+    check_rejected(
+        &["--demo", "sphere", "--mode", "pathtrace", "--size", "8x8"],
+        &[
+            (vec!["--g", "1.5"], "anisotropy"),
+            (vec!["--spp", "0"], "spp"),
+            (vec!["--env-light", "-1"], "environment light"),
+            (vec!["--budget", "8"], "PxS"),
+            (vec!["--budget", "0x8"], "at least 1"),
+            (vec!["--budget", "8x8", "--spp", "4"], "cannot be used with"),
+            (vec!["--psi", "-1"], "gradient threshold"),
+            (vec!["--psi", "1", "--blend-k", "2"], "cannot be used with"),
+            (vec!["--blend-k", "inf"], "stochastic blend"),
+            (vec!["--roughness", "0"], "roughness"),
+            (vec!["--bsdf-fresnel", "2"], "Fresnel"),
+            (vec!["--transmission", "1.5"], "transmission"),
+            (vec!["--cone-angle", "90"], "cone angle"),
+            (vec!["--scatter", "sometimes"], "invalid value"),
+        ],
+    );
 }
