@@ -82,6 +82,7 @@ lint: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
 	python3 scripts/check-core-layers.py
+	python3 scripts/check-architecture-doc.py
 
 # The C ABI tests load and link target/debug/libferrovol.so, which `cargo test` alone does
 # not build (it links tests against the rlib).
