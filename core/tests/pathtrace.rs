@@ -12,7 +12,7 @@ mod common;
 
 use common::gpu::{assert_error, pt_params, renderer, set_bricked, trace};
 use common::images::save;
-use common::scenes::{ball, component_transfer, volume};
+use common::scenes::{ball, component_transfer, volume, white};
 
 /// Colour `rgb` everywhere, opacity ramping linearly over [0, 1] from `a0` to `a1`.
 fn medium(rgb: [f32; 3], a0: f32, a1: f32, unit: f64) -> TransferFunction {
@@ -368,13 +368,8 @@ fn every_path_is_counted_in_a_dense_volume() {
     // fell to 0.6 at the ball's rim).
     let vol = ball(48, 20.0);
     r.set_volume(&vol).unwrap();
-    let c = component_transfer(
-        &[(0.0, [1.0; 3]), (1.0, [1.0; 3])],
-        &[(0.0, 0.0), (0.01, 0.0), (0.05, 0.999), (1.0, 0.999)],
-        0.2,
-    );
-    r.set_transfer_function(&TransferFunction::single(c))
-        .unwrap();
+    let dense = [(0.0, 0.0), (0.01, 0.0), (0.05, 0.999), (1.0, 0.999)];
+    r.set_transfer_function(&white(&dense, 0.2)).unwrap();
     r.set_environment(&Environment::hemisphere([1.0; 3], [0.0; 3]))
         .unwrap();
     let mut view = View::fit(vol.bounds(), 48, 48);

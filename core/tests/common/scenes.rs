@@ -61,6 +61,15 @@ pub fn component_transfer(
     c
 }
 
+/// White everywhere, the opacity given per `unit_distance`.
+pub fn white(opacity: &[(f64, f32)], unit_distance: f64) -> TransferFunction {
+    TransferFunction::single(component_transfer(
+        &[(0.0, [1.0; 3]), (1.0, [1.0; 3])],
+        opacity,
+        unit_distance,
+    ))
+}
+
 /// The colourful, semi-transparent transfer function used with [`blob_volume`].
 pub fn blob_transfer() -> ComponentTransfer {
     component_transfer(

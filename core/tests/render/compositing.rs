@@ -6,7 +6,7 @@ use crate::common::gpu::renderer;
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, footprint, image_diff, rgba};
 use crate::common::raycast::to_pixel;
-use crate::common::scenes::{blob_volume, component_transfer, shaded, volume};
+use crate::common::scenes::{blob_volume, component_transfer, shaded, volume, white};
 use crate::{box_corners, mask_extents, projected_extents};
 use ferrovol_core::*;
 use glam::DVec3;
@@ -24,13 +24,8 @@ fn slab_opacity_matches_beer_lambert() {
     // Expected opacity 0.75 = 1 − (1 − α)^(L/u) with u = 8: α = 1 − 0.25^(1/4) ≈ 0.293.
     let u = 8.0;
     let a = 1.0 - 0.25f64.powf(u / l);
-    let tf = component_transfer(
-        &[(0.0, [1.0; 3]), (1.0, [1.0; 3])],
-        &[(0.0, a as f32), (1.0, a as f32)],
-        u,
-    );
     r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&TransferFunction::single(tf))
+    r.set_transfer_function(&white(&[(0.0, a as f32), (1.0, a as f32)], u))
         .unwrap();
     let mut view = View::fit(vol.bounds(), 33, 33);
     view.camera.parallel = true;
@@ -295,9 +290,7 @@ fn mip_finds_planted_maximum() {
                    blend: BlendMode,
                    name: &str| {
         r.set_volume(vol).unwrap();
-        let tf = component_transfer(&[(0.0, [1.0; 3]), (1.0, [1.0; 3])], opacity, 1.0);
-        r.set_transfer_function(&TransferFunction::single(tf))
-            .unwrap();
+        r.set_transfer_function(&white(opacity, 1.0)).unwrap();
         let params = RenderParams {
             blend,
             ..RenderParams::default()

@@ -6,7 +6,7 @@ use crate::common::gpu::{new_renderer, renderer};
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{compare_to_reference, footprint, frame_diff};
 use crate::common::raycast::{self, index_box, pixel_ray, ray_segment};
-use crate::common::scenes::{blob_transfer, blob_volume, component_transfer, shaded, volume};
+use crate::common::scenes::{blob_transfer, blob_volume, shaded, volume, white};
 use crate::{box_corners, mask_extents, projected_extents};
 use ferrovol_core::*;
 use glam::DVec3;
@@ -21,13 +21,8 @@ use glam::DVec3;
 fn check_silhouette(vol: &VolumeData, view: &View, name: &str) {
     let mut r = renderer();
     r.set_volume(vol).unwrap();
-    let tf = component_transfer(
-        &[(0.0, [1.0; 3]), (1.0, [1.0; 3])],
-        &[(0.0, 0.0), (0.5, 0.0), (0.51, 1.0), (1.0, 1.0)],
-        1.0,
-    );
-    r.set_transfer_function(&TransferFunction::single(tf))
-        .unwrap();
+    let opaque = [(0.0, 0.0), (0.5, 0.0), (0.51, 1.0), (1.0, 1.0)];
+    r.set_transfer_function(&white(&opaque, 1.0)).unwrap();
     let img = r.render_image(view, &RenderParams::default()).unwrap();
     save_enlarged(&img, name);
     let (w, h) = (view.width, view.height);
