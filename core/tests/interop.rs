@@ -533,6 +533,14 @@ mod gl {
             // SAFETY: current context.
             unsafe { (self.fns.GetError)() }
         }
+
+        /// `Err` naming `what` and the GL error, if GL has one.
+        pub fn check(&self, what: &str) -> Result<(), String> {
+            match self.error() {
+                0 => Ok(()),
+                e => Err(format!("{what}: GL error 0x{e:04x}")),
+            }
+        }
     }
 
     impl Drop for Host {
@@ -570,10 +578,7 @@ impl<'a> Imported<'a> {
                 gl::HANDLE_TYPE_OPAQUE_FD_EXT,
                 img.fd.into_raw_fd(),
             );
-            let e = host.error();
-            if e != 0 {
-                return Err(format!("glImportMemoryFdEXT: GL error 0x{e:04x}"));
-            }
+            host.check("glImportMemoryFdEXT")?;
             (f.GenTextures)(1, &mut texture);
             (f.BindTexture)(gl::TEXTURE_2D, texture);
             (f.TexParameteri)(
@@ -592,10 +597,7 @@ impl<'a> Imported<'a> {
                 memory,
                 0,
             );
-            let e = host.error();
-            if e != 0 {
-                return Err(format!("glTexStorageMem2DEXT: GL error 0x{e:04x}"));
-            }
+            host.check("glTexStorageMem2DEXT")?;
             (f.GenFramebuffers)(1, &mut framebuffer);
             (f.BindFramebuffer)(gl::FRAMEBUFFER, framebuffer);
             (f.FramebufferTexture2D)(
