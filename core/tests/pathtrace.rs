@@ -1,8 +1,7 @@
-//! The path tracer on a real wgpu device (common/gpu.rs: what each device class is expected
-//! to do): its Henyey–Greenstein sampler
-//! against the density (chi-square), the white furnace, delta tracking against the ray
-//! marcher's transmittance on a heterogeneous slab, convergence like 1/√spp, accumulation
-//! and the errors of the API.
+//! The path tracer on a real wgpu device (see common/gpu.rs for what is expected of each
+//! device class): its Henyey–Greenstein sampler against the density (chi-square), the white
+//! furnace, delta tracking against the ray marcher's transmittance on a heterogeneous slab,
+//! convergence like 1/√spp, accumulation and the errors of the API.
 //!
 //! Every test prints what it measured and asserts a tolerance with the reason for it.
 //! Images go to `target/test-images/pathtrace-*.png` for inspection.
