@@ -10,7 +10,8 @@ use std::sync::{Mutex, MutexGuard, OnceLock};
 pub enum DeviceClass {
     /// A Vulkan implementation on the CPU: Mesa's lavapipe, the CI device.
     Cpu,
-    /// A hardware GPU (discrete, integrated or virtual), e.g. an NVIDIA H200 on Vulkan.
+    /// Any other adapter: a hardware GPU (the expectations are written for a discrete one,
+    /// e.g. an NVIDIA H200 on Vulkan).
     Gpu,
 }
 
@@ -31,17 +32,20 @@ impl DeviceClass {
 pub struct Expected {
     pub class: DeviceClass,
     /// float32 volumes are stored filterable (R32Float) and 16-bit ones as 16-bit normalised
-    /// textures: the reference comparisons' tolerances assume lossless storage.
+    /// textures: the reference comparisons' tolerances assume lossless storage (checked by
+    /// [`context`] for every test binary).
     pub lossless_volumes: bool,
     /// The shared output: the output images are exported as opaque fds
-    /// (VK_KHR_external_memory_fd; on the Vulkan backend only).
+    /// (VK_KHR_external_memory_fd; on the Vulkan backend only). The interop tests need it.
     pub exports_memory: bool,
     /// Each exported allocation shows in this process as a memfd mapping: the driver keeps
-    /// it in host memory (lavapipe). A GPU's is device memory, mapped no such way.
+    /// it in host memory (lavapipe). A GPU's is device memory, mapped no such way, so
+    /// interop's replaced_shared_memory_is_freed counts only fds there.
     pub exports_as_memfd: bool,
     /// OpenGL from EGL's surfaceless platform runs on this device (its device and driver
     /// UUIDs are Vulkan's): lavapipe and llvmpipe are one Mesa device. On a GPU it depends
-    /// on which vendor's EGL glvnd picks, so it is checked where it holds, not expected.
+    /// on which vendor's EGL glvnd picks: interop's OpenGL tests then skip, saying so, where
+    /// the UUIDs differ.
     pub surfaceless_gl_same_device: bool,
 }
 
