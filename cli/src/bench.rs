@@ -232,8 +232,11 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
             if let Some(dir) = &a.png_dir {
                 std::fs::create_dir_all(dir)
                     .map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
-                r.read_image()?
-                    .save_png(&dir.join(format!("ferrovol-{name}.png")), [0.0; 3])?;
+                ferrovol_io::image::write_png(
+                    &r.read_image()?,
+                    &dir.join(format!("ferrovol-{name}.png")),
+                    [0.0; 3],
+                )?;
             }
             ours.push((f.ms_per_frame, f.median_ms));
         }

@@ -503,7 +503,9 @@ fn iso_setup(a: &IsoArgs, vol: &VolumeData) -> Result<(IsoParams, Environment), 
 /// The environment the flags describe (the procedural sky by default).
 fn environment_setup(a: &IsoArgs) -> Result<Environment, CliError> {
     let mut env = match (&a.env, &a.env_cube) {
-        (Some(e), _) if e != "sky" => Environment::load(std::path::Path::new(e))?,
+        (Some(e), _) if e != "sky" => {
+            ferrovol_io::image::read_environment(std::path::Path::new(e))?
+        }
         (_, Some(list)) => {
             let paths: Vec<&std::path::Path> = list.split(',').map(std::path::Path::new).collect();
             let six: &[&std::path::Path; 6] = paths.as_slice().try_into().map_err(|_| {
@@ -512,7 +514,7 @@ fn environment_setup(a: &IsoArgs) -> Result<Environment, CliError> {
                     paths.len()
                 ))
             })?;
-            Environment::load_cube(six)?
+            ferrovol_io::image::read_environment_cube(six)?
         }
         _ => Environment::default(),
     };
@@ -560,6 +562,8 @@ fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
 pub enum CliError {
     #[error(transparent)]
     Read(#[from] ferrovol_io::ReadError),
+    #[error(transparent)]
+    Image(#[from] ferrovol_io::image::ImageError),
     #[error("{0}")]
     Core(#[from] ferrovol_core::Error),
     #[error("{0}")]
@@ -726,7 +730,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);
         img = r.read_image()?;
     }
-    img.save_png(&a.out, a.background)?;
+    ferrovol_io::image::write_png(&img, &a.out, a.background)?;
     pb.finish_and_clear();
     let src = a.input.as_ref().map_or_else(
         || format!("built-in {:?}", a.demo),

@@ -31,9 +31,6 @@ pub enum Error {
     /// The device was lost (driver reset, GPU removed): create a new context.
     #[error("GPU device lost: {0}; create a new context")]
     DeviceLost(String),
-    /// Writing an image failed.
-    #[error("could not write image '{path}': {message}")]
-    ImageWrite { path: String, message: String },
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

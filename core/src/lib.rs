@@ -11,7 +11,7 @@
 //! r.set_transfer_function(&TransferFunction::ramp([0.0, 1.0], 0.3))?;
 //! let view = View::fit(vol.bounds(), 256, 256);
 //! let img = r.render_image(&view, &RenderParams::default())?;
-//! img.save_png("ml.png".as_ref(), [0.0; 3])?;
+//! assert_eq!(img.rgba.len(), 4 * 256 * 256);
 //! # Ok::<(), ferrovol_core::Error>(())
 //! ```
 

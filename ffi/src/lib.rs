@@ -751,7 +751,7 @@ pub unsafe extern "C" fn fv_renderer_set_environment(
             let p = unsafe { CStr::from_ptr(path) }
                 .to_str()
                 .map_err(|_| FfiError::invalid("environment path is not UTF-8"))?;
-            Environment::load(p.as_ref())?
+            ferrovol_io::image::read_environment(p.as_ref())?
         };
         if !up.is_null() {
             // SAFETY: the caller passes 3 doubles at `up`.
@@ -1045,7 +1045,7 @@ pub unsafe extern "C" fn fv_frame_write_png(
             .to_str()
             .map_err(|_| FfiError::invalid("path is not UTF-8"))?;
         let bg = const_ref(background, "background")?;
-        f.image.save_png(p.as_ref(), *bg)?;
+        ferrovol_io::image::write_png(&f.image, p.as_ref(), *bg)?;
         Ok(())
     })
 }

@@ -1,8 +1,9 @@
 //! ferrovol-io: the file formats around ferrovol's renderer.
 //!
 //! Volume readers for VTK XML ImageData (`.vti`), NIfTI-1/2 (`.nii`, `.nii.gz`),
-//! MetaImage (`.mha`, `.mhd` + data file) and NRRD (`.nrrd`, `.nhdr` + data file), and
-//! the JSON transfer-function format ([`transfer`]).
+//! MetaImage (`.mha`, `.mhd` + data file) and NRRD (`.nrrd`, `.nhdr` + data file), the
+//! JSON transfer-function format ([`transfer`]), and image files: environment maps in,
+//! rendered frames out ([`image`]).
 //!
 //! Every reader has a byte-slice API beside the path API: [`read_volume`] reads a file
 //! and its detached data file from disk; [`Format::parse`] (or each format module's
@@ -26,6 +27,7 @@ use ferrovol_core::VolumeData;
 mod base64;
 mod decode;
 mod error;
+pub mod image;
 pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;

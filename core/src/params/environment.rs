@@ -1,8 +1,9 @@
 //! Environment maps for image-based lighting of isosurfaces.
 //!
 //! An [`Environment`] is the radiance arriving from every direction: a procedural sky (the
-//! default), an equirectangular image (HDR `.hdr`/`.exr` or LDR `.png`/`.jpg`, through the
-//! `image` crate) or six cube faces. [`crate::Renderer::set_environment`] turns it, once,
+//! default), an equirectangular image or six cube faces, given as texels (ferrovol-io reads
+//! them from `.hdr`, `.exr`, `.png` and `.jpg` files). [`crate::Renderer::set_environment`]
+//! turns it, once,
 //! into GPU maps (shaders/environment.wgsl):
 //!
 //! - the **environment cube** (`rgba16float`, full mip chain by 2×2 box filtering), which
@@ -20,7 +21,6 @@
 
 use crate::error::{Error, Result};
 use glam::{DMat3, DQuat, DVec3};
-use std::path::Path;
 
 /// Texels per edge of the irradiance cube's faces (irradiance is smooth).
 pub const IRRADIANCE_SIZE: u32 = 32;
@@ -171,45 +171,6 @@ fn finite_rgb(what: &str, c: [f32; 3]) -> Result<()> {
     }
 }
 
-/// Allowed file extensions of environment images.
-const IMAGE_EXTENSIONS: &[&str] = &["hdr", "exr", "png", "jpg", "jpeg"];
-
-fn read_image(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
-    let shown = path.display();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    if !IMAGE_EXTENSIONS.contains(&ext.as_str()) {
-        return Err(Error::InvalidParameter(format!(
-            "environment map '{shown}': unsupported file type '{ext}'; give an .hdr, .exr, \
-             .png or .jpg image"
-        )));
-    }
-    let reader = image::ImageReader::open(path).map_err(|e| {
-        Error::InvalidParameter(format!(
-            "environment map '{shown}' cannot be opened: {e}; check the path"
-        ))
-    })?;
-    let img = reader
-        .with_guessed_format()
-        .map_err(|e| Error::InvalidParameter(format!("environment map '{shown}': {e}")))?
-        .decode()
-        .map_err(|e| {
-            Error::InvalidParameter(format!(
-                "environment map '{shown}' is not a readable image: {e}"
-            ))
-        })?;
-    let rgb = img.into_rgb32f();
-    let (w, h) = rgb.dimensions();
-    let texels: Vec<[f32; 3]> = rgb
-        .pixels()
-        .map(|p| p.0.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 }))
-        .collect();
-    Ok((w, h, texels))
-}
-
 impl Environment {
     fn with_source(source: EnvironmentSource) -> Environment {
         Environment {
@@ -252,44 +213,6 @@ impl Environment {
         let e = Environment::with_source(EnvironmentSource::Cube { size, faces });
         e.validate()?;
         Ok(e)
-    }
-
-    /// Reads an equirectangular environment map: `.hdr` (Radiance RGBE), `.exr` (OpenEXR)
-    /// or `.png`/`.jpg`, twice as wide as high.
-    pub fn load(path: &Path) -> Result<Environment> {
-        let (w, h, texels) = read_image(path)?;
-        if w != 2 * h {
-            return Err(Error::InvalidParameter(format!(
-                "environment map '{}' is {w}x{h}: an equirectangular map must be exactly twice \
-                 as wide as high (for six cube faces use Environment::load_cube)",
-                path.display()
-            )));
-        }
-        Environment::from_equirect(w, h, texels)
-    }
-
-    /// Reads six square cube faces of one size, in the order +X, −X, +Y, −Y, +Z, −Z.
-    pub fn load_cube(paths: &[&Path; 6]) -> Result<Environment> {
-        let mut faces = Vec::with_capacity(6);
-        let mut size = 0;
-        for (i, p) in paths.iter().enumerate() {
-            let (w, h, texels) = read_image(p)?;
-            if w != h || (i > 0 && w != size) {
-                return Err(Error::InvalidParameter(format!(
-                    "cube face {} '{}' is {w}x{h}: the six faces must be square and of one size{}",
-                    FACE_NAMES[i],
-                    p.display(),
-                    if i > 0 {
-                        format!(" ({size}x{size} like the first)")
-                    } else {
-                        String::new()
-                    }
-                )));
-            }
-            size = w;
-            faces.push(texels);
-        }
-        Environment::from_cube(size, faces)
     }
 
     /// Checks the source and settings; every constructor calls it, the renderer again.

@@ -3,7 +3,6 @@
 
 use super::camera::Camera;
 use super::light::Light;
-use crate::error::{Error, Result};
 
 /// What the frame is seen through: camera, lights and image size.
 #[derive(Clone, Debug)]
@@ -67,23 +66,6 @@ pub struct Image {
 }
 
 impl Image {
-    /// Composites over an opaque background colour and writes a PNG.
-    pub fn save_png(&self, path: &std::path::Path, background: [f32; 3]) -> Result<()> {
-        let mut out = image::RgbImage::new(self.width, self.height);
-        for (i, px) in out.pixels_mut().enumerate() {
-            let p = &self.rgba[4 * i..4 * i + 4];
-            let a = p[3] as f32 / 255.0;
-            for c in 0..3 {
-                let v = p[c] as f32 + (1.0 - a) * background[c] * 255.0;
-                px.0[c] = v.round().clamp(0.0, 255.0) as u8;
-            }
-        }
-        out.save(path).map_err(|e| Error::ImageWrite {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })
-    }
-
     /// Pixel (x, y) as premultiplied RGBA in [0, 1].
     pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
         let i = 4 * (y * self.width + x) as usize;
