@@ -26,6 +26,31 @@ pub(crate) fn buffer_entry(
     )
 }
 
+/// A uniform block of type `T` bound at a dynamic offset (one block per dispatch, see
+/// [`super::uniforms::UNIFORM_STRIDE`]).
+pub(crate) fn dynamic_uniform_entry<T>(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<T>() as u64),
+        },
+    )
+}
+
+/// The `T`-sized block at the start of `buffer`, for a [`dynamic_uniform_entry`].
+pub(crate) fn bind_block<T>(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    bind(
+        binding,
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer,
+            offset: 0,
+            size: std::num::NonZeroU64::new(std::mem::size_of::<T>() as u64),
+        }),
+    )
+}
+
 /// A sampled texture of any sample type (float, uint, …).
 pub(crate) fn sampled_texture_entry(
     binding: u32,

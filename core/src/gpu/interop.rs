@@ -284,21 +284,32 @@ mod imp {
         use wgpu::TextureUsages as U;
         let mut vk_usage = vk::ImageUsageFlags::empty();
         let mut hal = wgpu::TextureUses::empty();
-        if usage.contains(U::COPY_SRC) {
-            vk_usage |= vk::ImageUsageFlags::TRANSFER_SRC;
-            hal |= wgpu::TextureUses::COPY_SRC;
-        }
-        if usage.contains(U::COPY_DST) {
-            vk_usage |= vk::ImageUsageFlags::TRANSFER_DST;
-            hal |= wgpu::TextureUses::COPY_DST;
-        }
-        if usage.contains(U::TEXTURE_BINDING) {
-            vk_usage |= vk::ImageUsageFlags::SAMPLED;
-            hal |= wgpu::TextureUses::RESOURCE;
-        }
-        if usage.contains(U::RENDER_ATTACHMENT) {
-            vk_usage |= vk::ImageUsageFlags::COLOR_ATTACHMENT;
-            hal |= wgpu::TextureUses::COLOR_TARGET;
+        for (wanted, vk_flag, hal_flag) in [
+            (
+                U::COPY_SRC,
+                vk::ImageUsageFlags::TRANSFER_SRC,
+                wgpu::TextureUses::COPY_SRC,
+            ),
+            (
+                U::COPY_DST,
+                vk::ImageUsageFlags::TRANSFER_DST,
+                wgpu::TextureUses::COPY_DST,
+            ),
+            (
+                U::TEXTURE_BINDING,
+                vk::ImageUsageFlags::SAMPLED,
+                wgpu::TextureUses::RESOURCE,
+            ),
+            (
+                U::RENDER_ATTACHMENT,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT,
+                wgpu::TextureUses::COLOR_TARGET,
+            ),
+        ] {
+            if usage.contains(wanted) {
+                vk_usage |= vk_flag;
+                hal |= hal_flag;
+            }
         }
         if usage.contains(U::STORAGE_BINDING) {
             vk_usage |= vk::ImageUsageFlags::STORAGE;

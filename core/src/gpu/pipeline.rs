@@ -45,12 +45,13 @@ pub(crate) fn pipeline_layout(
         })
 }
 
-/// The compute pipeline of `module`'s `main` with these override constants.
+/// The compute pipeline of `module`'s `entry` with these override constants.
 pub(crate) fn compute_pipeline(
     ctx: &Context,
     label: &str,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
+    entry: &str,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline> {
     ctx.checked(&format!("creating the {label} pipeline"), || {
@@ -59,7 +60,7 @@ pub(crate) fn compute_pipeline(
                 label: Some(label),
                 layout: Some(layout),
                 module,
-                entry_point: Some("main"),
+                entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants,
                     // no pass uses workgroup memory
@@ -75,14 +76,48 @@ pub(crate) trait Variant: Copy + Eq + Hash {
     fn constants(&self) -> Vec<(&'static str, f64)>;
 }
 
-/// 1.0 or 0.0: a boolean override constant's value.
-pub(crate) fn flag(on: bool) -> f64 {
-    if on {
-        1.0
-    } else {
-        0.0
+/// A field's value as an override constant: booleans 1 or 0, counts as they are.
+pub(crate) trait OverrideValue {
+    fn value(self) -> f64;
+}
+
+impl OverrideValue for bool {
+    fn value(self) -> f64 {
+        if self {
+            1.0
+        } else {
+            0.0
+        }
     }
 }
+
+impl OverrideValue for u32 {
+    fn value(self) -> f64 {
+        self as f64
+    }
+}
+
+/// Declares a pass's pipeline variant: a struct with one field per override constant
+/// (`field: type => "WGSL_NAME"`) and its [`Variant`] implementation.
+macro_rules! pipeline_variant {
+    ($(#[$meta:meta])* struct $name:ident {
+        $($(#[$fmeta:meta])* $field:ident: $ty:ty => $wgsl:literal,)*
+    }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        struct $name {
+            $($(#[$fmeta])* $field: $ty,)*
+        }
+
+        impl $crate::gpu::pipeline::Variant for $name {
+            fn constants(&self) -> Vec<(&'static str, f64)> {
+                use $crate::gpu::pipeline::OverrideValue;
+                vec![$(($wgsl, self.$field.value()),)*]
+            }
+        }
+    };
+}
+pub(crate) use pipeline_variant;
 
 /// A pass's shader module and pipeline layout with its pipelines, one per variant, created
 /// on first use.
@@ -113,7 +148,14 @@ impl<K: Variant> PipelineCache<K> {
         if let Some(p) = self.pipelines.get(&v) {
             return Ok(p.clone());
         }
-        let p = compute_pipeline(ctx, self.label, &self.layout, &self.module, &v.constants())?;
+        let p = compute_pipeline(
+            ctx,
+            self.label,
+            &self.layout,
+            &self.module,
+            "main",
+            &v.constants(),
+        )?;
         self.pipelines.insert(v, p.clone());
         Ok(p)
     }
@@ -135,6 +177,30 @@ pub(crate) fn single_group_pipeline(
         });
     let layout = pipeline_layout(ctx, file, &[&bgl]);
     let module = shader_module(ctx, file)?;
-    let pipeline = compute_pipeline(ctx, label, &layout, &module, &[])?;
+    let pipeline = compute_pipeline(ctx, label, &layout, &module, "main", &[])?;
     Ok((bgl, pipeline))
+}
+
+/// Records a compute pass of `pipeline` with one bind group (`entries` for `layout`) over
+/// `groups` workgroups.
+pub(crate) fn encode_single_group(
+    ctx: &Context,
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    (layout, pipeline): (&wgpu::BindGroupLayout, &wgpu::ComputePipeline),
+    entries: &[wgpu::BindGroupEntry<'_>],
+    groups: [u32; 3],
+) {
+    let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries,
+    });
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &bg, &[]);
+    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
 }

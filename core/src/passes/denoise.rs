@@ -2,7 +2,9 @@
 
 use super::frame::groups;
 use crate::error::Result;
-use crate::gpu::binding::{bind, buffer_entry, entry, storage_texture_entry};
+use crate::gpu::binding::{
+    bind, bind_block, buffer_entry, dynamic_uniform_entry, storage_texture_entry,
+};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::single_group_pipeline;
 use crate::gpu::uniforms::{DenoiseUniforms, DENOISE_FROM_SUMS, DENOISE_LAST, UNIFORM_STRIDE};
@@ -41,17 +43,7 @@ impl DenoisePass {
             "denoise.wgsl",
             "denoise",
             &[
-                entry(
-                    0,
-                    wgpu::BindingType::Buffer {
-                        ty: B::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<
-                            DenoiseUniforms,
-                        >()
-                            as u64),
-                    },
-                ),
+                dynamic_uniform_entry::<DenoiseUniforms>(0),
                 buffer_entry(1, B::Storage { read_only: true }),
                 buffer_entry(2, B::Storage { read_only: false }),
                 buffer_entry(3, B::Storage { read_only: true }),
@@ -117,16 +109,7 @@ impl DenoisePass {
                 label: Some("denoise"),
                 layout: &self.bgl,
                 entries: &[
-                    bind(
-                        0,
-                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &self.uniforms,
-                            offset: 0,
-                            size: std::num::NonZeroU64::new(
-                                std::mem::size_of::<DenoiseUniforms>() as u64
-                            ),
-                        }),
-                    ),
+                    bind_block::<DenoiseUniforms>(0, &self.uniforms),
                     bind(1, src.as_entire_binding()),
                     bind(2, dst.as_entire_binding()),
                     bind(3, out.guide.as_entire_binding()),

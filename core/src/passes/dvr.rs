@@ -8,49 +8,29 @@ use crate::error::Result;
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
-use crate::gpu::pipeline::{flag, single_group_pipeline, PipelineCache, Variant};
+use crate::gpu::pipeline::{pipeline_variant, single_group_pipeline, PipelineCache};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, View};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::Resources;
 
-/// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct DvrVariant {
-    blend: u32,
-    components: u32,
-    independent: bool,
-    shade: bool,
-    gradient_opacity: bool,
-    skip: bool,
-    crop: bool,
-    nearest: bool,
-    single_brick: bool,
-    positional_lights: bool,
-    lights: u32,
-    volumetric: bool,
-    precomputed_gradient: bool,
-    forward_diff: bool,
-}
-
-impl Variant for DvrVariant {
-    fn constants(&self) -> Vec<(&'static str, f64)> {
-        vec![
-            ("BLEND", self.blend as f64),
-            ("NCOMP", self.components as f64),
-            ("INDEPENDENT", flag(self.independent)),
-            ("SHADE", flag(self.shade)),
-            ("GRAD_OPACITY", flag(self.gradient_opacity)),
-            ("SKIP", flag(self.skip)),
-            ("CROP", flag(self.crop)),
-            ("NEAREST", flag(self.nearest)),
-            ("SINGLE_BRICK", flag(self.single_brick)),
-            ("POSITIONAL_LIGHTS", flag(self.positional_lights)),
-            ("NUM_LIGHTS", self.lights as f64),
-            ("VOLUMETRIC", flag(self.volumetric)),
-            ("PRECOMPUTED_GRADIENT", flag(self.precomputed_gradient)),
-            ("FORWARD_DIFF", flag(self.forward_diff)),
-        ]
+pipeline_variant! {
+    /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
+    struct DvrVariant {
+        blend: u32 => "BLEND",
+        components: u32 => "NCOMP",
+        independent: bool => "INDEPENDENT",
+        shade: bool => "SHADE",
+        gradient_opacity: bool => "GRAD_OPACITY",
+        skip: bool => "SKIP",
+        crop: bool => "CROP",
+        nearest: bool => "NEAREST",
+        single_brick: bool => "SINGLE_BRICK",
+        positional_lights: bool => "POSITIONAL_LIGHTS",
+        lights: u32 => "NUM_LIGHTS",
+        volumetric: bool => "VOLUMETRIC",
+        precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
+        forward_diff: bool => "FORWARD_DIFF",
     }
 }
 

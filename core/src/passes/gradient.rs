@@ -5,7 +5,7 @@
 use crate::error::Result;
 use crate::gpu::binding::{bind, buffer_entry, storage_texture_entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
-use crate::gpu::pipeline::single_group_pipeline;
+use crate::gpu::pipeline::{encode_single_group, single_group_pipeline};
 use crate::gpu::Context;
 use crate::resources::bricks::Layout;
 
@@ -59,26 +59,23 @@ impl GradientPass {
         ctx.queue
             .write_buffer(&uniforms, 0, bytemuck::bytes_of(&scale));
         let out = texture.create_view(&Default::default());
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gradient build"),
-            layout: &self.bgl,
-            entries: &[
+        let mut enc = d.create_command_encoder(&Default::default());
+        encode_single_group(
+            ctx,
+            &mut enc,
+            "gradient build",
+            (&self.bgl, &self.pipeline),
+            &[
                 bind(0, uniforms.as_entire_binding()),
                 bind(1, wgpu::BindingResource::TextureView(volume)),
                 bind(2, wgpu::BindingResource::TextureView(&out)),
             ],
-        });
-        let mut enc = d.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(
+            [
                 size.width.div_ceil(4),
                 size.height.div_ceil(4),
                 size.depth_or_array_layers.div_ceil(4),
-            );
-        }
+            ],
+        );
         ctx.checked("computing the gradients", || {
             ctx.queue.submit([enc.finish()]);
         })?;

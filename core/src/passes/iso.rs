@@ -28,7 +28,7 @@ use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::{flag, PipelineCache, Variant};
+use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::readback::{read_buffer, read_texture_layer};
 use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND};
 use crate::gpu::Context;
@@ -43,40 +43,22 @@ use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
 
-/// The pipeline constants of one specialisation of the first-hit pass.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct FirstHitVariant {
-    skip: bool,
-    crop: bool,
-    single_brick: bool,
-}
-
-impl Variant for FirstHitVariant {
-    fn constants(&self) -> Vec<(&'static str, f64)> {
-        vec![
-            ("SKIP", flag(self.skip)),
-            ("CROP", flag(self.crop)),
-            ("SINGLE_BRICK", flag(self.single_brick)),
-        ]
+pipeline_variant! {
+    /// The pipeline constants of one specialisation of the first-hit pass.
+    struct FirstHitVariant {
+        skip: bool => "SKIP",
+        crop: bool => "CROP",
+        single_brick: bool => "SINGLE_BRICK",
     }
 }
 
-/// The pipeline constants of one specialisation of the deferred pass.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct DeferredVariant {
-    lights: u32,
-    positional_lights: bool,
-    /// 0 none, 1 preview, 2 traced (IsoScattering).
-    scatter: u32,
-}
-
-impl Variant for DeferredVariant {
-    fn constants(&self) -> Vec<(&'static str, f64)> {
-        vec![
-            ("NUM_LIGHTS", self.lights as f64),
-            ("POSITIONAL_LIGHTS", flag(self.positional_lights)),
-            ("SCATTER", self.scatter as f64),
-        ]
+pipeline_variant! {
+    /// The pipeline constants of one specialisation of the deferred pass.
+    struct DeferredVariant {
+        lights: u32 => "NUM_LIGHTS",
+        positional_lights: bool => "POSITIONAL_LIGHTS",
+        /// 0 none, 1 preview, 2 traced (IsoScattering).
+        scatter: u32 => "SCATTER",
     }
 }
 

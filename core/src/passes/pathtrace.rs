@@ -28,11 +28,11 @@ use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::frame::{self, groups};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
-    bind, buffer_entry, entry, sampled_texture_entry, sampler_entry, storage_texture_entry,
-    texture_entry,
+    bind, bind_block, buffer_entry, dynamic_uniform_entry, sampled_texture_entry, sampler_entry,
+    storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::{flag, PipelineCache, Variant};
+use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::readback::read_buffer;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{
@@ -87,17 +87,7 @@ impl PathTracePass {
                 texture_entry(4, false, V::D2),
                 storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
                 storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
-                entry(
-                    7,
-                    wgpu::BindingType::Buffer {
-                        ty: B::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: std::num::NonZeroU64::new(std::mem::size_of::<
-                            PathTraceUniforms,
-                        >()
-                            as u64),
-                    },
-                ),
+                dynamic_uniform_entry::<PathTraceUniforms>(7),
                 texture_entry(11, true, V::Cube),
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
@@ -164,27 +154,17 @@ impl PathTracePass {
     }
 }
 
-/// The pipeline constants of one specialisation of the path tracer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct PathTraceVariant {
-    /// Nearest table lookups.
-    nearest: bool,
-    /// The BSDF and the scattering regions (anything but Henyey–Greenstein everywhere).
-    hybrid: bool,
-    /// The denoiser's guide.
-    guide: bool,
-    /// Forward-difference gradients (FORWARD_DIFF in lib/volume.wgsl).
-    forward_diff: bool,
-}
-
-impl Variant for PathTraceVariant {
-    fn constants(&self) -> Vec<(&'static str, f64)> {
-        vec![
-            ("NEAREST", flag(self.nearest)),
-            ("HYBRID", flag(self.hybrid)),
-            ("GUIDE", flag(self.guide)),
-            ("FORWARD_DIFF", flag(self.forward_diff)),
-        ]
+pipeline_variant! {
+    /// The pipeline constants of one specialisation of the path tracer.
+    struct PathTraceVariant {
+        /// Nearest table lookups.
+        nearest: bool => "NEAREST",
+        /// The BSDF and the scattering regions (anything but Henyey–Greenstein everywhere).
+        hybrid: bool => "HYBRID",
+        /// The denoiser's guide.
+        guide: bool => "GUIDE",
+        /// Forward-difference gradients (FORWARD_DIFF in lib/volume.wgsl).
+        forward_diff: bool => "FORWARD_DIFF",
     }
 }
 
@@ -480,16 +460,7 @@ impl PathTracePass {
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
                 bind(6, wgpu::BindingResource::TextureView(&depth_view)),
-                bind(
-                    7,
-                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.uniforms,
-                        offset: 0,
-                        size: std::num::NonZeroU64::new(
-                            std::mem::size_of::<PathTraceUniforms>() as u64
-                        ),
-                    }),
-                ),
+                bind_block::<PathTraceUniforms>(7, &self.uniforms),
                 bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
                 bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
                 bind(14, dist.as_entire_binding()),

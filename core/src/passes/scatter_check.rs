@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, buffer_entry};
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::single_group_pipeline;
+use crate::gpu::pipeline::{encode_single_group, single_group_pipeline};
 use crate::gpu::readback::read_buffer;
 use crate::gpu::uniforms::PhaseTestUniforms;
 use crate::gpu::Context;
@@ -75,7 +75,6 @@ fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>
         )));
     }
     use wgpu::BufferBindingType as B;
-    let d = &ctx.device;
     let (bgl, pipeline) = single_group_pipeline(
         ctx,
         "phase_test.wgsl",
@@ -97,21 +96,18 @@ fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>
         16 * n as u64,
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     );
-    let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("phase test"),
-        layout: &bgl,
-        entries: &[
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    encode_single_group(
+        ctx,
+        &mut enc,
+        "phase test",
+        (&bgl, &pipeline),
+        &[
             bind(0, ubuf.as_entire_binding()),
             bind(1, out.as_entire_binding()),
         ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(n.div_ceil(64), 1, 1);
-    }
+        [n.div_ceil(64), 1, 1],
+    );
     ctx.checked("running the scattering check", || {
         ctx.queue.submit([enc.finish()]);
     })?;

@@ -7,7 +7,7 @@ use crate::gpu::binding::{
     bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::uniform_buffer;
-use crate::gpu::pipeline::shader_module;
+use crate::gpu::pipeline::{compute_pipeline, encode_single_group, pipeline_layout, shader_module};
 use crate::gpu::readback::read_texture_layer;
 use crate::gpu::uniforms::{EnvUniforms, ENV_EQUIRECT, ENV_SKY};
 use crate::gpu::Context;
@@ -79,23 +79,14 @@ impl EnvPipelines {
             ],
         );
         let pipeline = |entry: &str, layout: &wgpu::BindGroupLayout| {
-            let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(entry),
-                bind_group_layouts: &[Some(layout)],
-                immediate_size: 0,
-            });
-            ctx.checked(
-                &format!("creating the environment {entry} pipeline"),
-                || {
-                    d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(entry),
-                        layout: Some(&pl),
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })
-                },
+            let pl = pipeline_layout(ctx, entry, &[layout]);
+            compute_pipeline(
+                ctx,
+                &format!("environment {entry}"),
+                &pl,
+                &module,
+                entry,
+                &[],
             )
         };
         let build = pipeline("build", &build_bgl)?;
@@ -297,21 +288,19 @@ impl GpuEnvironment {
                 let ub = uniform(&u);
                 let src_view = src_tex.create_view(&Default::default());
                 let dst = level_view(&cube, 0, wgpu::TextureViewDimension::D2Array);
-                let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("environment build"),
-                    layout: &p.build_bgl,
-                    entries: &[
+                encode_single_group(
+                    ctx,
+                    &mut enc,
+                    "environment build",
+                    (&p.build_bgl, &p.build),
+                    &[
                         bind(0, ub.as_entire_binding()),
                         bind(1, wgpu::BindingResource::TextureView(&src_view)),
                         bind(2, wgpu::BindingResource::Sampler(&p.equirect_sampler)),
                         bind(3, wgpu::BindingResource::TextureView(&dst)),
                     ],
-                });
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&p.build);
-                pass.set_bind_group(0, &bg, &[]);
-                pass.dispatch_workgroups(groups(size), groups(size), 6);
-                drop(pass);
+                    [groups(size), groups(size), 6],
+                );
                 keep.push(src_tex);
             }
         }
@@ -322,19 +311,18 @@ impl GpuEnvironment {
             let ub = uniform(&u);
             let src = level_view(&cube, level - 1, wgpu::TextureViewDimension::D2Array);
             let dst = level_view(&cube, level, wgpu::TextureViewDimension::D2Array);
-            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("environment downsample"),
-                layout: &p.downsample_bgl,
-                entries: &[
+            encode_single_group(
+                ctx,
+                &mut enc,
+                "environment downsample",
+                (&p.downsample_bgl, &p.downsample),
+                &[
                     bind(0, ub.as_entire_binding()),
                     bind(3, wgpu::BindingResource::TextureView(&dst)),
                     bind(4, wgpu::BindingResource::TextureView(&src)),
                 ],
-            });
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&p.downsample);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(groups(s), groups(s), 6);
+                [groups(s), groups(s), 6],
+            );
         }
         // The irradiance cube.
         let cube_view = cube.create_view(&wgpu::TextureViewDescriptor {
@@ -346,22 +334,19 @@ impl GpuEnvironment {
         u.params = [0, IRRADIANCE_SIZE, env.irradiance_samples, 0];
         let ub = uniform(&u);
         let dst = level_view(&irradiance, 0, wgpu::TextureViewDimension::D2Array);
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("environment irradiance"),
-            layout: &p.irradiance_bgl,
-            entries: &[
+        encode_single_group(
+            ctx,
+            &mut enc,
+            "environment irradiance",
+            (&p.irradiance_bgl, &p.irradiance),
+            &[
                 bind(0, ub.as_entire_binding()),
                 bind(3, wgpu::BindingResource::TextureView(&dst)),
                 bind(5, wgpu::BindingResource::TextureView(&cube_view)),
                 bind(6, wgpu::BindingResource::Sampler(&p.cube_sampler)),
             ],
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&p.irradiance);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(groups(IRRADIANCE_SIZE), groups(IRRADIANCE_SIZE), 6);
-        }
+            [groups(IRRADIANCE_SIZE), groups(IRRADIANCE_SIZE), 6],
+        );
         ctx.checked("computing the environment maps", || {
             q.submit([enc.finish()]);
         })?;
