@@ -10,6 +10,7 @@ use crate::params::{
     RenderParams, Stats, TransferFunction, UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
+use crate::passes::frame::FrameInput;
 use crate::passes::gradient::GradientPass;
 use crate::passes::iso::IsoPass;
 use crate::passes::pathtrace::PathTracePass;
@@ -276,6 +277,13 @@ impl Renderer {
         depth: DepthSource<'_>,
     ) -> Result<()> {
         let (ctx, res) = (&self.ctx, &mut self.res);
+        let input = |res| FrameInput {
+            ctx,
+            res,
+            view,
+            params,
+            depth,
+        };
         match params.blend {
             BlendMode::Isosurface => {
                 params.validate()?;
@@ -290,16 +298,16 @@ impl Renderer {
                 let pass = ensure(&mut self.iso, || {
                     Ok(Box::new(IsoPass::new(ctx, brick_bgl)?))
                 })?;
-                pass.render(ctx, res, view, params, iso, depth)
+                pass.render(input(res), iso)
             }
             BlendMode::PathTrace => {
                 let brick_bgl = &res.brick_bgl;
                 let pass = ensure(&mut self.pt, || {
                     Ok(Box::new(PathTracePass::new(ctx, brick_bgl)?))
                 })?;
-                pass.render(ctx, res, view, params, &self.pt_params, depth)
+                pass.render(input(res), &self.pt_params)
             }
-            _ => self.dvr.render(ctx, res, view, params, depth),
+            _ => self.dvr.render(input(res)),
         }
     }
 

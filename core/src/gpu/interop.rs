@@ -284,26 +284,16 @@ mod imp {
         use wgpu::TextureUsages as U;
         let mut vk_usage = vk::ImageUsageFlags::empty();
         let mut hal = wgpu::TextureUses::empty();
+        use vk::ImageUsageFlags as Vk;
+        use wgpu::TextureUses as Hal;
         for (wanted, vk_flag, hal_flag) in [
-            (
-                U::COPY_SRC,
-                vk::ImageUsageFlags::TRANSFER_SRC,
-                wgpu::TextureUses::COPY_SRC,
-            ),
-            (
-                U::COPY_DST,
-                vk::ImageUsageFlags::TRANSFER_DST,
-                wgpu::TextureUses::COPY_DST,
-            ),
-            (
-                U::TEXTURE_BINDING,
-                vk::ImageUsageFlags::SAMPLED,
-                wgpu::TextureUses::RESOURCE,
-            ),
+            (U::COPY_SRC, Vk::TRANSFER_SRC, Hal::COPY_SRC),
+            (U::COPY_DST, Vk::TRANSFER_DST, Hal::COPY_DST),
+            (U::TEXTURE_BINDING, Vk::SAMPLED, Hal::RESOURCE),
             (
                 U::RENDER_ATTACHMENT,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT,
-                wgpu::TextureUses::COLOR_TARGET,
+                Vk::COLOR_ATTACHMENT,
+                Hal::COLOR_TARGET,
             ),
         ] {
             if usage.contains(wanted) {

@@ -67,3 +67,26 @@ impl GridValue for u32 {
 impl GridValue for f32 {
     const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 }
+
+/// The descriptor of a 2D texture of one mip level and one layer.
+pub(crate) fn texture_2d<'a>(
+    label: &'a str,
+    [width, height]: [u32; 2],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::TextureDescriptor<'a> {
+    wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    }
+}

@@ -3,16 +3,15 @@
 //! visibility order; with several bricks a resolve pass (shaders/resolve.wgsl) turns the
 //! per-pixel ray state into the output images.
 
-use super::frame::{self, brick_order, groups, SKIP_MAX_OCCUPANCY};
+use super::frame::{self, brick_order, groups, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::Result;
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::pipeline::{pipeline_variant, single_group_pipeline, PipelineCache};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, View};
+use crate::params::{BlendMode, GradientMethod, Interpolation};
 use crate::resources::targets::{clear_outputs, DepthSource};
-use crate::resources::Resources;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -84,14 +83,8 @@ impl DvrPass {
     }
 
     /// One ray-cast frame.
-    pub fn render(
-        &mut self,
-        ctx: &Context,
-        res: &mut Resources,
-        view: &View,
-        params: &RenderParams,
-        depth: DepthSource<'_>,
-    ) -> Result<()> {
+    pub fn render(&mut self, input: FrameInput<'_>) -> Result<()> {
+        let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         if params.shading.enabled {
             frame::check_light_count(view)?;

@@ -7,8 +7,10 @@ use crate::gpu::uniforms::{
     flag_bits, mat, FrameUniforms, FLAG_AVERAGE_RANGE, FLAG_DEPTH_INPUT, FLAG_INDEPENDENT,
     FLAG_JITTER, FLAG_TWO_SIDED,
 };
+use crate::gpu::Context;
 use crate::params::{BlendMode, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS};
 use crate::resources::bricks::{BrickExtent, BLOCK_SIZE};
+use crate::resources::targets::DepthSource;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::{DMat4, DVec3};
@@ -39,6 +41,32 @@ pub(crate) fn groups(r: [u32; 4]) -> [u32; 2] {
         (r[2] - r[0]).div_ceil(WORKGROUP),
         (r[3] - r[1]).div_ceil(WORKGROUP),
     ]
+}
+
+/// What a pass renders a frame from: the device, the renderer's resources (which the pass
+/// builds on demand and borrows for the frame), the view, the render parameters and where
+/// the depth input comes from.
+pub(crate) struct FrameInput<'a> {
+    pub ctx: &'a Context,
+    pub res: &'a mut Resources,
+    pub view: &'a View,
+    pub params: &'a RenderParams,
+    pub depth: DepthSource<'a>,
+}
+
+impl<'a> FrameInput<'a> {
+    /// The fields, for a pass to take apart: (ctx, res, view, params, depth).
+    pub fn parts(
+        self,
+    ) -> (
+        &'a Context,
+        &'a mut Resources,
+        &'a View,
+        &'a RenderParams,
+        DepthSource<'a>,
+    ) {
+        (self.ctx, self.res, self.view, self.params, self.depth)
+    }
 }
 
 /// One frame's uniforms and the facts about it the passes specialise their pipelines on.

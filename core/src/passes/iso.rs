@@ -22,7 +22,7 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
-use super::frame::{self, brick_order, groups, SKIP_MAX_OCCUPANCY};
+use super::frame::{self, brick_order, groups, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
@@ -34,7 +34,7 @@ use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND};
 use crate::gpu::Context;
 use crate::params::iso::MAX_SPECULAR_SAMPLES;
 use crate::params::{
-    BlendMode, GBuffer, IsoParams, IsoScatterMode, RenderParams, Shading, Shininess, View,
+    BlendMode, GBuffer, IsoParams, IsoScatterMode, RenderParams, Shading, Shininess,
 };
 use crate::resources::environment::texel_solid_angle;
 use crate::resources::tables::{Occupancy, Tables};
@@ -195,14 +195,7 @@ impl IsoPass {
             deferred,
             iso_buf,
             lobe_dirs,
-            no_tables: Tables::new(
-                d,
-                wgpu::Extent3d {
-                    width: 1,
-                    height: 1,
-                    depth_or_array_layers: 1,
-                },
-            ),
+            no_tables: Tables::new(d, [1, 1]),
             gbuffer: None,
             occupancy: None,
             last_rect: [0; 4],
@@ -326,15 +319,8 @@ impl IsoPass {
     }
 
     /// One isosurface frame: first hit per brick in visibility order, then deferred shading.
-    pub fn render(
-        &mut self,
-        ctx: &Context,
-        res: &mut Resources,
-        view: &View,
-        params: &RenderParams,
-        iso: &IsoParams,
-        depth: DepthSource<'_>,
-    ) -> Result<()> {
+    pub fn render(&mut self, input: FrameInput<'_>, iso: &IsoParams) -> Result<()> {
+        let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         iso.validate()?;
         frame::check_light_count(view)?;

@@ -25,7 +25,7 @@
 //! medium; cropping and positional lights are refused.
 
 use super::denoise::{DenoiseOutputs, DenoisePass};
-use super::frame::{self, groups};
+use super::frame::{self, groups, FrameInput};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, bind_block, buffer_entry, dynamic_uniform_entry, sampled_texture_entry, sampler_entry,
@@ -43,7 +43,7 @@ use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
     BlendMode, CubeImage, GradientMethod, Interpolation, PathTraceParams, RenderParams,
-    ScatterRegions, Shading, View,
+    ScatterRegions, Shading,
 };
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::Resources;
@@ -304,15 +304,8 @@ impl PathTracePass {
     }
 
     /// One path-traced frame: `samples_per_frame` more paths per pixel.
-    pub fn render(
-        &mut self,
-        ctx: &Context,
-        res: &mut Resources,
-        view: &View,
-        params: &RenderParams,
-        pp: &PathTraceParams,
-        depth: DepthSource<'_>,
-    ) -> Result<()> {
+    pub fn render(&mut self, input: FrameInput<'_>, pp: &PathTraceParams) -> Result<()> {
+        let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         let pp = *pp;
         pp.validate()?;

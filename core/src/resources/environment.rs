@@ -9,6 +9,7 @@ use crate::gpu::binding::{
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::{compute_pipeline, encode_single_group, pipeline_layout, shader_module};
 use crate::gpu::readback::read_texture_layer;
+use crate::gpu::texture::texture_2d;
 use crate::gpu::uniforms::{EnvUniforms, ENV_EQUIRECT, ENV_SKY};
 use crate::gpu::Context;
 use crate::params::environment::{CubeImage, Environment, EnvironmentSource, IRRADIANCE_SIZE};
@@ -267,20 +268,12 @@ impl GpuEnvironment {
                     };
                 let src_tex = d.create_texture_with_data(
                     q,
-                    &wgpu::TextureDescriptor {
-                        label: Some("equirectangular source"),
-                        size: wgpu::Extent3d {
-                            width,
-                            height,
-                            depth_or_array_layers: 1,
-                        },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: ENV_FORMAT,
-                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
-                    },
+                    &texture_2d(
+                        "equirectangular source",
+                        [width, height],
+                        ENV_FORMAT,
+                        wgpu::TextureUsages::TEXTURE_BINDING,
+                    ),
                     wgpu::util::TextureDataOrder::LayerMajor,
                     bytemuck::cast_slice(&texels),
                 );

@@ -2,7 +2,7 @@
 
 use super::Resources;
 use crate::error::{Error, Result};
-use crate::gpu::texture::{block_grid, upload_texture};
+use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
 use crate::params::{build_tables, TransferFunction};
@@ -33,17 +33,14 @@ pub(crate) struct Tables {
 }
 
 impl Tables {
-    pub fn new(d: &wgpu::Device, size: wgpu::Extent3d) -> Tables {
-        let texture = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("transfer tables"),
+    /// Tables of `size` texels: `TABLE_SIZE` × two rows per component.
+    pub fn new(d: &wgpu::Device, size: [u32; 2]) -> Tables {
+        let texture = d.create_texture(&texture_2d(
+            "transfer tables",
             size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+            wgpu::TextureFormat::Rgba32Float,
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        ));
         let view = texture.create_view(&Default::default());
         Tables { texture, view }
     }
@@ -89,13 +86,9 @@ impl Resources {
         for c in 0..comps {
             data.extend(build_tables(tf.component(c), step));
         }
-        let size = wgpu::Extent3d {
-            width: TABLE_SIZE as u32,
-            height: 2 * comps as u32,
-            depth_or_array_layers: 1,
-        };
+        let size = [TABLE_SIZE as u32, 2 * comps as u32];
         let tables = match self.tables.take() {
-            Some((_, t)) if t.texture.size() == size => t,
+            Some((_, t)) if [t.texture.width(), t.texture.height()] == size => t,
             _ => Tables::new(&ctx.device, size),
         };
         upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 16);

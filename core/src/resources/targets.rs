@@ -5,7 +5,7 @@ use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::interop::{self, ExportableMemory, OutputPath, SharedOutput};
 use crate::gpu::readback::read_texture_layer;
-use crate::gpu::texture::upload_texture;
+use crate::gpu::texture::{texture_2d, upload_texture};
 use crate::gpu::uniforms::PIXEL_STATE_BYTES;
 use crate::gpu::Context;
 use crate::params::{Image, View};
@@ -98,20 +98,7 @@ impl Resources {
         let shared = self.output_path == OutputPath::Shared;
         let d = &ctx.device;
         let tex = |label, format, usage| -> Result<(wgpu::Texture, Option<ExportableMemory>)> {
-            let desc = wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            };
+            let desc = texture_2d(label, [width, height], format, usage);
             if shared {
                 let (t, m) = interop::create_exportable_texture(ctx, &desc)?;
                 Ok((t, Some(m)))
