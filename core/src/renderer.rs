@@ -216,7 +216,7 @@ impl Renderer {
         n: u32,
         seed: u32,
     ) -> Result<Vec<[f32; 3]>> {
-        scatter_check::sample_bsdf(&self.ctx, bsdf, normal, dir, n, seed)
+        scatter_check::sample_bsdf(&self.ctx, bsdf, [normal, dir], [n, seed])
     }
 
     /// Renders one frame and returns once it is submitted; read it with [`Renderer::read_image`]

@@ -67,14 +67,7 @@ impl Default for Sky {
 impl Sky {
     /// The same radiance `c` from every direction.
     pub fn constant(c: [f32; 3]) -> Sky {
-        Sky {
-            zenith: c,
-            horizon: c,
-            ground: c,
-            sun_color: [0.0; 3],
-            sun_halo: 0.0,
-            ..Sky::default()
-        }
+        Sky::hemisphere(c, c)
     }
 
     /// `above` over the whole upper hemisphere, `below` under it, no sun.

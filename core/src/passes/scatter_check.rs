@@ -28,19 +28,13 @@ pub(crate) fn sample_phase_cosines(ctx: &Context, g: f32, n: u32, seed: u32) -> 
     Ok(run_phase_check(ctx, &u)?.iter().map(|v| v[0]).collect())
 }
 
-/// Checks the path tracer's BSDF (shaders/lib/bsdf.wgsl, colour 1) at a surface with
-/// gradient direction `normal` for a path arriving along `dir` (both unit vectors):
-/// per sample, [value / density of a direction drawn by its sampler, 4π × value and 4π ×
-/// density of a uniformly drawn direction]. The means of the first two estimate the
-/// albedo (≤ 1 when energy is conserved; equal when sampler and density agree), the
-/// mean of the third is 1 when the density is normalised.
+/// [`crate::Renderer::sample_bsdf`]: `n` samples of `bsdf` at a surface with gradient
+/// direction `normal` for a path arriving along `dir`, from random stream `seed`.
 pub(crate) fn sample_bsdf(
     ctx: &Context,
     bsdf: &BsdfParams,
-    normal: [f32; 3],
-    dir: [f32; 3],
-    n: u32,
-    seed: u32,
+    [normal, dir]: [[f32; 3]; 2],
+    [n, seed]: [u32; 2],
 ) -> Result<Vec<[f32; 3]>> {
     bsdf.validate()?;
     let unit = |v: [f32; 3]| (glam::Vec3::from(v).length() - 1.0).abs() < 1e-3;
