@@ -43,7 +43,7 @@ vtk: deps
 	@echo "VTK module built: . build/env.sh && /usr/bin/python3 -c 'import vtk, ferrovol'"
 
 # C++ and Python tests of vtkFerroVolumeMapper in a private Xvfb (images and measured
-# figures land in build/vtk/test-images; ~30 s on 2 cores).
+# figures land in build/vtk/test-images).
 vtk-test: vtk
 	@scripts/fetch-data.sh >/dev/null || echo "vtk-test: no build/data/cranium.vti; the examples render a synthetic volume"
 	env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(VTK_BUILD) --output-on-failure -j1
@@ -96,9 +96,8 @@ test: lint
 # The regression suite (tests/regression/README.md): every scene of tests/regression/scenes.py
 # rendered by vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper and
 # vtkFerroVolumeMapper in a private Xvfb; SSIM, PSNR, FLIP and footprint colour difference
-# against tests/regression/thresholds.toml; report in build/regression/index.html. The whole
-# matrix takes ~70 s on 2 cores, the quick subset ~35 s. Scenes whose data is missing are
-# reported as skipped (scripts/fetch-data.sh makes it).
+# against tests/regression/thresholds.toml; report in build/regression/index.html. Scenes
+# whose data is missing are reported as skipped (scripts/fetch-data.sh makes it).
 REGRESSION = . build/env.sh && env -u DISPLAY scripts/with-xvfb.sh \
   vtk_plugin/tests/retry-on-x-failure.sh /usr/bin/python3 tests/regression/run.py
 regression: vtk

@@ -173,7 +173,7 @@ def main(argv):
     print("# VTK %s, %s" % (vtk.vtkVersion.GetVTKVersion(), ren_win.GetClassName()))
     print("# OpenGL: %s" % opengl_info(ren_win))
     # Every frame clears and resolves the window's multisampled framebuffer, a cost of its
-    # own on a CPU rasteriser (900x900 with 8 samples: ~25 ms a frame on llvmpipe).
+    # own on a CPU rasteriser (docs/PERFORMANCE.md).
     print("# window: MultiSamples=%d" % ren_win.GetMultiSamples())
     print("# data: vtkRTAnalyticSource extent -%d..%d (%dx%dx%d float32), range [%.4f, %.4f], "
           "made in %.2f s" % (n, n + 1, dims[0], dims[1], dims[2], lo, hi, make_data_s))
