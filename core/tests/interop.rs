@@ -62,6 +62,27 @@ fn view(width: u32, height: u32) -> View {
     v
 }
 
+/// Renders `v` without a depth input. Returns that frame; `cut`, the depth of its hit with a
+/// `k`th of its hits in front (k = 2: the median); and a depth input that is `cut` at the
+/// pixels (row-major indices) where `cut_here` holds and 1 (no cut) elsewhere.
+fn depth_cut(
+    r: &mut Renderer,
+    v: &View,
+    p: &RenderParams,
+    k: usize,
+    cut_here: impl Fn(u32) -> bool,
+) -> (Image, f32, Vec<f32>) {
+    r.render(v, p, None).expect("rendering");
+    let plain = r.read_image().expect("reading back");
+    let mut hits: Vec<f32> = plain.depth.iter().copied().filter(|&d| d < 1.0).collect();
+    hits.sort_by(f32::total_cmp);
+    let cut = hits[hits.len() / k];
+    let depth = (0..v.width * v.height)
+        .map(|i| if cut_here(i) { cut } else { 1.0 })
+        .collect();
+    (plain, cut, depth)
+}
+
 /// Open file descriptors of this process.
 fn open_fds() -> usize {
     std::fs::read_dir("/proc/self/fd")
@@ -107,14 +128,7 @@ fn sharing_does_not_change_the_image() {
     let p = params();
     // A depth input that cuts the right half of the volume off at the median volume depth.
     r.set_output_path(OutputPath::Readback).expect("readback");
-    r.render(&v, &p, None).expect("rendering");
-    let plain = r.read_image().expect("reading back");
-    let mut hits: Vec<f32> = plain.depth.iter().copied().filter(|&d| d < 1.0).collect();
-    hits.sort_by(f32::total_cmp);
-    let cut = hits[hits.len() / 2];
-    let depth_in: Vec<f32> = (0..w * h)
-        .map(|i| if i % w >= w / 2 { cut } else { 1.0 })
-        .collect();
+    let (plain, _, depth_in) = depth_cut(&mut r, &v, &p, 2, |i| i % w >= w / 2);
     r.render(&v, &p, Some(&depth_in))
         .expect("rendering with depth");
     let plain_cut = r.read_image().expect("reading back");
@@ -734,57 +748,65 @@ fn gl_host(ctx: &Context) -> Option<gl::Host> {
     Some(host)
 }
 
-/// OpenGL imports the exported colour and depth and sees exactly the frame read_image gives.
+/// Runs `test` on the renderer with its output in shared memory and an OpenGL host on the
+/// same device (or skips, saying why, where there is none), then returns the output to
+/// readback: what `test` imported into GL is gone by then.
 #[cfg(target_os = "linux")]
-#[test]
-fn opengl_sees_the_frame() {
+fn with_gl_sharing(test: impl FnOnce(&mut Renderer, &gl::Host)) {
     let mut r = renderer();
     let Some(host) = gl_host(r.context()) else {
         return;
     };
-
-    let (w, h) = (97, 61);
     r.set_output_path(OutputPath::Shared).expect("sharing");
-    r.prepare_output(w, h).expect("allocating");
-    let out = r.shared_output().expect("exporting");
-    let generation = out.generation;
-    let color = Imported::new(&host, out.color).expect("importing the colour into GL");
-    let depth = Imported::new(&host, out.depth).expect("importing the depth into GL");
-
-    // Import once, render several frames into the same memory.
-    for azimuth in [0.0, 40.0] {
-        let mut v = view(w, h);
-        v.camera.azimuth(azimuth);
-        r.render(&v, &params(), None).expect("rendering");
-        r.finish().expect("waiting for the GPU");
-        assert_eq!(r.output_generation(), generation, "no reallocation");
-        let gl_rgba = color.read(w, h, gl::RGBA, gl::UNSIGNED_BYTE);
-        let gl_depth = depth.read(w, h, gl::RED, gl::FLOAT);
-        let img = r.read_image().expect("reading back");
-        let gl_depth: Vec<f32> = gl_depth
-            .chunks(4)
-            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
-        let (dc, dd) = (
-            count_diff(&gl_rgba, &img.rgba),
-            count_diff(&gl_depth, &img.depth),
-        );
-        println!(
-            "azimuth {azimuth}: footprint {} px; GL vs read_image: {dc} of {} colour bytes, \
-             {dd} of {} depths differ",
-            footprint(&img),
-            img.rgba.len(),
-            img.depth.len()
-        );
-        assert!(
-            footprint(&img) > (w * h / 8) as usize,
-            "the volume is in view"
-        );
-        // The same memory read two ways: exact.
-        assert_eq!((dc, dd), (0, 0), "GL sees a different frame");
-    }
-    drop((color, depth));
+    test(&mut r, &host);
     r.set_output_path(OutputPath::Readback).expect("readback");
+}
+
+/// OpenGL imports the exported colour and depth and sees exactly the frame read_image gives.
+#[cfg(target_os = "linux")]
+#[test]
+fn opengl_sees_the_frame() {
+    with_gl_sharing(|r, host| {
+        let (w, h) = (97, 61);
+        r.prepare_output(w, h).expect("allocating");
+        let out = r.shared_output().expect("exporting");
+        let generation = out.generation;
+        let color = Imported::new(host, out.color).expect("importing the colour into GL");
+        let depth = Imported::new(host, out.depth).expect("importing the depth into GL");
+
+        // Import once, render several frames into the same memory.
+        for azimuth in [0.0, 40.0] {
+            let mut v = view(w, h);
+            v.camera.azimuth(azimuth);
+            r.render(&v, &params(), None).expect("rendering");
+            r.finish().expect("waiting for the GPU");
+            assert_eq!(r.output_generation(), generation, "no reallocation");
+            let gl_rgba = color.read(w, h, gl::RGBA, gl::UNSIGNED_BYTE);
+            let gl_depth = depth.read(w, h, gl::RED, gl::FLOAT);
+            let img = r.read_image().expect("reading back");
+            let gl_depth: Vec<f32> = gl_depth
+                .chunks(4)
+                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            let (dc, dd) = (
+                count_diff(&gl_rgba, &img.rgba),
+                count_diff(&gl_depth, &img.depth),
+            );
+            println!(
+                "azimuth {azimuth}: footprint {} px; GL vs read_image: {dc} of {} colour bytes, \
+                 {dd} of {} depths differ",
+                footprint(&img),
+                img.rgba.len(),
+                img.depth.len()
+            );
+            assert!(
+                footprint(&img) > (w * h / 8) as usize,
+                "the volume is in view"
+            );
+            // The same memory read two ways: exact.
+            assert_eq!((dc, dd), (0, 0), "GL sees a different frame");
+        }
+    });
 }
 
 /// The host writes the depth input through GL; the frame equals one with the same depth
@@ -792,56 +814,44 @@ fn opengl_sees_the_frame() {
 #[cfg(target_os = "linux")]
 #[test]
 fn opengl_writes_the_depth_input() {
-    let mut r = renderer();
-    let Some(host) = gl_host(r.context()) else {
-        return;
-    };
-    let (w, h) = (80, 56);
-    let v = view(w, h);
-    let p = params();
-    r.set_output_path(OutputPath::Shared).expect("sharing");
-    let e = r.render_with_shared_depth(&view(w + 1, h), &p);
-    assert!(
-        e.is_err(),
-        "a size the depth input does not have is refused"
-    );
-    r.render(&v, &p, None).expect("rendering");
-    let plain = r.read_image().expect("reading back");
-    let mut hits: Vec<f32> = plain.depth.iter().copied().filter(|&d| d < 1.0).collect();
-    hits.sort_by(f32::total_cmp);
-    let cut = hits[hits.len() / 3];
-    // Rows top to bottom: the upper half is cut at `cut`, the lower half not at all.
-    let depth: Vec<f32> = (0..w * h)
-        .map(|i| if i / w < h / 2 { cut } else { 1.0 })
-        .collect();
-    r.render(&v, &p, Some(&depth))
-        .expect("rendering with uploaded depth");
-    let uploaded = r.read_image().expect("reading back");
+    with_gl_sharing(|r, host| {
+        let (w, h) = (80, 56);
+        let v = view(w, h);
+        let p = params();
+        let e = r.render_with_shared_depth(&view(w + 1, h), &p);
+        assert!(
+            e.is_err(),
+            "a size the depth input does not have is refused"
+        );
+        // Rows top to bottom: the upper half is cut at `cut`, the lower half not at all.
+        let (plain, cut, depth) = depth_cut(r, &v, &p, 3, |i| i / w < h / 2);
+        r.render(&v, &p, Some(&depth))
+            .expect("rendering with uploaded depth");
+        let uploaded = r.read_image().expect("reading back");
 
-    let out = r.shared_output().expect("exporting");
-    let depth_in = Imported::new(&host, out.depth_in).expect("importing the depth input");
-    // GL row 0 is memory row 0, which is the top row of the frame: write the rows as they are.
-    depth_in.write_f32(w, h, &depth);
-    let read_back = depth_in.read(w, h, gl::RED, gl::FLOAT);
-    assert_eq!(
-        read_back,
-        bytemuck::cast_slice::<f32, u8>(&depth),
-        "GL wrote"
-    );
-    r.render_with_shared_depth(&v, &p)
-        .expect("rendering with the shared depth");
-    let shared = r.read_image().expect("reading back");
-    let changed = count_diff(&plain.rgba, &uploaded.rgba);
-    let (dc, dd) = (
-        count_diff(&uploaded.rgba, &shared.rgba),
-        count_diff(&uploaded.depth, &shared.depth),
-    );
-    println!(
-        "depth cut at {cut}: changes {changed} colour bytes; GL-written vs uploaded depth \
-         input: {dc} colour bytes, {dd} depths differ"
-    );
-    assert!(changed > 100, "the depth input has an effect");
-    assert_eq!((dc, dd), (0, 0));
-    drop(depth_in);
-    r.set_output_path(OutputPath::Readback).expect("readback");
+        let out = r.shared_output().expect("exporting");
+        let depth_in = Imported::new(host, out.depth_in).expect("importing the depth input");
+        // GL row 0 is memory row 0, which is the top row of the frame: write the rows as they are.
+        depth_in.write_f32(w, h, &depth);
+        let read_back = depth_in.read(w, h, gl::RED, gl::FLOAT);
+        assert_eq!(
+            read_back,
+            bytemuck::cast_slice::<f32, u8>(&depth),
+            "GL wrote"
+        );
+        r.render_with_shared_depth(&v, &p)
+            .expect("rendering with the shared depth");
+        let shared = r.read_image().expect("reading back");
+        let changed = count_diff(&plain.rgba, &uploaded.rgba);
+        let (dc, dd) = (
+            count_diff(&uploaded.rgba, &shared.rgba),
+            count_diff(&uploaded.depth, &shared.depth),
+        );
+        println!(
+            "depth cut at {cut}: changes {changed} colour bytes; GL-written vs uploaded depth \
+             input: {dc} colour bytes, {dd} depths differ"
+        );
+        assert!(changed > 100, "the depth input has an effect");
+        assert_eq!((dc, dd), (0, 0));
+    });
 }

@@ -7,6 +7,7 @@
 //! Images go to `target/test-images/pathtrace-*.png` for inspection.
 
 use ferrovol_core::*;
+use std::sync::MutexGuard;
 mod common;
 
 use common::gpu::{assert_error, pt_params, renderer, set_bricked, trace};
@@ -22,13 +23,26 @@ fn medium(rgb: [f32; 3], a0: f32, a1: f32, unit: f64) -> TransferFunction {
     ))
 }
 
-/// Sets the volume, its transfer function and, where given, the environment.
-fn set_scene(r: &mut Renderer, vol: &VolumeData, tf: TransferFunction, env: Option<Environment>) {
+/// The shared renderer with `vol`, its transfer function and, where given, the environment
+/// set; and the view that fits the volume into `size` × `size` pixels.
+fn scene(
+    vol: &VolumeData,
+    tf: TransferFunction,
+    env: Option<Environment>,
+    size: u32,
+) -> (MutexGuard<'static, Renderer>, View) {
+    let mut r = renderer();
     r.set_volume(vol).unwrap();
     r.set_transfer_function(&tf).unwrap();
     if let Some(env) = env {
         r.set_environment(&env).unwrap();
     }
+    (r, View::fit(vol.bounds(), size, size))
+}
+
+/// The uniform environment of radiance 1.
+fn white_sky() -> Option<Environment> {
+    Some(Environment::constant([1.0; 3]))
 }
 
 /// The Henyey–Greenstein CDF of the cosine μ between propagation directions.
@@ -78,18 +92,11 @@ fn phase_sampling_matches_henyey_greenstein() {
 
 #[test]
 fn white_furnace_returns_the_environment() {
-    let mut r = renderer();
     // A non-absorbing medium (albedo 1) of optical depth ~5 across, under a uniform
     // environment of radiance 1: every path must bring back exactly 1 on average, however
     // often it scatters (and the environment behind is 1 too).
     let vol = volume([16, 16, 16], |_, _, _| 0.5);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([1.0; 3], 0.3, 0.3, 1.0),
-        Some(Environment::constant([1.0; 3])),
-    );
-    let mut view = View::fit(vol.bounds(), 24, 24);
+    let (mut r, mut view) = scene(&vol, medium([1.0; 3], 0.3, 0.3, 1.0), white_sky(), 24);
     view.lights.clear();
     for g in [0.0f32, 0.6] {
         let p = PathTraceParams {
@@ -137,19 +144,12 @@ const MAX_BOUNCES_FOR_FURNACE: u32 = 10_000;
 
 #[test]
 fn delta_tracking_agrees_with_ray_marching() {
-    let mut r = renderer();
     // A heterogeneous black slab (opacity from 0 to 0.25 per unit across x) in front of a
     // uniform white background: the path tracer sees only the transmittance T, estimated
     // by delta tracking; the composite ray caster's 1 − alpha is the same T by ray
     // marching (sample distance 0.25).
     let vol = volume([32, 32, 8], |x, _, _| x / 31.0);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([0.0; 3], 0.0, 0.25, 1.0),
-        Some(Environment::constant([1.0; 3])),
-    );
-    let mut view = View::fit(vol.bounds(), 40, 40);
+    let (mut r, mut view) = scene(&vol, medium([0.0; 3], 0.0, 0.25, 1.0), white_sky(), 40);
     view.camera.parallel = true;
     view.lights.clear();
     let p = PathTraceParams {
@@ -197,20 +197,15 @@ fn delta_tracking_agrees_with_ray_marching() {
 
 #[test]
 fn error_falls_like_one_over_root_spp() {
-    let mut r = renderer();
     // A scattering blob under a two-hemisphere sky with the headlight: RMS error of 4, 16
     // and 64 paths per pixel against 2048 (another seed), fitted on log-log axes. (Under
     // the default sky, whose sun the uniform next-event directions rarely find, single
     // paths that hit the sun dominate the error at these counts: the environment is not
     // importance-sampled yet.)
     let vol = ball(20, 9.0);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0),
-        Some(Environment::hemisphere([0.9, 0.95, 1.0], [0.3, 0.25, 0.2])),
-    );
-    let view = View::fit(vol.bounds(), 24, 24);
+    let tf = medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0);
+    let sky = Environment::hemisphere([0.9, 0.95, 1.0], [0.3, 0.25, 0.2]);
+    let (mut r, view) = scene(&vol, tf, Some(sky), 24);
     let p = |spp: u32, seed: u32| PathTraceParams {
         samples_per_frame: spp.min(256),
         seed,
@@ -249,10 +244,8 @@ fn error_falls_like_one_over_root_spp() {
 
 #[test]
 fn accumulation_restarts_on_changes() {
-    let mut r = renderer();
     let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
-    set_scene(&mut r, &vol, medium([0.8; 3], 0.0, 0.5, 1.0), None);
-    let mut view = View::fit(vol.bounds(), 16, 16);
+    let (mut r, mut view) = scene(&vol, medium([0.8; 3], 0.0, 0.5, 1.0), None, 16);
     let p = PathTraceParams {
         samples_per_frame: 3,
         ..Default::default()
@@ -307,10 +300,8 @@ fn accumulation_restarts_on_changes() {
 
 #[test]
 fn errors_say_what_is_wrong() {
-    let mut r = renderer();
     let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
-    set_scene(&mut r, &vol, medium([0.8; 3], 0.0, 0.5, 1.0), None);
-    let view = View::fit(vol.bounds(), 16, 16);
+    let (mut r, view) = scene(&vol, medium([0.8; 3], 0.0, 0.5, 1.0), None, 16);
     let bad = |p: PathTraceParams, words: &str| {
         assert_error(PathTraceParams::validate(&p), "", &[words]);
     };
@@ -359,19 +350,15 @@ fn errors_say_what_is_wrong() {
 
 #[test]
 fn every_path_is_counted_in_a_dense_volume() {
-    let mut r = renderer();
     // A dense ball in an empty box: long free flights through the box, with many tentative
     // collisions against the dense ball's majorant. With the background on, every path
     // must count with coverage 1 (64 paths per pixel per frame once lost paths on lavapipe,
     // whose loop limiter stops all loops of an invocation after 65535 iterations: coverage
     // fell to 0.6 at the ball's rim).
     let vol = ball(48, 20.0);
-    r.set_volume(&vol).unwrap();
     let dense = [(0.0, 0.0), (0.01, 0.0), (0.05, 0.999), (1.0, 0.999)];
-    r.set_transfer_function(&white(&dense, 0.2)).unwrap();
-    r.set_environment(&Environment::hemisphere([1.0; 3], [0.0; 3]))
-        .unwrap();
-    let mut view = View::fit(vol.bounds(), 48, 48);
+    let sky = Environment::hemisphere([1.0; 3], [0.0; 3]);
+    let (mut r, mut view) = scene(&vol, white(&dense, 0.2), Some(sky), 48);
     view.lights.clear();
     let p = PathTraceParams {
         samples_per_frame: 64,
@@ -446,15 +433,8 @@ fn bsdf_conserves_energy_and_samples_its_density() {
 /// wherever the gradient is not zero, Henyey–Greenstein where it is.
 #[test]
 fn white_furnace_with_the_bsdf() {
-    let mut r = renderer();
     let vol = ball(16, 10.0);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([1.0; 3], 0.0, 0.6, 1.0),
-        Some(Environment::constant([1.0; 3])),
-    );
-    let mut view = View::fit(vol.bounds(), 24, 24);
+    let (mut r, mut view) = scene(&vol, medium([1.0; 3], 0.0, 0.6, 1.0), white_sky(), 24);
     view.lights.clear();
     for (name, psi, k) in [("switch", 0.0f32, 0.0f32), ("stochastic", 0.0, 20.0)] {
         let p = PathTraceParams {
@@ -481,15 +461,9 @@ fn white_furnace_with_the_bsdf() {
 
 #[test]
 fn scattering_regions_and_attenuation() {
-    let mut r = renderer();
     let vol = volume([16, 16, 16], |x, _, _| x / 15.0);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([0.8, 0.7, 0.6], 0.2, 0.6, 1.0),
-        Some(Environment::constant([1.0; 3])),
-    );
-    let view = View::fit(vol.bounds(), 24, 24);
+    let tf = medium([0.8, 0.7, 0.6], 0.2, 0.6, 1.0);
+    let (mut r, view) = scene(&vol, tf, white_sky(), 24);
     let base = PathTraceParams {
         samples_per_frame: 16,
         ..Default::default()
@@ -541,15 +515,9 @@ fn scattering_regions_and_attenuation() {
 
 #[test]
 fn ray_budgets_share_primary_rays() {
-    let mut r = renderer();
     let vol = ball(16, 8.0);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([0.9, 0.8, 0.7], 0.0, 0.5, 1.0),
-        Some(Environment::constant([1.0; 3])),
-    );
-    let view = View::fit(vol.bounds(), 32, 32);
+    let tf = medium([0.9, 0.8, 0.7], 0.0, 0.5, 1.0);
+    let (mut r, view) = scene(&vol, tf, white_sky(), 32);
     let mut means = vec![];
     for (p, s) in [(64u32, 1u32), (8, 8), (1, 64)] {
         let params = PathTraceParams {
@@ -597,15 +565,9 @@ fn ray_budgets_share_primary_rays() {
 /// was.
 #[test]
 fn denoiser_lowers_the_error_and_keeps_the_accumulation() {
-    let mut r = renderer();
     let vol = ball(24, 11.0);
-    set_scene(
-        &mut r,
-        &vol,
-        medium([0.9, 0.7, 0.5], 0.0, 0.8, 1.0),
-        Some(Environment::constant([1.0; 3])),
-    );
-    let view = View::fit(vol.bounds(), 96, 96);
+    let tf = medium([0.9, 0.7, 0.5], 0.0, 0.8, 1.0);
+    let (mut r, view) = scene(&vol, tf, white_sky(), 96);
     let p = PathTraceParams {
         samples_per_frame: 64,
         seed: 3,

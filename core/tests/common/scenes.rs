@@ -1,6 +1,7 @@
 //! Test volumes, transfer functions and render settings.
 
 use ferrovol_core::*;
+use glam::DVec3;
 
 /// A single-component float volume with unit spacing, `f` evaluated at index coordinates.
 pub fn volume(dims: [u32; 3], f: impl Fn(f64, f64, f64) -> f64) -> VolumeData {
@@ -91,5 +92,13 @@ pub fn shaded() -> RenderParams {
             ..Shading::default()
         },
         ..RenderParams::default()
+    }
+}
+
+/// `base` with one clipping plane, through `origin`, keeping the side `normal` points to.
+pub fn with_clip_plane(base: RenderParams, origin: DVec3, normal: DVec3) -> RenderParams {
+    RenderParams {
+        clip_planes: vec![ClipPlane { origin, normal }],
+        ..base
     }
 }

@@ -6,7 +6,7 @@ use super::{iso, lit, params, sphere_view};
 use crate::common::gpu::{assert_error, renderer, set_bricked};
 use crate::common::images::save;
 use crate::common::raycast::trilinear;
-use crate::common::scenes::{radial, volume};
+use crate::common::scenes::{radial, volume, with_clip_plane};
 use ferrovol_core::*;
 use glam::DVec3;
 
@@ -376,13 +376,7 @@ fn depth_input_and_clipping_end_rays() {
     assert_eq!(hidden, 0);
     assert_eq!(kept, hits);
     // a clipping plane through the centre keeps x ≥ 23.5: every hit on the kept side
-    let p = RenderParams {
-        clip_planes: vec![ClipPlane {
-            origin: DVec3::splat(23.5),
-            normal: DVec3::X,
-        }],
-        ..params()
-    };
+    let p = with_clip_plane(params(), DVec3::splat(23.5), DVec3::X);
     // the frame's first hits: how many, and their smallest coordinate `axis`
     let first_hits = |r: &mut Renderer, p: &RenderParams, axis: usize| {
         r.render_image(&view, p).unwrap();

@@ -6,7 +6,9 @@ use crate::common::gpu::renderer;
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, footprint, image_diff, rgba};
 use crate::common::raycast::to_pixel;
-use crate::common::scenes::{blob_volume, component_transfer, shaded, volume, white};
+use crate::common::scenes::{
+    blob_volume, component_transfer, shaded, volume, white, with_clip_plane,
+};
 use crate::{box_corners, mask_extents, projected_extents};
 use ferrovol_core::*;
 use glam::DVec3;
@@ -517,19 +519,9 @@ fn blend_modes_cropping_clipping() {
     assert!(worst <= 1.0, "cropped extents {got:?} vs {expect:?}");
 
     // a clipping plane through the centre, normal +x, keeps the right half
-    let clip = ClipPlane {
-        origin: DVec3::new(0.5 * (b[0] + b[1]), 0.0, 0.0),
-        normal: DVec3::X,
-    };
-    let clipped = r
-        .render_image(
-            &view,
-            &RenderParams {
-                clip_planes: vec![clip],
-                ..RenderParams::default()
-            },
-        )
-        .unwrap();
+    let centre = DVec3::new(0.5 * (b[0] + b[1]), 0.0, 0.0);
+    let clip = with_clip_plane(RenderParams::default(), centre, DVec3::X);
+    let clipped = r.render_image(&view, &clip).unwrap();
     save_enlarged(&clipped, "clipped_half");
     let fp_clip = footprint(&clipped);
     let ratio = fp_clip as f64 / fp_composite as f64;

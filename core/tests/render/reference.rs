@@ -7,7 +7,7 @@ use crate::common::metrics::{
     alpha, compare_to_reference, footprint, image_diff, pixels_off_by_more, reference_image,
 };
 use crate::common::raycast::{self, pixel_ray};
-use crate::common::scenes::{blob_transfer, blob_volume, shaded};
+use crate::common::scenes::{blob_transfer, blob_volume, shaded, with_clip_plane};
 use ferrovol_core::*;
 use glam::DVec3;
 
@@ -152,19 +152,8 @@ fn depth_input_terminates_rays() {
     r.render(&view, &params, Some(&depth_in)).unwrap();
     let cut = r.read_image().unwrap();
     // the same cut made by a clipping plane keeping z ≥ zc (the half facing the camera)
-    let clip = ClipPlane {
-        origin: DVec3::new(0.0, 0.0, zc),
-        normal: DVec3::Z,
-    };
-    let clipped = r
-        .render_image(
-            &view,
-            &RenderParams {
-                clip_planes: vec![clip],
-                ..shaded()
-            },
-        )
-        .unwrap();
+    let clip = with_clip_plane(shaded(), DVec3::new(0.0, 0.0, zc), DVec3::Z);
+    let clipped = r.render_image(&view, &clip).unwrap();
     save_enlarged(&full, "depth_full");
     save_enlarged(&cut, "depth_cut");
     let sum = |img: &Image| img.rgba.chunks(4).map(|p| p[3] as u64).sum::<u64>();
