@@ -288,32 +288,6 @@ typedef struct FvAdapterInfo {
 } FvAdapterInfo;
 
 /**
- * A volume's geometry and scalar layout. Point (i, j, k) sits at
- * origin + direction · (spacing ⊙ (i, j, k)), as vtkImageData places it.
- * Thread use: plain data.
- */
-typedef struct FvVolumeDesc {
-  /**
-   * Points along x, y, z (each ≥ 1).
-   */
-  uint32_t dims[3];
-  /**
-   * Components per point, 1–4, interleaved.
-   */
-  uint32_t components;
-  /**
-   * One of FvScalarType.
-   */
-  uint32_t scalar_type;
-  double spacing[3];
-  double origin[3];
-  /**
-   * Row-major 3×3 direction matrix (vtkImageData::GetDirectionMatrix).
-   */
-  double direction[9];
-} FvVolumeDesc;
-
-/**
  * A VTK camera. Matrices are column-major (OpenGL order: element (row r, column c) at
  * index 4·c + r). Thread use: plain data.
  */
@@ -679,6 +653,32 @@ typedef struct FvStats {
   uint32_t bricks;
 } FvStats;
 
+/**
+ * A volume's geometry and scalar layout. Point (i, j, k) sits at
+ * origin + direction · (spacing ⊙ (i, j, k)), as vtkImageData places it.
+ * Thread use: plain data.
+ */
+typedef struct FvVolumeDesc {
+  /**
+   * Points along x, y, z (each ≥ 1).
+   */
+  uint32_t dims[3];
+  /**
+   * Components per point, 1–4, interleaved.
+   */
+  uint32_t components;
+  /**
+   * One of FvScalarType.
+   */
+  uint32_t scalar_type;
+  double spacing[3];
+  double origin[3];
+  /**
+   * Row-major 3×3 direction matrix (vtkImageData::GetDirectionMatrix).
+   */
+  double direction[9];
+} FvVolumeDesc;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -725,74 +725,38 @@ enum FvStatus fv_context_uuids(const struct FvContext *ctx,
 bool fv_context_can_share(const struct FvContext *ctx);
 
 /**
- * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
- * `desc->scalar_type`, components interleaved, x fastest; `data_bytes` is its size in
- * bytes (checked). Scalars are validated (NaN/Inf refused, spacing > 0, direction
- * invertible). `*out` receives the volume, NULL on failure.
+ * Waits for the last frame and copies it to the CPU. `*out` receives the frame.
  */
-enum FvStatus fv_volume_new(const struct FvVolumeDesc *desc,
-                            const void *data,
-                            size_t data_bytes,
-                            struct FvVolume **out);
+enum FvStatus fv_renderer_read_frame(const struct FvRenderer *renderer, struct FvFrame **out);
 
 /**
- * Releases a volume (NULL is ignored). Renderers keep what they uploaded.
+ * Releases a frame (NULL is ignored).
  */
-void fv_volume_free(struct FvVolume *volume);
+void fv_frame_free(struct FvFrame *frame);
 
 /**
- * Minimum and maximum of one component into `range[0..2]`.
+ * Width and height of a frame (0 × 0 for NULL).
  */
-enum FvStatus fv_volume_range(const struct FvVolume *volume,
-                              uint32_t component,
-                              double (*range)[2]);
+void fv_frame_size(const struct FvFrame *frame, uint32_t *width, uint32_t *height);
 
 /**
- * A transfer function for `components` (1–4) components; `independent` is
- * vtkVolumeProperty::IndependentComponents (with dependent components, give one
- * component's functions). `*out` receives it, NULL on failure.
+ * Premultiplied RGBA8 pixels, width·height·4 bytes, rows top to bottom; valid until the
+ * frame is freed (NULL for a NULL frame).
  */
-enum FvStatus fv_transfer_function_new(uint32_t components,
-                                       bool independent,
-                                       struct FvTransferFunction **out);
+const uint8_t *fv_frame_rgba(const struct FvFrame *frame);
 
 /**
- * Releases a transfer function (NULL is ignored).
+ * Window depth per pixel (1 where the volume is transparent), width·height floats, rows top
+ * to bottom; valid until the frame is freed (NULL for a NULL frame).
  */
-void fv_transfer_function_free(struct FvTransferFunction *tf);
+const float *fv_frame_depth(const struct FvFrame *frame);
 
 /**
- * Colour points of one component: `count` quadruples (x, r, g, b), x increasing.
+ * Writes the frame over an opaque `background` (RGB in [0, 1]) as a PNG at `path` (UTF-8).
  */
-enum FvStatus fv_transfer_function_set_color(struct FvTransferFunction *tf,
-                                             uint32_t component,
-                                             const double *xrgb,
-                                             size_t count);
-
-/**
- * Scalar opacity points of one component: `count` pairs (x, opacity), x increasing.
- */
-enum FvStatus fv_transfer_function_set_opacity(struct FvTransferFunction *tf,
-                                               uint32_t component,
-                                               const double *xa,
-                                               size_t count);
-
-/**
- * Gradient-magnitude opacity points of one component: `count` pairs (|∇s| in scalar units
- * per world unit, opacity multiplier); count = 0 turns gradient opacity off.
- */
-enum FvStatus fv_transfer_function_set_gradient_opacity(struct FvTransferFunction *tf,
-                                                        uint32_t component,
-                                                        const double *xa,
-                                                        size_t count);
-
-/**
- * ScalarOpacityUnitDistance (> 0) and the component weight (≥ 0) of one component.
- */
-enum FvStatus fv_transfer_function_set_unit_distance(struct FvTransferFunction *tf,
-                                                     uint32_t component,
-                                                     double unit_distance,
-                                                     double weight);
+enum FvStatus fv_frame_write_png(const struct FvFrame *frame,
+                                 const char *path,
+                                 const float (*background)[3]);
 
 /**
  * A renderer on `ctx` (which may be freed afterwards). `*out` receives it.
@@ -959,40 +923,6 @@ enum FvStatus fv_renderer_finish(const struct FvRenderer *renderer);
 enum FvStatus fv_renderer_stats(const struct FvRenderer *renderer, struct FvStats *stats);
 
 /**
- * Waits for the last frame and copies it to the CPU. `*out` receives the frame.
- */
-enum FvStatus fv_renderer_read_frame(const struct FvRenderer *renderer, struct FvFrame **out);
-
-/**
- * Releases a frame (NULL is ignored).
- */
-void fv_frame_free(struct FvFrame *frame);
-
-/**
- * Width and height of a frame (0 × 0 for NULL).
- */
-void fv_frame_size(const struct FvFrame *frame, uint32_t *width, uint32_t *height);
-
-/**
- * Premultiplied RGBA8 pixels, width·height·4 bytes, rows top to bottom; valid until the
- * frame is freed (NULL for a NULL frame).
- */
-const uint8_t *fv_frame_rgba(const struct FvFrame *frame);
-
-/**
- * Window depth per pixel (1 where the volume is transparent), width·height floats, rows top
- * to bottom; valid until the frame is freed (NULL for a NULL frame).
- */
-const float *fv_frame_depth(const struct FvFrame *frame);
-
-/**
- * Writes the frame over an opaque `background` (RGB in [0, 1]) as a PNG at `path` (UTF-8).
- */
-enum FvStatus fv_frame_write_png(const struct FvFrame *frame,
-                                 const char *path,
-                                 const float (*background)[3]);
-
-/**
  * The message of the most recent call on this thread that did not return
  * FV_STATUS_OK ("" if there was none). The pointer stays valid until the next failing
  * ferrovol call on this thread.
@@ -1004,6 +934,76 @@ const char *fv_last_error(void);
  * that is not an FvStatus; never NULL. Takes an integer so that any value is safe to pass.
  */
 const char *fv_status_name(int32_t status);
+
+/**
+ * A transfer function for `components` (1–4) components; `independent` is
+ * vtkVolumeProperty::IndependentComponents (with dependent components, give one
+ * component's functions). `*out` receives it, NULL on failure.
+ */
+enum FvStatus fv_transfer_function_new(uint32_t components,
+                                       bool independent,
+                                       struct FvTransferFunction **out);
+
+/**
+ * Releases a transfer function (NULL is ignored).
+ */
+void fv_transfer_function_free(struct FvTransferFunction *tf);
+
+/**
+ * Colour points of one component: `count` quadruples (x, r, g, b), x increasing.
+ */
+enum FvStatus fv_transfer_function_set_color(struct FvTransferFunction *tf,
+                                             uint32_t component,
+                                             const double *xrgb,
+                                             size_t count);
+
+/**
+ * Scalar opacity points of one component: `count` pairs (x, opacity), x increasing.
+ */
+enum FvStatus fv_transfer_function_set_opacity(struct FvTransferFunction *tf,
+                                               uint32_t component,
+                                               const double *xa,
+                                               size_t count);
+
+/**
+ * Gradient-magnitude opacity points of one component: `count` pairs (|∇s| in scalar units
+ * per world unit, opacity multiplier); count = 0 turns gradient opacity off.
+ */
+enum FvStatus fv_transfer_function_set_gradient_opacity(struct FvTransferFunction *tf,
+                                                        uint32_t component,
+                                                        const double *xa,
+                                                        size_t count);
+
+/**
+ * ScalarOpacityUnitDistance (> 0) and the component weight (≥ 0) of one component.
+ */
+enum FvStatus fv_transfer_function_set_unit_distance(struct FvTransferFunction *tf,
+                                                     uint32_t component,
+                                                     double unit_distance,
+                                                     double weight);
+
+/**
+ * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
+ * `desc->scalar_type`, components interleaved, x fastest; `data_bytes` is its size in
+ * bytes (checked). Scalars are validated (NaN/Inf refused, spacing > 0, direction
+ * invertible). `*out` receives the volume, NULL on failure.
+ */
+enum FvStatus fv_volume_new(const struct FvVolumeDesc *desc,
+                            const void *data,
+                            size_t data_bytes,
+                            struct FvVolume **out);
+
+/**
+ * Releases a volume (NULL is ignored). Renderers keep what they uploaded.
+ */
+void fv_volume_free(struct FvVolume *volume);
+
+/**
+ * Minimum and maximum of one component into `range[0..2]`.
+ */
+enum FvStatus fv_volume_range(const struct FvVolume *volume,
+                              uint32_t component,
+                              double (*range)[2]);
 
 #ifdef __cplusplus
 }  // extern "C"

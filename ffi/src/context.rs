@@ -1,0 +1,108 @@
+//! The context: a GPU adapter and device (FvContext).
+
+use super::*;
+
+/// A GPU adapter and device. Create one per process (or per host graphics context) and
+/// share it between renderers. Thread use: may be used from any thread; calls on one
+/// context may run concurrently (the device is internally synchronised).
+pub struct FvContext {
+    pub(crate) ctx: Context,
+}
+
+/// What a context runs on. Strings are NUL-terminated and truncated to fit.
+/// Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct FvAdapterInfo {
+    pub name: [c_char; 256],
+    /// "Vulkan", "Gl", …
+    pub backend: [c_char; 32],
+    pub driver: [c_char; 256],
+    /// True for a CPU device such as Mesa's lavapipe.
+    pub is_cpu: bool,
+    pub max_texture_dimension_3d: u32,
+    pub max_texture_dimension_2d: u32,
+    pub max_buffer_size: u64,
+}
+
+fn copy_str<const N: usize>(dst: &mut [c_char; N], s: &str) {
+    let bytes = s.as_bytes();
+    let n = bytes.len().min(N - 1);
+    for (d, &b) in dst.iter_mut().zip(&bytes[..n]) {
+        *d = b as c_char;
+    }
+    dst[n] = 0;
+}
+
+/// Opens a GPU device (hardware first, Mesa's lavapipe otherwise; FERROVOL_ADAPTER and
+/// FERROVOL_BACKEND override the choice). `*out` receives the context, NULL on failure.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_new(out: *mut *mut FvContext) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        let ctx = Context::new()?;
+        *slot = Box::into_raw(Box::new(FvContext { ctx }));
+        Ok(())
+    })
+}
+
+/// Releases a context (NULL is ignored). Renderers created from it keep the device alive.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_free(ctx: *mut FvContext) {
+    guard_value((), || free_handle(ctx))
+}
+
+/// Fills `*info` with the adapter's name, backend, driver and limits.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_info(
+    ctx: *const FvContext,
+    info: *mut FvAdapterInfo,
+) -> FvStatus {
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        let out = mut_ref(info, "info")?;
+        let i = &c.ctx.info;
+        copy_str(&mut out.name, &i.name);
+        copy_str(&mut out.backend, &i.backend);
+        copy_str(&mut out.driver, &format!("{} {}", i.driver, i.driver_info));
+        out.is_cpu = i.device_type == "Cpu";
+        out.max_texture_dimension_3d = i.limits.max_texture_dimension_3d;
+        out.max_texture_dimension_2d = i.limits.max_texture_dimension_2d;
+        out.max_buffer_size = i.limits.max_buffer_size;
+        Ok(())
+    })
+}
+
+/// The Vulkan device and driver UUIDs of the context (16 bytes each), to compare with
+/// OpenGL's GL_DEVICE_UUID_EXT and GL_DRIVER_UUID_EXT before importing shared images.
+/// FV_STATUS_UNSUPPORTED where the device cannot tell (not Vulkan).
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_uuids(
+    ctx: *const FvContext,
+    device_uuid: *mut [u8; 16],
+    driver_uuid: *mut [u8; 16],
+) -> FvStatus {
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        let dev = mut_ref(device_uuid, "device_uuid")?;
+        let drv = mut_ref(driver_uuid, "driver_uuid")?;
+        let u = c.ctx.device_uuids()?;
+        *dev = u.device;
+        *drv = u.driver;
+        Ok(())
+    })
+}
+
+/// Whether renderers on this context can use FV_OUTPUT_PATH_SHARED (false with the reason
+/// in fv_last_error() when not).
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_can_share(ctx: *const FvContext) -> bool {
+    let mut can = false;
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        c.ctx.external_memory_support()?;
+        can = true;
+        Ok(())
+    });
+    can
+}

@@ -1,0 +1,213 @@
+//! Transfer functions: colour, opacity and gradient opacity per component.
+
+use super::*;
+
+#[derive(Clone, Default)]
+struct PartialComponent {
+    color: Option<Piecewise<3>>,
+    opacity: Option<Piecewise<1>>,
+    gradient_opacity: Option<Piecewise<1>>,
+    unit_distance: Option<f64>,
+    weight: Option<f32>,
+}
+
+/// Colour, scalar opacity and gradient opacity per component (vtkVolumeProperty's
+/// functions). Thread use: one thread at a time.
+pub struct FvTransferFunction {
+    components: Vec<PartialComponent>,
+    independent: bool,
+}
+
+impl FvTransferFunction {
+    fn component(&mut self, c: u32) -> FfiResult<&mut PartialComponent> {
+        let n = self.components.len();
+        self.components.get_mut(c as usize).ok_or_else(|| {
+            FfiError::invalid(format!(
+                "component {c}: this transfer function has {n} (0 to {})",
+                n - 1
+            ))
+        })
+    }
+}
+
+impl ToCore for FvTransferFunction {
+    type Core = TransferFunction;
+    fn to_core(&self) -> FfiResult<TransferFunction> {
+        let mut components = Vec::with_capacity(self.components.len());
+        for (i, c) in self.components.iter().enumerate() {
+            let (Some(color), Some(opacity)) = (&c.color, &c.opacity) else {
+                return Err(FfiError::invalid(format!(
+                    "component {i} needs both a colour and an opacity function (fv_transfer_function_set_color / _set_opacity)"
+                )));
+            };
+            let mut t = ComponentTransfer::new(color.clone(), opacity.clone());
+            t.gradient_opacity = c.gradient_opacity.clone();
+            t.unit_distance = c.unit_distance.unwrap_or(t.unit_distance);
+            t.weight = c.weight.unwrap_or(t.weight);
+            components.push(t);
+        }
+        Ok(TransferFunction {
+            components,
+            independent: self.independent,
+        })
+    }
+}
+
+fn points<const N: usize>(
+    what: &str,
+    p: *const f64,
+    count: usize,
+) -> FfiResult<Option<Piecewise<N>>> {
+    if count == 0 {
+        return Ok(None);
+    }
+    if p.is_null() {
+        return Err(FfiError::null(what));
+    }
+    // SAFETY: the caller guarantees `count` points of 1 + N doubles.
+    let flat = unsafe { std::slice::from_raw_parts(p, count * (N + 1)) };
+    let pts = flat
+        .chunks_exact(N + 1)
+        .map(|c| (c[0], std::array::from_fn(|i| c[i + 1] as f32)))
+        .collect();
+    Piecewise::new(pts)
+        .map(Some)
+        .map_err(|e| FfiError::invalid(format!("{what}: {e}")))
+}
+
+/// A transfer function for `components` (1–4) components; `independent` is
+/// vtkVolumeProperty::IndependentComponents (with dependent components, give one
+/// component's functions). `*out` receives it, NULL on failure.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_new(
+    components: u32,
+    independent: bool,
+    out: *mut *mut FvTransferFunction,
+) -> FvStatus {
+    guard(|| {
+        let slot = out_ptr(out, "out")?;
+        if !(1..=4).contains(&components) {
+            return Err(FfiError::invalid(format!(
+                "{components} components: a transfer function has 1 to 4"
+            )));
+        }
+        *slot = Box::into_raw(Box::new(FvTransferFunction {
+            components: vec![PartialComponent::default(); components as usize],
+            independent,
+        }));
+        Ok(())
+    })
+}
+
+/// Releases a transfer function (NULL is ignored).
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_free(tf: *mut FvTransferFunction) {
+    guard_value((), || free_handle(tf))
+}
+
+/// Replaces one of a component's piecewise functions (`field`) with `count` points of
+/// 1 + N doubles at `p`. `empty` is the refusal for count = 0, or None where no points
+/// turn the function off.
+fn set_component_points<const N: usize>(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    what: &str,
+    p: *const f64,
+    count: usize,
+    empty: Option<&str>,
+    field: fn(&mut PartialComponent) -> &mut Option<Piecewise<N>>,
+) -> FvStatus {
+    guard(|| {
+        let f = field(mut_ref(tf, "tf")?.component(component)?);
+        *f = points::<N>(what, p, count)?;
+        match empty {
+            Some(refusal) if f.is_none() => Err(FfiError::invalid(refusal)),
+            _ => Ok(()),
+        }
+    })
+}
+
+/// Colour points of one component: `count` quadruples (x, r, g, b), x increasing.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_color(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    xrgb: *const f64,
+    count: usize,
+) -> FvStatus {
+    set_component_points(
+        tf,
+        component,
+        "colour points",
+        xrgb,
+        count,
+        Some("a colour function needs at least one point"),
+        |c| &mut c.color,
+    )
+}
+
+/// Scalar opacity points of one component: `count` pairs (x, opacity), x increasing.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_opacity(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    xa: *const f64,
+    count: usize,
+) -> FvStatus {
+    set_component_points(
+        tf,
+        component,
+        "opacity points",
+        xa,
+        count,
+        Some("an opacity function needs at least one point"),
+        |c| &mut c.opacity,
+    )
+}
+
+/// Gradient-magnitude opacity points of one component: `count` pairs (|∇s| in scalar units
+/// per world unit, opacity multiplier); count = 0 turns gradient opacity off.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_gradient_opacity(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    xa: *const f64,
+    count: usize,
+) -> FvStatus {
+    set_component_points(
+        tf,
+        component,
+        "gradient opacity points",
+        xa,
+        count,
+        None,
+        |c| &mut c.gradient_opacity,
+    )
+}
+
+/// ScalarOpacityUnitDistance (> 0) and the component weight (≥ 0) of one component.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_unit_distance(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    unit_distance: f64,
+    weight: f64,
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        if !(unit_distance.is_finite() && unit_distance > 0.0) {
+            return Err(FfiError::invalid(format!(
+                "scalar opacity unit distance {unit_distance} must be positive"
+            )));
+        }
+        if !(weight.is_finite() && weight >= 0.0) {
+            return Err(FfiError::invalid(format!(
+                "component weight {weight} must be finite and non-negative"
+            )));
+        }
+        let c = t.component(component)?;
+        c.unit_distance = Some(unit_distance);
+        c.weight = Some(weight as f32);
+        Ok(())
+    })
+}
