@@ -99,7 +99,8 @@ struct RenderArgs {
     /// How far shadow rays reach, 0 to 1 (VTK's GlobalIlluminationReach).
     #[arg(long, default_value_t = 0.0)]
     reach: f32,
-    /// Transfer function: a preset name (see --help-presets) or a JSON file.
+    /// Transfer function: a preset name or a JSON file (the README gives the format); a
+    /// name that is neither lists the presets.
     #[arg(long)]
     tf: Option<String>,
     /// Camera rotation about the view up vector, degrees (vtkCamera::Azimuth).
