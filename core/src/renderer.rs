@@ -286,19 +286,11 @@ impl Renderer {
         };
         match params.blend {
             BlendMode::Isosurface => {
-                params.validate()?;
-                let iso = self.iso_params.as_ref().ok_or_else(|| {
-                    Error::InvalidParameter(
-                        "BlendMode::Isosurface needs iso-values: call Renderer::set_isosurface \
-                         first"
-                            .into(),
-                    )
-                })?;
                 let brick_bgl = &res.brick_bgl;
                 let pass = ensure(&mut self.iso, || {
                     Ok(Box::new(IsoPass::new(ctx, brick_bgl)?))
                 })?;
-                pass.render(input(res), iso)
+                pass.render(input(res), self.iso_params.as_ref())
             }
             BlendMode::PathTrace => {
                 let brick_bgl = &res.brick_bgl;

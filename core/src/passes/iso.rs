@@ -318,10 +318,17 @@ impl IsoPass {
         Ok(())
     }
 
-    /// One isosurface frame: first hit per brick in visibility order, then deferred shading.
-    pub fn render(&mut self, input: FrameInput<'_>, iso: &IsoParams) -> Result<()> {
+    /// One isosurface frame of the iso-values `iso` (an error without them): first hit per
+    /// brick in visibility order, then deferred shading.
+    pub fn render(&mut self, input: FrameInput<'_>, iso: Option<&IsoParams>) -> Result<()> {
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
+        let iso = iso.ok_or_else(|| {
+            Error::InvalidParameter(
+                "BlendMode::Isosurface needs iso-values: call Renderer::set_isosurface first"
+                    .into(),
+            )
+        })?;
         iso.validate()?;
         frame::check_light_count(view)?;
         res.volume()?;
