@@ -409,11 +409,11 @@ impl Resources {
 
     /// Builds the default environment (the procedural sky) unless one is set: isosurfaces
     /// and path tracing are lit by it.
-    pub fn ensure_environment(&mut self, ctx: &Context) -> Result<&GpuEnvironment> {
+    pub fn ensure_environment(&mut self, ctx: &Context) -> Result<()> {
         if self.environment.current.is_none() {
             self.set_environment(ctx, &Environment::default())?;
         }
-        self.current_environment()
+        Ok(())
     }
 
     /// The sampler the passes read the environment cubes with.
