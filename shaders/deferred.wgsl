@@ -178,7 +178,7 @@ fn scattered_light(x1: vec3<f32>, n1: vec3<f32>, c1: vec3<f32>, t_in: f32, px: v
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
-    brick = brick_ubo;
+    enter_volume();
     iso = iso_ubo;
     let r = iso.shade_rect;
     let px = gid.xy + r.xy;

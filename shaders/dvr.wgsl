@@ -1,10 +1,9 @@
-// Direct volume rendering: marches each pixel's ray through one brick and carries the
-// ray's state (colour, running max/min/sum, depth) to the next brick in visibility order.
-// Samples sit on one lattice per ray, whatever the bricking, so a bricked volume gives the
-// same samples as an unbricked one. The lattice is VTK 9.2's (tests/regression/SAMPLING.md):
-// t_k = t_entry + (k + 1)·Δ (k + jitter with jittering), the first sample taken even past
-// the exit, a sample on the exit face kept, and up to one step past opaque depth and
-// clipping planes.
+// Direct volume rendering: marches each pixel's ray through the volume, brick after brick
+// (lib/volume.wgsl), and writes the pixel. Samples sit on one lattice per ray, whatever the
+// bricking, so a bricked volume gives the same samples as an unbricked one. The lattice is
+// VTK 9.2's (tests/regression/SAMPLING.md): t_k = t_entry + (k + 1)·Δ (k + jitter with
+// jittering), the first sample taken even past the exit, a sample on the exit face kept,
+// and up to one step past opaque depth and clipping planes.
 #include "lib/common.wgsl"
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
@@ -22,13 +21,8 @@ override SHADE: bool = false;
 override GRAD_OPACITY: bool = false;
 override SKIP: bool = false;
 override CROP: bool = false;
-// One brick: the ray state starts empty here and the pass writes the output pixel itself
-// (no state buffer traffic, no resolve pass).
-override SINGLE_BRICK: bool = false;
-// Volumetric shadows (lib/shadow.wgsl; one component, one brick, shading on).
+// Volumetric shadows (lib/shadow.wgsl; one component, shading on).
 override VOLUMETRIC: bool = false;
-
-@group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
 
 // Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
 fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
@@ -135,7 +129,7 @@ fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
-    brick = brick_ubo;
+    enter_volume();
     // The dispatch covers only frame.rect, the pixels the volume's box can project to.
     let px = gid.xy + frame.rect.xy;
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
@@ -144,13 +138,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pix = px.y * frame.viewport.x + px.x;
     let blend = BLEND;
     var st: PixelState;
-    if (!SINGLE_BRICK) {
-        st = state[pix];
-    }
     let ert = frame.misc.y;
-    if (blend == BLEND_COMPOSITE && st.color.a >= ert) {
-        return;
-    }
     let ray = make_ray(px);
     // The whole ray segment inside the volume, near/far planes, opaque depth and clip planes.
     let dt = frame.misc.x;
@@ -185,25 +173,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             first_forced = true;
         }
     }
-    // This brick's part of it.
-    let b = box_interval(ray, brick.core_lo.xyz, brick.core_hi.xyz);
-    let t_lo = max(b.x, seg.x);
-    let t_hi = min(b.y, seg.y);
     // (written so that NaN from a degenerate ray also leaves)
-    if (!(t_lo < t_hi)) {
-        if (SINGLE_BRICK) {
-            write_pixel(px, st);
-        }
+    if (!(seg.x < seg.y)) {
+        write_pixel(px, st);
         return;
     }
-    var k = max(ceil((t_lo - seg.x) / dt - jit), 0.0);
-    // Bounded below 2^24 so that k + 1 is always exact and the loop always ends.
-    // Samples before t_hi; where this brick holds the segment's end, a sample exactly on it
-    // too (VTK keeps a sample on the exit face). Brick boundaries stay half-open, so a sample
-    // on one is taken once.
-    let k_last = (t_hi - seg.x) / dt - jit;
-    var k_end = min(select(ceil(k_last), floor(k_last) + 1.0, t_hi >= seg.y), 1.0e7);
-    if (first_forced && t_lo == seg.x) {
+    var k = 0.0;
+    // Bounded below 2^24 so that k + 1 is always exact and the loop always ends. Samples
+    // up to the segment's end, one exactly on it too (VTK keeps a sample on the exit face).
+    let k_last = (seg.y - seg.x) / dt - jit;
+    var k_end = min(floor(k_last) + 1.0, 1.0e7);
+    if (first_forced) {
         k_end = max(k_end, 1.0);
     }
     var color = st.color;
@@ -268,9 +248,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     st.color = color;
     st.value = value;
     st.misc = misc;
-    if (SINGLE_BRICK) {
-        write_pixel(px, st);
-    } else {
-        state[pix] = st;
-    }
+    write_pixel(px, st);
 }

@@ -1,4 +1,4 @@
-// First hit of the isosurfaces: marches each pixel's ray through one brick with the rays,
+// First hit of the isosurfaces: marches each pixel's ray through the volume with the rays,
 // segment (near/far planes, the host's depth, clipping planes), cropping, empty-space
 // skipping and sample lattice of the dvr pass; wherever the field crosses one of the
 // iso-values between two consecutive samples, the crossing is refined by interval
@@ -17,11 +17,9 @@
 // Pipeline constants (core/src/passes/iso.rs, FirstHitVariant).
 override SKIP: bool = false;
 override CROP: bool = false;
-// One brick: the pixel's state starts empty instead of being read back.
-override SINGLE_BRICK: bool = false;
 
-// Per pixel: color.x = layers written so far, color.y = their accumulated opacity. Carried
-// across brick passes; deferred.wgsl reads the layer count from it.
+// Per pixel: color.x = layers written, color.y = their accumulated opacity; deferred.wgsl
+// reads the layer count from it.
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
 // G-buffer, one array layer per surface layer:
 //   position  xyz world position of the hit, w iso index
@@ -39,31 +37,34 @@ fn point_at(ray: Ray, t: f32) -> vec3<f32> {
 }
 
 fn texel_scalar(c: vec3<i32>) -> f32 {
-    let tc = (vec3<f32>(c) + 0.5) * brick.tex_inv_size.xyz;
+    let tc = (vec3<f32>(c) + 0.5) * pool.inv_size.xyz;
     return textureSampleLevel(volume_tex, texel_sampler, tc, 0.0).x;
 }
 
-// Where p falls in the brick's texture: the cell's first texel (clamped so the cell lies
-// inside) and the fraction within it; outside the texture the nearest edge (as a clamping
-// sampler reads it).
+// Where p falls in its brick's slot of the pool: the cell's first texel (clamped so the
+// cell lies inside) and the fraction within it; outside the slot the nearest edge (as a
+// clamping sampler reads it).
 struct Cell {
     i0: vec3<i32>,
     f: vec3<f32>,
-    size: vec3<i32>,
+    lo: vec3<i32>,
+    hi: vec3<i32>,
 }
 
 fn cell_at(p: vec3<f32>) -> Cell {
     var c: Cell;
-    c.size = vec3<i32>(textureDimensions(volume_tex));
-    let q = clamp(p - brick.tex_lo.xyz, vec3<f32>(0.0), vec3<f32>(c.size - 1));
-    c.i0 = clamp(vec3<i32>(floor(q)), vec3<i32>(0), max(c.size - 2, vec3<i32>(0)));
-    c.f = q - vec3<f32>(c.i0);
+    let q = locate(p);
+    c.lo = vec3<i32>(brick.slot_lo);
+    c.hi = vec3<i32>(brick.slot_hi);
+    let t = clamp(q - brick.tex_lo, brick.slot_lo, brick.slot_hi);
+    c.i0 = clamp(vec3<i32>(floor(t)), c.lo, max(c.hi - 1, c.lo));
+    c.f = t - vec3<f32>(c.i0);
     return c;
 }
 
-// Texel (clamped to the texture) at offset o from the cell's first texel.
+// Texel (clamped to the slot) at offset o from the cell's first texel.
 fn cell_texel(c: Cell, o: vec3<i32>) -> f32 {
-    return texel_scalar(clamp(c.i0 + o, vec3<i32>(0), c.size - 1));
+    return texel_scalar(clamp(c.i0 + o, c.lo, c.hi));
 }
 
 // Component 0 at index-space point p, interpolated trilinearly in f32 from the texels
@@ -138,7 +139,7 @@ fn refine(ray: Ray, t0: f32, t1: f32, v: f32, below: bool) -> f32 {
 // Ambient accessibility at index-space point p with world normal n: the fraction of
 // iso.counts.w directions (Hammersley, uniform over the hemisphere around n) whose short
 // ray (iso.options.x steps over iso.ao.x world units) never reaches the other side of
-// iso-value v. A ray that leaves the data this brick holds counts as open.
+// iso-value v. A ray that leaves the volume counts as open.
 fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 {
     let count = iso.counts.w;
     if (count == 0u) {
@@ -146,8 +147,8 @@ fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 
     }
     let steps = max(iso.options.x, 1u);
     let frame_n = basis_around(n);
-    let lo = brick.tex_lo.xyz;
-    let hi = brick.tex_lo.xyz + vec3<f32>(textureDimensions(volume_tex)) - 1.0;
+    let lo = vec3<f32>(0.0);
+    let hi = frame.dims.xyz - 1.0;
     let step_len = iso.ao.x / f32(steps);
     var open = 0u;
     for (var i = 0u; i < count; i = i + 1u) {
@@ -193,7 +194,7 @@ fn write_hit(px: vec2<u32>, layer: u32, ray: Ray, t: f32, which: u32, below: boo
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
-    brick = brick_ubo;
+    enter_volume();
     iso = iso_ubo;
     let px = gid.xy + frame.rect.xy;
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
@@ -201,26 +202,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pix = px.y * frame.viewport.x + px.x;
     var st: PixelState;
-    if (!SINGLE_BRICK) {
-        st = state[pix];
-    }
-    var layers = u32(st.color.x);
-    var alpha = st.color.y;
+    var layers = 0u;
+    var alpha = 0.0;
     let max_layers = iso.counts.z;
     let ert = frame.misc.y;
-    if (layers >= max_layers || alpha >= ert) {
+    if (max_layers == 0u || ert <= 0.0) {
+        state[pix] = st;
         return;
     }
     let ray = make_ray(px);
     let seg = ray_segment(ray, px);
-    let b = box_interval(ray, brick.core_lo.xyz, brick.core_hi.xyz);
-    let t_lo = max(b.x, seg.x);
-    let t_hi = min(b.y, seg.y);
     // (written so that NaN from a degenerate ray also leaves)
-    if (!(t_lo < t_hi)) {
-        if (SINGLE_BRICK) {
-            state[pix] = st;
-        }
+    if (!(seg.x < seg.y)) {
+        state[pix] = st;
         return;
     }
     let dt = frame.misc.x;
@@ -228,16 +222,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (has_flag(FLAG_JITTER)) {
         jit = hash01(pix ^ frame.viewport.w);
     }
-    var k = max(ceil((t_lo - seg.x) / dt - jit), 0.0);
+    var k = 0.0;
     // Bounded below 2^24 so that k + 1 is always exact and the loop always ends.
-    let k_end = min(ceil((t_hi - seg.x) / dt - jit), 1.0e7);
-    // The brick holding the segment's end also samples the end itself, so a crossing
-    // between the last lattice sample and the end is found.
-    var tail = t_hi >= seg.y;
+    let k_end = min(ceil((seg.y - seg.x) / dt - jit), 1.0e7);
+    // The segment's end is sampled too, so a crossing between the last lattice sample and
+    // the end is found.
+    var tail = true;
     let n_iso = min(iso.counts.x, MAX_ISO);
     // The previous sample: a crossing lies between it and the current one. Taken afresh
-    // one lattice step back (or at the segment's start) at the ray's start in this brick
-    // and after every skip.
+    // one lattice step back (or at the segment's start) at the ray's start and after every
+    // skip.
     var have_prev = false;
     var t_prev = 0.0;
     var s_prev = 0.0;

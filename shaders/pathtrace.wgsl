@@ -424,7 +424,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
-    brick = brick_ubo;
+    enter_volume();
     pt = pt_ubo;
     let px = gid.xy + pt.rect.xy;
     if (px.x >= pt.rect.z || px.y >= pt.rect.w) {

@@ -66,7 +66,7 @@ impl Renderer {
 
     /// Number of bricks the current volume is split into (0 without a volume).
     pub fn brick_count(&self) -> usize {
-        self.res.volume.as_ref().map_or(0, |v| v.bricks.len())
+        self.res.volume.as_ref().map_or(0, |v| v.grid.len())
     }
 
     /// The texture format the current volume is stored in.

@@ -10,7 +10,7 @@ use ferrovol_core::*;
 use std::sync::MutexGuard;
 mod common;
 
-use common::gpu::{assert_error, pt_params, renderer, set_bricked, trace};
+use common::gpu::{assert_error, pt_params, renderer, trace};
 use common::images::save;
 use common::scenes::{ball, component_transfer, volume, white};
 
@@ -344,8 +344,6 @@ fn errors_say_what_is_wrong() {
     l.positional = true;
     lit.lights = vec![l];
     assert_error(r.render(&lit, &pt_params(), None), "", &["positional"]);
-    set_bricked(&mut r, &vol, 6);
-    assert_error(r.render(&view, &pt_params(), None), "", &["one brick"]);
 }
 
 #[test]

@@ -1,7 +1,6 @@
 // Turning a ray's final state into the output pixel: premultiplied RGBA and a window
 // depth. For the projection modes (maximum, minimum, average, additive) the transfer
-// function is applied here, once, to the value the ray found. Used by the resolve pass
-// (bricked volumes) and by the ray-casting pass itself when the volume is one brick.
+// function is applied here, once, to the value the ray found (shaders/dvr.wgsl).
 
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
 @group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;

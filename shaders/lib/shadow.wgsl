@@ -8,8 +8,7 @@
 // between the light's travel direction and the direction to the eye; it is mixed with the
 // gradient shading by a weight that grows with the blending where the gradient and the
 // opacity are small. Distances are measured in texture space (the volume's point box
-// mapped to the unit cube), as VTK's are. The volume is one brick (the host refuses more).
-// Needs lib/common.wgsl and lib/volume.wgsl.
+// mapped to the unit cube), as VTK's are. Needs lib/common.wgsl and lib/volume.wgsl.
 
 // The shadow and jitter offset of the current pixel (dvr.wgsl sets it: VTK reuses the
 // primary ray's jitter, 0 without jittering).

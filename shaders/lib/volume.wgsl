@@ -1,25 +1,72 @@
-// The volume as the ray-casting passes see it: one brick at a time (group 1), sampled in
-// index space and converted back to scalar units.
+// The volume as the ray-casting passes see it (group 1): bricks in slots of a pool texture
+// and a page table that maps each brick to its slot, sampled in index space and converted
+// back to scalar units. A sample first makes the brick holding it current (`locate`): the
+// page table is read when a ray enters a brick, not at every sample. A volume of one brick
+// (SINGLE_BRICK) is its own texture and is sampled directly.
 
-struct Brick {
-    // index-space box this pass marches through (the brick's own cells)
-    core_lo: vec4<f32>,
-    core_hi: vec4<f32>,
-    // first point index held by the texture, and 1 / the texture's size in points; the
-    // texture extends past the core by an overlap so interpolation and gradients see no seam
-    tex_lo: vec4<f32>,
-    tex_inv_size: vec4<f32>,
+struct Pool {
+    brick: vec4<f32>,     // x: cells per brick edge, y: apron points around a brick's core
+    grid: vec4<u32>,      // bricks per axis
+    slot: vec4<f32>,      // points per slot, per axis
+    inv_size: vec4<f32>,  // 1 / the pool texture's size in points, per axis
 }
 
-@group(1) @binding(0) var<uniform> brick_ubo: Brick;
-// A private copy filled by each entry point (`brick = brick_ubo;`), as lib/common.wgsl's
-// `frame`.
-var<private> brick: Brick;
+@group(1) @binding(0) var<uniform> pool_ubo: Pool;
+// A private copy filled by each entry point (`enter_volume`), as lib/common.wgsl's `frame`.
+var<private> pool: Pool;
 @group(1) @binding(1) var volume_tex: texture_3d<f32>;
 @group(1) @binding(2) var volume_sampler: sampler;
-// The first component's central differences per texel (shaders/gradient.wgsl), where the
-// upload made them (PRECOMPUTED_GRADIENT); otherwise the volume texture again, unused.
+// The first component's central differences per texel of the pool (shaders/gradient.wgsl),
+// where the upload made them (PRECOMPUTED_GRADIENT); otherwise the pool again, unused.
 @group(1) @binding(3) var gradient_tex: texture_3d<f32>;
+// Per brick: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest).
+@group(1) @binding(4) var page_table: texture_3d<u32>;
+
+// The volume is one brick, its texture the pool: no page-table lookups (a pipeline
+// constant each pass sets from the volume).
+override SINGLE_BRICK: bool = true;
+
+// The current brick.
+struct Brick {
+    core_lo: vec3<f32>,   // index-space box of the brick's own cells
+    core_hi: vec3<f32>,
+    tex_lo: vec3<f32>,    // index-space point at the pool's texel 0 (p − tex_lo: pool texels)
+    slot_lo: vec3<f32>,   // the brick's slot: first and last texel in the pool
+    slot_hi: vec3<f32>,
+}
+
+var<private> brick: Brick;
+
+fn enter_brick(cell: vec3<u32>) {
+    let e = textureLoad(page_table, vec3<i32>(cell), 0).x;
+    let m = (1u << PAGE_SLOT_BITS) - 1u;
+    let s = vec3<u32>(e & m, (e >> PAGE_SLOT_BITS) & m, e >> (2u * PAGE_SLOT_BITS));
+    let slot = vec3<f32>(s) * pool.slot.xyz;
+    brick.core_lo = vec3<f32>(cell) * pool.brick.x;
+    brick.core_hi = min(brick.core_lo + pool.brick.x, frame.dims.xyz - 1.0);
+    brick.tex_lo = brick.core_lo - pool.brick.y - slot;
+    brick.slot_lo = slot;
+    brick.slot_hi = slot + pool.slot.xyz - 1.0;
+}
+
+// Called by each entry point after `frame = frame_ubo;`.
+fn enter_volume() {
+    pool = pool_ubo;
+    enter_brick(vec3<u32>(0u));
+}
+
+// Index-space point p clamped to the volume (as a clamping sampler reads a point outside),
+// with the brick holding it made current.
+fn locate(p: vec3<f32>) -> vec3<f32> {
+    if (SINGLE_BRICK) {
+        return p;
+    }
+    let q = clamp(p, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    if (any(q < brick.core_lo) || any(q > brick.core_hi)) {
+        enter_brick(min(vec3<u32>(q / pool.brick.x), pool.grid.xyz - 1u));
+    }
+    return q;
+}
 
 // Read gradients from gradient_tex (one fetch) instead of six volume fetches: the same
 // values (a pipeline constant; single-component volumes only).
@@ -31,7 +78,7 @@ override FORWARD_DIFF: bool = false;
 
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
-    let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
+    let tc = (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
     return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
 }
 
@@ -55,7 +102,7 @@ struct Gradient {
 // differences from the centre value s (3 samples).
 fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
     // neighbours one voxel away, offset directly in texture coordinates
-    let tc = (p - brick.tex_lo.xyz + 0.5) * brick.tex_inv_size.xyz;
+    let tc = (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
     if (PRECOMPUTED_GRADIENT && !FORWARD_DIFF) {
         let d = textureSampleLevel(gradient_tex, volume_sampler, tc, 0.0).xyz;
         var g: Gradient;
@@ -64,9 +111,9 @@ fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
         g.z = vec4<f32>(d.z, 0.0, 0.0, 0.0);
         return g;
     }
-    let dx = vec3<f32>(brick.tex_inv_size.x, 0.0, 0.0);
-    let dy = vec3<f32>(0.0, brick.tex_inv_size.y, 0.0);
-    let dz = vec3<f32>(0.0, 0.0, brick.tex_inv_size.z);
+    let dx = vec3<f32>(pool.inv_size.x, 0.0, 0.0);
+    let dy = vec3<f32>(0.0, pool.inv_size.y, 0.0);
+    let dz = vec3<f32>(0.0, 0.0, pool.inv_size.z);
     var g: Gradient;
     if (FORWARD_DIFF) {
         g.x = scalars_at(tc + dx) - s;

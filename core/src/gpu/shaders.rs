@@ -55,10 +55,6 @@ pub const FILES: &[(&str, &str)] = &[
     ),
     ("dvr.wgsl", include_str!("../../../shaders/dvr.wgsl")),
     (
-        "resolve.wgsl",
-        include_str!("../../../shaders/resolve.wgsl"),
-    ),
-    (
         "firsthit.wgsl",
         include_str!("../../../shaders/firsthit.wgsl"),
     ),
@@ -91,7 +87,6 @@ pub const FILES: &[(&str, &str)] = &[
 /// The passes (entry files, not library pieces).
 pub const PASSES: &[&str] = &[
     "dvr.wgsl",
-    "resolve.wgsl",
     "firsthit.wgsl",
     "deferred.wgsl",
     "environment.wgsl",

@@ -42,17 +42,56 @@ pub(crate) fn upload_texture(
     bytes: &[u8],
     texel_bytes: u32,
 ) {
-    let size = texture.size();
-    queue.write_texture(
-        texture.as_image_copy(),
-        bytes,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(size.width * texel_bytes),
-            rows_per_image: Some(size.height),
-        },
-        size,
-    );
+    let s = texture.size();
+    let size = [s.width, s.height, s.depth_or_array_layers];
+    upload_region(queue, texture, [0; 3], size, bytes, texel_bytes);
+}
+
+/// Most bytes one texture write stages: larger regions go in slabs of whole images.
+const MAX_WRITE_BYTES: usize = 64 << 20;
+
+/// Writes tightly packed texels (`texel_bytes` each, rows then images) over the box of
+/// `size` texels at `origin` in `texture`'s first mip level.
+pub(crate) fn upload_region(
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    origin: [u32; 3],
+    size: [u32; 3],
+    bytes: &[u8],
+    texel_bytes: u32,
+) {
+    let row = size[0] * texel_bytes;
+    let image = row as usize * size[1] as usize;
+    let slab = (MAX_WRITE_BYTES / image.max(1)).clamp(1, size[2].max(1) as usize) as u32;
+    let mut z = 0;
+    while z < size[2] {
+        let n = slab.min(size[2] - z);
+        let at = z as usize * image;
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: origin[0],
+                    y: origin[1],
+                    z: origin[2] + z,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &bytes[at..at + n as usize * image],
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(size[1]),
+            },
+            wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: n,
+            },
+        );
+        z += n;
+    }
 }
 
 /// The value types of [`block_grid`] textures.

@@ -49,11 +49,11 @@ pub struct FrameUniforms {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct BrickUniforms {
-    pub core_lo: [f32; 4],
-    pub core_hi: [f32; 4],
-    pub tex_lo: [f32; 4],
-    pub tex_inv_size: [f32; 4],
+pub struct PoolUniforms {
+    pub brick: [f32; 4],
+    pub grid: [u32; 4],
+    pub slot: [f32; 4],
+    pub inv_size: [f32; 4],
 }
 
 /// Per-pixel ray state (PixelState in WGSL), 48 bytes.
@@ -151,6 +151,9 @@ pub const FLAG_INDEPENDENT: u32 = 64;
 pub const FLAG_DEPTH_INPUT: u32 = 128;
 pub const FLAG_AVERAGE_RANGE: u32 = 1024;
 
+/// Bits per axis of a page-table entry's slot position (lib/volume.wgsl).
+pub const PAGE_SLOT_BITS: u32 = 10;
+
 /// Most lights and clipping planes a frame takes (the sizes of Frame's arrays).
 pub const MAX_LIGHTS: usize = 8;
 pub const MAX_CLIP_PLANES: usize = 6;
@@ -213,6 +216,7 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("FLAG_DEPTH_INPUT", Wgsl::U32(FLAG_DEPTH_INPUT)),
     ("FLAG_AVERAGE_RANGE", Wgsl::U32(FLAG_AVERAGE_RANGE)),
     ("MAX_LIGHTS", Wgsl::U32(MAX_LIGHTS as u32)),
+    ("PAGE_SLOT_BITS", Wgsl::U32(PAGE_SLOT_BITS)),
     ("MAX_CLIP", Wgsl::U32(MAX_CLIP_PLANES as u32)),
     ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
     ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),
@@ -336,12 +340,7 @@ mod layout_tests {
             GpuLight,
             [position, spot, diffuse, specular, ambient, attenuation]
         );
-        check!(
-            m,
-            "Brick",
-            BrickUniforms,
-            [core_lo, core_hi, tex_lo, tex_inv_size]
-        );
+        check!(m, "Pool", PoolUniforms, [brick, grid, slot, inv_size]);
     }
 
     #[test]

@@ -159,7 +159,7 @@ pub enum IsoScatterMode {
 /// scatters there (Lambertian, albedo the inner surface's colour), and leaves toward the
 /// environment; the result and the first surface's own shading are blended by Schlick's
 /// Fresnel term, and the first surface is opaque. Lit by the environment (weight
-/// [`IsoParams::environment_light`]); the volume must fit in one brick.
+/// [`IsoParams::environment_light`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IsoScattering {
     pub mode: IsoScatterMode,

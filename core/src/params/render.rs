@@ -74,7 +74,7 @@ pub struct Shading {
     /// Volumetric shadows (single scattering) blended with the gradient shading, VTK 9.2's
     /// vtkGPUVolumeRayCastMapper::VolumetricScatteringBlending: 0 off, up to 1 the
     /// volumetric share grows where the gradient is weak, 2 volumetric only. Composite
-    /// blend mode with shading and at least one light; one brick, one component.
+    /// blend mode with shading and at least one light; one-component volumes.
     pub volumetric_blending: f32,
     /// How far shadow rays reach, 0 (about one step) to 1 (across the whole volume), as
     /// vtkGPUVolumeRayCastMapper::GlobalIlluminationReach.

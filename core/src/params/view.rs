@@ -33,9 +33,12 @@ impl View {
 /// Options for uploading a volume.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct UploadOptions {
-    /// Largest brick edge in points (overlap included); `None` = the device limit.
+    /// Largest brick edge in points (apron included); `None` = the device's 3D texture
+    /// limit. A volume larger than this along some axis is cut into bricks stored in a
+    /// pool texture that every pass samples through a page table.
     pub max_brick_points: Option<u32>,
-    /// Largest brick texture in bytes; `None` = the device's buffer limit, at most 1 GiB.
+    /// Largest volume texture (one brick or the brick pool) in bytes; `None` = the
+    /// device's buffer limit.
     pub max_brick_bytes: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same

@@ -1,14 +1,13 @@
 //! Ray casting (shaders/dvr.wgsl) in the blend modes of VTK's mappers (composite with early
-//! ray termination, maximum, minimum, average, additive), one dispatch per brick in
-//! visibility order; with several bricks a resolve pass (shaders/resolve.wgsl) turns the
-//! per-pixel ray state into the output images.
+//! ray termination, maximum, minimum, average, additive): one dispatch, each ray marching
+//! through the bricks it crosses.
 
-use super::frame::{self, brick_order, groups, FrameInput, SKIP_MAX_OCCUPANCY};
+use super::frame::{self, groups, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::Result;
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
-use crate::gpu::pipeline::{pipeline_variant, single_group_pipeline, PipelineCache};
+use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation};
 use crate::resources::targets::{clear_outputs, DepthSource};
@@ -33,20 +32,16 @@ pipeline_variant! {
     }
 }
 
-/// The ray-casting pass: its pipelines (one per variant) and the resolve pass.
+/// The ray-casting pass: its pipelines (one per variant).
 pub(crate) struct DvrPass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<DvrVariant>,
-    resolve_bgl: wgpu::BindGroupLayout,
-    resolve: wgpu::ComputePipeline,
 }
 
 impl DvrPass {
     pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
-        let color_out = storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2);
-        let depth_out = storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2);
         let bgl = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -54,32 +49,14 @@ impl DvrPass {
                 entries: &[
                     buffer_entry(0, B::Uniform),
                     texture_entry(1, false, V::D2),
-                    buffer_entry(2, B::Storage { read_only: false }),
                     sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(4, false, V::D2),
-                    color_out,
-                    depth_out,
+                    storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+                    storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
-        let (resolve_bgl, resolve) = single_group_pipeline(
-            ctx,
-            "resolve.wgsl",
-            "resolve",
-            &[
-                buffer_entry(0, B::Uniform),
-                texture_entry(1, false, V::D2),
-                buffer_entry(2, B::Storage { read_only: true }),
-                color_out,
-                depth_out,
-            ],
-        )?;
-        Ok(DvrPass {
-            bgl,
-            pipelines,
-            resolve_bgl,
-            resolve,
-        })
+        Ok(DvrPass { bgl, pipelines })
     }
 
     /// One ray-cast frame.
@@ -110,7 +87,7 @@ impl DvrPass {
             skip,
             crop: params.cropping.is_some(),
             nearest: params.interpolation == Interpolation::Nearest,
-            single_brick: vol.bricks.len() == 1,
+            single_brick: vol.single_brick(),
             positional_lights: f.positional_lights(),
             lights: f.lights(),
             volumetric: f.volumetric,
@@ -118,7 +95,6 @@ impl DvrPass {
             forward_diff: params.gradient == GradientMethod::Forward,
         };
         let dvr = self.pipelines.get(ctx, variant)?;
-        let order = brick_order(res, view, params);
         let t = res.targets.as_ref().expect("targets allocated above");
         let (_, tables) = res.tables.as_ref().expect("tables built above");
         let occupancy = &res.occupancy.as_ref().expect("occupancy built above").grid;
@@ -129,25 +105,17 @@ impl DvrPass {
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
         let depth_view = t.depth.create_view(&Default::default());
-        let common = [
-            bind(0, res.frame_buf.as_entire_binding()),
-            bind(1, wgpu::BindingResource::TextureView(&tables.view)),
-            bind(2, t.state.as_entire_binding()),
-            bind(5, wgpu::BindingResource::TextureView(&color_view)),
-            bind(6, wgpu::BindingResource::TextureView(&depth_view)),
-        ];
-        let mut dvr_entries = common.to_vec();
-        dvr_entries.push(bind(3, wgpu::BindingResource::TextureView(occupancy)));
-        dvr_entries.push(bind(4, wgpu::BindingResource::TextureView(&depth_in_view)));
         let dvr_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dvr frame"),
             layout: &self.bgl,
-            entries: &dvr_entries,
-        });
-        let resolve_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("resolve"),
-            layout: &self.resolve_bgl,
-            entries: &common,
+            entries: &[
+                bind(0, res.frame_buf.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+                bind(3, wgpu::BindingResource::TextureView(occupancy)),
+                bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
+                bind(5, wgpu::BindingResource::TextureView(&color_view)),
+                bind(6, wgpu::BindingResource::TextureView(&depth_view)),
+            ],
         });
         let rect = u.rect;
         let gr = groups(rect);
@@ -157,32 +125,14 @@ impl DvrPass {
         if rect != [0, 0, view.width, view.height] {
             clear_outputs(&mut enc, &color_view, &depth_view);
         }
-        if !variant.single_brick {
-            enc.clear_buffer(&t.state, 0, None);
-        }
-        for i in order {
-            let b = &vol.bricks[i];
+        {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("dvr"),
                 timestamp_writes: None,
             });
             pass.set_pipeline(&dvr);
             pass.set_bind_group(0, &dvr_bg, &[]);
-            let bg = if params.interpolation == Interpolation::Nearest {
-                &b.bind_nearest
-            } else {
-                &b.bind_linear
-            };
-            pass.set_bind_group(1, bg, &[]);
-            pass.dispatch_workgroups(gr[0], gr[1], 1);
-        }
-        if !variant.single_brick {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("resolve"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.resolve);
-            pass.set_bind_group(0, &resolve_bg, &[]);
+            pass.set_bind_group(1, vol.bind_group(variant.nearest), &[]);
             pass.dispatch_workgroups(gr[0], gr[1], 1);
         }
         q.submit([enc.finish()]);

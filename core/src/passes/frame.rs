@@ -1,6 +1,6 @@
 //! What every pass of a frame shares: the frame uniforms (camera, volume transform, tables'
-//! ranges, material, lights, clipping, the screen rectangle the volume covers), the bricks'
-//! visibility order and the workgroup size.
+//! ranges, material, lights, clipping, the screen rectangle the volume covers) and the
+//! workgroup size.
 
 use crate::error::{Error, Result};
 use crate::gpu::uniforms::{
@@ -9,7 +9,7 @@ use crate::gpu::uniforms::{
 };
 use crate::gpu::Context;
 use crate::params::{BlendMode, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS};
-use crate::resources::bricks::{BrickExtent, BLOCK_SIZE};
+use crate::resources::bricks::BLOCK_SIZE;
 use crate::resources::targets::DepthSource;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -293,17 +293,15 @@ pub(crate) fn frame(
         (tf.independent, FLAG_INDEPENDENT),
         (depth_input, FLAG_DEPTH_INPUT),
     ]);
-    // VTK's volumetric shadows: composite, shaded, lit; one component in one brick (the
-    // shadow rays read the whole volume from one texture).
+    // VTK's volumetric shadows: composite, shaded, lit; one component.
     let volumetric =
         s.enabled && s.volumetric_blending > 0.0 && nl > 0 && params.blend == BlendMode::Composite;
     if volumetric {
-        if vol.bricks.len() != 1 || vol.components != 1 {
+        if vol.components != 1 {
             return Err(Error::Unsupported(format!(
-                "volumetric scattering needs a one-component volume in one brick (this one \
-                 has {} component(s) in {} brick(s)): turn the scattering blending off",
-                vol.components,
-                vol.bricks.len()
+                "volumetric scattering needs a one-component volume (this one has {}): turn \
+                 the scattering blending off",
+                vol.components
             )));
         }
         let extent = [DVec3::X, DVec3::Y, DVec3::Z]
@@ -356,40 +354,4 @@ pub(crate) fn frame(
         independent: tf.independent,
         volumetric,
     })
-}
-
-/// Bricks in front-to-back order for this camera: along each axis, bricks on the
-/// camera's side of a brick boundary come first. For a grid of boxes this order is a
-/// valid visibility order for perspective and parallel projection alike.
-pub(crate) fn brick_order(res: &Resources, view: &View, params: &RenderParams) -> Vec<usize> {
-    let Some(vol) = res.volume.as_ref() else {
-        return vec![];
-    };
-    let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
-    let cam = world_to_index.transform_point3(view.camera.position);
-    let dir = world_to_index.transform_vector3(view.camera.direction());
-    let bc = vol.layout.brick_cells as f64;
-    let mut order: Vec<usize> = (0..vol.bricks.len()).collect();
-    // Per axis, how many brick steps separate a brick from the camera's brick (perspective:
-    // a ray's successive bricks have non-decreasing steps on every axis and a strictly
-    // larger sum) or how far it lies along the view direction (parallel).
-    let key = |e: &BrickExtent| -> [i64; 3] {
-        [0, 1, 2].map(|a| {
-            let cell = e.cell[a] as i64;
-            if view.camera.parallel {
-                if dir[a] >= 0.0 {
-                    cell
-                } else {
-                    -cell
-                }
-            } else {
-                (cell - (cam[a] / bc).floor() as i64).abs()
-            }
-        })
-    };
-    order.sort_by_key(|&i| {
-        let k = key(&vol.bricks[i].extent);
-        k[0] + k[1] + k[2]
-    });
-    order
 }

@@ -22,7 +22,7 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
-use super::frame::{self, brick_order, groups, FrameInput, SKIP_MAX_OCCUPANCY};
+use super::frame::{self, groups, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
@@ -59,6 +59,7 @@ pipeline_variant! {
         positional_lights: bool => "POSITIONAL_LIGHTS",
         /// 0 none, 1 preview, 2 traced (IsoScattering).
         scatter: u32 => "SCATTER",
+        single_brick: bool => "SINGLE_BRICK",
     }
 }
 
@@ -318,8 +319,8 @@ impl IsoPass {
         Ok(())
     }
 
-    /// One isosurface frame of the iso-values `iso` (an error without them): first hit per
-    /// brick in visibility order, then deferred shading.
+    /// One isosurface frame of the iso-values `iso` (an error without them): first hit,
+    /// then deferred shading.
     pub fn render(&mut self, input: FrameInput<'_>, iso: Option<&IsoParams>) -> Result<()> {
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
@@ -363,7 +364,6 @@ impl IsoPass {
             ..params.clone()
         };
         let f = frame::frame(res, view, &lit, step, depth_input)?;
-        let order = brick_order(res, view, params);
         let vol = res.volume()?;
         let data_range = vol
             .minmax
@@ -372,14 +372,7 @@ impl IsoPass {
             .fold([f32::INFINITY, f32::NEG_INFINITY], |a, r| {
                 [a[0].min(r[0][0]), a[1].max(r[0][1])]
             });
-        let single_brick = vol.bricks.len() == 1;
-        if iso.scattering.is_some() && !single_brick {
-            return Err(Error::Unsupported(format!(
-                "scattering between isosurfaces needs the volume in one brick; it is split \
-                 into {} (it exceeds the device's 3D texture or allocation limits)",
-                vol.bricks.len()
-            )));
-        }
+        let single_brick = vol.single_brick();
         let unit = res
             .tf
             .as_ref()
@@ -399,6 +392,7 @@ impl IsoPass {
                 Some(IsoScatterMode::Preview) => 1,
                 Some(IsoScatterMode::Traced) => 2,
             },
+            single_brick,
         };
         let firsthit = self.firsthit.get(ctx, fh)?;
         let deferred = self.deferred.get(ctx, df)?;
@@ -544,18 +538,16 @@ impl IsoPass {
         if shade_rect != full {
             clear_outputs(&mut enc, &color_view, &depth_view);
         }
-        if !single_brick {
-            enc.clear_buffer(&t.state, 0, None);
-        }
-        let gr = groups(rect);
-        for i in order {
+        let volume = vol.bind_group(false);
+        {
+            let gr = groups(rect);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("first hit"),
                 timestamp_writes: None,
             });
             pass.set_pipeline(&firsthit);
             pass.set_bind_group(0, &firsthit_bg, &[]);
-            pass.set_bind_group(1, &vol.bricks[i].bind_linear, &[]);
+            pass.set_bind_group(1, volume, &[]);
             pass.dispatch_workgroups(gr[0], gr[1], 1);
         }
         {
@@ -566,8 +558,7 @@ impl IsoPass {
             });
             pass.set_pipeline(&deferred);
             pass.set_bind_group(0, &deferred_bg, &[]);
-            // (the scattering pass samples the volume: one brick)
-            pass.set_bind_group(1, &vol.bricks[0].bind_linear, &[]);
+            pass.set_bind_group(1, volume, &[]);
             pass.dispatch_workgroups(gs[0], gs[1], 1);
         }
         ctx.checked("rendering the isosurface frame", || {

@@ -21,8 +21,8 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment) built (the procedural sky
 //! by default).
 //!
-//! Limits of this version: the volume must fit in one brick; the first component is the
-//! medium; cropping and positional lights are refused.
+//! Limits of this version: the first component is the medium; cropping and positional
+//! lights are refused.
 
 use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::frame::{self, groups, FrameInput};
@@ -165,6 +165,8 @@ pipeline_variant! {
         guide: bool => "GUIDE",
         /// Forward-difference gradients (FORWARD_DIFF in lib/volume.wgsl).
         forward_diff: bool => "FORWARD_DIFF",
+        /// The volume is one brick (lib/volume.wgsl).
+        single_brick: bool => "SINGLE_BRICK",
     }
 }
 
@@ -309,14 +311,7 @@ impl PathTracePass {
         params.validate()?;
         let pp = *pp;
         pp.validate()?;
-        let vol = res.volume()?;
-        if vol.bricks.len() != 1 {
-            return Err(Error::Unsupported(format!(
-                "path tracing needs the volume in one brick; it is split into {} (it exceeds \
-                 the device's 3D texture or allocation limits)",
-                vol.bricks.len()
-            )));
-        }
+        let single_brick = res.volume()?.single_brick();
         if params.cropping.is_some() {
             return Err(Error::Unsupported(
                 "path tracing does not crop yet: turn cropping off (clipping planes work)".into(),
@@ -371,6 +366,7 @@ impl PathTracePass {
                 || pp.scatter != ScatterRegions::Everywhere,
             guide: pp.denoise,
             forward_diff: params.gradient == GradientMethod::Forward,
+            single_brick,
         };
         let pipeline = self.pipelines.get(ctx, variant)?;
         self.ensure_accum(ctx, view.width, view.height)?;
@@ -461,12 +457,7 @@ impl PathTracePass {
                 bind(16, guide.as_entire_binding()),
             ],
         });
-        let vol = res.volume()?;
-        let brick = if nearest {
-            &vol.bricks[0].bind_nearest
-        } else {
-            &vol.bricks[0].bind_linear
-        };
+        let brick = res.volume()?.bind_group(nearest);
         let mut enc = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {

@@ -1,5 +1,5 @@
-//! Volume upload: texture format choice, bricking, and the min–max grid for empty-space
-//! skipping.
+//! Volume upload: texture format choice, bricking into the pool, and the min–max grid for
+//! empty-space skipping.
 //!
 //! Storage keeps the data's precision where a filterable format allows it: 8-bit data in
 //! 8-bit normalised textures, 16-bit data in 16-bit normalised textures (signed types are
@@ -7,6 +7,7 @@
 //! device filters it, otherwise as float16 normalised to the data range. The shader turns a
 //! texel back into a scalar with a per-component `scale · texel + shift`.
 
+use crate::error::{Error, Result};
 use crate::gpu::DeviceInfo;
 use crate::params::{ScalarType, VolumeData};
 
@@ -39,21 +40,6 @@ pub struct Layout {
     /// scalar = scale · texel + shift, per component.
     pub scale: [f32; 4],
     pub shift: [f32; 4],
-    /// Cells per brick along each axis (the brick's core).
-    pub brick_cells: u32,
-}
-
-/// One brick: the cells it owns and the points its texture holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BrickExtent {
-    /// Grid position of the brick.
-    pub cell: [u32; 3],
-    /// Owned index-space box [core_lo, core_hi].
-    pub core_lo: [u32; 3],
-    pub core_hi: [u32; 3],
-    /// First point held by the texture, and the texture's size in points.
-    pub tex_lo: [u32; 3],
-    pub tex_size: [u32; 3],
 }
 
 pub(crate) fn channels_for(components: u32) -> u32 {
@@ -122,86 +108,130 @@ pub fn choose_storage(
     (storage, format, bytes * ch, scale, shift)
 }
 
-/// Splits the volume into bricks no larger than `max_points` per axis (overlap included)
-/// and `max_bytes` per texture. A volume that fits is one brick with no overlap.
+/// How the volume is cut into bricks and where they live in the pool texture. One brick is
+/// the volume's own texture (no apron); several are cubes of `brick_cells` cells stored
+/// with an apron of [`BRICK_OVERLAP`] points on every side in equal slots of the pool, and
+/// the page table maps each brick to its slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BrickGrid {
+    /// Cells per brick edge (the brick's core).
+    pub brick_cells: u32,
+    /// Points of apron around each brick's core in its slot.
+    pub apron: u32,
+    /// Bricks per axis.
+    pub counts: [u32; 3],
+    /// Points per slot, per axis.
+    pub slot: [u32; 3],
+    /// Slots per pool axis.
+    pub slots: [u32; 3],
+}
+
+impl BrickGrid {
+    /// Number of bricks.
+    pub fn len(&self) -> usize {
+        self.counts.iter().map(|&c| c as usize).product()
+    }
+
+    /// The pool texture's size in points.
+    pub fn pool_size(&self) -> [u32; 3] {
+        [0, 1, 2].map(|a| self.slot[a] * self.slots[a])
+    }
+
+    /// Grid position of brick `i` (x fastest).
+    pub fn cell(&self, i: usize) -> [u32; 3] {
+        let [nx, ny, _] = self.counts.map(|c| c as usize);
+        [i % nx, (i / nx) % ny, i / (nx * ny)].map(|c| c as u32)
+    }
+
+    /// Slot position in the pool of slot `i` (x fastest).
+    pub fn slot_cell(&self, i: usize) -> [u32; 3] {
+        let [nx, ny, _] = self.slots.map(|c| c as usize);
+        [i % nx, (i / nx) % ny, i / (nx * ny)].map(|c| c as u32)
+    }
+
+    /// The first point (index space, may lie outside the volume) the slot of the brick at
+    /// `cell` holds.
+    pub fn slot_origin_point(&self, cell: [u32; 3]) -> [i64; 3] {
+        cell.map(|c| c as i64 * self.brick_cells as i64 - self.apron as i64)
+    }
+}
+
+/// Splits a volume of `dims` points into bricks of at most `max_brick` points per axis
+/// (apron included) and lays their slots out in one pool texture of at most `max_pool`
+/// points per axis and `max_bytes` bytes. A volume that fits is one brick with no apron;
+/// otherwise the bricks are cubes whose slots have an edge of `slot_points` (at most
+/// `max_brick`). An error names the sizes when the pool does not fit.
 pub fn plan_bricks(
     dims: [u32; 3],
     texel_bytes: u32,
-    max_points: u32,
+    max_brick: u32,
+    max_pool: u32,
     max_bytes: u64,
-) -> (u32, Vec<BrickExtent>) {
-    let fits = |n: [u32; 3]| {
-        n.iter().all(|&d| d <= max_points)
-            && n.iter().map(|&d| d as u64).product::<u64>() * texel_bytes as u64 <= max_bytes
-    };
+    slot_points: u32,
+) -> Result<BrickGrid> {
+    let bytes = |n: [u32; 3]| n.iter().map(|&d| d as u64).product::<u64>() * texel_bytes as u64;
     let cells = dims.map(|d| d.saturating_sub(1).max(1));
-    let max_cells = *cells.iter().max().unwrap_or(&1);
-    let brick_cells = if fits(dims) {
-        max_cells
-    } else {
-        // largest brick edge whose texture (core + overlap on both sides) fits
-        let mut b = max_points
-            .saturating_sub(2 * BRICK_OVERLAP + 1)
-            .max(1)
-            .min(max_cells);
-        while b > 1 && !fits([b + 2 * BRICK_OVERLAP + 1; 3]) {
-            b = (b * 7 / 8).max(1);
-        }
-        b
-    };
-    let counts = cells.map(|c| c.div_ceil(brick_cells));
-    let mut bricks = Vec::new();
-    for bz in 0..counts[2] {
-        for by in 0..counts[1] {
-            for bx in 0..counts[0] {
-                let cell = [bx, by, bz];
-                let mut core_lo = [0; 3];
-                let mut core_hi = [0; 3];
-                let mut tex_lo = [0; 3];
-                let mut tex_size = [0; 3];
-                for a in 0..3 {
-                    core_lo[a] = cell[a] * brick_cells;
-                    core_hi[a] = ((cell[a] + 1) * brick_cells).min(dims[a] - 1);
-                    let single = counts[a] == 1;
-                    let lo = if single {
-                        0
-                    } else {
-                        core_lo[a].saturating_sub(BRICK_OVERLAP)
-                    };
-                    let hi = if single {
-                        dims[a] - 1
-                    } else {
-                        (core_hi[a] + BRICK_OVERLAP).min(dims[a] - 1)
-                    };
-                    tex_lo[a] = lo;
-                    tex_size[a] = hi - lo + 1;
-                }
-                bricks.push(BrickExtent {
-                    cell,
-                    core_lo,
-                    core_hi,
-                    tex_lo,
-                    tex_size,
-                });
-            }
-        }
+    let max_points = max_brick.min(max_pool);
+    if dims.iter().all(|&d| d <= max_points) && bytes(dims) <= max_bytes {
+        return Ok(BrickGrid {
+            brick_cells: *cells.iter().max().unwrap_or(&1),
+            apron: 0,
+            counts: [1; 3],
+            slot: dims,
+            slots: [1; 3],
+        });
     }
-    (brick_cells, bricks)
+    let min_slot = 2 * BRICK_OVERLAP + 2;
+    let edge = slot_points.min(max_points);
+    if edge < min_slot {
+        return Err(Error::InvalidParameter(format!(
+            "brick edge {edge} is too small (at least {min_slot})"
+        )));
+    }
+    let b = edge - (2 * BRICK_OVERLAP + 1);
+    let counts = cells.map(|c| c.div_ceil(b));
+    let n: u64 = counts.iter().map(|&c| c as u64).product();
+    let per_axis = (max_pool / edge) as u64;
+    let sx = n.min(per_axis);
+    let sy = n.div_ceil(sx).min(per_axis);
+    let sz = n.div_ceil(sx * sy);
+    let slot_bytes = bytes([edge; 3]);
+    if sz > per_axis || sx * sy * sz * slot_bytes > max_bytes {
+        return Err(Error::Unsupported(format!(
+            "the volume ({} × {} × {} points, {} bytes per point) needs {n} bricks of {edge}³ \
+             points, {:.2} GiB of texture; the device takes at most {max_pool} points per \
+             axis and {:.2} GiB in one texture",
+            dims[0],
+            dims[1],
+            dims[2],
+            texel_bytes,
+            (n * slot_bytes) as f64 / (1u64 << 30) as f64,
+            max_bytes as f64 / (1u64 << 30) as f64,
+        )));
+    }
+    Ok(BrickGrid {
+        brick_cells: b,
+        apron: BRICK_OVERLAP,
+        counts,
+        slot: [edge; 3],
+        slots: [sx, sy, sz].map(|s| s as u32),
+    })
 }
 
-/// Texel bytes of one brick in the chosen storage.
-pub fn brick_texels(v: &VolumeData, layout: &Layout, b: &BrickExtent) -> Vec<u8> {
+/// Texel bytes of the `size` points from `lo` (index space; points outside the volume take
+/// the nearest edge point's value, as a clamping sampler reads them) in the chosen storage.
+pub fn brick_texels(v: &VolumeData, layout: &Layout, lo: [i64; 3], size: [u32; 3]) -> Vec<u8> {
     let nc = v.components as usize;
     let ch = layout.channels as usize;
-    let n: usize = b.tex_size.iter().map(|&d| d as usize).product();
+    let n: usize = size.iter().map(|&d| d as usize).product();
     let mut out = Vec::with_capacity(n * layout.texel_bytes as usize);
     let (nx, ny) = (v.dims[0] as usize, v.dims[1] as usize);
-    for k in 0..b.tex_size[2] as usize {
-        for j in 0..b.tex_size[1] as usize {
-            let row = ((b.tex_lo[2] as usize + k) * ny + b.tex_lo[1] as usize + j) * nx
-                + b.tex_lo[0] as usize;
-            for i in 0..b.tex_size[0] as usize {
-                let p = (row + i) * nc;
+    let at = |a: usize, i: u32| (lo[a] + i as i64).clamp(0, v.dims[a] as i64 - 1) as usize;
+    for k in 0..size[2] {
+        for j in 0..size[1] {
+            let row = (at(2, k) * ny + at(1, j)) * nx;
+            for i in 0..size[0] {
+                let p = (row + at(0, i)) * nc;
                 for c in 0..ch {
                     let val = if c < nc { v.scalars.get(p + c) } else { 0.0 };
                     match layout.storage {
@@ -280,38 +310,57 @@ mod tests {
 
     #[test]
     fn one_brick_when_it_fits() {
-        let (b, bricks) = plan_bricks([64, 32, 16], 4, 2048, 1 << 30);
-        assert_eq!(b, 63);
-        assert_eq!(bricks.len(), 1);
-        assert_eq!(bricks[0].tex_size, [64, 32, 16]);
-        assert_eq!(bricks[0].core_hi, [63, 31, 15]);
+        let g = plan_bricks([64, 32, 16], 4, 2048, 2048, 1 << 30, 128).unwrap();
+        assert_eq!(g.brick_cells, 63);
+        assert_eq!(g.len(), 1);
+        assert_eq!(g.apron, 0);
+        assert_eq!(g.pool_size(), [64, 32, 16]);
     }
 
     #[test]
-    fn bricks_cover_every_cell_once_with_overlap() {
+    fn bricks_cover_every_cell_with_an_apron() {
         let dims = [50, 33, 20];
-        let (b, bricks) = plan_bricks(dims, 1, 20, u64::MAX);
-        assert!(b + 2 * BRICK_OVERLAP < 20);
-        // each cell (i, j, k) of the grid lies in exactly one core
-        for k in 0..dims[2] - 1 {
-            for j in 0..dims[1] - 1 {
-                for i in 0..dims[0] - 1 {
-                    let c = [i, j, k];
-                    let n = bricks
-                        .iter()
-                        .filter(|br| (0..3).all(|a| c[a] >= br.core_lo[a] && c[a] < br.core_hi[a]))
-                        .count();
-                    assert_eq!(n, 1, "cell {c:?}");
-                }
-            }
+        let g = plan_bricks(dims, 1, 20, 2048, u64::MAX, 128).unwrap();
+        assert_eq!(g.slot, [20; 3]);
+        assert_eq!(g.brick_cells, 15);
+        assert_eq!(g.counts, [4, 3, 2]);
+        // every cell lies in the core of the brick floor(cell / B) selects
+        for (n, d) in g.counts.into_iter().zip(dims) {
+            assert!(n * g.brick_cells >= d - 1);
+            assert!((n - 1) * g.brick_cells < d - 1);
         }
-        for br in &bricks {
-            for (a, &dim) in dims.iter().enumerate() {
-                assert!(br.tex_size[a] <= 20);
-                assert!(br.tex_lo[a] + 2 <= br.core_lo[a] || br.tex_lo[a] == 0);
-                let tex_hi = br.tex_lo[a] + br.tex_size[a] - 1;
-                assert!(tex_hi >= (br.core_hi[a] + 2).min(dim - 1));
-            }
-        }
+        // the slots fit the pool and the core plus apron fits a slot
+        assert!(g.pool_size().iter().all(|&p| p <= 2048));
+        assert!(g.slots.iter().product::<u32>() as usize >= g.len());
+        assert_eq!(g.brick_cells + 1 + 2 * g.apron, 20);
+        assert_eq!(g.slot_origin_point([1, 0, 0]), [13, -2, -2]);
+    }
+
+    #[test]
+    fn a_pool_too_large_names_the_sizes() {
+        let e = plan_bricks([5000, 5000, 5000], 4, 4096, 4096, 1 << 31, 128).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("5000 × 5000 × 5000") && msg.contains("4096"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn apron_points_outside_take_the_edge() {
+        use crate::params::Scalars;
+        let v = VolumeData::new([3, 1, 1], 1, Scalars::U8(vec![10, 20, 30])).unwrap();
+        let layout = Layout {
+            storage: Storage::Unorm8 { offset: 0.0 },
+            format: wgpu::TextureFormat::R8Unorm,
+            texel_bytes: 1,
+            channels: 1,
+            scale: [255.0; 4],
+            shift: [0.0; 4],
+        };
+        assert_eq!(
+            brick_texels(&v, &layout, [-2, 0, 0], [7, 1, 1]),
+            vec![10, 10, 10, 20, 30, 30, 30]
+        );
     }
 }

@@ -9,7 +9,7 @@ pub(crate) mod targets;
 pub(crate) mod volume;
 
 use crate::error::{Error, Result};
-use crate::gpu::binding::{buffer_entry, entry, texture_entry};
+use crate::gpu::binding::{buffer_entry, entry, sampled_texture_entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::interop::OutputPath;
 use crate::gpu::uniforms::FrameUniforms;
@@ -23,7 +23,8 @@ use volume::GpuVolume;
 /// The renderer's resources. Passes get `&mut Resources` for a frame; each resource is built
 /// or rebuilt on demand by its `ensure_*` function when what decides its contents changed.
 pub(crate) struct Resources {
-    /// Layout of a brick's bind group (group 1 of every pass that samples the volume).
+    /// Layout of the volume's bind group (group 1 of every pass that samples the volume):
+    /// pool uniforms, pool texture, sampler, gradient pool, page table.
     pub brick_bgl: wgpu::BindGroupLayout,
     pub nearest: wgpu::Sampler,
     linear: wgpu::Sampler,
@@ -55,6 +56,11 @@ impl Resources {
                     wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 ),
                 texture_entry(3, true, wgpu::TextureViewDimension::D3),
+                sampled_texture_entry(
+                    4,
+                    wgpu::TextureSampleType::Uint,
+                    wgpu::TextureViewDimension::D3,
+                ),
             ],
         });
         let sampler = |f: wgpu::FilterMode| {

@@ -1,17 +1,20 @@
-//! The volume on the device: its bricks (texture, uniforms, bind groups) and min–max grid.
+//! The volume on the device: its bricks in the pool texture, the page table that maps each
+//! brick to its slot, the uniforms and bind groups the passes sample it through, and the
+//! min–max grid.
 
-use super::bricks::{self, BrickExtent, Layout, MinMaxGrid};
+use super::bricks::{self, BrickGrid, Layout, MinMaxGrid};
 use super::Resources;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::binding::bind;
 use crate::gpu::buffers::uniform_buffer;
-use crate::gpu::texture::upload_texture;
-use crate::gpu::uniforms::BrickUniforms;
+use crate::gpu::texture::{block_grid, upload_region};
+use crate::gpu::uniforms::{PoolUniforms, PAGE_SLOT_BITS};
 use crate::gpu::Context;
 use crate::params::{UploadOptions, VolumeData};
 use glam::DMat4;
 
-/// Computes a brick's gradient texture from its volume texture (the gradient build pass).
+/// Computes the gradient texture of the pool from the pool texture (the gradient build
+/// pass).
 pub(crate) type GradientBuilder<'a> =
     dyn Fn(&Context, &wgpu::TextureView, wgpu::Extent3d, &Layout) -> Result<wgpu::Texture> + 'a;
 
@@ -23,30 +26,48 @@ pub(crate) fn wants_gradients(v: &VolumeData, opts: &UploadOptions) -> bool {
     v.components == 1 && opts.precompute_gradients.unwrap_or(false)
 }
 
-pub(crate) struct GpuBrick {
-    pub extent: BrickExtent,
-    _texture: wgpu::Texture,
-    _gradient: Option<wgpu::Texture>,
-    _uniform: wgpu::Buffer,
-    pub bind_linear: wgpu::BindGroup,
-    pub bind_nearest: wgpu::BindGroup,
-}
+/// Slot edge (points) of the bricks of a volume too large for one texture: 123³ cells and
+/// an apron of two points, 12% more texels than the bricks' cores.
+pub(crate) const SLOT_POINTS: u32 = 128;
 
 pub(crate) struct GpuVolume {
     pub data_dims: [u32; 3],
     pub components: u32,
     pub index_to_data: DMat4,
     pub layout: Layout,
-    pub bricks: Vec<GpuBrick>,
+    pub grid: BrickGrid,
+    _pool: wgpu::Texture,
+    _gradient: Option<wgpu::Texture>,
+    _page_table: wgpu::TextureView,
+    _uniform: wgpu::Buffer,
+    bind_linear: wgpu::BindGroup,
+    bind_nearest: wgpu::BindGroup,
     pub minmax: MinMaxGrid,
-    /// The bricks carry precomputed gradients (binding 3).
+    /// The pool carries precomputed gradients (binding 3).
     pub gradients: bool,
+}
+
+impl GpuVolume {
+    /// The volume's bind group (group 1 of every pass that samples it), read through the
+    /// nearest or the linear sampler.
+    pub fn bind_group(&self, nearest: bool) -> &wgpu::BindGroup {
+        if nearest {
+            &self.bind_nearest
+        } else {
+            &self.bind_linear
+        }
+    }
+
+    /// The volume is one brick: the passes sample its texture directly.
+    pub fn single_brick(&self) -> bool {
+        self.grid.len() == 1
+    }
 }
 
 impl Resources {
     /// Uploads a volume (replacing any previous one). With precomputed gradients (one
-    /// component and [`UploadOptions::precompute_gradients`]), `gradients` computes each
-    /// brick's gradient texture from its volume texture.
+    /// component and [`UploadOptions::precompute_gradients`]), `gradients` computes the
+    /// pool's gradient texture from it.
     pub fn set_volume(
         &mut self,
         ctx: &Context,
@@ -57,21 +78,17 @@ impl Resources {
         v.validate()?;
         let info = &ctx.info;
         let (storage, format, texel_bytes, scale, shift) = bricks::choose_storage(v, info);
-        let max_points = opts
-            .max_brick_points
-            .unwrap_or(info.limits.max_texture_dimension_3d)
-            .min(info.limits.max_texture_dimension_3d);
-        if max_points < 2 * bricks::BRICK_OVERLAP + 2 {
-            return Err(Error::InvalidParameter(format!(
-                "brick edge {max_points} is too small (at least {})",
-                2 * bricks::BRICK_OVERLAP + 2
-            )));
-        }
-        let max_bytes = opts
-            .max_brick_bytes
-            .unwrap_or(info.limits.max_buffer_size.min(1 << 30));
-        let (brick_cells, extents) =
-            bricks::plan_bricks(v.dims, texel_bytes, max_points, max_bytes);
+        let max_pool = info.limits.max_texture_dimension_3d;
+        let max_brick = opts.max_brick_points.unwrap_or(max_pool);
+        let max_bytes = opts.max_brick_bytes.unwrap_or(info.limits.max_buffer_size);
+        let grid = bricks::plan_bricks(
+            v.dims,
+            texel_bytes,
+            max_brick,
+            max_pool,
+            max_bytes,
+            SLOT_POINTS,
+        )?;
         let layout = Layout {
             storage,
             format,
@@ -79,88 +96,93 @@ impl Resources {
             channels: bricks::channels_for(v.components),
             scale,
             shift,
-            brick_cells,
         };
         let build_gradients = gradients.filter(|_| wants_gradients(v, &opts));
         let d = &ctx.device;
-        let mut bricks = Vec::with_capacity(extents.len());
-        for e in &extents {
-            let size = wgpu::Extent3d {
-                width: e.tex_size[0],
-                height: e.tex_size[1],
-                depth_or_array_layers: e.tex_size[2],
-            };
-            let texels = bricks::brick_texels(v, &layout, e);
-            let (texture, uniform) = ctx.checked("uploading the volume", || {
-                let texture = d.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("volume brick"),
-                    size,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D3,
-                    format,
-                    usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                    view_formats: &[],
-                });
-                upload_texture(&ctx.queue, &texture, &texels, texel_bytes);
-                let v4 = |v: [u32; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
-                let tex_size = v4(e.tex_size);
-                let bu = BrickUniforms {
-                    core_lo: v4(e.core_lo),
-                    core_hi: v4(e.core_hi),
-                    tex_lo: v4(e.tex_lo),
-                    tex_inv_size: [1.0 / tex_size[0], 1.0 / tex_size[1], 1.0 / tex_size[2], 0.0],
-                };
-                let uniform = uniform_buffer(
-                    ctx,
-                    "brick uniforms",
-                    std::mem::size_of::<BrickUniforms>() as u64,
-                );
-                ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&bu));
-                (texture, uniform)
-            })?;
-            let view = texture.create_view(&Default::default());
-            let gradient = match build_gradients {
-                Some(build) => Some(build(ctx, &view, size, &layout)?),
-                None => None,
-            };
-            let gradient_view = gradient
-                .as_ref()
-                .map(|t| t.create_view(&Default::default()));
-            let brick_group = |s: &wgpu::Sampler| {
-                d.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("brick"),
-                    layout: &self.brick_bgl,
-                    entries: &[
-                        bind(0, uniform.as_entire_binding()),
-                        bind(1, wgpu::BindingResource::TextureView(&view)),
-                        bind(2, wgpu::BindingResource::Sampler(s)),
-                        bind(
-                            3,
-                            wgpu::BindingResource::TextureView(
-                                gradient_view.as_ref().unwrap_or(&view),
-                            ),
-                        ),
-                    ],
-                })
-            };
-            let bind_linear = brick_group(&self.linear);
-            let bind_nearest = brick_group(&self.nearest);
-            bricks.push(GpuBrick {
-                extent: *e,
-                _texture: texture,
-                _gradient: gradient,
-                _uniform: uniform,
-                bind_linear,
-                bind_nearest,
+        let [px, py, pz] = grid.pool_size();
+        let size = wgpu::Extent3d {
+            width: px,
+            height: py,
+            depth_or_array_layers: pz,
+        };
+        let mut pages = vec![0u32; grid.len()];
+        let pool = ctx.checked("uploading the volume", || {
+            let pool = d.create_texture(&wgpu::TextureDescriptor {
+                label: Some("brick pool"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
             });
-        }
+            for (i, page) in pages.iter_mut().enumerate() {
+                let slot = grid.slot_cell(i);
+                let texels = bricks::brick_texels(
+                    v,
+                    &layout,
+                    grid.slot_origin_point(grid.cell(i)),
+                    grid.slot,
+                );
+                let origin = [0, 1, 2].map(|a| slot[a] * grid.slot[a]);
+                upload_region(&ctx.queue, &pool, origin, grid.slot, &texels, texel_bytes);
+                *page = slot[0] | slot[1] << PAGE_SLOT_BITS | slot[2] << (2 * PAGE_SLOT_BITS);
+            }
+            pool
+        })?;
+        let view = pool.create_view(&Default::default());
+        let gradient = match build_gradients {
+            Some(build) => Some(build(ctx, &view, size, &layout)?),
+            None => None,
+        };
+        let gradient_view = gradient
+            .as_ref()
+            .map(|t| t.create_view(&Default::default()));
+        let page_table = block_grid(ctx, "page table", grid.counts, &pages);
+        let f = |v: [u32; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+        let pu = PoolUniforms {
+            brick: [grid.brick_cells as f32, grid.apron as f32, 0.0, 0.0],
+            grid: [grid.counts[0], grid.counts[1], grid.counts[2], 0],
+            slot: f(grid.slot),
+            inv_size: [1.0 / px as f32, 1.0 / py as f32, 1.0 / pz as f32, 0.0],
+        };
+        let uniform = uniform_buffer(
+            ctx,
+            "pool uniforms",
+            std::mem::size_of::<PoolUniforms>() as u64,
+        );
+        ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&pu));
+        let group = |s: &wgpu::Sampler| {
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("volume"),
+                layout: &self.brick_bgl,
+                entries: &[
+                    bind(0, uniform.as_entire_binding()),
+                    bind(1, wgpu::BindingResource::TextureView(&view)),
+                    bind(2, wgpu::BindingResource::Sampler(s)),
+                    bind(
+                        3,
+                        wgpu::BindingResource::TextureView(gradient_view.as_ref().unwrap_or(&view)),
+                    ),
+                    bind(4, wgpu::BindingResource::TextureView(&page_table)),
+                ],
+            })
+        };
+        let bind_linear = group(&self.linear);
+        let bind_nearest = group(&self.nearest);
         self.volume = Some(GpuVolume {
             data_dims: v.dims,
             components: v.components,
             index_to_data: v.index_to_data(),
             layout,
-            bricks,
+            grid,
+            _pool: pool,
+            _gradient: gradient,
+            _page_table: page_table,
+            _uniform: uniform,
+            bind_linear,
+            bind_nearest,
             minmax: MinMaxGrid::new(v),
             gradients: build_gradients.is_some(),
         });
