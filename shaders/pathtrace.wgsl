@@ -21,7 +21,7 @@
 // empty blocks are crossed in one step), scatters at real collisions; at each one it takes next-event estimates toward
 // the environment (a direction importance-sampled from the environment's luminance,
 // combined with the phase-sampled continuation by multiple importance sampling, power
-// heuristic) and toward each directional light
+// heuristic) and toward each light (directional, or positional with attenuation and cone)
 // (transmittance by ratio tracking); Russian roulette after 3 bounces, at most
 // pt.counts.z scattering events. Camera paths that miss the medium see the environment
 // when it is the background; alpha is the fraction of paths that met the medium.
@@ -48,6 +48,8 @@ struct PathTrace {
 // lavapipe a path tracer carrying unused code runs markedly slower).
 override HYBRID: bool = true;
 override GUIDE: bool = true;
+// VTK's cropping regions: the medium is empty in the regions cropped away.
+override CROP: bool = false;
 
 // Declared from Rust (gpu::uniforms): PT_FLAG_BACKGROUND; PT_FLAG_ATTENUATION, collisions
 // that do not scatter absorb (otherwise they do not happen); PT_FLAG_GUIDE, sum the
@@ -198,6 +200,9 @@ fn attenuates() -> bool {
 // nothing scatters and nothing attenuates).
 fn extinction_at(r: Ray, t: f32) -> f32 {
     let p = r.index_origin + t * r.index_dir;
+    if (CROP && !in_crop(p)) {
+        return 0.0;
+    }
     let s = sample_scalars(p);
     var sigma = extinction(s.x);
     let partial = pt.options.z == PT_SCATTER_SURFACES || pt.options.z == PT_SCATTER_BETWEEN;
@@ -388,16 +393,30 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
             let tl = transmittance(rl, sl.x, sl.y, rng);
             radiance = radiance + beta * el.rgb * (tl * power_heuristic(pl, el.a) / pl) * env_radiance(wl);
         }
-        // ... and the directional lights (the headlight along the camera ray).
+        // ... and the lights: directional (the headlight along the camera ray) and
+        // positional, with VTK's attenuation and spot cone.
         for (var i = 0u; i < frame.counts.y; i = i + 1u) {
             let light = frame.lights[i];
-            let l = select(light.position.xyz, -camera_ray.dir, light.position.w > 1.5);
+            var l = select(light.position.xyz, -camera_ray.dir, light.position.w > 1.5);
+            var reach = 3.0e38;
+            var k = 1.0;
+            if (light.position.w > 0.5 && light.position.w < 1.5) {
+                let to_light = light.position.xyz - x;
+                reach = length(to_light);
+                l = to_light / max(reach, 1e-30);
+                let a3 = light.attenuation;
+                k = 1.0 / max(a3.x + a3.y * reach + a3.z * reach * reach, 1e-20);
+                if (light.spot.w > -1.5) {
+                    let cos_a = dot(-l, light.spot.xyz);
+                    k = select(0.0, k * pow(max(cos_a, 0.0), light.diffuse.w), cos_a > light.spot.w);
+                }
+            }
             let ed = scatter_eval(sc, r.dir, l);
-            if (any(ed.rgb > vec3<f32>(0.0))) {
+            if (k > 0.0 && any(ed.rgb > vec3<f32>(0.0))) {
                 let rd = ray_from(x, l);
                 let sd = inner_segment(rd);
-                let td = transmittance(rd, sd.x, sd.y, rng);
-                radiance = radiance + beta * ed.rgb * td * light.diffuse.rgb;
+                let td = transmittance(rd, sd.x, min(sd.y, reach), rng);
+                radiance = radiance + beta * ed.rgb * (td * k) * light.diffuse.rgb;
             }
         }
         // Continue along a sampled direction, weighted by value / density.

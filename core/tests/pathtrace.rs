@@ -7,6 +7,7 @@
 //! Images go to `target/test-images/pathtrace-*.png` for inspection.
 
 use ferrovol_core::*;
+use glam::DVec3;
 use std::sync::MutexGuard;
 mod common;
 
@@ -301,7 +302,7 @@ fn accumulation_restarts_on_changes() {
 #[test]
 fn errors_say_what_is_wrong() {
     let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
-    let (mut r, view) = scene(&vol, medium([0.8; 3], 0.0, 0.5, 1.0), None, 16);
+    let (mut r, _) = scene(&vol, medium([0.8; 3], 0.0, 0.5, 1.0), None, 16);
     let bad = |p: PathTraceParams, words: &str| {
         assert_error(PathTraceParams::validate(&p), "", &[words]);
     };
@@ -333,17 +334,85 @@ fn errors_say_what_is_wrong() {
             ..d
         })
         .is_err());
-    let mut crop = pt_params();
-    crop.cropping = Some(Cropping {
-        planes: [0.0, 4.0, 0.0, 4.0, 0.0, 4.0],
+}
+
+/// Positional lights and cropping: a positional light far away (no attenuation, no cone)
+/// lights the medium as a directional light from the same side does; a spot whose cone
+/// points away from the volume adds nothing; the cropped-away half is empty.
+#[test]
+fn positional_lights_and_cropping() {
+    let n = 24;
+    let vol = ball(n, 10.0);
+    let dense = [(0.0, 0.0), (0.05, 0.3), (1.0, 0.6)];
+    let dark = Environment::constant([0.0; 3]);
+    let (mut r, mut view) = scene(&vol, white(&dense, 2.0), Some(dark), 32);
+    let b = vol.bounds();
+    let centre = DVec3::new(b[0] + b[1], b[2] + b[3], b[4] + b[5]) * 0.5;
+    let p = PathTraceParams {
+        samples_per_frame: 16,
+        max_bounces: 2,
+        ..Default::default()
+    };
+    let mut lit = |r: &mut Renderer, light: Light| {
+        view.lights = vec![light];
+        trace(r, &view, &p, 64)
+    };
+    let sum = |img: &[[f32; 4]], k: usize| img.iter().map(|v| v[k] as f64).sum::<f64>();
+    let directional = lit(
+        &mut r,
+        Light::directional(centre + DVec3::X * 100.0, centre, 1.0),
+    );
+    let far = lit(
+        &mut r,
+        Light::positional(centre + DVec3::X * 1e5, centre, 1.0),
+    );
+    let mut spot = Light::positional(centre + DVec3::X * 100.0, centre + DVec3::X * 200.0, 1.0);
+    spot.cone_angle = 20.0;
+    let away = lit(&mut r, spot);
+    let diff: f64 = directional
+        .iter()
+        .zip(&far)
+        .map(|(a, b)| (a[0] - b[0]).abs() as f64)
+        .sum();
+    println!(
+        "radiance: directional {:.2}, positional far away {:.2} (sum of |differences| {diff:.4}), \
+         spot turned away {:.2}",
+        sum(&directional, 0),
+        sum(&far, 0),
+        sum(&away, 0)
+    );
+    assert!(sum(&directional, 0) > 5.0);
+    // the same random streams, light directions 1e-4 rad apart
+    assert!(diff < 0.01 * sum(&directional, 0));
+    assert_eq!(sum(&away, 0), 0.0);
+    assert!(sum(&away, 3) > 50.0, "the medium is still there");
+    // cropping away x > centre: no coverage on the right half of the image (+x to the right)
+    let mut cropped = pt_params();
+    cropped.cropping = Some(Cropping {
+        planes: [b[0], centre.x, b[2], b[3], b[4], b[5]],
         regions: Cropping::SUBVOLUME,
     });
-    assert_error(r.render(&view, &crop, None), "", &["crop"]);
-    let mut lit = view.clone();
-    let mut l = Light::headlight();
-    l.positional = true;
-    lit.lights = vec![l];
-    assert_error(r.render(&lit, &pt_params(), None), "", &["positional"]);
+    r.set_path_tracing(&PathTraceParams {
+        max_samples: 16,
+        ..p
+    })
+    .unwrap();
+    r.reset_accumulation();
+    r.render(&view, &cropped, None).unwrap();
+    let img = r.read_accumulation().unwrap();
+    let half = |right: bool| {
+        (0..32usize)
+            .flat_map(|y| (0..16usize).map(move |x| (y, x)))
+            .map(|(y, x)| img[y * 32 + if right { x + 16 } else { x }][3] as f64)
+            .sum::<f64>()
+    };
+    println!(
+        "cropped: coverage left {:.1}, right {:.1}",
+        half(false),
+        half(true)
+    );
+    assert!(half(false) > 20.0);
+    assert!(half(true) < 0.02 * half(false), "the cropped half is empty");
 }
 
 #[test]

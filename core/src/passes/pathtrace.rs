@@ -8,9 +8,10 @@
 //! tracking against the majorant of each 8³-cell block they cross (from the block's
 //! scalar range, so empty space is crossed block by block), take next-event estimates
 //! toward the environment (directions drawn from its luminance on a 32² cube, multiple
-//! importance sampling with the phase function) and the view's directional lights
-//! (ratio-tracking transmittance), and end by Russian roulette or after
-//! [`PathTraceParams::max_bounces`] scattering events.
+//! importance sampling with the phase function) and the view's lights (directional, or
+//! positional with VTK's attenuation and spot cone; ratio-tracking transmittance), and end
+//! by Russian roulette or after [`PathTraceParams::max_bounces`] scattering events. VTK's
+//! cropping regions empty the medium where they crop.
 //!
 //! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
 //! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before,
@@ -21,8 +22,7 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment) built (the procedural sky
 //! by default).
 //!
-//! Limits of this version: the first component is the medium; cropping and positional
-//! lights are refused.
+//! The first component is the medium (other components are not read).
 
 use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::frame::{self, groups, FrameInput};
@@ -167,6 +167,8 @@ pipeline_variant! {
         forward_diff: bool => "FORWARD_DIFF",
         /// The volume is one brick (lib/volume.wgsl).
         single_brick: bool => "SINGLE_BRICK",
+        /// Cropping regions.
+        crop: bool => "CROP",
     }
 }
 
@@ -312,18 +314,7 @@ impl PathTracePass {
         let pp = *pp;
         pp.validate()?;
         let single_brick = res.volume()?.single_brick();
-        if params.cropping.is_some() {
-            return Err(Error::Unsupported(
-                "path tracing does not crop yet: turn cropping off (clipping planes work)".into(),
-            ));
-        }
         frame::check_light_count(view)?;
-        if let Some(i) = view.lights.iter().position(|l| l.positional) {
-            return Err(Error::Unsupported(format!(
-                "light {i} is positional: path tracing lights with directional lights, the \
-                 headlight and the environment"
-            )));
-        }
         let unit = res
             .tf
             .as_ref()
@@ -367,6 +358,7 @@ impl PathTracePass {
             guide: pp.denoise,
             forward_diff: params.gradient == GradientMethod::Forward,
             single_brick,
+            crop: params.cropping.is_some(),
         };
         let pipeline = self.pipelines.get(ctx, variant)?;
         self.ensure_accum(ctx, view.width, view.height)?;
