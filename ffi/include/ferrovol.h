@@ -512,7 +512,7 @@ typedef struct FvIsoParams {
   /**
    * Light scattered between the surfaces: 0 none (the default), 1 the preview
    * (transmittance squared, the irradiance cube), 2 traced (`scatter_samples` directions
-   * from the inner surface out of the volume). Needs the volume in one brick.
+   * from the inner surface out of the volume).
    */
   uint32_t scatter_mode;
   /**

@@ -72,7 +72,7 @@ pub struct FvIsoParams {
     pub background: bool,
     /// Light scattered between the surfaces: 0 none (the default), 1 the preview
     /// (transmittance squared, the irradiance cube), 2 traced (`scatter_samples` directions
-    /// from the inner surface out of the volume). Needs the volume in one brick.
+    /// from the inner surface out of the volume).
     pub scatter_mode: u32,
     /// Directions traced per pixel (scatter_mode 2), 1 to 256.
     pub scatter_samples: u32,

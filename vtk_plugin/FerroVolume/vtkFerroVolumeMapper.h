@@ -264,8 +264,7 @@ public:
   /**
    * RENDER_MODE_RAY_CAST (the default): ray casting in the blend mode. RENDER_MODE_PATH_TRACE:
    * progressive Monte Carlo path tracing of the volume as a scattering medium (the blend
-   * mode is not used; see the class documentation). Path tracing needs a volume that fits
-   * in one 3D texture, no cropping and no positional lights (each is reported).
+   * mode is not used; see the class documentation).
    */
   vtkSetClampMacro(RenderMode, int, RENDER_MODE_RAY_CAST, RENDER_MODE_PATH_TRACE);
   vtkGetMacro(RenderMode, int);

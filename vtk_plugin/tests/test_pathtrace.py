@@ -1,7 +1,7 @@
 """vtkFerroVolumeMapper's path tracing render mode: a still render traces its whole budget
 and later still renders show the converged image; interactive renders add a few paths per
-frame; the property's ScatteringAnisotropy changes the image; what path tracing cannot do
-yet is reported. Images: build/vtk/test-images (pathtrace-*.png)."""
+frame; the property's ScatteringAnisotropy changes the image; cropping and positional
+lights work. Images: build/vtk/test-images (pathtrace-*.png)."""
 import unittest
 
 import numpy as np
@@ -127,22 +127,28 @@ class PathTrace(unittest.TestCase):
         self.assertLess(roughness(smooth), 0.6 * roughness(noisy))
         self.assertEqual(self.errors.messages, [])
 
-    def test_what_path_tracing_cannot_do_is_reported(self):
+    def test_cropping_and_positional_lights(self):
+        full = self.scene().render()
         s = self.scene(configure=lambda m: (m.CroppingOn(),
-                                            m.SetCroppingRegionPlanes(-5, 5, -5, 5, -5, 5)))
-        s.render()
-        log("cropping:", self.errors.last().strip().splitlines()[-1])
-        self.assertIn("crop", self.errors.last())
-        self.assertFalse(s.mapper.GetLastRenderDrew())
+                                            m.SetCroppingRegionPlanes(-15, 0, -15, 15, -15, 15)))
+        cropped = s.render()
+        self.assertEqual(self.errors.messages, [])
+        self.assertTrue(s.mapper.GetLastRenderDrew())
         s = self.scene()
         light = vtk.vtkLight()
         light.SetPositional(1)
         light.SetPosition(0, 0, 50)
+        light.SetFocalPoint(0, 0, 0)
         s.renderer.AddLight(light)
-        s.render()
-        log("positional light:", self.errors.last().strip().splitlines()[-1])
-        self.assertIn("positional", self.errors.last())
-
+        lit = s.render()
+        save("pathtrace-crop-positional", full, cropped, lit)
+        log("coverage: whole %.3f, cropped to x < 0 %.3f; with a positional light added the "
+            "mean brightness is %.2f times the headlight's alone"
+            % (coverage(full), coverage(cropped), float(lit.mean() / full.mean())))
+        self.assertEqual(self.errors.messages, [])
+        self.assertLess(coverage(cropped), 0.8 * coverage(full))
+        self.assertGreater(coverage(cropped), 0.1 * coverage(full))
+        self.assertGreater(float(lit.mean()), 1.02 * float(full.mean()))
 
 if __name__ == "__main__":
     unittest.main()
