@@ -1,8 +1,9 @@
 //! End-to-end accuracy tests of the ray caster on a real wgpu device (see
 //! common/gpu.rs for what is expected of each device class), by topic: the composite
 //! integral and the other blend modes, silhouettes and the cleared outside, the GPU image
-//! against the f64 CPU reference, and renderer state (bricks, uploads, errors, volumetric
-//! shadows, precomputed gradients).
+//! against the f64 CPU reference, renderer state (bricks, uploads, errors, volumetric
+//! shadows, precomputed gradients), and bricking in every mode (ray casting, isosurfaces,
+//! path tracing).
 //!
 //! Every test prints what it measured and asserts a tolerance with the reason for it.
 //! Images of the interesting cases go to `target/test-images/*.png` for inspection.
@@ -10,6 +11,7 @@
 use ferrovol_core::*;
 use glam::DVec3;
 
+mod bricks;
 #[path = "../common/mod.rs"]
 mod common;
 mod compositing;
