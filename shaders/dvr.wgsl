@@ -20,9 +20,29 @@ override INDEPENDENT: bool = true;
 override SHADE: bool = false;
 override GRAD_OPACITY: bool = false;
 override SKIP: bool = false;
+// MIP and MinIP (one component): skip blocks whose scalar range cannot move the ray's
+// extremum, i.e. the block's max ≤ the running max (MIP), its min ≥ the running min (MinIP).
+// Such a block's samples leave the value unchanged, so the image is the same as without
+// (exactly so in real arithmetic; a filtered f32 sample may round an ulp past its corners).
+override RANGE_SKIP: bool = false;
 override CROP: bool = false;
 // Volumetric shadows (lib/shadow.wgsl; one component, shading on).
 override VOLUMETRIC: bool = false;
+
+// Per min–max block, the first component's (min, max) over every point a sample in the
+// block interpolates from (nearest or trilinear), widened where the storage rounds the data
+// (MinMaxGrid::sample_bounds). Built once per volume upload; read by RANGE_SKIP only.
+@group(0) @binding(2) var block_range: texture_3d<f32>;
+
+// Whether the samples of the block holding p cannot change the extremum v (MIP: none can
+// exceed it; MinIP: none can fall below it); a tie leaves max/min unchanged too.
+fn block_keeps_extremum(p: vec3<f32>, v: f32) -> bool {
+    let r = textureLoad(block_range, block_coord(p), 0).xy;
+    if (BLEND == BLEND_MAXIMUM) {
+        return r.y <= v;
+    }
+    return r.x >= v;
+}
 
 // Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
 fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
@@ -194,6 +214,45 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the conversion reads the camera at a dynamic index (lib/ray.wgsl) with a gather per
     // matrix element.
     var depth_t = -1.0;
+    if (RANGE_SKIP) {
+        // MIP / MinIP block by block: an outer loop decides per block, as the ray enters it,
+        // whether to skip the block whole or to march all its samples in the inner loop.
+        // Not a test inside the sample loop: lavapipe runs a branch's code for all lanes
+        // whenever any lane takes it, so a per-sample test costs the lookup every sample.
+        // Skipping waits for the ray to hold a value (misc.x counts the samples taken).
+        // Samples stay on the lattice: each block's run ends at the first k past its exit,
+        // as SKIP's jump does. This loop leaves k at k_end, so the general loop below
+        // takes no sample.
+        loop {
+            if (k >= k_end) {
+                break;
+            }
+            let p0 = ray.index_origin + (seg.x + (k + jit) * dt) * ray.index_dir;
+            let next = max(k + 1.0, ceil((block_exit(ray, p0) - seg.x) / dt - jit));
+            if (misc.x > 0.0 && block_keeps_extremum(p0, value.x)) {
+                k = next;
+                continue;
+            }
+            let stop = min(next, k_end);
+            loop {
+                if (k >= stop) {
+                    break;
+                }
+                let t = seg.x + (k + jit) * dt;
+                let p = ray.index_origin + t * ray.index_dir;
+                if (!CROP || in_crop(p)) {
+                    let s = sample_scalars(p);
+                    if (blend == BLEND_MAXIMUM) {
+                        value = select(max(value, s), s, misc.x == 0.0);
+                    } else {
+                        value = select(min(value, s), s, misc.x == 0.0);
+                    }
+                    misc.x = misc.x + 1.0;
+                }
+                k = k + 1.0;
+            }
+        }
+    }
     loop {
         if (k >= k_end) {
             break;

@@ -2,10 +2,10 @@
 
 use super::Context;
 
-/// A value per min–max block (occupancy flags, majorants) as a 3D texture of `dims` that
-/// the passes read with textureLoad (lib/march.wgsl, block_coord): u32 values go to an
-/// r32uint texture, f32 values to r32float. A texture for the same reason as the transfer
-/// tables (resources::tables).
+/// A value per min–max block (occupancy flags, majorants, scalar ranges) as a 3D texture of
+/// `dims` that the passes read with textureLoad (lib/march.wgsl, block_coord): u32 values
+/// go to an r32uint texture, f32 values to r32float, [f32; 2] values to rg32float. A
+/// texture for the same reason as the transfer tables (resources::tables).
 pub(crate) fn block_grid<T: GridValue>(
     ctx: &Context,
     label: &str,
@@ -30,7 +30,13 @@ pub(crate) fn block_grid<T: GridValue>(
     let n = (size.width * size.height * size.depth_or_array_layers) as usize;
     let mut data = values.to_vec();
     data.resize(n, T::default());
-    upload_texture(&ctx.queue, &texture, bytemuck::cast_slice(&data), 4);
+    let texel_bytes = std::mem::size_of::<T>() as u32;
+    upload_texture(
+        &ctx.queue,
+        &texture,
+        bytemuck::cast_slice(&data),
+        texel_bytes,
+    );
     texture.create_view(&Default::default())
 }
 
@@ -105,6 +111,10 @@ impl GridValue for u32 {
 
 impl GridValue for f32 {
     const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+}
+
+impl GridValue for [f32; 2] {
+    const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 }
 
 /// The descriptor of a 2D texture of one mip level and one layer.

@@ -144,7 +144,8 @@ pub struct RenderParams {
     pub clip_planes: Vec<ClipPlane>,
     /// AverageIPScalarRange: samples outside are ignored by the average blend mode.
     pub average_range: Option<[f64; 2]>,
-    /// Skip blocks classified empty by the transfer function (composite mode).
+    /// Skip blocks classified empty by the transfer function (composite mode), and blocks
+    /// whose scalar range cannot change the extremum (MIP, MinIP; one component).
     pub empty_space_skipping: bool,
     /// Depth output: the first sample where accumulated opacity exceeds this (0: the first
     /// sample with any opacity, as VTK's RenderToImage depth).

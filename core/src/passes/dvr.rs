@@ -1,6 +1,7 @@
 //! Ray casting (shaders/dvr.wgsl) in the blend modes of VTK's mappers (composite with early
 //! ray termination, maximum, minimum, average, additive): one dispatch, each ray marching
-//! through the bricks it crosses.
+//! through the bricks it crosses. Composite skips blocks the transfer function makes empty
+//! (occupancy), MIP and MinIP blocks whose scalar range cannot change the ray's extremum.
 
 use super::frame::{self, groups, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::Result;
@@ -21,6 +22,7 @@ pipeline_variant! {
         shade: bool => "SHADE",
         gradient_opacity: bool => "GRAD_OPACITY",
         skip: bool => "SKIP",
+        range_skip: bool => "RANGE_SKIP",
         crop: bool => "CROP",
         nearest: bool => "NEAREST",
         single_brick: bool => "SINGLE_BRICK",
@@ -49,6 +51,7 @@ impl DvrPass {
                 entries: &[
                     buffer_entry(0, B::Uniform),
                     texture_entry(1, false, V::D2),
+                    texture_entry(2, false, V::D3),
                     sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(4, false, V::D2),
                     storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
@@ -78,6 +81,11 @@ impl DvrPass {
         let depth_input = !matches!(depth, DepthSource::None);
         let f = frame::frame(res, view, params, step, depth_input)?;
         let vol = res.volume()?;
+        // MIP and MinIP skip blocks whose range cannot move the ray's extremum, on
+        // one-component volumes (the range grid holds the first component).
+        let range_skip = params.empty_space_skipping
+            && matches!(params.blend, BlendMode::Maximum | BlendMode::Minimum)
+            && vol.components == 1;
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
@@ -85,6 +93,7 @@ impl DvrPass {
             shade: params.shading.enabled,
             gradient_opacity: f.gradient_opacity,
             skip,
+            range_skip,
             crop: params.cropping.is_some(),
             nearest: params.interpolation == Interpolation::Nearest,
             single_brick: vol.single_brick(),
@@ -111,6 +120,7 @@ impl DvrPass {
             entries: &[
                 bind(0, res.frame_buf.as_entire_binding()),
                 bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+                bind(2, wgpu::BindingResource::TextureView(&vol.ranges)),
                 bind(3, wgpu::BindingResource::TextureView(occupancy)),
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),

@@ -302,6 +302,30 @@ impl MinMaxGrid {
         }
         MinMaxGrid { dims, ranges }
     }
+
+    /// Component `c`'s range per block as the device samples it: the data's own values
+    /// where the storage keeps them exactly (8/16-bit normalised, float32), widened by the
+    /// storage's rounding where it does not (float16 keeps 11 bits of the normalised value).
+    /// MIP and MinIP skip a block only when this range cannot move the ray's extremum
+    /// (shaders/dvr.wgsl, RANGE_SKIP).
+    pub fn sample_bounds(&self, c: usize, nc: usize, layout: &Layout) -> Vec<[f32; 2]> {
+        let margin = match layout.storage {
+            Storage::Float16Normalized => layout.scale[c].abs() as f64 / 1024.0,
+            _ => 0.0,
+        };
+        self.ranges
+            .iter()
+            .skip(c)
+            .step_by(nc)
+            .map(|&[lo, hi]| {
+                if margin == 0.0 {
+                    [lo, hi]
+                } else {
+                    [(lo as f64 - margin) as f32, (hi as f64 + margin) as f32]
+                }
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]

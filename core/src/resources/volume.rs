@@ -1,6 +1,6 @@
 //! The volume on the device: its bricks in the pool texture, the page table that maps each
 //! brick to its slot, the uniforms and bind groups the passes sample it through, and the
-//! min–max grid.
+//! min–max grid (on the CPU, and the first component's ranges on the device).
 
 use super::bricks::{self, BrickGrid, Layout, MinMaxGrid};
 use super::Resources;
@@ -43,6 +43,10 @@ pub(crate) struct GpuVolume {
     bind_linear: wgpu::BindGroup,
     bind_nearest: wgpu::BindGroup,
     pub minmax: MinMaxGrid,
+    /// The first component's scalar range per min–max block, widened to bound every sample
+    /// (MinMaxGrid::sample_bounds): an rg32float block grid, (min, max), that MIP and MinIP
+    /// skip by (dvr.wgsl, RANGE_SKIP).
+    pub ranges: wgpu::TextureView,
     /// The pool carries precomputed gradients (binding 3).
     pub gradients: bool,
 }
@@ -171,6 +175,9 @@ impl Resources {
         };
         let bind_linear = group(&self.linear);
         let bind_nearest = group(&self.nearest);
+        let minmax = MinMaxGrid::new(v);
+        let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
+        let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
         self.volume = Some(GpuVolume {
             data_dims: v.dims,
             components: v.components,
@@ -183,7 +190,8 @@ impl Resources {
             _uniform: uniform,
             bind_linear,
             bind_nearest,
-            minmax: MinMaxGrid::new(v),
+            minmax,
+            ranges,
             gradients: build_gradients.is_some(),
         });
         self.occupancy = None;

@@ -548,3 +548,111 @@ fn blend_modes_cropping_clipping() {
         "the kept half changed ({right_changed} px)"
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// MIP / MinIP skipping by block range leaves the image as it is
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn mip_minip_skipping_changes_no_pixel() {
+    let mut r = renderer();
+    let n = 40u32;
+    let blob = blob_volume(n);
+    let f32_values = match &blob.scalars {
+        Scalars::F32(v) => v.clone(),
+        _ => unreachable!("blob_volume is float32"),
+    };
+    // The same field as float32 in [0, 1] and as int16 in [-1000, 2000] (CT-like, 16-bit
+    // normalised storage); MinIP reads the inverted field, so that its minimum has the
+    // structure MIP's maximum has. Far from the blobs the field is ~0: blocks to skip.
+    let as_i16 = |v: &[f32], invert: bool| {
+        let q = v
+            .iter()
+            .map(|&x| {
+                let x = if invert { 1.0 - x } else { x };
+                (3000.0 * x - 1000.0).round() as i16
+            })
+            .collect();
+        VolumeData::new([n; 3], 1, Scalars::I16(q)).unwrap()
+    };
+    let inverted: Vec<f32> = f32_values.iter().map(|&x| 1.0 - x).collect();
+    let cases = [
+        ("f32", blob.clone(), [0.0, 1.0], BlendMode::Maximum),
+        (
+            "f32",
+            VolumeData::new([n; 3], 1, Scalars::F32(inverted)).unwrap(),
+            [0.0, 1.0],
+            BlendMode::Minimum,
+        ),
+        (
+            "i16",
+            as_i16(&f32_values, false),
+            [-1000.0, 2000.0],
+            BlendMode::Maximum,
+        ),
+        (
+            "i16",
+            as_i16(&f32_values, true),
+            [-1000.0, 2000.0],
+            BlendMode::Minimum,
+        ),
+    ];
+    let mut view = View::fit(blob.bounds(), 72, 72);
+    view.camera.azimuth(33.0);
+    view.camera.elevation(21.0);
+    view.camera.orthogonalize_view_up();
+    view.camera.reset_clipping_range(blob.bounds());
+    let mut compared = 0;
+    for (name, vol, [lo, hi], blend) in cases {
+        // grey = the extremum found, over the data range
+        let opacity = match blend {
+            BlendMode::Maximum => [(lo, 0.0), (hi, 1.0)],
+            _ => [(lo, 1.0), (hi, 0.0)],
+        };
+        r.set_transfer_function(&TransferFunction::single(component_transfer(
+            &[(lo, [1.0; 3]), (hi, [1.0; 3])],
+            &opacity,
+            1.0,
+        )))
+        .unwrap();
+        // one brick, and bricks of 16 points (blocks and bricks do not align)
+        for bricked in [false, true] {
+            if bricked {
+                crate::common::gpu::set_bricked(&mut r, &vol, 16);
+            } else {
+                r.set_volume(&vol).unwrap();
+            }
+            for interpolation in [Interpolation::Linear, Interpolation::Nearest] {
+                for jitter in [false, true] {
+                    let render = |r: &mut Renderer, skip: bool| {
+                        let params = RenderParams {
+                            blend,
+                            interpolation,
+                            jitter,
+                            empty_space_skipping: skip,
+                            ..RenderParams::default()
+                        };
+                        r.render_image(&view, &params).unwrap()
+                    };
+                    let on = render(&mut r, true);
+                    let off = render(&mut r, false);
+                    let label = format!(
+                        "{blend:?} {name} bricked={bricked} {interpolation:?} jitter={jitter}"
+                    );
+                    let differ = on.rgba.chunks(4).zip(off.rgba.chunks(4));
+                    let differ = differ.filter(|(a, b)| a != b).count();
+                    let lit = footprint(&off);
+                    println!("{label}: {lit} pixels lit, {differ} differ with skipping on");
+                    assert!(lit > 500, "{label}: only {lit} pixels lit");
+                    assert_eq!(differ, 0, "{label}: skipping changed {differ} pixels");
+                    assert!(on.depth == off.depth, "{label}: skipping changed the depth");
+                    if !bricked && !jitter && interpolation == Interpolation::Linear {
+                        save_enlarged(&on, &format!("skip_{blend:?}_{name}").to_lowercase());
+                    }
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 32);
+}
