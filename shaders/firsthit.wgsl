@@ -77,7 +77,10 @@ fn exact_scalar(p: vec3<f32>) -> f32 {
     let x10 = mix(cell_texel(c, vec3<i32>(0, 1, 0)), cell_texel(c, vec3<i32>(1, 1, 0)), f.x);
     let x01 = mix(cell_texel(c, vec3<i32>(0, 0, 1)), cell_texel(c, vec3<i32>(1, 0, 1)), f.x);
     let x11 = mix(cell_texel(c, vec3<i32>(0, 1, 1)), cell_texel(c, vec3<i32>(1, 1, 1)), f.x);
-    let v = mix(mix(x00, x10, f.y), mix(x01, x11, f.y), f.z);
+    var v = mix(mix(x00, x10, f.y), mix(x01, x11, f.y), f.z);
+    if (!SINGLE_BRICK && brick.empty) {
+        v = brick.constant.x;
+    }
     return v * frame.scalar_scale.x + frame.scalar_shift.x;
 }
 
@@ -107,6 +110,9 @@ fn exact_gradient(p: vec3<f32>) -> vec3<f32> {
         g.x = g.x + wx * (mix(x1, cell_texel(c, vec3<i32>(2, a, b)), f.x) - mix(cell_texel(c, vec3<i32>(-1, a, b)), x0, f.x));
         g.y = g.y + wy * (mix(y1, cell_texel(c, vec3<i32>(a, 2, b)), f.y) - mix(cell_texel(c, vec3<i32>(a, -1, b)), y0, f.y));
         g.z = g.z + wz * (mix(z1, cell_texel(c, vec3<i32>(a, b, 2)), f.z) - mix(cell_texel(c, vec3<i32>(a, b, -1)), z0, f.z));
+    }
+    if (!SINGLE_BRICK && brick.empty) {
+        g = vec3<f32>(0.0);
     }
     return 0.5 * frame.scalar_scale.x * g;
 }

@@ -737,13 +737,19 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         || format!("built-in {:?}", a.demo),
         |p| p.display().to_string(),
     );
+    let res = r.residency();
+    let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
     println!(
-        "ferrovol: rendered {src} ({}x{}x{} {}, {} brick(s)) at {w}x{h} on {} -> {}",
+        "ferrovol: rendered {src} ({}x{}x{} {}, {} of {} brick(s) resident: {:.1} MiB on the \
+         device, {:.1} MiB dense) at {w}x{h} on {} -> {}",
         vol.dims[0],
         vol.dims[1],
         vol.dims[2],
         vol.scalars.scalar_type().name(),
-        r.brick_count(),
+        res.resident,
+        res.bricks,
+        mib(res.pool_bytes),
+        mib(res.dense_bytes),
         r.context().info.name,
         a.out.display()
     );

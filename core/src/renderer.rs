@@ -7,24 +7,23 @@ use crate::gpu::interop::{OutputPath, SharedOutput};
 use crate::gpu::Context;
 use crate::params::{
     BlendMode, BsdfParams, CubeImage, Environment, GBuffer, Image, IsoParams, PathTraceParams,
-    RenderParams, Stats, TransferFunction, UploadOptions, View, VolumeData,
+    RenderParams, Residency, Stats, TransferFunction, UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
 use crate::passes::frame::FrameInput;
-use crate::passes::gradient::GradientPass;
 use crate::passes::iso::IsoPass;
 use crate::passes::pathtrace::PathTracePass;
 use crate::passes::scatter_check;
 use crate::resources::targets::DepthSource;
-use crate::resources::volume::wants_gradients;
+use crate::resources::volume::HostVolume;
 use crate::resources::Resources;
+use std::sync::Arc;
 
 pub struct Renderer {
     ctx: Context,
     res: Resources,
     dvr: DvrPass,
     /// The passes of the other modes, created on first use.
-    gradient: Option<GradientPass>,
     iso: Option<Box<IsoPass>>,
     pt: Option<Box<PathTracePass>>,
     iso_params: Option<IsoParams>,
@@ -48,7 +47,6 @@ impl Renderer {
             ctx,
             res,
             dvr,
-            gradient: None,
             iso: None,
             pt: None,
             iso_params: None,
@@ -79,20 +77,26 @@ impl Renderer {
         self.set_volume_with(v, UploadOptions::default())
     }
 
+    /// Uploads a volume with `opts`. A volume too large for one texture is bricked and
+    /// keeps a copy of `v` to read bricks from as frames need them
+    /// ([`Renderer::set_shared_volume`] shares it instead).
     pub fn set_volume_with(&mut self, v: &VolumeData, opts: UploadOptions) -> Result<()> {
-        let gradient = if wants_gradients(v, &opts) {
-            let ctx = &self.ctx;
-            Some(&*ensure(&mut self.gradient, || GradientPass::new(ctx))?)
-        } else {
-            None
-        };
-        let build = gradient.map(|g| {
-            move |ctx: &Context, view: &wgpu::TextureView, size, layout: &_| {
-                g.build(ctx, view, size, layout)
-            }
-        });
         self.res
-            .set_volume(&self.ctx, v, opts, build.as_ref().map(|b| b as _))
+            .set_volume(&self.ctx, HostVolume::Borrowed(v), opts)
+    }
+
+    /// [`Renderer::set_volume_with`] for data the caller shares: a bricked volume reads its
+    /// bricks from `v` without a copy.
+    pub fn set_shared_volume(&mut self, v: Arc<VolumeData>, opts: UploadOptions) -> Result<()> {
+        self.res.set_volume(&self.ctx, HostVolume::Shared(v), opts)
+    }
+
+    /// How much of the volume is on the device (zeros without a volume).
+    pub fn residency(&self) -> Residency {
+        self.res
+            .volume
+            .as_ref()
+            .map_or(Residency::default(), |v| v.residency())
     }
 
     /// Sets the transfer function; its tables are (re)built at the next frame if it changed.

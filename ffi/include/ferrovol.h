@@ -262,7 +262,8 @@ typedef struct FvRenderer FvRenderer;
 typedef struct FvTransferFunction FvTransferFunction;
 
 /**
- * Volume data on the CPU (a copy of the caller's array), ready to upload to renderers.
+ * Volume data on the CPU (a copy of the caller's array), ready to upload to renderers;
+ * renderers that keep a bricked volume's data share it (the caller may free the volume).
  * Thread use: immutable after creation; may be read from several threads at once.
  */
 typedef struct FvVolume FvVolume;
@@ -654,6 +655,29 @@ typedef struct FvStats {
 } FvStats;
 
 /**
+ * How much of the volume is on the device. A volume too large for one texture is split
+ * into bricks of which only those a frame needs (something visible, an iso-value) are
+ * resident. Thread use: plain data.
+ */
+typedef struct FvResidency {
+  /**
+   * Bricks the volume is split into, and how many of them are resident.
+   */
+  uint32_t bricks;
+  uint32_t resident;
+  /**
+   * Bricks read into the device so far.
+   */
+  uint32_t brick_uploads;
+  /**
+   * Bytes of the resident bricks' pool (with its apron and precomputed gradients), and
+   * of the whole volume as one texture.
+   */
+  uint64_t pool_bytes;
+  uint64_t dense_bytes;
+} FvResidency;
+
+/**
  * A volume's geometry and scalar layout. Point (i, j, k) sits at
  * origin + direction · (spacing ⊙ (i, j, k)), as vtkImageData places it.
  * Thread use: plain data.
@@ -921,6 +945,12 @@ enum FvStatus fv_renderer_finish(const struct FvRenderer *renderer);
  * Counters of what was uploaded and rendered so far.
  */
 enum FvStatus fv_renderer_stats(const struct FvRenderer *renderer, struct FvStats *stats);
+
+/**
+ * How much of the volume is on the device (resident bricks and bytes).
+ */
+enum FvStatus fv_renderer_residency(const struct FvRenderer *renderer,
+                                    struct FvResidency *residency);
 
 /**
  * The message of the most recent call on this thread that did not return

@@ -281,6 +281,11 @@ public:
     check(fv_renderer_stats(h_.get(), &s));
     return s;
   }
+  FvResidency residency() const {
+    FvResidency r{};
+    check(fv_renderer_residency(h_.get(), &r));
+    return r;
+  }
   FvRenderer *get() const noexcept { return h_.get(); }
 
 private:

@@ -95,7 +95,7 @@ pub unsafe extern "C" fn fv_renderer_set_volume(
 ) -> FvStatus {
     with_renderer(renderer, |r| {
         let v = const_ref(volume, "volume")?;
-        r.r.set_volume_with(&v.data, r.upload)?;
+        r.r.set_shared_volume(v.data.clone(), r.upload)?;
         Ok(())
     })
 }
@@ -426,6 +426,25 @@ pub unsafe extern "C" fn fv_renderer_stats(
             table_uploads: s.table_uploads,
             frames: s.frames,
             bricks: r.r.brick_count() as u32,
+        };
+        Ok(())
+    })
+}
+
+/// How much of the volume is on the device (resident bricks and bytes).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_residency(
+    renderer: *const FvRenderer,
+    residency: *mut FvResidency,
+) -> FvStatus {
+    with_renderer_ref(renderer, |r| {
+        let s = r.r.residency();
+        *mut_ref(residency, "residency")? = FvResidency {
+            bricks: s.bricks,
+            resident: s.resident,
+            brick_uploads: r.r.stats().brick_uploads,
+            pool_bytes: s.pool_bytes,
+            dense_bytes: s.dense_bytes,
         };
         Ok(())
     })

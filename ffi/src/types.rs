@@ -255,6 +255,23 @@ pub struct FvStats {
     pub bricks: u32,
 }
 
+/// How much of the volume is on the device. A volume too large for one texture is split
+/// into bricks of which only those a frame needs (something visible, an iso-value) are
+/// resident. Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FvResidency {
+    /// Bricks the volume is split into, and how many of them are resident.
+    pub bricks: u32,
+    pub resident: u32,
+    /// Bricks read into the device so far.
+    pub brick_uploads: u32,
+    /// Bytes of the resident bricks' pool (with its apron and precomputed gradients), and
+    /// of the whole volume as one texture.
+    pub pool_bytes: u64,
+    pub dense_bytes: u64,
+}
+
 /// A C description that converts, validated, into its core type.
 pub trait ToCore {
     type Core;

@@ -1,11 +1,13 @@
 //! Volumes: the caller's scalars copied into an FvVolume.
 
 use super::*;
+use std::sync::Arc;
 
-/// Volume data on the CPU (a copy of the caller's array), ready to upload to renderers.
+/// Volume data on the CPU (a copy of the caller's array), ready to upload to renderers;
+/// renderers that keep a bricked volume's data share it (the caller may free the volume).
 /// Thread use: immutable after creation; may be read from several threads at once.
 pub struct FvVolume {
-    pub(crate) data: VolumeData,
+    pub(crate) data: Arc<VolumeData>,
 }
 
 fn scalars_from_bytes(t: FvScalarType, bytes: &[u8]) -> Scalars {
@@ -109,7 +111,7 @@ pub unsafe extern "C" fn fv_volume_new(
             scalars: scalars_from_bytes(t, bytes),
         };
         v.validate()?;
-        *slot = Box::into_raw(Box::new(FvVolume { data: v }));
+        *slot = Box::into_raw(Box::new(FvVolume { data: Arc::new(v) }));
         Ok(())
     })
 }

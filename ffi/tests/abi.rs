@@ -610,3 +610,63 @@ fn path_tracing_accumulates_and_refuses_bad_settings() {
     println!("accumulated paths per pixel: {counts:?} (camera moved before the last)");
     assert_eq!(counts, vec![2, 4, 6, 2]);
 }
+
+/// A bricked volume keeps only the bricks something visible lies in, reports it through
+/// fv_renderer_residency, and keeps rendering after the caller frees its FvVolume (the
+/// renderer shares the data it reads bricks from).
+#[test]
+fn bricked_volume_residency_outlives_the_volume() {
+    let lib = Lib::open();
+    let n = 24usize;
+    // a bright ball in one corner of a dark volume
+    let data: Vec<u8> = (0..n * n * n)
+        .map(|i| {
+            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
+            let r2 = (x as f32 - 5.0).powi(2) + (y as f32 - 5.0).powi(2) + (z as f32 - 5.0).powi(2);
+            if r2 < 16.0 {
+                200
+            } else {
+                0
+            }
+        })
+        .collect();
+    let mut s = Session::new(&lib);
+    let set_bricks =
+        lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_max_brick_points");
+    let residency = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus>(
+        "fv_renderer_residency",
+    );
+    // SAFETY: a valid handle; the residency out-pointer is checked for NULL.
+    unsafe {
+        lib.ok(set_bricks(s.r, 10));
+        lib.expect(residency(s.r, null_mut()), Null, "residency");
+    }
+    s.set_volume([24, 24, 24], FvScalarType::U8, &data);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0],
+        &[0.0, 0.0, 100.0, 0.0, 255.0, 1.0],
+    );
+    s.set_camera(&camera([11.5, 11.5, 80.0], [11.5; 3], [1.0, 200.0]));
+    let before = s.frame(32, 32).to_vec();
+    assert!(before.chunks(4).any(|p| p[3] > 100), "the ball is drawn");
+    let mut res = ferrovol::FvResidency::default();
+    // SAFETY: valid handles; the volume is freed once and forgotten by the session.
+    unsafe {
+        lib.ok(residency(s.r, &mut res));
+        lib.f::<Free>("fv_volume_free")(s.volume);
+    }
+    s.volume = null_mut();
+    let after = s.frame(32, 32).to_vec();
+    println!(
+        "{} of {} bricks resident ({} uploaded), pool {} bytes, dense {} bytes",
+        res.resident, res.bricks, res.brick_uploads, res.pool_bytes, res.dense_bytes
+    );
+    assert!(res.bricks >= 8);
+    assert!(
+        res.resident >= 1 && res.resident * 3 <= res.bricks,
+        "{res:?}"
+    );
+    assert_eq!(res.brick_uploads, res.resident);
+    assert_eq!(res.dense_bytes, (n * n * n) as u64);
+    assert_eq!(before, after, "the renderer still has the data");
+}

@@ -1,7 +1,9 @@
 // The volume as the ray-casting passes see it (group 1): bricks in slots of a pool texture
 // and a page table that maps each brick to its slot, sampled in index space and converted
 // back to scalar units. A sample first makes the brick holding it current (`locate`): the
-// page table is read when a ray enters a brick, not at every sample. A volume of one brick
+// page table is read when a ray enters a brick, not at every sample. A brick the frame does
+// not need (nothing in it is visible) is not resident and reads as a constant from its own
+// range, which is as invisible as every value of the brick. A volume of one brick
 // (SINGLE_BRICK) is its own texture and is sampled directly.
 
 struct Pool {
@@ -19,8 +21,11 @@ var<private> pool: Pool;
 // The first component's central differences per texel of the pool (shaders/gradient.wgsl),
 // where the upload made them (PRECOMPUTED_GRADIENT); otherwise the pool again, unused.
 @group(1) @binding(3) var gradient_tex: texture_3d<f32>;
-// Per brick: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest).
+// Per brick: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest), or
+// PAGE_EMPTY when it is not resident.
 @group(1) @binding(4) var page_table: texture_3d<u32>;
+// Per brick: the texel value a non-resident brick reads as (each component's lowest value).
+@group(1) @binding(5) var brick_constants: texture_3d<f32>;
 
 // The volume is one brick, its texture the pool: no page-table lookups (a pipeline
 // constant each pass sets from the volume).
@@ -33,12 +38,16 @@ struct Brick {
     tex_lo: vec3<f32>,    // index-space point at the pool's texel 0 (p − tex_lo: pool texels)
     slot_lo: vec3<f32>,   // the brick's slot: first and last texel in the pool
     slot_hi: vec3<f32>,
+    empty: bool,          // not resident: every sample reads `constant`
+    constant: vec4<f32>,
 }
 
 var<private> brick: Brick;
 
 fn enter_brick(cell: vec3<u32>) {
     let e = textureLoad(page_table, vec3<i32>(cell), 0).x;
+    brick.empty = (e & PAGE_EMPTY) != 0u;
+    brick.constant = textureLoad(brick_constants, vec3<i32>(cell), 0);
     let m = (1u << PAGE_SLOT_BITS) - 1u;
     let s = vec3<u32>(e & m, (e >> PAGE_SLOT_BITS) & m, e >> (2u * PAGE_SLOT_BITS));
     let slot = vec3<f32>(s) * pool.slot.xyz;
@@ -79,7 +88,11 @@ override FORWARD_DIFF: bool = false;
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
     let tc = (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
-    return textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
+    let v = textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
+    if (SINGLE_BRICK) {
+        return v;
+    }
+    return select(v, brick.constant, brick.empty);
 }
 
 // Scalars (data units) of every component at texture coordinate tc.
@@ -100,7 +113,7 @@ struct Gradient {
 
 // Index-space gradient of every component: central differences (6 samples) or forward
 // differences from the centre value s (3 samples).
-fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
+fn brick_gradient(p: vec3<f32>, s: vec4<f32>) -> Gradient {
     // neighbours one voxel away, offset directly in texture coordinates
     let tc = (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
     if (PRECOMPUTED_GRADIENT && !FORWARD_DIFF) {
@@ -123,6 +136,18 @@ fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
         g.x = 0.5 * (scalars_at(tc + dx) - scalars_at(tc - dx));
         g.y = 0.5 * (scalars_at(tc + dy) - scalars_at(tc - dy));
         g.z = 0.5 * (scalars_at(tc + dz) - scalars_at(tc - dz));
+    }
+    return g;
+}
+
+// Index-space gradient of every component at p (zero in a non-resident brick, whose
+// values are all invisible).
+fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
+    var g = brick_gradient(p, s);
+    if (!SINGLE_BRICK && brick.empty) {
+        g.x = vec4<f32>(0.0);
+        g.y = vec4<f32>(0.0);
+        g.z = vec4<f32>(0.0);
     }
     return g;
 }

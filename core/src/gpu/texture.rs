@@ -2,16 +2,27 @@
 
 use super::Context;
 
-/// A value per min–max block (occupancy flags, majorants, scalar ranges) as a 3D texture of
-/// `dims` that the passes read with textureLoad (lib/march.wgsl, block_coord): u32 values
-/// go to an r32uint texture, f32 values to r32float, [f32; 2] values to rg32float. A
-/// texture for the same reason as the transfer tables (resources::tables).
+/// A value per min–max block or brick (occupancy flags, majorants, scalar ranges, the page
+/// table) as a 3D texture of `dims` that the passes read with textureLoad (lib/march.wgsl,
+/// block_coord): u32 values go to an r32uint texture, f32 values to r32float, [f32; 2] to
+/// rg32float, [f32; 4] to rgba32float. A texture for the same reason as the transfer tables
+/// (resources::tables).
 pub(crate) fn block_grid<T: GridValue>(
     ctx: &Context,
     label: &str,
     dims: [u32; 3],
     values: &[T],
 ) -> wgpu::TextureView {
+    block_grid_texture(ctx, label, dims, values).create_view(&Default::default())
+}
+
+/// [`block_grid`]'s texture, for grids rewritten later (with [`upload_texture`]).
+pub(crate) fn block_grid_texture<T: GridValue>(
+    ctx: &Context,
+    label: &str,
+    dims: [u32; 3],
+    values: &[T],
+) -> wgpu::Texture {
     let size = wgpu::Extent3d {
         width: dims[0].max(1),
         height: dims[1].max(1),
@@ -30,14 +41,13 @@ pub(crate) fn block_grid<T: GridValue>(
     let n = (size.width * size.height * size.depth_or_array_layers) as usize;
     let mut data = values.to_vec();
     data.resize(n, T::default());
-    let texel_bytes = std::mem::size_of::<T>() as u32;
     upload_texture(
         &ctx.queue,
         &texture,
         bytemuck::cast_slice(&data),
-        texel_bytes,
+        std::mem::size_of::<T>() as u32,
     );
-    texture.create_view(&Default::default())
+    texture
 }
 
 /// Writes tightly packed texels (`texel_bytes` each, rows then images) over the whole of
@@ -115,6 +125,10 @@ impl GridValue for f32 {
 
 impl GridValue for [f32; 2] {
     const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+}
+
+impl GridValue for [f32; 4] {
+    const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 }
 
 /// The descriptor of a 2D texture of one mip level and one layer.

@@ -55,6 +55,19 @@ pub struct Stats {
     pub table_uploads: u32,
     pub occupancy_updates: u32,
     pub frames: u32,
+    /// Bricks read into the pool of a bricked volume.
+    pub brick_uploads: u32,
+}
+
+/// How much of the volume is on the device: bricks resident against all bricks, and the
+/// pool's bytes (volume texture and precomputed gradients) against what the whole volume
+/// would take. A volume that fits one texture is one brick, always resident.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Residency {
+    pub bricks: u32,
+    pub resident: u32,
+    pub pool_bytes: u64,
+    pub dense_bytes: u64,
 }
 
 /// A finished frame read back to the CPU.

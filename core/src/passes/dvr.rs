@@ -12,6 +12,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation};
 use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::volume::Needed;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -72,6 +73,14 @@ impl DvrPass {
         let step = res.sample_distance(params)?;
         res.ensure_tables(ctx, step)?;
         res.ensure_occupancy(ctx, step)?;
+        res.ensure_resident(
+            ctx,
+            if params.blend == BlendMode::Composite {
+                Needed::Occupied
+            } else {
+                Needed::All
+            },
+        )?;
         let occupied = res.occupancy.as_ref().map_or(1.0, |o| o.fraction);
         let skip = params.empty_space_skipping
             && params.blend == BlendMode::Composite

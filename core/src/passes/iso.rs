@@ -39,6 +39,7 @@ use crate::params::{
 use crate::resources::environment::texel_solid_angle;
 use crate::resources::tables::{Occupancy, Tables};
 use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::volume::Needed;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
@@ -351,6 +352,16 @@ impl IsoPass {
         })?;
         let values: Vec<f32> = iso.values.iter().map(|v| v.value as f32).collect();
         self.ensure_occupancy(ctx, res, &values)?;
+        let surfaces = &self.occupancy.as_ref().expect("built above").flags;
+        if iso.scattering.is_some() {
+            // the scattering also reads the transfer function's opacity between the surfaces
+            res.ensure_occupancy(ctx, step)?;
+            let visible = &res.occupancy.as_ref().expect("built above").flags;
+            let both: Vec<u32> = surfaces.iter().zip(visible).map(|(a, b)| a | b).collect();
+            res.ensure_resident(ctx, Needed::Blocks(&both))?;
+        } else {
+            res.ensure_resident(ctx, Needed::Blocks(surfaces))?;
+        }
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);

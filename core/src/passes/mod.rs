@@ -5,7 +5,6 @@
 pub(crate) mod denoise;
 pub(crate) mod dvr;
 pub(crate) mod frame;
-pub(crate) mod gradient;
 pub(crate) mod iso;
 pub(crate) mod pathtrace;
 pub(crate) mod scatter_check;

@@ -46,6 +46,7 @@ use crate::params::{
     ScatterRegions, Shading,
 };
 use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::volume::Needed;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
@@ -321,6 +322,8 @@ impl PathTracePass {
             .map_or(1.0, |tf| tf.component(0).unit_distance);
         let step = res.sample_distance(params)?;
         res.ensure_tables(ctx, step)?;
+        res.ensure_occupancy(ctx, step)?;
+        res.ensure_resident(ctx, Needed::Occupied)?;
         res.ensure_environment(ctx)?;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;

@@ -122,7 +122,8 @@ pub struct BrickGrid {
     pub counts: [u32; 3],
     /// Points per slot, per axis.
     pub slot: [u32; 3],
-    /// Slots per pool axis.
+    /// Slots per pool axis: x and y per layer of slots, and the most layers (the pool
+    /// grows layer by layer as bricks become resident).
     pub slots: [u32; 3],
 }
 
@@ -132,20 +133,33 @@ impl BrickGrid {
         self.counts.iter().map(|&c| c as usize).product()
     }
 
-    /// The pool texture's size in points.
-    pub fn pool_size(&self) -> [u32; 3] {
-        [0, 1, 2].map(|a| self.slot[a] * self.slots[a])
+    /// The size in points of a pool of `layers` layers of slots.
+    pub fn pool_size(&self, layers: u32) -> [u32; 3] {
+        [
+            self.slot[0] * self.slots[0],
+            self.slot[1] * self.slots[1],
+            self.slot[2] * layers,
+        ]
+    }
+
+    /// Slots per layer.
+    pub fn layer_slots(&self) -> u32 {
+        self.slots[0] * self.slots[1]
+    }
+
+    /// The min–max blocks (of `block_dims`, [`BLOCK_SIZE`] cells each) the core of the
+    /// brick at `cell` overlaps, as inclusive ranges per axis.
+    pub fn blocks_of(&self, cell: [u32; 3], block_dims: [u32; 3]) -> [[u32; 2]; 3] {
+        [0, 1, 2].map(|a| {
+            let lo = cell[a] * self.brick_cells / BLOCK_SIZE;
+            let hi = (cell[a] + 1) * self.brick_cells / BLOCK_SIZE;
+            [lo.min(block_dims[a] - 1), hi.min(block_dims[a] - 1)]
+        })
     }
 
     /// Grid position of brick `i` (x fastest).
     pub fn cell(&self, i: usize) -> [u32; 3] {
         let [nx, ny, _] = self.counts.map(|c| c as usize);
-        [i % nx, (i / nx) % ny, i / (nx * ny)].map(|c| c as u32)
-    }
-
-    /// Slot position in the pool of slot `i` (x fastest).
-    pub fn slot_cell(&self, i: usize) -> [u32; 3] {
-        let [nx, ny, _] = self.slots.map(|c| c as usize);
         [i % nx, (i / nx) % ny, i / (nx * ny)].map(|c| c as u32)
     }
 
@@ -157,10 +171,11 @@ impl BrickGrid {
 }
 
 /// Splits a volume of `dims` points into bricks of at most `max_brick` points per axis
-/// (apron included) and lays their slots out in one pool texture of at most `max_pool`
-/// points per axis and `max_bytes` bytes. A volume that fits is one brick with no apron;
-/// otherwise the bricks are cubes whose slots have an edge of `slot_points` (at most
-/// `max_brick`). An error names the sizes when the pool does not fit.
+/// (apron included), their slots laid out for a pool texture of at most `max_pool` points
+/// per axis. A volume that fits (and whose texture takes at most `max_bytes`) is one brick
+/// with no apron; otherwise the bricks are cubes whose slots have an edge of `slot_points`
+/// (at most `max_brick`), layers of slots stacked along z. An error names the sizes when
+/// even a pool holding every brick would exceed the 3D texture limit.
 pub fn plan_bricks(
     dims: [u32; 3],
     texel_bytes: u32,
@@ -192,21 +207,21 @@ pub fn plan_bricks(
     let counts = cells.map(|c| c.div_ceil(b));
     let n: u64 = counts.iter().map(|&c| c as u64).product();
     let per_axis = (max_pool / edge) as u64;
-    let sx = n.min(per_axis);
-    let sy = n.div_ceil(sx).min(per_axis);
-    let sz = n.div_ceil(sx * sy);
+    let per_layer = n.div_ceil(per_axis.max(1));
+    let sx = per_layer.min(per_axis);
+    let sy = per_layer.div_ceil(sx.max(1));
+    let sz = n.div_ceil(sx * sy).min(per_axis);
     let slot_bytes = bytes([edge; 3]);
-    if sz > per_axis || sx * sy * sz * slot_bytes > max_bytes {
+    if per_axis == 0 || sy > per_axis {
         return Err(Error::Unsupported(format!(
             "the volume ({} × {} × {} points, {} bytes per point) needs {n} bricks of {edge}³ \
              points, {:.2} GiB of texture; the device takes at most {max_pool} points per \
-             axis and {:.2} GiB in one texture",
+             axis in one 3D texture",
             dims[0],
             dims[1],
             dims[2],
             texel_bytes,
             (n * slot_bytes) as f64 / (1u64 << 30) as f64,
-            max_bytes as f64 / (1u64 << 30) as f64,
         )));
     }
     Ok(BrickGrid {
@@ -338,7 +353,7 @@ mod tests {
         assert_eq!(g.brick_cells, 63);
         assert_eq!(g.len(), 1);
         assert_eq!(g.apron, 0);
-        assert_eq!(g.pool_size(), [64, 32, 16]);
+        assert_eq!(g.pool_size(1), [64, 32, 16]);
     }
 
     #[test]
@@ -354,8 +369,11 @@ mod tests {
             assert!((n - 1) * g.brick_cells < d - 1);
         }
         // the slots fit the pool and the core plus apron fits a slot
-        assert!(g.pool_size().iter().all(|&p| p <= 2048));
+        assert!(g.pool_size(g.slots[2]).iter().all(|&p| p <= 2048));
         assert!(g.slots.iter().product::<u32>() as usize >= g.len());
+        // a layer of slots is a fraction of the bricks: the pool grows in small steps
+        assert_eq!(g.layer_slots(), 1);
+        assert_eq!(g.blocks_of([1, 0, 0], [7, 5, 3]), [[1, 3], [0, 1], [0, 1]]);
         assert_eq!(g.brick_cells + 1 + 2 * g.apron, 20);
         assert_eq!(g.slot_origin_point([1, 0, 0]), [13, -2, -2]);
     }

@@ -4,6 +4,7 @@
 
 pub(crate) mod bricks;
 pub(crate) mod environment;
+pub(crate) mod gradients;
 pub(crate) mod tables;
 pub(crate) mod targets;
 pub(crate) mod volume;
@@ -16,6 +17,7 @@ use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Context;
 use crate::params::{RenderParams, Stats, TransferFunction};
 use environment::EnvironmentState;
+use gradients::GradientPass;
 use tables::{Occupancy, TableKey, Tables};
 use targets::Targets;
 use volume::GpuVolume;
@@ -24,7 +26,7 @@ use volume::GpuVolume;
 /// or rebuilt on demand by its `ensure_*` function when what decides its contents changed.
 pub(crate) struct Resources {
     /// Layout of the volume's bind group (group 1 of every pass that samples the volume):
-    /// pool uniforms, pool texture, sampler, gradient pool, page table.
+    /// pool uniforms, pool texture, sampler, gradient pool, page table, empty bricks' values.
     pub brick_bgl: wgpu::BindGroupLayout,
     pub nearest: wgpu::Sampler,
     linear: wgpu::Sampler,
@@ -41,6 +43,8 @@ pub(crate) struct Resources {
     pub generation: u64,
     pub environment: EnvironmentState,
     pub stats: Stats,
+    /// The gradient build, created when a volume first asks for precomputed gradients.
+    gradient_pass: Option<GradientPass>,
 }
 
 impl Resources {
@@ -61,6 +65,7 @@ impl Resources {
                     wgpu::TextureSampleType::Uint,
                     wgpu::TextureViewDimension::D3,
                 ),
+                texture_entry(5, false, wgpu::TextureViewDimension::D3),
             ],
         });
         let sampler = |f: wgpu::FilterMode| {
@@ -93,6 +98,7 @@ impl Resources {
             generation: 0,
             environment: EnvironmentState::default(),
             stats: Stats::default(),
+            gradient_pass: None,
         }
     }
 

@@ -51,6 +51,8 @@ impl Tables {
 pub(crate) struct Occupancy<K> {
     pub key: K,
     pub grid: wgpu::TextureView,
+    /// The same flags on the CPU, one per block.
+    pub flags: Vec<u32>,
     /// The fraction of blocks occupied.
     pub fraction: f64,
 }
@@ -67,6 +69,7 @@ impl<K: PartialEq> Occupancy<K> {
         Occupancy {
             key,
             grid,
+            flags: occ.to_vec(),
             fraction,
         }
     }

@@ -1,28 +1,28 @@
 //! The volume on the device: its bricks in the pool texture, the page table that maps each
-//! brick to its slot, the uniforms and bind groups the passes sample it through, and the
-//! min–max grid (on the CPU, and the first component's ranges on the device).
+//! brick to its slot (or marks it empty), the uniforms and bind groups the passes sample it
+//! through, and the min–max grid. A volume that fits one texture is uploaded whole; a
+//! bricked one keeps only the bricks a frame needs resident (`ensure_resident`), read from
+//! the host's data when they are first needed. The min–max grid is on the CPU, and the
+//! first component's ranges on the device.
 
 use super::bricks::{self, BrickGrid, Layout, MinMaxGrid};
+use super::gradients::GradientPass;
 use super::Resources;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::binding::bind;
 use crate::gpu::buffers::uniform_buffer;
-use crate::gpu::texture::{block_grid, upload_region};
-use crate::gpu::uniforms::{PoolUniforms, PAGE_SLOT_BITS};
+use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
+use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_SLOT_BITS};
 use crate::gpu::Context;
-use crate::params::{UploadOptions, VolumeData};
+use crate::params::{Residency, UploadOptions, VolumeData};
 use glam::DMat4;
-
-/// Computes the gradient texture of the pool from the pool texture (the gradient build
-/// pass).
-pub(crate) type GradientBuilder<'a> =
-    dyn Fn(&Context, &wgpu::TextureView, wgpu::Extent3d, &Layout) -> Result<wgpu::Texture> + 'a;
+use std::sync::Arc;
 
 /// Whether an upload of `v` with `opts` stores precomputed gradients: one-component volumes,
 /// when asked for. Off by default: on lavapipe one rgba16float fetch costs more than the six
 /// single-channel fetches it replaces, and 8-bit storage is filtered to 8-bit precision,
 /// which VTK's on-the-fly gradients share (exact gradients differ from VTK's on uint8 data).
-pub(crate) fn wants_gradients(v: &VolumeData, opts: &UploadOptions) -> bool {
+fn wants_gradients(v: &VolumeData, opts: &UploadOptions) -> bool {
     v.components == 1 && opts.precompute_gradients.unwrap_or(false)
 }
 
@@ -30,18 +30,46 @@ pub(crate) fn wants_gradients(v: &VolumeData, opts: &UploadOptions) -> bool {
 /// an apron of two points, 12% more texels than the bricks' cores.
 pub(crate) const SLOT_POINTS: u32 = 128;
 
+/// The volume data as the caller hands it over: borrowed (copied where a bricked volume
+/// must keep it) or shared.
+pub(crate) enum HostVolume<'a> {
+    Borrowed(&'a VolumeData),
+    Shared(Arc<VolumeData>),
+}
+
+impl HostVolume<'_> {
+    fn data(&self) -> &VolumeData {
+        match self {
+            HostVolume::Borrowed(v) => v,
+            HostVolume::Shared(v) => v,
+        }
+    }
+
+    fn into_shared(self) -> Arc<VolumeData> {
+        match self {
+            HostVolume::Borrowed(v) => Arc::new(v.clone()),
+            HostVolume::Shared(v) => v,
+        }
+    }
+}
+
+/// Which bricks a frame needs resident.
+pub(crate) enum Needed<'a> {
+    /// All of them (the projection modes read every value).
+    All,
+    /// Those overlapping a min–max block the transfer function makes visible (the
+    /// resources' occupancy, built first).
+    Occupied,
+    /// Those overlapping a min–max block flagged non-zero here (the iso-values' blocks).
+    Blocks(&'a [u32]),
+}
+
 pub(crate) struct GpuVolume {
     pub data_dims: [u32; 3],
     pub components: u32,
     pub index_to_data: DMat4,
     pub layout: Layout,
     pub grid: BrickGrid,
-    _pool: wgpu::Texture,
-    _gradient: Option<wgpu::Texture>,
-    _page_table: wgpu::TextureView,
-    _uniform: wgpu::Buffer,
-    bind_linear: wgpu::BindGroup,
-    bind_nearest: wgpu::BindGroup,
     pub minmax: MinMaxGrid,
     /// The first component's scalar range per min–max block, widened to bound every sample
     /// (MinMaxGrid::sample_bounds): an rg32float block grid, (min, max), that MIP and MinIP
@@ -49,36 +77,68 @@ pub(crate) struct GpuVolume {
     pub ranges: wgpu::TextureView,
     /// The pool carries precomputed gradients (binding 3).
     pub gradients: bool,
+    /// Bricked volumes: the data bricks are read from when they become resident.
+    host: Option<Arc<VolumeData>>,
+    /// Largest pool texture in bytes.
+    max_bytes: u64,
+    /// Per brick: its slot in the pool once resident.
+    slot_of: Vec<Option<u32>>,
+    /// Slots in use (filled in order) and layers of slots allocated.
+    resident: u32,
+    layers: u32,
+    pool: Option<wgpu::Texture>,
+    gradient: Option<wgpu::Texture>,
+    page: Vec<u32>,
+    page_table: wgpu::Texture,
+    constants: wgpu::Texture,
+    uniform: wgpu::Buffer,
+    /// Bind groups through the linear and the nearest sampler, once the pool exists.
+    groups: Option<[wgpu::BindGroup; 2]>,
 }
 
 impl GpuVolume {
     /// The volume's bind group (group 1 of every pass that samples it), read through the
-    /// nearest or the linear sampler.
+    /// nearest or the linear sampler. Passes call [`Resources::ensure_resident`] first.
     pub fn bind_group(&self, nearest: bool) -> &wgpu::BindGroup {
-        if nearest {
-            &self.bind_nearest
-        } else {
-            &self.bind_linear
-        }
+        let groups = self
+            .groups
+            .as_ref()
+            .expect("ensure_resident before binding");
+        &groups[nearest as usize]
     }
 
     /// The volume is one brick: the passes sample its texture directly.
     pub fn single_brick(&self) -> bool {
         self.grid.len() == 1
     }
+
+    /// What is resident against what the dense volume would take.
+    pub fn residency(&self) -> Residency {
+        // bytes per point: the volume's texel and, with precomputed gradients, 4 halves
+        let point = self.layout.texel_bytes as u64 + if self.gradients { 8 } else { 0 };
+        let bytes = |n: [u32; 3]| n.iter().map(|&d| d as u64).product::<u64>() * point;
+        Residency {
+            bricks: self.grid.len() as u32,
+            resident: self.resident,
+            pool_bytes: self.pool.as_ref().map_or(0, |t| {
+                let s = t.size();
+                bytes([s.width, s.height, s.depth_or_array_layers])
+            }),
+            dense_bytes: bytes(self.data_dims),
+        }
+    }
 }
 
 impl Resources {
-    /// Uploads a volume (replacing any previous one). With precomputed gradients (one
-    /// component and [`UploadOptions::precompute_gradients`]), `gradients` computes the
-    /// pool's gradient texture from it.
+    /// Uploads a volume (replacing any previous one): whole when it fits one texture,
+    /// otherwise as bricks that become resident when a frame needs them.
     pub fn set_volume(
         &mut self,
         ctx: &Context,
-        v: &VolumeData,
+        host: HostVolume<'_>,
         opts: UploadOptions,
-        gradients: Option<&GradientBuilder<'_>>,
     ) -> Result<()> {
+        let v = host.data();
         v.validate()?;
         let info = &ctx.info;
         let (storage, format, texel_bytes, scale, shift) = bricks::choose_storage(v, info);
@@ -101,101 +161,270 @@ impl Resources {
             scale,
             shift,
         };
-        let build_gradients = gradients.filter(|_| wants_gradients(v, &opts));
-        let d = &ctx.device;
-        let [px, py, pz] = grid.pool_size();
-        let size = wgpu::Extent3d {
-            width: px,
-            height: py,
-            depth_or_array_layers: pz,
-        };
-        let mut pages = vec![0u32; grid.len()];
-        let pool = ctx.checked("uploading the volume", || {
-            let pool = d.create_texture(&wgpu::TextureDescriptor {
-                label: Some("brick pool"),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
-                format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            for (i, page) in pages.iter_mut().enumerate() {
-                let slot = grid.slot_cell(i);
-                let texels = bricks::brick_texels(
-                    v,
-                    &layout,
-                    grid.slot_origin_point(grid.cell(i)),
-                    grid.slot,
-                );
-                let origin = [0, 1, 2].map(|a| slot[a] * grid.slot[a]);
-                upload_region(&ctx.queue, &pool, origin, grid.slot, &texels, texel_bytes);
-                *page = slot[0] | slot[1] << PAGE_SLOT_BITS | slot[2] << (2 * PAGE_SLOT_BITS);
+        let minmax = MinMaxGrid::new(v);
+        let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
+        let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
+        let gradients = wants_gradients(v, &opts);
+        let nc = v.components as usize;
+        // Empty bricks read as a constant that lies in their range: the lowest value of each
+        // component (as a texel), transparent wherever the whole range is.
+        let mut constants = vec![[0f32; 4]; grid.len()];
+        for (i, c) in constants.iter_mut().enumerate() {
+            let [x, y, z] = grid.blocks_of(grid.cell(i), minmax.dims);
+            let mut lo = [f32::INFINITY; 4];
+            for k in z[0]..=z[1] {
+                for j in y[0]..=y[1] {
+                    for b in x[0]..=x[1] {
+                        let block = ((k * minmax.dims[1] + j) * minmax.dims[0] + b) as usize;
+                        for (comp, l) in lo.iter_mut().enumerate().take(nc) {
+                            *l = l.min(minmax.ranges[block * nc + comp][0]);
+                        }
+                    }
+                }
             }
-            pool
-        })?;
-        let view = pool.create_view(&Default::default());
-        let gradient = match build_gradients {
-            Some(build) => Some(build(ctx, &view, size, &layout)?),
-            None => None,
-        };
-        let gradient_view = gradient
-            .as_ref()
-            .map(|t| t.create_view(&Default::default()));
-        let page_table = block_grid(ctx, "page table", grid.counts, &pages);
-        let f = |v: [u32; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
-        let pu = PoolUniforms {
-            brick: [grid.brick_cells as f32, grid.apron as f32, 0.0, 0.0],
-            grid: [grid.counts[0], grid.counts[1], grid.counts[2], 0],
-            slot: f(grid.slot),
-            inv_size: [1.0 / px as f32, 1.0 / py as f32, 1.0 / pz as f32, 0.0],
-        };
+            for comp in 0..nc {
+                c[comp] = (lo[comp] - layout.shift[comp]) / layout.scale[comp];
+            }
+        }
+        let page = vec![PAGE_EMPTY; grid.len()];
+        let page_table = block_grid_texture(ctx, "page table", grid.counts, &page);
+        let constants = block_grid_texture(ctx, "empty bricks' values", grid.counts, &constants);
         let uniform = uniform_buffer(
             ctx,
             "pool uniforms",
             std::mem::size_of::<PoolUniforms>() as u64,
         );
-        ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&pu));
+        let data_dims = v.dims;
+        let components = v.components;
+        let index_to_data = v.index_to_data();
+        let (host, whole) = if grid.len() == 1 {
+            (None, Some(bricks::brick_texels(v, &layout, [0; 3], v.dims)))
+        } else {
+            (Some(host.into_shared()), None)
+        };
+        self.volume = Some(GpuVolume {
+            data_dims,
+            components,
+            index_to_data,
+            layout,
+            grid,
+            minmax,
+            ranges,
+            gradients,
+            host,
+            max_bytes,
+            slot_of: vec![None; grid.len()],
+            resident: 0,
+            layers: 0,
+            pool: None,
+            gradient: None,
+            page,
+            page_table,
+            constants,
+            uniform,
+            groups: None,
+        });
+        self.occupancy = None;
+        self.stats.volume_uploads += 1;
+        match whole {
+            Some(texels) => self.upload_whole(ctx, &texels),
+            None => Ok(()),
+        }
+    }
+
+    /// A one-brick volume: its texture (of `texels`) is the pool.
+    fn upload_whole(&mut self, ctx: &Context, texels: &[u8]) -> Result<()> {
+        let vol = self.volume.as_mut().expect("set above");
+        let pool = new_pool(ctx, vol, 1)?;
+        upload_texture(&ctx.queue, &pool, texels, vol.layout.texel_bytes);
+        vol.pool = Some(pool);
+        vol.slot_of[0] = Some(0);
+        vol.page[0] = 0;
+        vol.resident = 1;
+        vol.layers = 1;
+        self.finish_residency(ctx)
+    }
+
+    /// Makes the bricks `needed` names resident: each is read from the host's data into a
+    /// free slot, the pool growing by layers of slots as it fills. Bricks stay resident
+    /// once uploaded, so a transfer-function change uploads only the bricks it adds.
+    pub fn ensure_resident(&mut self, ctx: &Context, needed: Needed<'_>) -> Result<()> {
+        match needed {
+            Needed::All => self.make_resident(ctx, None),
+            Needed::Blocks(flags) => self.make_resident(ctx, Some(flags)),
+            Needed::Occupied => {
+                let occupancy = self.occupancy.take();
+                let done = self.make_resident(ctx, occupancy.as_ref().map(|o| &o.flags[..]));
+                self.occupancy = occupancy;
+                done
+            }
+        }
+    }
+
+    /// The bricks overlapping a block flagged in `flags` (all of them without) resident.
+    fn make_resident(&mut self, ctx: &Context, flags: Option<&[u32]>) -> Result<()> {
+        let vol = self
+            .volume
+            .as_mut()
+            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
+        let Some(host) = vol.host.clone() else {
+            return Ok(());
+        };
+        let grid = vol.grid;
+        let bd = vol.minmax.dims;
+        let wanted: Vec<usize> = (0..grid.len())
+            .filter(|&i| vol.slot_of[i].is_none())
+            .filter(|&i| match flags {
+                None => true,
+                Some(flags) => {
+                    let [x, y, z] = grid.blocks_of(grid.cell(i), bd);
+                    (z[0]..=z[1]).any(|k| {
+                        (y[0]..=y[1]).any(|j| {
+                            (x[0]..=x[1])
+                                .any(|b| flags[((k * bd[1] + j) * bd[0] + b) as usize] != 0)
+                        })
+                    })
+                }
+            })
+            .collect();
+        if wanted.is_empty() && vol.groups.is_some() {
+            return Ok(());
+        }
+        let layers = (vol.resident + wanted.len() as u32)
+            .div_ceil(grid.layer_slots())
+            .max(1);
+        if layers > vol.layers {
+            let pool = new_pool(ctx, vol, layers)?;
+            if let Some(old) = vol.pool.as_ref() {
+                let mut enc = ctx.device.create_command_encoder(&Default::default());
+                enc.copy_texture_to_texture(old.as_image_copy(), pool.as_image_copy(), old.size());
+                ctx.queue.submit([enc.finish()]);
+            }
+            vol.pool = Some(pool);
+            vol.layers = layers;
+        }
+        let pool = vol.pool.as_ref().expect("allocated above");
+        for &i in &wanted {
+            let slot = vol.resident;
+            vol.resident += 1;
+            let [sx, sy, sz] = [
+                slot % grid.slots[0],
+                slot / grid.slots[0] % grid.slots[1],
+                slot / grid.layer_slots(),
+            ];
+            let texels = bricks::brick_texels(
+                &host,
+                &vol.layout,
+                grid.slot_origin_point(grid.cell(i)),
+                grid.slot,
+            );
+            let origin = [sx * grid.slot[0], sy * grid.slot[1], sz * grid.slot[2]];
+            upload_region(
+                &ctx.queue,
+                pool,
+                origin,
+                grid.slot,
+                &texels,
+                vol.layout.texel_bytes,
+            );
+            vol.slot_of[i] = Some(slot);
+            vol.page[i] = sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS);
+        }
+        self.stats.brick_uploads += wanted.len() as u32;
+        self.finish_residency(ctx)
+    }
+
+    /// After the pool changed: the page table, the pool's gradients, uniforms and bind
+    /// groups.
+    fn finish_residency(&mut self, ctx: &Context) -> Result<()> {
+        let vol = self.volume.as_mut().expect("a volume");
+        upload_texture(
+            &ctx.queue,
+            &vol.page_table,
+            bytemuck::cast_slice(&vol.page),
+            4,
+        );
+        let pool = vol.pool.as_ref().expect("a pool");
+        let view = pool.create_view(&Default::default());
+        if vol.gradients {
+            let pass = match self.gradient_pass.take() {
+                Some(p) => p,
+                None => GradientPass::new(ctx)?,
+            };
+            vol.gradient = Some(pass.build(ctx, &view, pool.size(), &vol.layout)?);
+            self.gradient_pass = Some(pass);
+        }
+        let s = pool.size();
+        let g = &vol.grid;
+        let pu = PoolUniforms {
+            brick: [g.brick_cells as f32, g.apron as f32, 0.0, 0.0],
+            grid: [g.counts[0], g.counts[1], g.counts[2], 0],
+            slot: [g.slot[0] as f32, g.slot[1] as f32, g.slot[2] as f32, 0.0],
+            inv_size: [
+                1.0 / s.width as f32,
+                1.0 / s.height as f32,
+                1.0 / s.depth_or_array_layers as f32,
+                0.0,
+            ],
+        };
+        ctx.queue
+            .write_buffer(&vol.uniform, 0, bytemuck::bytes_of(&pu));
+        let gradient_view = vol
+            .gradient
+            .as_ref()
+            .map(|t| t.create_view(&Default::default()));
+        let page_view = vol.page_table.create_view(&Default::default());
+        let constants_view = vol.constants.create_view(&Default::default());
         let group = |s: &wgpu::Sampler| {
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("volume"),
                 layout: &self.brick_bgl,
                 entries: &[
-                    bind(0, uniform.as_entire_binding()),
+                    bind(0, vol.uniform.as_entire_binding()),
                     bind(1, wgpu::BindingResource::TextureView(&view)),
                     bind(2, wgpu::BindingResource::Sampler(s)),
                     bind(
                         3,
                         wgpu::BindingResource::TextureView(gradient_view.as_ref().unwrap_or(&view)),
                     ),
-                    bind(4, wgpu::BindingResource::TextureView(&page_table)),
+                    bind(4, wgpu::BindingResource::TextureView(&page_view)),
+                    bind(5, wgpu::BindingResource::TextureView(&constants_view)),
                 ],
             })
         };
-        let bind_linear = group(&self.linear);
-        let bind_nearest = group(&self.nearest);
-        let minmax = MinMaxGrid::new(v);
-        let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
-        let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
-        self.volume = Some(GpuVolume {
-            data_dims: v.dims,
-            components: v.components,
-            index_to_data: v.index_to_data(),
-            layout,
-            grid,
-            _pool: pool,
-            _gradient: gradient,
-            _page_table: page_table,
-            _uniform: uniform,
-            bind_linear,
-            bind_nearest,
-            minmax,
-            ranges,
-            gradients: build_gradients.is_some(),
-        });
-        self.occupancy = None;
-        self.stats.volume_uploads += 1;
+        vol.groups = Some([group(&self.linear), group(&self.nearest)]);
         Ok(())
     }
+}
+
+/// A pool texture of `layers` layers of slots for `vol`, within its byte limit.
+fn new_pool(ctx: &Context, vol: &GpuVolume, layers: u32) -> Result<wgpu::Texture> {
+    let [w, h, d] = vol.grid.pool_size(layers);
+    let bytes = w as u64 * h as u64 * d as u64 * vol.layout.texel_bytes as u64;
+    if bytes > vol.max_bytes {
+        return Err(Error::Unsupported(format!(
+            "the bricks this frame needs take {w} × {h} × {d} points ({:.2} GiB) of brick \
+             pool; the device allows {:.2} GiB in one texture",
+            bytes as f64 / (1u64 << 30) as f64,
+            vol.max_bytes as f64 / (1u64 << 30) as f64,
+        )));
+    }
+    ctx.checked("allocating the brick pool", || {
+        ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("brick pool"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: d,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: vol.layout.format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    })
 }

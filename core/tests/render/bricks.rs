@@ -562,3 +562,83 @@ fn bricked_path_tracing_equals_unbricked() {
     );
     assert!(flip_split <= 1.1 * flip_seed);
 }
+
+/// Sparse residency: a bricked volume keeps only the bricks something visible lies in, so a
+/// transfer function that shows a small part of the volume takes a matching part of the
+/// memory; widening it uploads only the bricks it adds; the projection modes make every
+/// brick resident; every image equals the one-brick image.
+#[test]
+fn only_visible_bricks_are_resident() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    let view = View::fit(vol.bounds(), 64, 64);
+    let tf = |from: f64| {
+        TransferFunction::single(component_transfer(
+            &[(0.0, [0.9, 0.6, 0.2]), (1.0, [1.0, 1.0, 0.9])],
+            &[(0.0, 0.0), (from, 0.0), (1.0, 0.8)],
+            3.0,
+        ))
+    };
+    let params = RenderParams::default();
+    let mut frames = Vec::new();
+    for from in [0.55, 0.1] {
+        r.set_transfer_function(&tf(from)).unwrap();
+        r.set_volume(&vol).unwrap();
+        let one = r.render_image(&view, &params).unwrap();
+        set_bricked(&mut r, &vol, 12);
+        let uploads = r.stats().brick_uploads;
+        let split = r.render_image(&view, &params).unwrap();
+        // (a small blob core with the narrow transfer function: no assert_content)
+        assert!(footprint(&split) > 150, "the blob is drawn");
+        let (mean, max) = image_diff(&one, &split);
+        let res = r.residency();
+        println!(
+            "opacity from {from}: {} of {} bricks resident, pool {} of {} bytes dense \
+             ({:.0}%), {} bricks uploaded; image against one brick: mean {mean:.4}/255, \
+             max {max}/255",
+            res.resident,
+            res.bricks,
+            res.pool_bytes,
+            res.dense_bytes,
+            100.0 * res.pool_bytes as f64 / res.dense_bytes as f64,
+            r.stats().brick_uploads - uploads
+        );
+        assert!(max <= 2, "sparse bricks draw what one brick draws");
+        assert_eq!(res.bricks, 216);
+        assert_eq!(r.stats().brick_uploads - uploads, res.resident);
+        frames.push(res);
+    }
+    let [narrow, wide] = [frames[0], frames[1]];
+    assert!(narrow.resident * 3 < narrow.bricks, "{narrow:?}");
+    assert!(wide.resident > narrow.resident);
+    // Widening the transfer function on the same upload: only the added bricks come in.
+    r.set_transfer_function(&tf(0.55)).unwrap();
+    r.render_image(&view, &params).unwrap();
+    let before = r.stats().brick_uploads;
+    let narrow_resident = r.residency().resident;
+    r.set_transfer_function(&tf(0.1)).unwrap();
+    r.render_image(&view, &params).unwrap();
+    assert_eq!(
+        r.stats().brick_uploads - before,
+        r.residency().resident - narrow_resident,
+        "a wider transfer function uploads only the bricks it adds"
+    );
+    // Maximum intensity reads every value: every brick comes in.
+    let mip = RenderParams {
+        blend: BlendMode::Maximum,
+        ..Default::default()
+    };
+    r.render_image(&view, &mip).unwrap();
+    let all = r.residency();
+    println!(
+        "every brick resident: pool {} bytes; the narrow transfer function's pool is {:.0}% \
+         of it",
+        all.pool_bytes,
+        100.0 * narrow.pool_bytes as f64 / all.pool_bytes as f64
+    );
+    assert_eq!(all.resident, 216);
+    assert!(
+        narrow.pool_bytes * 2 < all.pool_bytes,
+        "{narrow:?} against {all:?}"
+    );
+}

@@ -1,4 +1,4 @@
-//! The gradient build (shaders/gradient.wgsl): central-difference gradients of a brick's
+//! The gradient build (shaders/gradient.wgsl): central-difference gradients of the pool's
 //! first component into an rgba16float texture beside it, for
 //! [`UploadOptions::precompute_gradients`](crate::UploadOptions::precompute_gradients).
 
@@ -33,7 +33,7 @@ impl GradientPass {
         Ok(GradientPass { bgl, pipeline })
     }
 
-    /// A brick's gradient texture, computed from its volume texture on the GPU.
+    /// The gradient texture of a volume texture (one brick or the pool), computed on the GPU.
     pub fn build(
         &self,
         ctx: &Context,
