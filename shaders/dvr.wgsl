@@ -28,6 +28,21 @@ override RANGE_SKIP: bool = false;
 override CROP: bool = false;
 // Volumetric shadows (lib/shadow.wgsl; one component, shading on).
 override VOLUMETRIC: bool = false;
+// A streamed frame (its bricks exceed the memory budget): several passes, each with a group
+// of bricks resident, front to back. A ray marches until its next sample's brick waits for
+// a later pass (PAGE_MISSING), keeps its state in `state` and resumes there; misc.w holds
+// the next sample's index, or −1 once the pixel is written.
+override STREAMING: bool = false;
+
+@group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
+
+// Whether the brick a sample at p (on a ray going along d) reads waits for a later pass.
+// The brick is the one just ahead along the ray: a sample on a brick face is served by
+// either brick (their aprons overlap), and the one behind may be gone.
+fn waits(p: vec3<f32>, d: vec3<f32>) -> bool {
+    locate_within(p + d * (1e-3 / max(length(d), 1e-30)), 0.0);
+    return brick.missing;
+}
 
 // Per min–max block, the first component's (min, max) over every point a sample in the
 // block interpolates from (nearest or trilinear), widened where the storage rounds the data
@@ -158,6 +173,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pix = px.y * frame.viewport.x + px.x;
     let blend = BLEND;
     var st: PixelState;
+    if (STREAMING) {
+        st = state[pix];
+        if (st.misc.w < 0.0) {
+            return;
+        }
+        locate_slack = 0.5;
+    }
     let ert = frame.misc.y;
     let ray = make_ray(px);
     // The whole ray segment inside the volume, near/far planes, opaque depth and clip planes.
@@ -195,10 +217,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // (written so that NaN from a degenerate ray also leaves)
     if (!(seg.x < seg.y)) {
+        if (STREAMING) {
+            st.misc.w = -1.0;
+            state[pix] = st;
+        }
         write_pixel(px, st);
         return;
     }
     var k = 0.0;
+    if (STREAMING) {
+        k = st.misc.w;
+    }
+    var suspended = false;
     // Bounded below 2^24 so that k + 1 is always exact and the loop always ends. Samples
     // up to the segment's end, one exactly on it too (VTK keeps a sample on the exit face).
     let k_last = (seg.y - seg.x) / dt - jit;
@@ -267,6 +297,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             k = k + 1.0;
             continue;
         }
+        if (STREAMING && waits(p, ray.index_dir)) {
+            suspended = true;
+            break;
+        }
         let s = sample_scalars(p);
         if (blend == BLEND_COMPOSITE) {
             let c = classify_sample(s, p, ray.origin + t * ray.dir, ray.dir);
@@ -307,5 +341,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     st.color = color;
     st.value = value;
     st.misc = misc;
+    if (STREAMING) {
+        st.misc.w = select(-1.0, k, suspended);
+        state[pix] = st;
+        if (suspended) {
+            return;
+        }
+    }
     write_pixel(px, st);
 }

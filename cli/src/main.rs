@@ -143,6 +143,11 @@ struct RenderArgs {
     /// Split the volume into bricks of at most this many points per edge.
     #[arg(long)]
     brick: Option<u32>,
+    /// Most MiB the volume may take on the device. A larger volume is bricked with only the
+    /// bricks a frame needs resident; when even those exceed it, ray casting streams them
+    /// through the pool in several passes (the other modes report the sizes).
+    #[arg(long, value_name = "MIB")]
+    gpu_memory: Option<u64>,
     /// Render this many frames and print the mean time per frame (the first, which builds
     /// pipelines and maps, is not counted). Path tracing: each timed frame starts the
     /// accumulation over, as a moving camera does, and traces --spp paths per pixel.
@@ -628,8 +633,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         &vol,
         UploadOptions {
             max_brick_points: a.brick,
+            memory_budget: a.gpu_memory.map(|m| m << 20),
             precompute_gradients: Some(a.precompute_gradients),
-            ..Default::default()
         },
     )?;
     r.set_transfer_function(&tf)?;
@@ -753,6 +758,14 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         r.context().info.name,
         a.out.display()
     );
+    let passes = r.stats().streamed_passes;
+    if passes > 0 {
+        println!(
+            "ferrovol: the visible bricks exceed --gpu-memory: {passes} streamed pass(es) over \
+             {} frame(s)",
+            r.stats().frames
+        );
+    }
     if let Some(ms) = timing {
         println!(
             "ferrovol: {:.1} ms/frame (mean of {} frames after the first)",

@@ -799,6 +799,14 @@ void fv_renderer_free(struct FvRenderer *renderer);
 enum FvStatus fv_renderer_set_max_brick_points(struct FvRenderer *renderer, uint32_t points);
 
 /**
+ * Most bytes a later volume upload may take on the device (0 = the device's limit). A
+ * larger volume is bricked with only the bricks a frame needs resident; when even those
+ * exceed the budget, ray casting streams them through the pool in several passes of one
+ * frame, and the other modes fail with FV_STATUS_UNSUPPORTED naming the sizes.
+ */
+enum FvStatus fv_renderer_set_memory_budget(struct FvRenderer *renderer, uint64_t bytes);
+
+/**
  * Uploads a volume (replacing the previous one). Call again only when the data changed:
  * camera and parameter changes never re-upload.
  */

@@ -241,6 +241,9 @@ public:
   }
   /// An FvOutputPath.
   void set_output_path(uint32_t path) { check(fv_renderer_set_output_path(h_.get(), path)); }
+  void set_memory_budget(uint64_t bytes) {
+    check(fv_renderer_set_memory_budget(h_.get(), bytes));
+  }
   void set_max_brick_points(uint32_t points) {
     check(fv_renderer_set_max_brick_points(h_.get(), points));
   }

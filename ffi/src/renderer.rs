@@ -86,6 +86,21 @@ pub unsafe extern "C" fn fv_renderer_set_max_brick_points(
     })
 }
 
+/// Most bytes a later volume upload may take on the device (0 = the device's limit). A
+/// larger volume is bricked with only the bricks a frame needs resident; when even those
+/// exceed the budget, ray casting streams them through the pool in several passes of one
+/// frame, and the other modes fail with FV_STATUS_UNSUPPORTED naming the sizes.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_memory_budget(
+    renderer: *mut FvRenderer,
+    bytes: u64,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        r.upload.memory_budget = (bytes > 0).then_some(bytes);
+        Ok(())
+    })
+}
+
 /// Uploads a volume (replacing the previous one). Call again only when the data changed:
 /// camera and parameter changes never re-upload.
 #[no_mangle]

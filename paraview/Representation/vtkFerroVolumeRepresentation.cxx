@@ -97,6 +97,18 @@ void vtkFerroVolumeRepresentation::SetEmptySpaceSkipping(int value)
 }
 
 //------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetMaxMemoryInBytes(vtkIdType value)
+{
+  this->GetFerroVolumeMapper()->SetMaxMemoryInBytes(value);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetMaxMemoryFraction(double value)
+{
+  this->GetFerroVolumeMapper()->SetMaxMemoryFraction(static_cast<float>(value));
+}
+
+//------------------------------------------------------------------------------------------
 // Isosurface settings: straight to the mapper, which clamps and documents them.
 void vtkFerroVolumeRepresentation::SetEnvironmentLighting(double value)
 {

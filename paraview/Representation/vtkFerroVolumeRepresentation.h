@@ -21,8 +21,8 @@
  * - the isosurface shading of vtkFerroVolumeMapper: environment lighting and map,
  *   background, specular sampling, ambient occlusion, shininess from the gradient, Fresnel;
  * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
- *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering, and
- *   EmptySpaceSkipping.
+ *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering,
+ *   EmptySpaceSkipping, MaxMemoryInBytes and MaxMemoryFraction.
  *
  * Inputs: vtkImageData only (what vtkFerroVolumeMapper renders). Rectilinear grids and
  * composite datasets, which "Volume" accepts, are not drawn; a warning says so.
@@ -81,6 +81,8 @@ public:
   void SetImageSampleDistance(double value);
   void SetUseJittering(int value);
   void SetEmptySpaceSkipping(int value);
+  void SetMaxMemoryInBytes(vtkIdType value);
+  void SetMaxMemoryFraction(double value);
   ///@}
 
   ///@{

@@ -68,11 +68,12 @@ var<private> frame: Frame;
 // at per-lane indices one lane at a time.
 @group(0) @binding(1) var tables: texture_2d<f32>;
 
-// Per-pixel ray state carried across brick passes.
+// Per-pixel ray state: the first-hit pass's layer counts, and a streamed ray's state between
+// the passes of its frame (shaders/dvr.wgsl).
 struct PixelState {
     color: vec4<f32>,   // premultiplied RGBA accumulated front to back
     value: vec4<f32>,   // per component: max (MIP), min (MinIP), sum (average, additive)
-    misc: vec4<f32>,    // x: samples counted, y: window depth of the depth sample, z: 1 once depth is set
+    misc: vec4<f32>,    // x: samples counted, y: window depth of the depth sample, z: 1 once depth is set, w: next sample of a streamed ray (−1: done)
 }
 
 fn has_flag(f: u32) -> bool {

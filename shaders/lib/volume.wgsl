@@ -22,7 +22,8 @@ var<private> pool: Pool;
 // where the upload made them (PRECOMPUTED_GRADIENT); otherwise the pool again, unused.
 @group(1) @binding(3) var gradient_tex: texture_3d<f32>;
 // Per brick: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest), or
-// PAGE_EMPTY when it is not resident.
+// PAGE_EMPTY when it is not resident, or PAGE_MISSING when a later pass of a streamed
+// frame brings it.
 @group(1) @binding(4) var page_table: texture_3d<u32>;
 // Per brick: the texel value a non-resident brick reads as (each component's lowest value).
 @group(1) @binding(5) var brick_constants: texture_3d<f32>;
@@ -40,6 +41,7 @@ struct Brick {
     slot_hi: vec3<f32>,
     empty: bool,          // not resident: every sample reads `constant`
     constant: vec4<f32>,
+    missing: bool,        // needed, resident in a later pass of a streamed frame
 }
 
 var<private> brick: Brick;
@@ -47,6 +49,7 @@ var<private> brick: Brick;
 fn enter_brick(cell: vec3<u32>) {
     let e = textureLoad(page_table, vec3<i32>(cell), 0).x;
     brick.empty = (e & PAGE_EMPTY) != 0u;
+    brick.missing = (e & PAGE_MISSING) != 0u;
     brick.constant = textureLoad(brick_constants, vec3<i32>(cell), 0);
     let m = (1u << PAGE_SLOT_BITS) - 1u;
     let s = vec3<u32>(e & m, (e >> PAGE_SLOT_BITS) & m, e >> (2u * PAGE_SLOT_BITS));
@@ -64,17 +67,28 @@ fn enter_volume() {
     enter_brick(vec3<u32>(0u));
 }
 
+// How far past its core (index units) the current brick keeps serving samples: 0, or up to
+// one point less than the apron, which still holds every point trilinear interpolation
+// and central differences read (shaders/dvr.wgsl sets it when streaming, so that a sample
+// just behind a brick face is read from the brick ahead).
+var<private> locate_slack: f32 = 0.0;
+
 // Index-space point p clamped to the volume (as a clamping sampler reads a point outside),
-// with the brick holding it made current.
-fn locate(p: vec3<f32>) -> vec3<f32> {
+// with a brick serving it made current: the current one if p lies within `slack` of its
+// core, otherwise the one holding it.
+fn locate_within(p: vec3<f32>, slack: f32) -> vec3<f32> {
     if (SINGLE_BRICK) {
         return p;
     }
     let q = clamp(p, vec3<f32>(0.0), frame.dims.xyz - 1.0);
-    if (any(q < brick.core_lo) || any(q > brick.core_hi)) {
+    if (any(q < brick.core_lo - slack) || any(q > brick.core_hi + slack)) {
         enter_brick(min(vec3<u32>(q / pool.brick.x), pool.grid.xyz - 1u));
     }
     return q;
+}
+
+fn locate(p: vec3<f32>) -> vec3<f32> {
+    return locate_within(p, locate_slack);
 }
 
 // Read gradients from gradient_tex (one fetch) instead of six volume fetches: the same

@@ -347,7 +347,8 @@ bool vtkFerroVolumeInputHelper::Key::operator==(const Key& o) const
   return this->Input == o.Input && this->InputMTime == o.InputMTime &&
     this->Scalars == o.Scalars && this->ScalarsMTime == o.ScalarsMTime &&
     this->CellFlag == o.CellFlag && this->Dims[0] == o.Dims[0] && this->Dims[1] == o.Dims[1] &&
-    this->Dims[2] == o.Dims[2] && this->DataType == o.DataType && this->Components == o.Components;
+    this->Dims[2] == o.Dims[2] && this->DataType == o.DataType &&
+    this->Components == o.Components && this->Budget == o.Budget;
 }
 
 bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& error)
@@ -384,9 +385,11 @@ bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& 
   return true;
 }
 
-bool vtkFerroVolumeInputHelper::Upload(ferrovol::Renderer& renderer, std::string& error)
+bool vtkFerroVolumeInputHelper::Upload(
+  ferrovol::Renderer& renderer, uint64_t budget, std::string& error)
 {
   Key key;
+  key.Budget = budget;
   key.Input = this->Image;
   key.InputMTime = this->Image->GetMTime();
   key.Scalars = this->Scalars;
@@ -408,7 +411,10 @@ bool vtkFerroVolumeInputHelper::Upload(ferrovol::Renderer& renderer, std::string
   std::unique_ptr<ferrovol::Volume> volume;
   if (!vtkFerroVolumeCall("take the input volume", error,
         [&] { volume.reset(new ferrovol::Volume(pv.Desc, pv.Data, pv.Bytes)); }) ||
-    !vtkFerroVolumeCall("upload the volume", error, [&] { renderer.set_volume(*volume); }))
+    !vtkFerroVolumeCall("upload the volume", error, [&] {
+      renderer.set_memory_budget(budget);
+      renderer.set_volume(*volume);
+    }))
   {
     return false;
   }

@@ -27,9 +27,9 @@ public:
   // SelectScalarArray); false with the reason when there are none to render.
   bool Select(vtkFerroVolumeMapper* self, std::string& error);
 
-  // Gives the renderer the selected scalars as a volume when they changed since the last
-  // upload.
-  bool Upload(ferrovol::Renderer& renderer, std::string& error);
+  // Gives the renderer the selected scalars as a volume, within `budget` bytes of device
+  // memory (0: the device's limit), when they or the budget changed since the last upload.
+  bool Upload(ferrovol::Renderer& renderer, uint64_t budget, std::string& error);
 
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }
@@ -53,6 +53,7 @@ private:
     int Dims[3] = { 0, 0, 0 };
     int DataType = -1;
     int Components = 0;
+    uint64_t Budget = 0;
 
     bool operator==(const Key& o) const;
   };

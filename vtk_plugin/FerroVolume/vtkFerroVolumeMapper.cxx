@@ -98,6 +98,8 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , ImageSampleDistance(1.0f)
   , UseJittering(0)
   , EmptySpaceSkipping(1)
+  , MaxMemoryInBytes(0)
+  , MaxMemoryFraction(0.75f)
   , OutputPath(OUTPUT_PATH_AUTOMATIC)
   , EnvironmentLighting(0.0)
   , EnvironmentMap(nullptr)
@@ -230,7 +232,13 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   // Blend mode, input, volume (on change), tables (on change), frame parameters.
   std::string error;
   if (!in->Settings.SelectBlendMode(this, error) || !in->Input.Select(this, error) ||
-    !in->MakeRenderer(error) || !in->Input.Upload(*in->Renderer, error) ||
+    !in->MakeRenderer(error) ||
+    !in->Input.Upload(*in->Renderer,
+      this->MaxMemoryInBytes > 0
+        ? static_cast<uint64_t>(static_cast<double>(this->MaxMemoryInBytes) *
+            this->MaxMemoryFraction)
+        : 0,
+      error) ||
     !in->Tables.Update(vol, in->Input, *in->Renderer, error))
   {
     vtkErrorMacro(<< error);
@@ -314,6 +322,8 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
   os << indent << "UseJittering: " << this->UseJittering << "\n";
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
+  os << indent << "MaxMemoryInBytes: " << this->MaxMemoryInBytes << "\n";
+  os << indent << "MaxMemoryFraction: " << this->MaxMemoryFraction << "\n";
   os << indent << "EnvironmentLighting: " << this->EnvironmentLighting << "\n";
   os << indent << "EnvironmentMap: "
      << (this->EnvironmentMap && *this->EnvironmentMap ? this->EnvironmentMap : "(sky)") << "\n";

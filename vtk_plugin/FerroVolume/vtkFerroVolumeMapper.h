@@ -114,6 +114,21 @@ public:
 
   ///@{
   /**
+   * The device memory the volume may take, as vtkGPUVolumeRayCastMapper's settings: at most
+   * MaxMemoryInBytes × MaxMemoryFraction bytes (MaxMemoryInBytes 0, the default: the
+   * device's limit; the fraction defaults to 0.75). A larger volume is split into bricks of
+   * which only those a frame needs are on the device; when even those exceed the budget,
+   * ray casting streams them in several passes of one frame (the same image) and the other
+   * render modes report the sizes. Takes effect at the next upload.
+   */
+  vtkSetMacro(MaxMemoryInBytes, vtkIdType);
+  vtkGetMacro(MaxMemoryInBytes, vtkIdType);
+  vtkSetClampMacro(MaxMemoryFraction, float, 0.1f, 1.0f);
+  vtkGetMacro(MaxMemoryFraction, float);
+  ///@}
+
+  ///@{
+  /**
    * Isosurface blend mode: how much of the environment's light falls on the surfaces,
    * diffuse (irradiance) and specular (the Phong lobe sampled on the environment map),
    * added to the renderer's lights. 0 (the default) lights the surfaces as
@@ -472,6 +487,8 @@ protected:
   float ImageSampleDistance;
   vtkTypeBool UseJittering;
   vtkTypeBool EmptySpaceSkipping;
+  vtkIdType MaxMemoryInBytes;
+  float MaxMemoryFraction;
   int OutputPath;
   double EnvironmentLighting;
   char* EnvironmentMap;

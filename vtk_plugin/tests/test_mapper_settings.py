@@ -195,6 +195,19 @@ class Settings(unittest.TestCase):
         off, _ = self.render(lambda m: m.EmptySpaceSkippingOff())
         self.assertLessEqual(mean_diff(on, off), 0.05)
 
+    def test_memory_budget_streams_the_same_image(self):
+        # wavelet(23): 48^3 float32, 432 KiB; a budget of a quarter of it (MaxMemoryInBytes x
+        # MaxMemoryFraction) bricks the volume and streams the bricks in several passes
+        full, _ = self.render()
+        streamed, mapper = self.render(lambda m: (m.SetMaxMemoryInBytes(48 ** 3 * 4 // 2),
+                                                  m.SetMaxMemoryFraction(0.5)))
+        save("settings-memory-budget", full, streamed)
+        d = float(np.abs(streamed - full).max())
+        print("memory budget 108 KiB: max |difference| to unlimited %.1f levels" % d)
+        self.assertEqual(mapper.GetMaxMemoryFraction(), 0.5)
+        self.assertLessEqual(d, 2.0)
+        self.assertGreater(coverage(streamed), 0.2)
+
     def test_volume_matrix(self):
         # Parallel projection: moving the volume by 10 world units moves its image by
         # 10 / (2 * parallel scale) of the window height.

@@ -137,18 +137,20 @@ class PathTrace(unittest.TestCase):
         s = self.scene()
         light = vtk.vtkLight()
         light.SetPositional(1)
-        light.SetPosition(0, 0, 50)
+        light.SetPosition(40, 0, 10)
         light.SetFocalPoint(0, 0, 0)
         s.renderer.AddLight(light)
         lit = s.render()
         save("pathtrace-crop-positional", full, cropped, lit)
-        log("coverage: whole %.3f, cropped to x < 0 %.3f; with a positional light added the "
-            "mean brightness is %.2f times the headlight's alone"
-            % (coverage(full), coverage(cropped), float(lit.mean() / full.mean())))
+        # (a light of the renderer's own replaces VTK's automatic headlight)
+        d = float(np.abs(lit - full).mean())
+        log("coverage: whole %.3f, cropped to x < 0 %.3f; a positional light instead of the "
+            "headlight: mean |difference| %.2f levels" % (coverage(full), coverage(cropped), d))
         self.assertEqual(self.errors.messages, [])
         self.assertLess(coverage(cropped), 0.8 * coverage(full))
         self.assertGreater(coverage(cropped), 0.1 * coverage(full))
-        self.assertGreater(float(lit.mean()), 1.02 * float(full.mean()))
+        self.assertGreater(d, 0.3)
+        self.assertGreater(coverage(lit), 0.2)
 
 if __name__ == "__main__":
     unittest.main()

@@ -156,6 +156,9 @@ pub const PAGE_SLOT_BITS: u32 = 10;
 /// A page-table entry with this bit set: the brick is not resident and reads as the constant
 /// its texel in the empty bricks' values holds (lib/volume.wgsl).
 pub const PAGE_EMPTY: u32 = 1 << 31;
+/// A page-table entry with this bit set: the brick is needed but waits for a later pass of
+/// a streamed frame (the ray stops there and resumes then; shaders/dvr.wgsl).
+pub const PAGE_MISSING: u32 = 1 << 30;
 
 /// Most lights and clipping planes a frame takes (the sizes of Frame's arrays).
 pub const MAX_LIGHTS: usize = 8;
@@ -221,6 +224,7 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("MAX_LIGHTS", Wgsl::U32(MAX_LIGHTS as u32)),
     ("PAGE_SLOT_BITS", Wgsl::U32(PAGE_SLOT_BITS)),
     ("PAGE_EMPTY", Wgsl::U32(PAGE_EMPTY)),
+    ("PAGE_MISSING", Wgsl::U32(PAGE_MISSING)),
     ("MAX_CLIP", Wgsl::U32(MAX_CLIP_PLANES as u32)),
     ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
     ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),

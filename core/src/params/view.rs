@@ -37,9 +37,12 @@ pub struct UploadOptions {
     /// limit. A volume larger than this along some axis is cut into bricks stored in a
     /// pool texture that every pass samples through a page table.
     pub max_brick_points: Option<u32>,
-    /// Largest volume texture (one brick or the brick pool) in bytes; `None` = the
-    /// device's buffer limit.
-    pub max_brick_bytes: Option<u64>,
+    /// Most bytes the volume may take on the device (its texture, or the brick pool with
+    /// any precomputed gradients); `None` = the device's single-allocation limit. A volume
+    /// larger than this is bricked and only the bricks a frame needs are resident; when
+    /// even they do not fit, ray casting streams them through the pool, front to back, in
+    /// several passes of one frame (the other modes report the sizes).
+    pub memory_budget: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
     /// gradients: see shaders/gradient.wgsl); single-component volumes only. `None`: off
@@ -57,6 +60,9 @@ pub struct Stats {
     pub frames: u32,
     /// Bricks read into the pool of a bricked volume.
     pub brick_uploads: u32,
+    /// Passes of streamed frames (frames whose bricks exceed the memory budget take one
+    /// pass per group of bricks the pool holds).
+    pub streamed_passes: u32,
 }
 
 /// How much of the volume is on the device: bricks resident against all bricks, and the

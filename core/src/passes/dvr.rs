@@ -4,15 +4,16 @@
 //! (occupancy), MIP and MinIP blocks whose scalar range cannot change the ray's extremum.
 
 use super::frame::{self, groups, FrameInput, SKIP_MAX_OCCUPANCY};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation};
+use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, View};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
+use crate::resources::Resources;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -32,6 +33,7 @@ pipeline_variant! {
         volumetric: bool => "VOLUMETRIC",
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
+        streaming: bool => "STREAMING",
     }
 }
 
@@ -57,6 +59,7 @@ impl DvrPass {
                     texture_entry(4, false, V::D2),
                     storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
                     storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
+                    buffer_entry(7, B::Storage { read_only: false }),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -73,14 +76,13 @@ impl DvrPass {
         let step = res.sample_distance(params)?;
         res.ensure_tables(ctx, step)?;
         res.ensure_occupancy(ctx, step)?;
-        res.ensure_resident(
-            ctx,
-            if params.blend == BlendMode::Composite {
-                Needed::Occupied
-            } else {
-                Needed::All
-            },
-        )?;
+        let needed = if params.blend == BlendMode::Composite {
+            Needed::Occupied
+        } else {
+            Needed::All
+        };
+        let order = visibility_order(res, view, params)?;
+        let plan = res.plan_streaming(ctx, needed, &order)?;
         let occupied = res.occupancy.as_ref().map_or(1.0, |o| o.fraction);
         let skip = params.empty_space_skipping
             && params.blend == BlendMode::Composite
@@ -89,12 +91,22 @@ impl DvrPass {
         res.write_depth_input(ctx, view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
         let f = frame::frame(res, view, params, step, depth_input)?;
+        if plan.is_some() && f.volumetric {
+            return Err(Error::Unsupported(
+                "volumetric shadows need every visible brick resident, and the visible bricks \
+                 exceed the volume's memory budget: raise the budget or turn the scattering \
+                 blending off"
+                    .into(),
+            ));
+        }
+        let streaming = plan.is_some();
         let vol = res.volume()?;
         // MIP and MinIP skip blocks whose range cannot move the ray's extremum, on
         // one-component volumes (the range grid holds the first component).
         let range_skip = params.empty_space_skipping
             && matches!(params.blend, BlendMode::Maximum | BlendMode::Minimum)
-            && vol.components == 1;
+            && vol.components == 1
+            && !streaming;
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
@@ -111,6 +123,7 @@ impl DvrPass {
             volumetric: f.volumetric,
             precomputed_gradient: vol.gradients,
             forward_diff: params.gradient == GradientMethod::Forward,
+            streaming,
         };
         let dvr = self.pipelines.get(ctx, variant)?;
         let t = res.targets.as_ref().expect("targets allocated above");
@@ -134,6 +147,7 @@ impl DvrPass {
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
                 bind(6, wgpu::BindingResource::TextureView(&depth_view)),
+                bind(7, t.state.as_entire_binding()),
             ],
         });
         let rect = u.rect;
@@ -144,18 +158,48 @@ impl DvrPass {
         if rect != [0, 0, view.width, view.height] {
             clear_outputs(&mut enc, &color_view, &depth_view);
         }
-        {
+        let dispatch = |enc: &mut wgpu::CommandEncoder, volume: &wgpu::BindGroup| {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("dvr"),
                 timestamp_writes: None,
             });
             pass.set_pipeline(&dvr);
             pass.set_bind_group(0, &dvr_bg, &[]);
-            pass.set_bind_group(1, vol.bind_group(variant.nearest), &[]);
+            pass.set_bind_group(1, volume, &[]);
             pass.dispatch_workgroups(gr[0], gr[1], 1);
+        };
+        match plan {
+            None => {
+                dispatch(&mut enc, vol.bind_group(variant.nearest));
+                q.submit([enc.finish()]);
+            }
+            Some(plan) => {
+                // One pass per group of bricks, front to back: each ray marches what is
+                // resident and stops where its next brick waits, its state in `t.state`.
+                enc.clear_buffer(&t.state, 0, None);
+                q.submit([enc.finish()]);
+                for g in 0..plan.groups.len() {
+                    res.load_stream_group(ctx, &plan, g)?;
+                    let vol = res.volume()?;
+                    let mut enc = d.create_command_encoder(&Default::default());
+                    dispatch(&mut enc, vol.bind_group(variant.nearest));
+                    q.submit([enc.finish()]);
+                }
+                res.stats.streamed_passes += plan.groups.len() as u32;
+            }
         }
-        q.submit([enc.finish()]);
         res.stats.frames += 1;
         Ok(())
     }
+}
+
+/// The volume's bricks front to back for this view (index space), for streaming.
+fn visibility_order(res: &Resources, view: &View, params: &RenderParams) -> Result<Vec<usize>> {
+    let vol = res.volume()?;
+    let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
+    Ok(vol.grid.visibility_order(
+        world_to_index.transform_point3(view.camera.position),
+        world_to_index.transform_vector3(view.camera.direction()),
+        view.camera.parallel,
+    ))
 }

@@ -15,6 +15,9 @@ use crate::params::{ScalarType, VolumeData};
 /// more for central-difference gradients, so bricks meet without seams.
 pub const BRICK_OVERLAP: u32 = 2;
 
+/// Fewest slots the memory budget must hold (the slot edge shrinks to fit them).
+const MIN_SLOTS: u64 = 8;
+
 /// Edge of an occupancy block in cells.
 pub const BLOCK_SIZE: u32 = 8;
 
@@ -147,6 +150,40 @@ impl BrickGrid {
         self.slots[0] * self.slots[1]
     }
 
+    /// All bricks front to back for a camera at `eye` looking along `dir` (index space):
+    /// along each axis, bricks on the camera's side of a brick boundary come first. Along
+    /// any ray a later brick has a strictly larger key (perspective: the sum over the axes of
+    /// the brick steps from the camera's brick; parallel: the sum of the cells signed by the
+    /// view direction), so the order holds for every ray.
+    pub fn visibility_order(
+        &self,
+        eye: glam::DVec3,
+        dir: glam::DVec3,
+        parallel: bool,
+    ) -> Vec<usize> {
+        let b = self.brick_cells as f64;
+        let key = |i: usize| -> i64 {
+            let cell = self.cell(i);
+            (0..3)
+                .map(|a| {
+                    let c = cell[a] as i64;
+                    if parallel {
+                        if dir[a] >= 0.0 {
+                            c
+                        } else {
+                            -c
+                        }
+                    } else {
+                        (c - (eye[a] / b).floor() as i64).abs()
+                    }
+                })
+                .sum()
+        };
+        let mut order: Vec<usize> = (0..self.len()).collect();
+        order.sort_by_key(|&i| key(i));
+        order
+    }
+
     /// The min–max blocks (of `block_dims`, [`BLOCK_SIZE`] cells each) the core of the
     /// brick at `cell` overlaps, as inclusive ranges per axis.
     pub fn blocks_of(&self, cell: [u32; 3], block_dims: [u32; 3]) -> [[u32; 2]; 3] {
@@ -197,7 +234,17 @@ pub fn plan_bricks(
         });
     }
     let min_slot = 2 * BRICK_OVERLAP + 2;
-    let edge = slot_points.min(max_points);
+    // Slots small enough that the budget holds at least MIN_SLOTS of them, so that a
+    // streamed frame moves on by several bricks per pass.
+    let budget_edge = ((max_bytes / (MIN_SLOTS * texel_bytes as u64)) as f64).cbrt() as u32;
+    if budget_edge < min_slot {
+        return Err(Error::InvalidParameter(format!(
+            "a memory budget of {max_bytes} bytes is too small for this volume: it must hold \
+             {MIN_SLOTS} bricks of {min_slot}³ points ({} bytes)",
+            MIN_SLOTS * (min_slot as u64).pow(3) * texel_bytes as u64
+        )));
+    }
+    let edge = slot_points.min(max_points).min(budget_edge);
     if edge < min_slot {
         return Err(Error::InvalidParameter(format!(
             "brick edge {edge} is too small (at least {min_slot})"

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::gpu::binding::bind;
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
-use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_SLOT_BITS};
+use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS};
 use crate::gpu::Context;
 use crate::params::{Residency, UploadOptions, VolumeData};
 use glam::DMat4;
@@ -79,7 +79,7 @@ pub(crate) struct GpuVolume {
     pub gradients: bool,
     /// Bricked volumes: the data bricks are read from when they become resident.
     host: Option<Arc<VolumeData>>,
-    /// Largest pool texture in bytes.
+    /// The memory budget: most bytes of the pool (with precomputed gradients).
     max_bytes: u64,
     /// Per brick: its slot in the pool once resident.
     slot_of: Vec<Option<u32>>,
@@ -144,7 +144,10 @@ impl Resources {
         let (storage, format, texel_bytes, scale, shift) = bricks::choose_storage(v, info);
         let max_pool = info.limits.max_texture_dimension_3d;
         let max_brick = opts.max_brick_points.unwrap_or(max_pool);
-        let max_bytes = opts.max_brick_bytes.unwrap_or(info.limits.max_buffer_size);
+        let max_bytes = opts
+            .memory_budget
+            .unwrap_or(u64::MAX)
+            .min(info.limits.max_buffer_size);
         let grid = bricks::plan_bricks(
             v.dims,
             texel_bytes,
@@ -247,91 +250,110 @@ impl Resources {
 
     /// Makes the bricks `needed` names resident: each is read from the host's data into a
     /// free slot, the pool growing by layers of slots as it fills. Bricks stay resident
-    /// once uploaded, so a transfer-function change uploads only the bricks it adds.
+    /// while the memory budget holds them, so a transfer-function change uploads only the
+    /// bricks it adds; past the budget the pool is refilled with what this frame needs. An
+    /// error names the sizes when even that exceeds the budget (only ray casting streams).
     pub fn ensure_resident(&mut self, ctx: &Context, needed: Needed<'_>) -> Result<()> {
+        self.with_flags(needed, |res, flags| {
+            res.plan_residency(ctx, flags, None).map(|_| ())
+        })
+    }
+
+    /// [`Resources::ensure_resident`] for a pass that can stream: when the bricks `needed`
+    /// names exceed the memory budget, none is uploaded and the plan to stream them comes
+    /// back instead, in groups the pool holds, front to back in `order` (a visibility order
+    /// of all bricks).
+    pub fn plan_streaming(
+        &mut self,
+        ctx: &Context,
+        needed: Needed<'_>,
+        order: &[usize],
+    ) -> Result<Option<StreamPlan>> {
+        self.with_flags(needed, |res, flags| {
+            res.plan_residency(ctx, flags, Some(order))
+        })
+    }
+
+    /// Loads group `g` of a streaming plan: its bricks resident, the plan's other bricks
+    /// PAGE_MISSING (rays stop there and resume in a later pass), the rest empty.
+    pub fn load_stream_group(&mut self, ctx: &Context, plan: &StreamPlan, g: usize) -> Result<()> {
+        let vol = self.volume.as_mut().expect("a plan is for a volume");
+        let host = vol.host.clone().expect("a plan is for a bricked volume");
+        evict_all(vol);
+        for (page, &needed) in vol.page.iter_mut().zip(&plan.needed) {
+            if needed {
+                *page = PAGE_MISSING;
+            }
+        }
+        upload_bricks(ctx, vol, &host, &plan.groups[g])?;
+        self.stats.brick_uploads += plan.groups[g].len() as u32;
+        self.finish_residency(ctx)
+    }
+
+    /// Runs `f` with the block flags `needed` stands for (`None`: every brick).
+    fn with_flags<T>(
+        &mut self,
+        needed: Needed<'_>,
+        f: impl FnOnce(&mut Resources, Option<&[u32]>) -> Result<T>,
+    ) -> Result<T> {
         match needed {
-            Needed::All => self.make_resident(ctx, None),
-            Needed::Blocks(flags) => self.make_resident(ctx, Some(flags)),
+            Needed::All => f(self, None),
+            Needed::Blocks(flags) => f(self, Some(flags)),
             Needed::Occupied => {
                 let occupancy = self.occupancy.take();
-                let done = self.make_resident(ctx, occupancy.as_ref().map(|o| &o.flags[..]));
+                let done = f(self, occupancy.as_ref().map(|o| &o.flags[..]));
                 self.occupancy = occupancy;
                 done
             }
         }
     }
 
-    /// The bricks overlapping a block flagged in `flags` (all of them without) resident.
-    fn make_resident(&mut self, ctx: &Context, flags: Option<&[u32]>) -> Result<()> {
+    /// The bricks overlapping a block flagged in `flags` (all of them without) resident,
+    /// or, past the budget with a streaming `order`, the plan to stream them.
+    fn plan_residency(
+        &mut self,
+        ctx: &Context,
+        flags: Option<&[u32]>,
+        order: Option<&[usize]>,
+    ) -> Result<Option<StreamPlan>> {
         let vol = self
             .volume
             .as_mut()
             .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
         let Some(host) = vol.host.clone() else {
-            return Ok(());
+            return Ok(None);
         };
-        let grid = vol.grid;
-        let bd = vol.minmax.dims;
-        let wanted: Vec<usize> = (0..grid.len())
-            .filter(|&i| vol.slot_of[i].is_none())
-            .filter(|&i| match flags {
-                None => true,
-                Some(flags) => {
-                    let [x, y, z] = grid.blocks_of(grid.cell(i), bd);
-                    (z[0]..=z[1]).any(|k| {
-                        (y[0]..=y[1]).any(|j| {
-                            (x[0]..=x[1])
-                                .any(|b| flags[((k * bd[1] + j) * bd[0] + b) as usize] != 0)
-                        })
-                    })
-                }
-            })
+        let needed = needed_bricks(vol, flags);
+        let count = needed.iter().filter(|&&n| n).count() as u32;
+        let capacity = capacity(vol);
+        if capacity == 0 {
+            return Err(over_budget(vol, count));
+        }
+        if count > capacity {
+            let Some(order) = order else {
+                return Err(over_budget(vol, count));
+            };
+            let ahead: Vec<usize> = order.iter().copied().filter(|&i| needed[i]).collect();
+            let groups = ahead
+                .chunks(capacity as usize)
+                .map(|c| c.to_vec())
+                .collect();
+            return Ok(Some(StreamPlan { groups, needed }));
+        }
+        let mut wanted: Vec<usize> = (0..needed.len())
+            .filter(|&i| needed[i] && vol.slot_of[i].is_none())
             .collect();
-        if wanted.is_empty() && vol.groups.is_some() {
-            return Ok(());
+        if vol.resident + wanted.len() as u32 > capacity || vol.page.contains(&PAGE_MISSING) {
+            // (past the budget, or left by a streamed frame: start again from this frame)
+            evict_all(vol);
+            wanted = (0..needed.len()).filter(|&i| needed[i]).collect();
+        } else if wanted.is_empty() && vol.groups.is_some() {
+            return Ok(None);
         }
-        let layers = (vol.resident + wanted.len() as u32)
-            .div_ceil(grid.layer_slots())
-            .max(1);
-        if layers > vol.layers {
-            let pool = new_pool(ctx, vol, layers)?;
-            if let Some(old) = vol.pool.as_ref() {
-                let mut enc = ctx.device.create_command_encoder(&Default::default());
-                enc.copy_texture_to_texture(old.as_image_copy(), pool.as_image_copy(), old.size());
-                ctx.queue.submit([enc.finish()]);
-            }
-            vol.pool = Some(pool);
-            vol.layers = layers;
-        }
-        let pool = vol.pool.as_ref().expect("allocated above");
-        for &i in &wanted {
-            let slot = vol.resident;
-            vol.resident += 1;
-            let [sx, sy, sz] = [
-                slot % grid.slots[0],
-                slot / grid.slots[0] % grid.slots[1],
-                slot / grid.layer_slots(),
-            ];
-            let texels = bricks::brick_texels(
-                &host,
-                &vol.layout,
-                grid.slot_origin_point(grid.cell(i)),
-                grid.slot,
-            );
-            let origin = [sx * grid.slot[0], sy * grid.slot[1], sz * grid.slot[2]];
-            upload_region(
-                &ctx.queue,
-                pool,
-                origin,
-                grid.slot,
-                &texels,
-                vol.layout.texel_bytes,
-            );
-            vol.slot_of[i] = Some(slot);
-            vol.page[i] = sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS);
-        }
+        upload_bricks(ctx, vol, &host, &wanted)?;
         self.stats.brick_uploads += wanted.len() as u32;
-        self.finish_residency(ctx)
+        self.finish_residency(ctx)?;
+        Ok(None)
     }
 
     /// After the pool changed: the page table, the pool's gradients, uniforms and bind
@@ -397,34 +419,146 @@ impl Resources {
     }
 }
 
-/// A pool texture of `layers` layers of slots for `vol`, within its byte limit.
+/// A pool texture of `layers` layers of slots for `vol` (within its budget: the plan and
+/// `capacity` see to that).
 fn new_pool(ctx: &Context, vol: &GpuVolume, layers: u32) -> Result<wgpu::Texture> {
     let [w, h, d] = vol.grid.pool_size(layers);
-    let bytes = w as u64 * h as u64 * d as u64 * vol.layout.texel_bytes as u64;
-    if bytes > vol.max_bytes {
-        return Err(Error::Unsupported(format!(
-            "the bricks this frame needs take {w} × {h} × {d} points ({:.2} GiB) of brick \
-             pool; the device allows {:.2} GiB in one texture",
-            bytes as f64 / (1u64 << 30) as f64,
-            vol.max_bytes as f64 / (1u64 << 30) as f64,
-        )));
-    }
+    let descriptor = wgpu::TextureDescriptor {
+        label: Some("brick pool"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: d,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: vol.layout.format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    };
     ctx.checked("allocating the brick pool", || {
-        ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("brick pool"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: d,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: vol.layout.format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_DST
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        })
+        ctx.device.create_texture(&descriptor)
     })
+}
+
+/// Streaming a frame: the bricks it needs (per brick) and, front to back, the groups of
+/// them the pool holds, one pass each.
+pub(crate) struct StreamPlan {
+    pub groups: Vec<Vec<usize>>,
+    needed: Vec<bool>,
+}
+
+/// Per brick: whether it overlaps a block flagged in `flags` (all bricks without).
+fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
+    let grid = vol.grid;
+    let bd = vol.minmax.dims;
+    (0..grid.len())
+        .map(|i| match flags {
+            None => true,
+            Some(flags) => {
+                let [x, y, z] = grid.blocks_of(grid.cell(i), bd);
+                (z[0]..=z[1]).any(|k| {
+                    (y[0]..=y[1]).any(|j| {
+                        (x[0]..=x[1]).any(|b| flags[((k * bd[1] + j) * bd[0] + b) as usize] != 0)
+                    })
+                })
+            }
+        })
+        .collect()
+}
+
+/// Bytes of one slot: its points, with any precomputed gradients.
+fn slot_bytes(vol: &GpuVolume) -> u64 {
+    let point = vol.layout.texel_bytes as u64 + if vol.gradients { 8 } else { 0 };
+    vol.grid.slot.iter().map(|&d| d as u64).product::<u64>() * point
+}
+
+/// Slots the memory budget holds: whole layers, at most the 3D texture limit's.
+fn capacity(vol: &GpuVolume) -> u32 {
+    let layer = vol.grid.layer_slots() as u64 * slot_bytes(vol);
+    let layers = (vol.max_bytes / layer).min(vol.grid.slots[2] as u64) as u32;
+    layers * vol.grid.layer_slots()
+}
+
+fn over_budget(vol: &GpuVolume, count: u32) -> Error {
+    let each = slot_bytes(vol);
+    Error::Unsupported(format!(
+        "this frame needs {count} bricks of {}³ points ({}) but the volume's memory budget \
+         ({}) holds {}: raise the budget, or draw it by ray casting, which streams bricks",
+        vol.grid.slot[0],
+        size_text(count as u64 * each),
+        size_text(vol.max_bytes),
+        capacity(vol),
+    ))
+}
+
+/// Bytes as MiB below a GiB, GiB above.
+fn size_text(bytes: u64) -> String {
+    let mib = bytes as f64 / (1u64 << 20) as f64;
+    if mib < 1024.0 {
+        format!("{mib:.1} MiB")
+    } else {
+        format!("{:.2} GiB", mib / 1024.0)
+    }
+}
+
+/// No brick resident.
+fn evict_all(vol: &mut GpuVolume) {
+    vol.slot_of.fill(None);
+    vol.resident = 0;
+    vol.page.fill(PAGE_EMPTY);
+}
+
+/// Reads `bricks` from `host` into the next free slots, growing the pool by layers.
+fn upload_bricks(
+    ctx: &Context,
+    vol: &mut GpuVolume,
+    host: &VolumeData,
+    bricks: &[usize],
+) -> Result<()> {
+    let grid = vol.grid;
+    let layers = (vol.resident + bricks.len() as u32)
+        .div_ceil(grid.layer_slots())
+        .max(1);
+    if layers > vol.layers {
+        let pool = new_pool(ctx, vol, layers)?;
+        if let Some(old) = vol.pool.as_ref() {
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            enc.copy_texture_to_texture(old.as_image_copy(), pool.as_image_copy(), old.size());
+            ctx.queue.submit([enc.finish()]);
+        }
+        vol.pool = Some(pool);
+        vol.layers = layers;
+    }
+    let pool = vol.pool.as_ref().expect("allocated above");
+    for &i in bricks {
+        let slot = vol.resident;
+        vol.resident += 1;
+        let [sx, sy, sz] = [
+            slot % grid.slots[0],
+            slot / grid.slots[0] % grid.slots[1],
+            slot / grid.layer_slots(),
+        ];
+        let texels = bricks::brick_texels(
+            host,
+            &vol.layout,
+            grid.slot_origin_point(grid.cell(i)),
+            grid.slot,
+        );
+        let origin = [sx * grid.slot[0], sy * grid.slot[1], sz * grid.slot[2]];
+        upload_region(
+            &ctx.queue,
+            pool,
+            origin,
+            grid.slot,
+            &texels,
+            vol.layout.texel_bytes,
+        );
+        vol.slot_of[i] = Some(slot);
+        vol.page[i] = sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS);
+    }
+    Ok(())
 }

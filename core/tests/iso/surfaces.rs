@@ -306,7 +306,7 @@ fn bricked_equals_unbricked() {
             &vol,
             UploadOptions {
                 max_brick_points: brick,
-                max_brick_bytes: None,
+                memory_budget: None,
                 ..Default::default()
             },
         )
