@@ -123,3 +123,22 @@ pub fn flip(reference: &[u8], test: &[u8], size: u32) -> (f64, Vec<u8>) {
     let mean = nv_flip::FlipPool::from_image(&err).mean() as f64;
     (mean, err.apply_color_lut(&nv_flip::magma_lut()).to_vec())
 }
+
+/// Exact ambient accessibility of a floor point (dx, dy) inside a corner of two half-space
+/// walls (at x = −dx and y = −dy from it), for AO rays of length `radius`: the uniform
+/// hemisphere's share of directions with ω_x ≥ −dx/R and ω_y ≥ −dy/R (a ray is occluded iff
+/// its end is inside a wall), by quadrature over (cos θ, φ) on an nz × nphi grid.
+pub fn corner_accessibility(dx: f64, dy: f64, radius: f64, nz: usize, nphi: usize) -> f64 {
+    let mut open = 0usize;
+    for i in 0..nz {
+        let z = (i as f64 + 0.5) / nz as f64;
+        let s = (1.0 - z * z).sqrt();
+        for j in 0..nphi {
+            let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / nphi as f64;
+            if s * phi.cos() >= -dx / radius && s * phi.sin() >= -dy / radius {
+                open += 1;
+            }
+        }
+    }
+    open as f64 / (nz * nphi) as f64
+}

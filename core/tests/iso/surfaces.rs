@@ -5,6 +5,7 @@
 use super::{iso, lit, params, sphere_view};
 use crate::common::gpu::{assert_error, renderer};
 use crate::common::images::save;
+use crate::common::metrics::corner_accessibility;
 use crate::common::raycast::trilinear;
 use crate::common::scenes::{radial, volume, with_clip_plane};
 use ferrovol_core::*;
@@ -227,24 +228,7 @@ fn ambient_occlusion_of_a_plane_and_a_corner() {
     let img = r.render_image(&view, &params()).unwrap();
     save(&img, "iso-corner-ao");
     let g = r.read_gbuffer().unwrap();
-    // exact accessibility of a floor point (dx, dy) from the walls: the uniform hemisphere's
-    // share of directions with ω_x ≥ −dx/R and ω_y ≥ −dy/R (half-space walls: a ray is
-    // occluded iff its end is inside), by quadrature over (cos θ, φ)
-    let exact = |dx: f64, dy: f64| {
-        let (nz, nphi) = (150, 300);
-        let mut open = 0usize;
-        for i in 0..nz {
-            let z = (i as f64 + 0.5) / nz as f64;
-            let s = (1.0 - z * z).sqrt();
-            for j in 0..nphi {
-                let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / nphi as f64;
-                if s * phi.cos() >= -dx / radius && s * phi.sin() >= -dy / radius {
-                    open += 1;
-                }
-            }
-        }
-        open as f64 / (nz * nphi) as f64
-    };
+    let exact = |dx: f64, dy: f64| corner_accessibility(dx, dy, radius, 150, 300);
     let (mut count, mut sum, mut worst, mut deepest) = (0, 0.0, 0.0f64, (f64::MAX, 0.0, 0.0));
     for y in 0..96 {
         for x in 0..96 {

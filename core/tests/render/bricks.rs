@@ -11,7 +11,7 @@
 
 use crate::common::gpu::{pt_params, renderer, set_bricked, trace};
 use crate::common::images::{save_enlarged, save_rgb};
-use crate::common::metrics::{flip, footprint, image_diff, srgb8};
+use crate::common::metrics::{corner_accessibility, flip, footprint, image_diff, srgb8};
 use crate::common::scenes::{
     blob_transfer, blob_volume, component_transfer, radial, shaded, volume, white,
 };
@@ -389,23 +389,7 @@ fn ambient_occlusion_crosses_brick_faces() {
     save_enlarged(&one, "bricks_ao_seam_one");
     save_enlarged(&split, "bricks_ao_seam_split");
 
-    // exact accessibility of a floor point (dx, dy) from the walls: the uniform hemisphere's
-    // share of directions with ω_x ≥ −dx/R and ω_y ≥ −dy/R, by quadrature over (cos θ, φ)
-    let exact = |dx: f64, dy: f64| {
-        let (nz, nphi) = (100, 200);
-        let mut open = 0usize;
-        for i in 0..nz {
-            let z = (i as f64 + 0.5) / nz as f64;
-            let s = (1.0 - z * z).sqrt();
-            for j in 0..nphi {
-                let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / nphi as f64;
-                if s * phi.cos() >= -dx / radius && s * phi.sin() >= -dy / radius {
-                    open += 1;
-                }
-            }
-        }
-        open as f64 / (nz * nphi) as f64
-    };
+    let exact = |dx: f64, dy: f64| corner_accessibility(dx, dy, radius, 100, 200);
     let (mut all, mut all_sum, mut all_max) = (0usize, 0.0f64, 0.0f32);
     let (mut seam, mut seam_sum, mut seam_max, mut seam_ao, mut seam_min) =
         (0usize, 0.0f64, 0.0f32, 0.0f64, 1.0f32);
