@@ -229,10 +229,15 @@ impl Resources {
         });
         self.occupancy = None;
         self.stats.volume_uploads += 1;
-        match whole {
+        let uploaded = match whole {
             Some(texels) => self.upload_whole(ctx, &texels),
             None => Ok(()),
+        };
+        if uploaded.is_err() {
+            // (no half-made volume: the next frame reports that none is set)
+            self.volume = None;
         }
+        uploaded
     }
 
     /// A one-brick volume: its texture (of `texels`) is the pool.
@@ -350,7 +355,12 @@ impl Resources {
         } else if wanted.is_empty() && vol.groups.is_some() {
             return Ok(None);
         }
-        upload_bricks(ctx, vol, &host, &wanted)?;
+        if let Err(e) = upload_bricks(ctx, vol, &host, &wanted) {
+            // (nothing half-resident: the next frame starts again)
+            evict_all(vol);
+            vol.groups = None;
+            return Err(e);
+        }
         self.stats.brick_uploads += wanted.len() as u32;
         self.finish_residency(ctx)?;
         Ok(None)
