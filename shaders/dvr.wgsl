@@ -36,13 +36,6 @@ override STREAMING: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 
-// Whether the brick a sample at p (on a ray going along d) reads waits for a later pass.
-// The brick is the one just ahead along the ray: a sample on a brick face is served by
-// either brick (their aprons overlap), and the one behind may be gone.
-fn waits(p: vec3<f32>, d: vec3<f32>) -> bool {
-    locate_within(p + d * (1e-3 / max(length(d), 1e-30)), 0.0);
-    return brick.missing;
-}
 
 // Per min–max block, the first component's (min, max) over every point a sample in the
 // block interpolates from (nearest or trilinear), widened where the storage rounds the data

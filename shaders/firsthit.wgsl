@@ -17,9 +17,17 @@
 // Pipeline constants (core/src/passes/iso.rs, FirstHitVariant).
 override SKIP: bool = false;
 override CROP: bool = false;
+// A streamed frame (its bricks exceed the memory budget): several passes, each with a group
+// of bricks resident, front to back, as in dvr.wgsl. A ray stops before a sample whose brick
+// waits for a later pass and resumes there. Samples stay within one voxel of the brick
+// serving them (the host streams only with a sample distance of at most one voxel and no
+// ambient occlusion), so its apron holds every point a crossing's refinement reads.
+override STREAMING: bool = false;
 
 // Per pixel: color.x = layers written, color.y = their accumulated opacity; deferred.wgsl
-// reads the layer count from it.
+// reads the layer count from it. Streaming also keeps: color.z the next sample, color.w 1
+// while the ray waits (−1 once done), value = (whether a previous sample is held, its
+// distance, its scalar, whether the segment's end is still to sample).
 @group(0) @binding(2) var<storage, read_write> state: array<PixelState>;
 // G-buffer, one array layer per surface layer:
 //   position  xyz world position of the hit, w iso index
@@ -208,8 +216,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pix = px.y * frame.viewport.x + px.x;
     var st: PixelState;
-    var layers = 0u;
-    var alpha = 0.0;
+    if (STREAMING) {
+        st = state[pix];
+        if (st.color.w < 0.0) {
+            return;
+        }
+        locate_slack = 1.0;
+    }
+    var layers = u32(st.color.x);
+    var alpha = st.color.y;
     let max_layers = iso.counts.z;
     let ert = frame.misc.y;
     if (max_layers == 0u || ert <= 0.0) {
@@ -220,6 +235,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let seg = ray_segment(ray, px);
     // (written so that NaN from a degenerate ray also leaves)
     if (!(seg.x < seg.y)) {
+        st.color.w = -1.0;
         state[pix] = st;
         return;
     }
@@ -241,6 +257,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var have_prev = false;
     var t_prev = 0.0;
     var s_prev = 0.0;
+    if (STREAMING && st.color.w > 0.0) {
+        k = st.color.z;
+        have_prev = st.value.x > 0.0;
+        t_prev = st.value.y;
+        s_prev = st.value.z;
+        tail = st.value.w > 0.0;
+    }
+    var suspended = false;
     var done = false;
     // The last sample taken (t, s at p), and whether the march still has to step past it
     // (it has once the sample was compared, or its crossing handled).
@@ -308,6 +332,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             let t_back = max(seg.x, seg.x + (k_here - 1.0 + jit) * dt);
             let take_prev = !have_prev;
             let t_q = select(t, t_back, take_prev);
+            if (STREAMING && waits(point_at(ray, t_q), ray.index_dir)) {
+                suspended = true;
+                tail = tail || at_tail;
+                break;
+            }
             let s_q = sample_scalars(point_at(ray, t_q)).x;
             if (take_prev) {
                 t_prev = t_q;
@@ -361,5 +390,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     st.color.x = f32(layers);
     st.color.y = alpha;
+    if (STREAMING) {
+        st.color.z = k;
+        st.color.w = select(-1.0, 1.0, suspended);
+        st.value = vec4<f32>(select(0.0, 1.0, have_prev), t_prev, s_prev, select(0.0, 1.0, tail));
+    }
     state[pix] = st;
 }

@@ -144,8 +144,9 @@ struct RenderArgs {
     #[arg(long)]
     brick: Option<u32>,
     /// Most MiB the volume may take on the device. A larger volume is bricked with only the
-    /// bricks a frame needs resident; when even those exceed it, ray casting streams them
-    /// through the pool in several passes (the other modes report the sizes).
+    /// bricks a frame needs resident; when even those exceed it, ray casting and isosurfaces
+    /// stream them through the pool in several passes (path tracing, volumetric shadows,
+    /// AO and scattering report the sizes).
     #[arg(long, value_name = "MIB")]
     gpu_memory: Option<u64>,
     /// Render this many frames and print the mean time per frame (the first, which builds

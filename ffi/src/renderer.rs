@@ -88,8 +88,9 @@ pub unsafe extern "C" fn fv_renderer_set_max_brick_points(
 
 /// Most bytes a later volume upload may take on the device (0 = the device's limit). A
 /// larger volume is bricked with only the bricks a frame needs resident; when even those
-/// exceed the budget, ray casting streams them through the pool in several passes of one
-/// frame, and the other modes fail with FV_STATUS_UNSUPPORTED naming the sizes.
+/// exceed the budget, ray casting and isosurfaces stream them through the pool in several
+/// passes of one frame, and path tracing, volumetric shadows and isosurfaces with ambient
+/// occlusion or scattering fail with FV_STATUS_UNSUPPORTED naming the sizes.
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_set_memory_budget(
     renderer: *mut FvRenderer,

@@ -91,6 +91,21 @@ fn locate(p: vec3<f32>) -> vec3<f32> {
     return locate_within(p, locate_slack);
 }
 
+// Streamed frames: whether the sample at p, on a ray going along d, waits for a brick a
+// later pass brings, leaving a brick that serves it current. The brick just ahead along
+// the ray serves it when resident (a sample on a face is served by either brick, whose
+// aprons overlap, and the one behind may be gone); failing that, the brick `locate_slack`
+// ahead, whose apron holds p too (a ray resuming a step behind a face whose brick is gone).
+fn waits(p: vec3<f32>, d: vec3<f32>) -> bool {
+    let u = d / max(length(d), 1e-30);
+    locate_within(p + 1e-3 * u, 0.0);
+    if (!brick.missing) {
+        return false;
+    }
+    locate_within(p + locate_slack * u, 0.0);
+    return brick.missing;
+}
+
 // Read gradients from gradient_tex (one fetch) instead of six volume fetches: the same
 // values (a pipeline constant; single-component volumes only).
 override PRECOMPUTED_GRADIENT: bool = false;

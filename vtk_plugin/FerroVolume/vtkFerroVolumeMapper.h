@@ -118,8 +118,9 @@ public:
    * MaxMemoryInBytes × MaxMemoryFraction bytes (MaxMemoryInBytes 0, the default: the
    * device's limit; the fraction defaults to 0.75). A larger volume is split into bricks of
    * which only those a frame needs are on the device; when even those exceed the budget,
-   * ray casting streams them in several passes of one frame (the same image) and the other
-   * render modes report the sizes. Takes effect at the next upload.
+   * ray casting and isosurfaces stream them in several passes of one frame (the same image)
+   * and path tracing, volumetric shadows and isosurface ambient occlusion report the sizes.
+   * Takes effect at the next upload.
    */
   vtkSetMacro(MaxMemoryInBytes, vtkIdType);
   vtkGetMacro(MaxMemoryInBytes, vtkIdType);

@@ -40,8 +40,9 @@ pub struct UploadOptions {
     /// Most bytes the volume may take on the device (its texture, or the brick pool with
     /// any precomputed gradients); `None` = the device's single-allocation limit. A volume
     /// larger than this is bricked and only the bricks a frame needs are resident; when
-    /// even they do not fit, ray casting streams them through the pool, front to back, in
-    /// several passes of one frame (the other modes report the sizes).
+    /// even they do not fit, ray casting and isosurfaces stream them through the pool, front
+    /// to back, in several passes of one frame (path tracing, volumetric shadows, ambient
+    /// occlusion and scattering between isosurfaces report the sizes).
     pub memory_budget: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same

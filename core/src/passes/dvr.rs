@@ -3,17 +3,16 @@
 //! through the bricks it crosses. Composite skips blocks the transfer function makes empty
 //! (occupancy), MIP and MinIP blocks whose scalar range cannot change the ray's extremum.
 
-use super::frame::{self, groups, FrameInput, SKIP_MAX_OCCUPANCY};
+use super::frame::{self, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation, RenderParams, View};
+use crate::params::{BlendMode, GradientMethod, Interpolation};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
-use crate::resources::Resources;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -191,15 +190,4 @@ impl DvrPass {
         res.stats.frames += 1;
         Ok(())
     }
-}
-
-/// The volume's bricks front to back for this view (index space), for streaming.
-fn visibility_order(res: &Resources, view: &View, params: &RenderParams) -> Result<Vec<usize>> {
-    let vol = res.volume()?;
-    let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
-    Ok(vol.grid.visibility_order(
-        world_to_index.transform_point3(view.camera.position),
-        world_to_index.transform_vector3(view.camera.direction()),
-        view.camera.parallel,
-    ))
 }

@@ -355,3 +355,18 @@ pub(crate) fn frame(
         volumetric,
     })
 }
+
+/// The volume's bricks front to back for this view (index space), for streaming.
+pub(crate) fn visibility_order(
+    res: &Resources,
+    view: &View,
+    params: &RenderParams,
+) -> Result<Vec<usize>> {
+    let vol = res.volume()?;
+    let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
+    Ok(vol.grid.visibility_order(
+        world_to_index.transform_point3(view.camera.position),
+        world_to_index.transform_vector3(view.camera.direction()),
+        view.camera.parallel,
+    ))
+}

@@ -22,7 +22,7 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
-use super::frame::{self, groups, FrameInput, SKIP_MAX_OCCUPANCY};
+use super::frame::{self, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
@@ -50,6 +50,7 @@ pipeline_variant! {
         skip: bool => "SKIP",
         crop: bool => "CROP",
         single_brick: bool => "SINGLE_BRICK",
+        streaming: bool => "STREAMING",
     }
 }
 
@@ -353,14 +354,19 @@ impl IsoPass {
         let values: Vec<f32> = iso.values.iter().map(|v| v.value as f32).collect();
         self.ensure_occupancy(ctx, res, &values)?;
         let surfaces = &self.occupancy.as_ref().expect("built above").flags;
-        if iso.scattering.is_some() {
+        let plan = if iso.scattering.is_some() {
             // the scattering also reads the transfer function's opacity between the surfaces
             res.ensure_occupancy(ctx, step)?;
             let visible = &res.occupancy.as_ref().expect("built above").flags;
             let both: Vec<u32> = surfaces.iter().zip(visible).map(|(a, b)| a | b).collect();
             res.ensure_resident(ctx, Needed::Blocks(&both))?;
+            None
         } else {
-            res.ensure_resident(ctx, Needed::Blocks(surfaces))?;
+            let order = visibility_order(res, view, params)?;
+            res.plan_streaming(ctx, Needed::Blocks(surfaces), &order)?
+        };
+        if plan.is_some() {
+            check_streamable(res, params, iso, step)?;
         }
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
@@ -394,6 +400,7 @@ impl IsoPass {
             skip: params.empty_space_skipping && occupied < SKIP_MAX_OCCUPANCY,
             crop: params.cropping.is_some(),
             single_brick,
+            streaming: plan.is_some(),
         };
         let df = DeferredVariant {
             lights: f.lights(),
@@ -549,8 +556,7 @@ impl IsoPass {
         if shade_rect != full {
             clear_outputs(&mut enc, &color_view, &depth_view);
         }
-        let volume = vol.bind_group(false);
-        {
+        let first_hit = |enc: &mut wgpu::CommandEncoder, volume: &wgpu::BindGroup| {
             let gr = groups(rect);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("first hit"),
@@ -560,7 +566,26 @@ impl IsoPass {
             pass.set_bind_group(0, &firsthit_bg, &[]);
             pass.set_bind_group(1, volume, &[]);
             pass.dispatch_workgroups(gr[0], gr[1], 1);
+        };
+        match &plan {
+            None => first_hit(&mut enc, vol.bind_group(false)),
+            Some(plan) => {
+                // One pass per group of bricks, front to back (as dvr.rs streams), then the
+                // deferred shading of the layers they wrote.
+                let state = t.state.clone();
+                enc.clear_buffer(&state, 0, None);
+                q.submit([enc.finish()]);
+                for g in 0..plan.groups.len() {
+                    res.load_stream_group(ctx, plan, g)?;
+                    let mut enc = d.create_command_encoder(&Default::default());
+                    first_hit(&mut enc, res.volume()?.bind_group(false));
+                    q.submit([enc.finish()]);
+                }
+                res.stats.streamed_passes += plan.groups.len() as u32;
+                enc = d.create_command_encoder(&Default::default());
+            }
         }
+        let volume = res.volume()?.bind_group(false);
         {
             let gs = groups(shade_rect);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -578,4 +603,41 @@ impl IsoPass {
         res.stats.frames += 1;
         Ok(())
     }
+}
+
+/// Whether an isosurface frame can stream its bricks: the first hit's samples and their
+/// refinement stay within one voxel of the brick serving them only with a sample distance
+/// of at most one voxel along every direction (the spectral norm of world → index), and
+/// ambient-occlusion rays reach beyond the bricks the surfaces lie in.
+fn check_streamable(
+    res: &Resources,
+    params: &RenderParams,
+    iso: &IsoParams,
+    step: f64,
+) -> Result<()> {
+    let over = "the bricks the isosurfaces lie in exceed the volume's memory budget";
+    if iso.ambient_occlusion.is_some_and(|a| a.samples > 0) {
+        return Err(Error::Unsupported(format!(
+            "{over}, and ambient occlusion reads around them: raise the budget or turn \
+             ambient occlusion off"
+        )));
+    }
+    let vol = res.volume()?;
+    let m = (params.volume_matrix * vol.index_to_data).inverse();
+    let a = glam::DMat3::from_mat4(m);
+    // the largest singular value of `a`, by power iteration on aᵀa
+    let ata = a.transpose() * a;
+    let mut v = glam::DVec3::new(1.0, 0.7, 0.3);
+    for _ in 0..64 {
+        v = (ata * v).normalize_or_zero();
+    }
+    let stretch = (ata * v).length().sqrt();
+    if step * stretch > 1.0 + 1e-9 {
+        return Err(Error::Unsupported(format!(
+            "{over}, and streaming them needs a sample distance of at most one voxel (this one \
+             is {:.3} voxels): raise the budget or lower the sample distance",
+            step * stretch
+        )));
+    }
+    Ok(())
 }
