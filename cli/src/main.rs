@@ -638,6 +638,10 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             precompute_gradients: Some(a.precompute_gradients),
         },
     )?;
+    let streaming = pb.clone();
+    r.set_progress(Some(Box::new(move |done, total| {
+        streaming.set_message(format!("streaming the bricks: pass {done} of {total}"));
+    })));
     r.set_transfer_function(&tf)?;
     if let Some((p, env)) = &iso {
         pb.set_message("filtering the environment");

@@ -7,7 +7,8 @@ use crate::gpu::interop::{OutputPath, SharedOutput};
 use crate::gpu::Context;
 use crate::params::{
     BlendMode, BsdfParams, CubeImage, Environment, GBuffer, Image, IsoParams, PathTraceParams,
-    RenderParams, Residency, Stats, TransferFunction, UploadOptions, View, VolumeData,
+    RenderParams, Residency, Stats, StreamProgress, TransferFunction, UploadOptions, View,
+    VolumeData,
 };
 use crate::passes::dvr::DvrPass;
 use crate::passes::frame::FrameInput;
@@ -89,6 +90,11 @@ impl Renderer {
     /// bricks from `v` without a copy.
     pub fn set_shared_volume(&mut self, v: Arc<VolumeData>, opts: UploadOptions) -> Result<()> {
         self.res.set_volume(&self.ctx, HostVolume::Shared(v), opts)
+    }
+
+    /// Calls `progress` after each pass of a streamed frame (`None`: no calls).
+    pub fn set_progress(&mut self, progress: Option<StreamProgress>) {
+        self.res.progress = progress;
     }
 
     /// How much of the volume is on the device (zeros without a volume).

@@ -678,6 +678,13 @@ typedef struct FvResidency {
 } FvResidency;
 
 /**
+ * Told after each pass of a streamed frame (its bricks exceed the memory budget) is
+ * submitted: `user` as given to fv_renderer_set_progress, the passes so far and the passes
+ * in the frame. Called on the thread rendering the frame, inside fv_renderer_render.
+ */
+typedef void (*FvProgressFn)(void *user, uint32_t done, uint32_t total);
+
+/**
  * A volume's geometry and scalar layout. Point (i, j, k) sits at
  * origin + direction · (spacing ⊙ (i, j, k)), as vtkImageData places it.
  * Thread use: plain data.
@@ -960,6 +967,14 @@ enum FvStatus fv_renderer_stats(const struct FvRenderer *renderer, struct FvStat
  */
 enum FvStatus fv_renderer_residency(const struct FvRenderer *renderer,
                                     struct FvResidency *residency);
+
+/**
+ * Calls `progress(user, done, total)` after each pass of a streamed frame (NULL: no
+ * calls).
+ */
+enum FvStatus fv_renderer_set_progress(struct FvRenderer *renderer,
+                                       FvProgressFn progress,
+                                       void *user);
 
 /**
  * The message of the most recent call on this thread that did not return

@@ -241,6 +241,9 @@ public:
   }
   /// An FvOutputPath.
   void set_output_path(uint32_t path) { check(fv_renderer_set_output_path(h_.get(), path)); }
+  void set_progress(FvProgressFn progress, void *user) {
+    check(fv_renderer_set_progress(h_.get(), progress, user));
+  }
   void set_memory_budget(uint64_t bytes) {
     check(fv_renderer_set_memory_budget(h_.get(), bytes));
   }

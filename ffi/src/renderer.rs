@@ -465,3 +465,41 @@ pub unsafe extern "C" fn fv_renderer_residency(
         Ok(())
     })
 }
+
+/// Told after each pass of a streamed frame (its bricks exceed the memory budget) is
+/// submitted: `user` as given to fv_renderer_set_progress, the passes so far and the passes
+/// in the frame. Called on the thread rendering the frame, inside fv_renderer_render.
+pub type FvProgressFn = Option<unsafe extern "C" fn(user: *mut c_void, done: u32, total: u32)>;
+
+/// The caller's `user` pointer, handed back to its callback on the rendering thread.
+struct UserData(*mut c_void);
+
+// SAFETY: ferrovol only hands the pointer back to the caller's callback, on the thread
+// that renders; what it points to is the caller's to make safe.
+unsafe impl Send for UserData {}
+
+impl UserData {
+    fn get(&self) -> *mut c_void {
+        self.0
+    }
+}
+
+/// Calls `progress(user, done, total)` after each pass of a streamed frame (NULL: no
+/// calls).
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_progress(
+    renderer: *mut FvRenderer,
+    progress: FvProgressFn,
+    user: *mut c_void,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        r.r.set_progress(progress.map(|f| {
+            let user = UserData(user);
+            Box::new(move |done: u32, total: u32| {
+                // SAFETY: the caller's callback with the caller's pointer, as documented.
+                unsafe { f(user.get(), done, total) }
+            }) as ferrovol_core::StreamProgress
+        }));
+        Ok(())
+    })
+}

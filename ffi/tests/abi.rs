@@ -670,3 +670,50 @@ fn bricked_volume_residency_outlives_the_volume() {
     assert_eq!(res.dense_bytes, (n * n * n) as u64);
     assert_eq!(before, after, "the renderer still has the data");
 }
+
+/// Progress of a streamed frame: a memory budget under what a frame needs makes ray casting
+/// stream the bricks in several passes, and the callback hears of each one in order.
+#[test]
+fn streamed_frames_report_progress() {
+    unsafe extern "C" fn record(user: *mut c_void, done: u32, total: u32) {
+        // SAFETY: `user` is the test's Vec, alive for the whole render.
+        unsafe { (*(user as *mut Vec<(u32, u32)>)).push((done, total)) };
+    }
+    let lib = Lib::open();
+    let n = 32usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    let mut s = Session::new(&lib);
+    let budget = lib.f::<unsafe extern "C" fn(H, u64) -> FvStatus>("fv_renderer_set_memory_budget");
+    let progress = lib
+        .f::<unsafe extern "C" fn(H, ferrovol::FvProgressFn, *mut c_void) -> FvStatus>(
+            "fv_renderer_set_progress",
+        );
+    let mut calls: Vec<(u32, u32)> = Vec::new();
+    // SAFETY: a valid handle; `calls` outlives every frame rendered with the callback.
+    unsafe {
+        lib.ok(budget(s.r, (n * n * n) as u64)); // a quarter of the float32 volume
+        lib.ok(progress(
+            s.r,
+            Some(record),
+            (&mut calls as *mut Vec<(u32, u32)>).cast(),
+        ));
+    }
+    s.set_volume([32, 32, 32], FvScalarType::F32, &data);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 31.0, 1.0, 1.0, 1.0],
+        &[0.0, 0.1, 31.0, 0.5],
+    );
+    s.set_camera(&camera([15.5, 15.5, 100.0], [15.5; 3], [1.0, 300.0]));
+    let streamed = s.frame(32, 32).to_vec();
+    // SAFETY: a valid handle; NULL turns the callback off.
+    unsafe { lib.ok(progress(s.r, None, null_mut())) };
+    println!("progress calls: {calls:?}");
+    let total = calls.last().map_or(0, |c| c.1);
+    assert!(total >= 2, "the frame was streamed: {calls:?}");
+    assert_eq!(
+        calls,
+        (1..=total).map(|d| (d, total)).collect::<Vec<_>>(),
+        "one call per pass, in order"
+    );
+    assert!(streamed.chunks(4).any(|p| p[3] > 50), "drawn");
+}

@@ -51,17 +51,25 @@ public:
 
   ~vtkInternals() { this->FreeRenderer(); }
 
-  // The renderer, created on first use from the process-wide device.
-  bool MakeRenderer(std::string& error)
+  // The renderer, created on first use from the process-wide device; the passes of a
+  // streamed frame (a volume over the memory budget) report to `self`'s progress.
+  bool MakeRenderer(vtkFerroVolumeMapper* self, std::string& error)
   {
     if (this->Renderer)
     {
       return true;
     }
     const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(error);
-    return ctx &&
-      vtkFerroVolumeCall("create a renderer", error,
-        [&] { this->Renderer.reset(new ferrovol::Renderer(*ctx)); });
+    return ctx && vtkFerroVolumeCall("create a renderer", error, [&] {
+      this->Renderer.reset(new ferrovol::Renderer(*ctx));
+      this->Renderer->set_progress(&vtkInternals::StreamProgress, self);
+    });
+  }
+
+  static void StreamProgress(void* mapper, uint32_t done, uint32_t total)
+  {
+    static_cast<vtkFerroVolumeMapper*>(mapper)->UpdateProgress(
+      static_cast<double>(done) / static_cast<double>(total));
   }
 
   void FreeRenderer()
@@ -232,7 +240,7 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   // Blend mode, input, volume (on change), tables (on change), frame parameters.
   std::string error;
   if (!in->Settings.SelectBlendMode(this, error) || !in->Input.Select(this, error) ||
-    !in->MakeRenderer(error) ||
+    !in->MakeRenderer(this, error) ||
     !in->Input.Upload(*in->Renderer,
       this->MaxMemoryInBytes > 0
         ? static_cast<uint64_t>(static_cast<double>(this->MaxMemoryInBytes) *

@@ -199,12 +199,21 @@ class Settings(unittest.TestCase):
         # wavelet(23): 48^3 float32, 432 KiB; a budget of a quarter of it (MaxMemoryInBytes x
         # MaxMemoryFraction) bricks the volume and streams the bricks in several passes
         full, _ = self.render()
-        streamed, mapper = self.render(lambda m: (m.SetMaxMemoryInBytes(48 ** 3 * 4 // 2),
-                                                  m.SetMaxMemoryFraction(0.5)))
+        progress = []
+
+        def configure(m):
+            m.SetMaxMemoryInBytes(48 ** 3 * 4 // 2)
+            m.SetMaxMemoryFraction(0.5)
+            m.AddObserver(vtk.vtkCommand.ProgressEvent,
+                          lambda o, e: progress.append(o.GetProgress()))
+        streamed, mapper = self.render(configure)
         save("settings-memory-budget", full, streamed)
         d = float(np.abs(streamed - full).max())
-        print("memory budget 108 KiB: max |difference| to unlimited %.1f levels" % d)
+        print("memory budget 108 KiB: max |difference| to unlimited %.1f levels; progress "
+              "reported %d times, last %.2f" % (d, len(progress), progress[-1] if progress else -1))
         self.assertEqual(mapper.GetMaxMemoryFraction(), 0.5)
+        self.assertGreater(len(progress), 1, "each streamed pass reports progress")
+        self.assertEqual(progress[-1], 1.0)
         self.assertLessEqual(d, 2.0)
         self.assertGreater(coverage(streamed), 0.2)
 

@@ -27,5 +27,5 @@ pub use render::{
 };
 pub(crate) use transfer::build_tables;
 pub use transfer::{ComponentTransfer, Piecewise, TransferFunction, TABLE_SIZE};
-pub use view::{Image, Residency, Stats, UploadOptions, View};
+pub use view::{Image, Residency, Stats, StreamProgress, UploadOptions, View};
 pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

@@ -66,6 +66,10 @@ pub struct Stats {
     pub streamed_passes: u32,
 }
 
+/// Called after each pass of a streamed frame is submitted: (passes so far, passes in the
+/// frame).
+pub type StreamProgress = Box<dyn FnMut(u32, u32) + Send>;
+
 /// How much of the volume is on the device: bricks resident against all bricks, and the
 /// pool's bytes (volume texture and precomputed gradients) against what the whole volume
 /// would take. A volume that fits one texture is one brick, always resident.

@@ -183,8 +183,8 @@ impl DvrPass {
                     let mut enc = d.create_command_encoder(&Default::default());
                     dispatch(&mut enc, vol.bind_group(variant.nearest));
                     q.submit([enc.finish()]);
+                    res.streamed_pass(&plan, g);
                 }
-                res.stats.streamed_passes += plan.groups.len() as u32;
             }
         }
         res.stats.frames += 1;

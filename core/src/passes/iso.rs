@@ -580,8 +580,8 @@ impl IsoPass {
                     let mut enc = d.create_command_encoder(&Default::default());
                     first_hit(&mut enc, res.volume()?.bind_group(false));
                     q.submit([enc.finish()]);
+                    res.streamed_pass(plan, g);
                 }
-                res.stats.streamed_passes += plan.groups.len() as u32;
                 enc = d.create_command_encoder(&Default::default());
             }
         }

@@ -15,7 +15,7 @@ use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::interop::OutputPath;
 use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Context;
-use crate::params::{RenderParams, Stats, TransferFunction};
+use crate::params::{RenderParams, Stats, StreamProgress, TransferFunction};
 use environment::EnvironmentState;
 use gradients::GradientPass;
 use tables::{Occupancy, TableKey, Tables};
@@ -45,6 +45,8 @@ pub(crate) struct Resources {
     pub stats: Stats,
     /// The gradient build, created when a volume first asks for precomputed gradients.
     gradient_pass: Option<GradientPass>,
+    /// Told of each pass of a streamed frame.
+    pub progress: Option<StreamProgress>,
 }
 
 impl Resources {
@@ -99,6 +101,7 @@ impl Resources {
             environment: EnvironmentState::default(),
             stats: Stats::default(),
             gradient_pass: None,
+            progress: None,
         }
     }
 

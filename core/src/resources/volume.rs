@@ -295,6 +295,15 @@ impl Resources {
         self.finish_residency(ctx)
     }
 
+    /// After group `g` of a streaming plan is submitted: counts the pass and tells the
+    /// progress callback.
+    pub fn streamed_pass(&mut self, plan: &StreamPlan, g: usize) {
+        self.stats.streamed_passes += 1;
+        if let Some(progress) = self.progress.as_mut() {
+            progress(g as u32 + 1, plan.groups.len() as u32);
+        }
+    }
+
     /// Runs `f` with the block flags `needed` stands for (`None`: every brick).
     fn with_flags<T>(
         &mut self,

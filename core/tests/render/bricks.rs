@@ -669,6 +669,11 @@ fn streamed_frames_equal_in_core_ones() {
             },
         ),
     ];
+    let told = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let log = told.clone();
+    r.set_progress(Some(Box::new(move |done, total| {
+        log.lock().unwrap().push((done, total))
+    })));
     for (name, params) in modes {
         r.set_volume(&vol).unwrap();
         let in_core = r.render_image(&view, &params).unwrap();
@@ -690,6 +695,12 @@ fn streamed_frames_equal_in_core_ones() {
             assert_content(&streamed, name);
         }
         assert!(passes >= 2, "{name}: the frame was streamed");
+        let calls = std::mem::take(&mut *told.lock().unwrap());
+        assert_eq!(
+            calls,
+            (1..=passes).map(|d| (d, passes)).collect::<Vec<_>>(),
+            "{name}: progress after each pass"
+        );
         assert!(
             r.residency().pool_bytes <= dense / 4,
             "{name}: the pool stays within the budget"
@@ -735,6 +746,7 @@ fn streamed_frames_equal_in_core_ones() {
     r.set_isosurface(&surfaces(Some(AmbientOcclusion::default())))
         .unwrap();
     let err = r.render_image(&view, &iso_params).unwrap_err().to_string();
+    r.set_progress(None);
     println!("isosurfaces with AO over the budget: {err}");
     assert!(
         err.contains("memory budget") && err.contains("ambient occlusion"),
