@@ -184,13 +184,21 @@ impl BrickGrid {
         order
     }
 
-    /// The min–max blocks (of `block_dims`, [`BLOCK_SIZE`] cells each) the core of the
-    /// brick at `cell` overlaps, as inclusive ranges per axis.
-    pub fn blocks_of(&self, cell: [u32; 3], block_dims: [u32; 3]) -> [[u32; 2]; 3] {
-        [0, 1, 2].map(|a| {
+    /// The min–max blocks (of `block_dims`, [`BLOCK_SIZE`] cells each, x fastest) the core
+    /// of brick `i` overlaps, by index.
+    pub fn blocks_of(&self, i: usize, block_dims: [u32; 3]) -> impl Iterator<Item = usize> {
+        let cell = self.cell(i);
+        let [x, y, z] = [0, 1, 2].map(|a| {
             let lo = cell[a] * self.brick_cells / BLOCK_SIZE;
             let hi = (cell[a] + 1) * self.brick_cells / BLOCK_SIZE;
-            [lo.min(block_dims[a] - 1), hi.min(block_dims[a] - 1)]
+            lo.min(block_dims[a] - 1)..=hi.min(block_dims[a] - 1)
+        });
+        z.flat_map(move |k| {
+            let x = x.clone();
+            y.clone().flat_map(move |j| {
+                x.clone()
+                    .map(move |b| ((k * block_dims[1] + j) * block_dims[0] + b) as usize)
+            })
         })
     }
 
@@ -420,7 +428,10 @@ mod tests {
         assert!(g.slots.iter().product::<u32>() as usize >= g.len());
         // a layer of slots is a fraction of the bricks: the pool grows in small steps
         assert_eq!(g.layer_slots(), 1);
-        assert_eq!(g.blocks_of([1, 0, 0], [7, 5, 3]), [[1, 3], [0, 1], [0, 1]]);
+        // brick (1, 0, 0): blocks x 1..=3, y 0..=1, z 0..=1 of a 7 × 5 × 3 grid
+        let blocks: Vec<usize> = g.blocks_of(1, [7, 5, 3]).collect();
+        assert_eq!(blocks.len(), 12);
+        assert_eq!((blocks[0], blocks[11]), (1, 35 + 7 + 3));
         assert_eq!(g.brick_cells + 1 + 2 * g.apron, 20);
         assert_eq!(g.slot_origin_point([1, 0, 0]), [13, -2, -2]);
     }

@@ -173,16 +173,10 @@ impl Resources {
         // component (as a texel), transparent wherever the whole range is.
         let mut constants = vec![[0f32; 4]; grid.len()];
         for (i, c) in constants.iter_mut().enumerate() {
-            let [x, y, z] = grid.blocks_of(grid.cell(i), minmax.dims);
             let mut lo = [f32::INFINITY; 4];
-            for k in z[0]..=z[1] {
-                for j in y[0]..=y[1] {
-                    for b in x[0]..=x[1] {
-                        let block = ((k * minmax.dims[1] + j) * minmax.dims[0] + b) as usize;
-                        for (comp, l) in lo.iter_mut().enumerate().take(nc) {
-                            *l = l.min(minmax.ranges[block * nc + comp][0]);
-                        }
-                    }
+            for block in grid.blocks_of(i, minmax.dims) {
+                for (comp, l) in lo.iter_mut().enumerate().take(nc) {
+                    *l = l.min(minmax.ranges[block * nc + comp][0]);
                 }
             }
             for comp in 0..nc {
@@ -477,14 +471,7 @@ fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
     (0..grid.len())
         .map(|i| match flags {
             None => true,
-            Some(flags) => {
-                let [x, y, z] = grid.blocks_of(grid.cell(i), bd);
-                (z[0]..=z[1]).any(|k| {
-                    (y[0]..=y[1]).any(|j| {
-                        (x[0]..=x[1]).any(|b| flags[((k * bd[1] + j) * bd[0] + b) as usize] != 0)
-                    })
-                })
-            }
+            Some(flags) => grid.blocks_of(i, bd).any(|b| flags[b] != 0),
         })
         .collect()
 }
