@@ -7,11 +7,12 @@ use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
     synth, AmbientOcclusion, BlendMode, BsdfParams, Context, Environment, GradientMethod,
     Interpolation, IsoParams, IsoScatterMode, IsoScattering, IsoValue, PathTraceParams,
-    RenderParams, Renderer, ScatterRegions, Shininess, SpecularMode, UploadOptions, View,
-    VolumeData,
+    RenderParams, Renderer, ScalarType, ScatterRegions, Shininess, SpecularMode, UploadOptions,
+    View, VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(Parser)]
@@ -29,6 +30,12 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Print the GPU adapter, backend and limits ferrovol would use.
     Info,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
+enum DemoType {
+    Float32,
+    Uint16,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -80,6 +87,14 @@ struct RenderArgs {
     /// Built-in volume to render when no input file is given.
     #[arg(long, value_enum, default_value = "wavelet")]
     demo: Demo,
+    /// Points per edge of the built-in wavelet, computed as the renderer reads it (never
+    /// held whole in memory, so any size renders; with --gpu-memory it streams).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=65536))]
+    demo_size: Option<u32>,
+    /// Scalar type of the --demo-size wavelet: float32 (VTK's values) or uint16 (scaled:
+    /// (value + 40) · 180; the transfer function defaults to auto).
+    #[arg(long, value_enum, default_value = "float32", requires = "demo_size")]
+    demo_type: DemoType,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
     size: (u32, u32),
@@ -449,7 +464,7 @@ fn parse_range(s: &str) -> Result<[f64; 2], String> {
 /// The isosurface parameters and environment the flags describe.
 fn iso_setup(a: &IsoArgs, vol: &VolumeData) -> Result<(IsoParams, Environment), CliError> {
     let specs: Vec<IsoSpec> = if a.values.is_empty() {
-        let [lo, hi] = vol.range(0);
+        let [lo, hi] = vol.try_range(0)?;
         let mid = 0.5 * (lo + hi);
         eprintln!("ferrovol: no --iso given; using the middle of the data range, {mid}");
         vec![(mid, None, None)]
@@ -603,9 +618,21 @@ fn demo_volume(d: Demo) -> VolumeData {
 
 fn render(a: RenderArgs) -> Result<(), CliError> {
     let pb = spinner("loading volume");
-    let (vol, default_tf) = match &a.input {
-        Some(p) => (ferrovol_io::read_volume(p)?, "auto"),
-        None => (
+    let (vol, default_tf) = match (&a.input, a.demo_size) {
+        (Some(p), _) => (ferrovol_io::open_volume(p)?, "auto"),
+        (None, Some(n)) => {
+            if a.demo != Demo::Wavelet {
+                return Err(CliError::Usage(
+                    "--demo-size generates the wavelet only (--demo wavelet)".into(),
+                ));
+            }
+            let (ty, tf) = match a.demo_type {
+                DemoType::Float32 => (ScalarType::F32, "wavelet"),
+                DemoType::Uint16 => (ScalarType::U16, "auto"),
+            };
+            (synth::wavelet_generated(synth::wavelet_extent(n), ty)?, tf)
+        }
+        (None, None) => (
             demo_volume(a.demo),
             match a.demo {
                 Demo::Wavelet => "wavelet",
@@ -614,6 +641,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             },
         ),
     };
+    // Shared with the renderer, which reads a bricked volume's bricks from it (no copy).
+    let vol = Arc::new(vol);
     let tf = presets::transfer_function(a.tf.as_deref().unwrap_or(default_tf), &vol)?;
     let iso = if a.mode == Mode::Iso {
         Some(iso_setup(&a.iso, &vol)?)
@@ -630,8 +659,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     pb.set_message("starting the GPU");
     let mut r = Renderer::new(Context::new()?)?;
     pb.set_message("uploading");
-    r.set_volume_with(
-        &vol,
+    r.set_shared_volume(
+        vol.clone(),
         UploadOptions {
             max_brick_points: a.brick,
             memory_budget: a.gpu_memory.map(|m| m << 20),

@@ -37,7 +37,12 @@ fn tf(color: &[(f64, [f32; 3])], opacity: &[(f64, f32)]) -> TransferFunction {
 
 /// A preset by name, or a JSON file.
 pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunction, CliError> {
-    let [lo, hi] = vol.range(0);
+    // Only the presets placed by the data range read it (a pass over the whole volume).
+    let [lo, hi] = if matches!(name, "mri" | "grey" | "auto") {
+        vol.try_range(0)?
+    } else {
+        [0.0, 1.0]
+    };
     let at = |f: f64| lo + (hi - lo) * f;
     let mut t = match name {
         "wavelet" => wavelet_tf(),

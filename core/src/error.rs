@@ -13,6 +13,9 @@ pub enum Error {
     /// The volume description is inconsistent or not renderable.
     #[error("invalid volume: {0}")]
     InvalidVolume(String),
+    /// A volume's scalar source failed to read (a file that shrank, an I/O error).
+    #[error("reading the volume's data failed: {0}")]
+    Source(String),
     /// A transfer function is malformed.
     #[error("invalid transfer function: {0}")]
     InvalidTransferFunction(String),

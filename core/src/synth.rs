@@ -1,9 +1,12 @@
 //! Analytic test volumes: VTK's wavelet (`vtkRTAnalyticSource`), the Marschner–Lobb
 //! signal, and a sphere signed distance field.
 //!
-//! All generators return single-component `float32` volumes with identity direction.
+//! All generators return single-component `float32` volumes with identity direction;
+//! [`wavelet_generated`] also gives `uint16`, computed in runs as the renderer reads it.
 
-use crate::params::{Scalars, VolumeData, IDENTITY_DIRECTION};
+use crate::error::{Error, Result};
+use crate::params::{ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};
+use std::sync::Arc;
 
 /// `vtkRTAnalyticSource::Maximum` default.
 pub const WAVELET_MAXIMUM: f64 = 255.0;
@@ -55,64 +58,169 @@ fn f32_volume(dims: [u32; 3], spacing: [f64; 3], origin: [f64; 3], data: Vec<f32
 /// # Panics
 /// If `extent` is empty on some axis (`min > max`).
 pub fn wavelet(extent: [i32; 6]) -> VolumeData {
-    let mut dims = [0u32; 3];
-    let mut scale = [0f64; 3];
-    for a in 0..3 {
-        let (lo, hi) = (extent[2 * a], extent[2 * a + 1]);
-        assert!(
-            lo <= hi,
-            "wavelet: empty extent {extent:?} (min > max on axis {a})"
-        );
-        dims[a] = (i64::from(hi) - i64::from(lo) + 1) as u32;
-        scale[a] = if hi > lo {
-            1.0 / (f64::from(hi) - f64::from(lo))
-        } else {
-            1.0
-        };
-    }
-    let temp2 = 1.0 / (2.0 * WAVELET_STANDARD_DEVIATION * WAVELET_STANDARD_DEVIATION);
-    // Center is (0, 0, 0): coordinate = (center - index) * scale.
-    let coord = |a: usize, idx: i32| (0.0 - f64::from(idx)) * scale[a];
-
-    // Per-axis terms, as VTK computes them: the squared coordinate in f64 and the
-    // trigonometric term rounded to f32.
-    let xs: Vec<(f64, f32)> = (extent[0]..=extent[1])
-        .map(|i| {
-            let x = coord(0, i);
-            (x * x, (WAVELET_MAG[0] * (WAVELET_FREQ[0] * x).sin()) as f32)
-        })
-        .collect();
-
-    let n = dims.iter().map(|&d| d as usize).product();
-    let mut data = Vec::with_capacity(n);
-    for k in extent[4]..=extent[5] {
-        let z = coord(2, k);
-        let z_contrib = z * z;
-        let zfactor = (WAVELET_MAG[2] * (WAVELET_FREQ[2] * z).cos()) as f32;
-        for j in extent[2]..=extent[3] {
-            let y = coord(1, j);
-            let y_contrib = y * y;
-            let yfactor = (WAVELET_MAG[1] * (WAVELET_FREQ[1] * y).sin()) as f32;
-            let sum_zy = z_contrib + y_contrib;
-            data.extend(xs.iter().map(|&(x2, xfactor)| {
-                let sum = sum_zy + x2;
-                (WAVELET_MAXIMUM * (-sum * temp2).exp()
-                    + f64::from(xfactor)
-                    + f64::from(yfactor)
-                    + f64::from(zfactor)) as f32
-            }));
+    let w = WaveletTerms::new(extent);
+    let mut data = Vec::with_capacity(w.len());
+    for k in 0..w.dims[2] as usize {
+        for j in 0..w.dims[1] as usize {
+            data.extend((0..w.dims[0] as usize).map(|i| w.value(i, j, k)));
         }
     }
-    f32_volume(
+    f32_volume(w.dims, [1.0; 3], w.origin(), data)
+}
+
+/// The extent of an `n`-point wavelet axis centred as VTK's benchmark extents are:
+/// `-(n - 1) / 2 ..= n / 2` (`-63..=64` for 128 points), on every axis.
+///
+/// # Panics
+/// If `n` is 0 or above `i32::MAX`.
+pub fn wavelet_extent(n: u32) -> [i32; 6] {
+    assert!(
+        n >= 1 && n <= i32::MAX as u32,
+        "wavelet_extent: n = {n} points"
+    );
+    let lo = -(((n - 1) / 2) as i32);
+    let hi = lo + (n - 1) as i32;
+    [lo, hi, lo, hi, lo, hi]
+}
+
+/// The wavelet as `uint16`: `round((s − WAVELET_U16_OFFSET) · WAVELET_U16_SCALE)` of the
+/// float32 sample `s` (whose values lie within `[-33, 288]` on any extent).
+pub const WAVELET_U16_OFFSET: f64 = -40.0;
+/// See [`WAVELET_U16_OFFSET`].
+pub const WAVELET_U16_SCALE: f64 = 180.0;
+
+/// The wavelet ([`wavelet`]) over `extent` as a generated volume: its scalars are a
+/// [`ScalarSource`] that computes the samples of whatever run the renderer reads, so no
+/// size of volume is ever held in memory. `float32` gives [`wavelet`]'s values bit for
+/// bit; `uint16` scales them ([`WAVELET_U16_OFFSET`], [`WAVELET_U16_SCALE`]). Errors for
+/// other scalar types and for an extent over `u32::MAX` points per axis.
+///
+/// # Panics
+/// If `extent` is empty on some axis (`min > max`).
+pub fn wavelet_generated(extent: [i32; 6], ty: ScalarType) -> Result<VolumeData> {
+    if !matches!(ty, ScalarType::F32 | ScalarType::U16) {
+        return Err(Error::InvalidParameter(format!(
+            "the generated wavelet is float32 or uint16, not {}",
+            ty.name()
+        )));
+    }
+    let w = WaveletTerms::new(extent);
+    let (dims, origin) = (w.dims, w.origin());
+    let v = VolumeData {
         dims,
-        [1.0; 3],
-        [
-            f64::from(extent[0]),
-            f64::from(extent[2]),
-            f64::from(extent[4]),
-        ],
-        data,
-    )
+        spacing: [1.0; 3],
+        origin,
+        direction: IDENTITY_DIRECTION,
+        components: 1,
+        scalars: Scalars::Source(Arc::new(WaveletSource { w, ty })),
+    };
+    v.validate()?;
+    Ok(v)
+}
+
+/// The wavelet's per-axis terms, as VTK computes them: the squared coordinate in f64 and
+/// the trigonometric term rounded to f32.
+#[derive(Debug)]
+struct WaveletTerms {
+    extent: [i32; 6],
+    dims: [u32; 3],
+    /// Per axis, per index: (coordinate², magnitude · sin or cos).
+    axes: [Vec<(f64, f32)>; 3],
+}
+
+impl WaveletTerms {
+    fn new(extent: [i32; 6]) -> WaveletTerms {
+        let mut dims = [0u32; 3];
+        let mut scale = [0f64; 3];
+        for a in 0..3 {
+            let (lo, hi) = (extent[2 * a], extent[2 * a + 1]);
+            assert!(
+                lo <= hi,
+                "wavelet: empty extent {extent:?} (min > max on axis {a})"
+            );
+            dims[a] = (i64::from(hi) - i64::from(lo) + 1) as u32;
+            scale[a] = if hi > lo {
+                1.0 / (f64::from(hi) - f64::from(lo))
+            } else {
+                1.0
+            };
+        }
+        // Center is (0, 0, 0): coordinate = (center - index) * scale.
+        let axes = [0, 1, 2].map(|a| {
+            (extent[2 * a]..=extent[2 * a + 1])
+                .map(|idx| {
+                    let c = (0.0 - f64::from(idx)) * scale[a];
+                    let arg = WAVELET_FREQ[a] * c;
+                    let trig = if a == 2 { arg.cos() } else { arg.sin() };
+                    (c * c, (WAVELET_MAG[a] * trig) as f32)
+                })
+                .collect()
+        });
+        WaveletTerms { extent, dims, axes }
+    }
+
+    fn len(&self) -> usize {
+        self.dims.iter().map(|&d| d as usize).product()
+    }
+
+    fn origin(&self) -> [f64; 3] {
+        [0, 2, 4].map(|a| f64::from(self.extent[a]))
+    }
+
+    /// The sample at point (i, j, k) (0-based).
+    #[inline]
+    fn value(&self, i: usize, j: usize, k: usize) -> f32 {
+        let temp2 = 1.0 / (2.0 * WAVELET_STANDARD_DEVIATION * WAVELET_STANDARD_DEVIATION);
+        let (x2, xfactor) = self.axes[0][i];
+        let (y2, yfactor) = self.axes[1][j];
+        let (z2, zfactor) = self.axes[2][k];
+        let sum = z2 + y2 + x2;
+        (WAVELET_MAXIMUM * (-sum * temp2).exp()
+            + f64::from(xfactor)
+            + f64::from(yfactor)
+            + f64::from(zfactor)) as f32
+    }
+}
+
+/// The generated wavelet's scalars ([`wavelet_generated`]).
+#[derive(Debug)]
+struct WaveletSource {
+    w: WaveletTerms,
+    ty: ScalarType,
+}
+
+impl ScalarSource for WaveletSource {
+    fn scalar_type(&self) -> ScalarType {
+        self.ty
+    }
+
+    fn len(&self) -> usize {
+        self.w.len()
+    }
+
+    fn read(&self, start: usize, out: &mut [f64]) -> std::io::Result<()> {
+        let [nx, ny, _] = self.w.dims.map(|d| d as usize);
+        let mut p = start;
+        let mut rest = out;
+        while !rest.is_empty() {
+            // the rest of the x-row holding point p
+            let (i0, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
+            let n = (nx - i0).min(rest.len());
+            let (run, tail) = rest.split_at_mut(n);
+            for (o, i) in run.iter_mut().zip(i0..) {
+                let s = self.w.value(i, j, k);
+                *o = match self.ty {
+                    ScalarType::U16 => ((f64::from(s) - WAVELET_U16_OFFSET) * WAVELET_U16_SCALE)
+                        .round()
+                        .clamp(0.0, 65535.0),
+                    _ => f64::from(s),
+                };
+            }
+            p += n;
+            rest = tail;
+        }
+        Ok(())
+    }
 }
 
 /// Marschner–Lobb frequency `f_M`.
@@ -216,6 +324,44 @@ mod tests {
     }
 
     // Reference values printed by VTK 9.2 (`vtkRTAnalyticSource`, default parameters).
+    #[test]
+    fn the_generated_wavelet_is_the_wavelet() {
+        let extent = [-5, 7, -3, 2, 0, 4];
+        let memory = wavelet(extent);
+        let generated = wavelet_generated(extent, ScalarType::F32).unwrap();
+        assert_eq!(
+            (generated.dims, generated.origin),
+            (memory.dims, memory.origin)
+        );
+        let n = memory.scalars.len();
+        // runs that start mid-row and cross rows and slices
+        let mut all = vec![0.0; n];
+        for start in (0..n).step_by(11) {
+            let end = (start + 11).min(n);
+            generated
+                .scalars
+                .read_run(start, &mut all[start..end])
+                .unwrap();
+        }
+        let Scalars::F32(want) = &memory.scalars else {
+            panic!("float32")
+        };
+        assert!(all.iter().zip(want).all(|(&a, &b)| a == b as f64));
+        let u16 = wavelet_generated(extent, ScalarType::U16).unwrap();
+        let mut q = vec![0.0; n];
+        u16.scalars.read_run(0, &mut q).unwrap();
+        for (&a, &b) in q.iter().zip(want) {
+            let back = a / WAVELET_U16_SCALE + WAVELET_U16_OFFSET;
+            assert!(a.fract() == 0.0 && (0.0..=65535.0).contains(&a));
+            assert!(
+                (back - b as f64).abs() <= 0.5 / WAVELET_U16_SCALE,
+                "{a} {b}"
+            );
+        }
+        assert_eq!(wavelet_extent(128), [-63, 64, -63, 64, -63, 64]);
+        assert!(wavelet_generated(extent, ScalarType::U8).is_err());
+    }
+
     #[test]
     fn synth_wavelet_matches_vtk_default_extent() {
         let v = wavelet(WAVELET_DEFAULT_EXTENT);

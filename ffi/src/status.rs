@@ -68,6 +68,7 @@ impl FfiError {
             E::OutOfMemory(_) => FvStatus::OutOfMemory,
             E::DeviceLost(_) => FvStatus::DeviceLost,
             E::Gpu(_) => FvStatus::GpuError,
+            E::Source(_) => FvStatus::IoError,
         }
     }
 }
@@ -209,6 +210,7 @@ mod tests {
             (E::Gpu(s()), FvStatus::GpuError),
             (E::OutOfMemory(s()), FvStatus::OutOfMemory),
             (E::DeviceLost(s()), FvStatus::DeviceLost),
+            (E::Source(s()), FvStatus::IoError),
         ];
         for (error, want) in cases {
             // A new core variant must get a row here: this match stops compiling without it.
@@ -221,7 +223,8 @@ mod tests {
                 | E::Unsupported(_)
                 | E::Gpu(_)
                 | E::OutOfMemory(_)
-                | E::DeviceLost(_) => {}
+                | E::DeviceLost(_)
+                | E::Source(_) => {}
             }
             let text = error.to_string();
             let e = FfiError::from(error);

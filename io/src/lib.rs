@@ -31,10 +31,12 @@ pub mod image;
 pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;
+mod raw;
 pub mod transfer;
 pub mod vti;
 
 pub use error::{Problem, ReadError};
+pub use raw::RawFileSource;
 
 /// File name endings [`read_volume`] understands.
 pub const SUPPORTED_EXTENSIONS: &[&str] =
@@ -115,6 +117,49 @@ pub fn read_volume(path: &Path) -> Result<VolumeData, ReadError> {
                 file.map_or_else(|| path.to_path_buf(), |name| data_file_path(path, name))
             })
         })
+}
+
+/// Opens a volume file as [`read_volume`] reads it, but leaves uncompressed binary data
+/// where it is: a NRRD (`encoding: raw`, no `line skip`) or MetaImage (`BinaryData`, not
+/// `CompressedData`) volume, its data detached or attached, comes back with
+/// [`ferrovol_core::Scalars::Source`] scalars ([`RawFileSource`]) that read runs of values
+/// with positioned reads as the renderer needs them, so it never holds the whole volume.
+/// Other files (other formats, encodings and compressions) are read into memory by
+/// [`read_volume`]. A data file shorter than its header says is an error here, as there.
+///
+/// NaN and infinite values in float data read in place are not found here (that would
+/// read the whole file); the upload finds them (see [`ferrovol_core::Scalars`]).
+pub fn open_volume(path: &Path) -> Result<VolumeData, ReadError> {
+    let raw = match Format::from_path(path) {
+        Some(Format::Nrrd) => header_prefix(path).map(|h| nrrd::raw_data(&h)),
+        Some(Format::MetaImage) => header_prefix(path).map(|h| metaimage::raw_data(&h)),
+        _ => None,
+    };
+    // A header the in-place reader cannot use (or an error in it) goes to read_volume,
+    // which reports errors as it always does.
+    match raw {
+        Some(Ok(Some(raw))) => {
+            let data_path = match &raw.file {
+                Some(name) => data_file_path(path, name),
+                None => path.to_path_buf(),
+            };
+            raw.open(&data_path)
+        }
+        _ => read_volume(path),
+    }
+}
+
+/// The first bytes of a file, enough for any header: the whole file up to 1 MiB. `None`
+/// if it cannot be read (read_volume reports that).
+fn header_prefix(path: &Path) -> Option<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(1 << 20)
+        .read_to_end(&mut bytes)
+        .ok()?;
+    Some(bytes)
 }
 
 /// Where a header at `header` finds the data file it calls `name`: relative to the

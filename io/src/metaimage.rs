@@ -113,6 +113,92 @@ pub fn parse(
     bytes: &[u8],
     data_file: impl FnOnce(&str) -> Result<Vec<u8>, ReadError>,
 ) -> Result<VolumeData, ReadError> {
+    let Plan {
+        layout,
+        geometry,
+        binary,
+        big_endian,
+        compressed,
+        header_size,
+        file,
+        data_start,
+    } = plan(bytes)?;
+    let Some(file_value) = file else {
+        let data = bytes.get(data_start..).unwrap_or(&[]);
+        let scalars = decode(data, layout, binary, big_endian, compressed)?;
+        return layout.volume(geometry, scalars);
+    };
+    let file_value = file_value.as_str();
+    let external = data_file(file_value)?;
+    let in_data_file = |e: ReadError| e.in_file(Path::new(file_value));
+    let skipped = match usize::try_from(header_size) {
+        Ok(skip) => skip,
+        // -1: the data is at the end of the file.
+        Err(_) if header_size == -1 && !compressed && binary => {
+            external.len().saturating_sub(layout.nbytes)
+        }
+        Err(_) => {
+            return Err(bad(format!(
+                "HeaderSize = {header_size}; expected a byte count or -1 (uncompressed binary data only)"
+            )))
+        }
+    };
+    let data = external
+        .get(skipped..)
+        .ok_or_else(|| {
+            ReadError::truncated(
+                format!("MetaImage data file (HeaderSize {header_size})"),
+                skipped,
+                external.len(),
+            )
+        })
+        .map_err(in_data_file)?;
+    let scalars = decode(data, layout, binary, big_endian, compressed).map_err(in_data_file)?;
+    layout.volume(geometry, scalars)
+}
+
+/// Where uncompressed binary data lies, for reading it in place (`header`: any prefix of
+/// the file holding the whole header). `None` for ASCII or compressed data.
+pub(crate) fn raw_data(header: &[u8]) -> Result<Option<crate::raw::RawData>, ReadError> {
+    use crate::raw::{RawData, RawStart};
+    let p = plan(header)?;
+    if !p.binary || p.compressed {
+        return Ok(None);
+    }
+    let (file, start) = match p.file {
+        Some(f) => match u64::try_from(p.header_size) {
+            Ok(skip) => (Some(f), RawStart::At(skip)),
+            Err(_) if p.header_size == -1 => (Some(f), RawStart::FromEnd),
+            Err(_) => return Ok(None), // the in-memory reader names the problem
+        },
+        None => (None, RawStart::At(p.data_start as u64)),
+    };
+    Ok(Some(RawData {
+        format: FORMAT,
+        layout: p.layout,
+        geometry: p.geometry,
+        big_endian: p.big_endian,
+        file,
+        start,
+    }))
+}
+
+/// What a header says about the volume and where its data is.
+struct Plan {
+    layout: Layout,
+    geometry: Geometry,
+    binary: bool,
+    big_endian: bool,
+    compressed: bool,
+    header_size: i64,
+    /// The detached data file, as the header names it (None: LOCAL).
+    file: Option<String>,
+    /// Where LOCAL data starts.
+    data_start: usize,
+}
+
+/// Parses the header and checks what it says.
+fn plan(bytes: &[u8]) -> Result<Plan, ReadError> {
     let (h, data_start) = parse_header(bytes)?;
 
     if let Some((k, v)) = h.get(&["ObjectType"]) {
@@ -189,9 +275,16 @@ pub fn parse(
         .get(&["ElementDataFile"])
         .ok_or_else(|| bad("no ElementDataFile line"))?;
     if file_value.eq_ignore_ascii_case("LOCAL") {
-        let data = bytes.get(data_start..).unwrap_or(&[]);
-        let scalars = decode(data, layout, binary, big_endian, compressed)?;
-        return layout.volume(geometry, scalars);
+        return Ok(Plan {
+            layout,
+            geometry,
+            binary,
+            big_endian,
+            compressed,
+            header_size,
+            file: None,
+            data_start,
+        });
     }
     if file_value.eq_ignore_ascii_case("LIST") || file_value.contains('%') {
         return Err(ReadError::unsupported(format!(
@@ -203,32 +296,16 @@ pub fn parse(
             "ElementDataFile is empty; it must be LOCAL or a file name",
         ));
     }
-    let external = data_file(file_value)?;
-    let in_data_file = |e: ReadError| e.in_file(Path::new(file_value));
-    let skipped = match usize::try_from(header_size) {
-        Ok(skip) => skip,
-        // -1: the data is at the end of the file.
-        Err(_) if header_size == -1 && !compressed && binary => {
-            external.len().saturating_sub(layout.nbytes)
-        }
-        Err(_) => {
-            return Err(bad(format!(
-                "HeaderSize = {header_size}; expected a byte count or -1 (uncompressed binary data only)"
-            )))
-        }
-    };
-    let data = external
-        .get(skipped..)
-        .ok_or_else(|| {
-            ReadError::truncated(
-                format!("MetaImage data file (HeaderSize {header_size})"),
-                skipped,
-                external.len(),
-            )
-        })
-        .map_err(in_data_file)?;
-    let scalars = decode(data, layout, binary, big_endian, compressed).map_err(in_data_file)?;
-    layout.volume(geometry, scalars)
+    Ok(Plan {
+        layout,
+        geometry,
+        binary,
+        big_endian,
+        compressed,
+        header_size,
+        file: Some(file_value.to_string()),
+        data_start,
+    })
 }
 
 /// The voxel values in `data`: binary (maybe compressed) or ASCII numbers.

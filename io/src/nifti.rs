@@ -501,6 +501,8 @@ fn interleave(s: Scalars, nvox: usize, vector: usize, per: usize) -> Scalars {
         Scalars::I32(v) => Scalars::I32(go(v, nvox, vector, per)),
         Scalars::F32(v) => Scalars::F32(go(v, nvox, vector, per)),
         Scalars::F64(v) => Scalars::F64(go(v, nvox, vector, per)),
+        // decoded data is always in memory
+        s @ Scalars::Source(_) => s,
     }
 }
 

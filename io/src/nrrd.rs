@@ -148,6 +148,74 @@ pub fn parse(
     bytes: &[u8],
     data_file: impl FnOnce(&str) -> Result<Vec<u8>, ReadError>,
 ) -> Result<VolumeData, ReadError> {
+    let Plan {
+        layout,
+        geometry,
+        stored,
+        data,
+    } = plan(bytes)?;
+    let scalars = match data {
+        Data::File(f) => {
+            let external = data_file(&f)?;
+            decode(&external, layout, stored).map_err(|e| e.in_file(Path::new(&f)))?
+        }
+        Data::Attached(s) => decode(bytes.get(s..).unwrap_or(&[]), layout, stored)?,
+    };
+    layout.volume(geometry, scalars)
+}
+
+/// Where raw (uncompressed binary) data lies, for reading it in place: the header (any
+/// prefix of the file holding the whole header) says the data is raw with no line skip.
+/// `None` for data that must be decoded (gzip, ASCII, hex, line skip).
+pub(crate) fn raw_data(header: &[u8]) -> Result<Option<crate::raw::RawData>, ReadError> {
+    use crate::raw::{RawData, RawStart};
+    let Plan {
+        layout,
+        geometry,
+        stored,
+        data,
+    } = plan(header)?;
+    if stored.encoding != Encoding::Raw || stored.line_skip != 0 {
+        return Ok(None);
+    }
+    let start = if stored.byte_skip == -1 {
+        RawStart::FromEnd
+    } else {
+        RawStart::At(stored.byte_skip as u64)
+    };
+    let (file, start) = match data {
+        Data::File(f) => (Some(f), start),
+        Data::Attached(s) => match start {
+            RawStart::At(skip) => (None, RawStart::At(s as u64 + skip)),
+            RawStart::FromEnd => (None, RawStart::FromEnd),
+        },
+    };
+    Ok(Some(RawData {
+        format: FORMAT,
+        layout,
+        geometry,
+        big_endian: stored.big_endian,
+        file,
+        start,
+    }))
+}
+
+/// What a header says about the volume and where its data is.
+struct Plan {
+    layout: Layout,
+    geometry: Geometry,
+    stored: Stored,
+    data: Data,
+}
+
+/// Where the data is: a detached file (as the header names it) or after the header.
+enum Data {
+    File(String),
+    Attached(usize),
+}
+
+/// Parses the header and checks what it says.
+fn plan(bytes: &[u8]) -> Result<Plan, ReadError> {
     let h = parse_header(bytes)?;
     let need = |keys: &[&str], what: &str| {
         h.get(keys)
@@ -337,7 +405,7 @@ pub fn parse(
         line_skip,
         byte_skip,
     };
-    let scalars = match h.get(&["data file", "datafile"]) {
+    let data = match h.get(&["data file", "datafile"]) {
         Some(f) => {
             let first = f.split_ascii_whitespace().next().unwrap_or("");
             if first == "LIST" || f.contains('%') {
@@ -345,11 +413,10 @@ pub fn parse(
                     "data file: {f}: data split over several files; join them into one file (e.g. with unu join, then unu save)"
                 )));
             }
-            let external = data_file(f)?;
-            decode(&external, layout, stored).map_err(|e| e.in_file(Path::new(f)))?
+            Data::File(f.to_string())
         }
         None => match h.data_start {
-            Some(s) => decode(bytes.get(s..).unwrap_or(&[]), layout, stored)?,
+            Some(s) => Data::Attached(s),
             None => {
                 return Err(bad(
                     "no 'data file' field and no blank line followed by data; a detached header (.nhdr) must name its data file",
@@ -357,7 +424,12 @@ pub fn parse(
             }
         },
     };
-    layout.volume(geometry, scalars)
+    Ok(Plan {
+        layout,
+        geometry,
+        stored,
+        data,
+    })
 }
 
 /// How the data is stored: the header's `encoding`, `endian`, `line skip` and

@@ -28,4 +28,4 @@ pub use render::{
 pub(crate) use transfer::build_tables;
 pub use transfer::{ComponentTransfer, Piecewise, TransferFunction, TABLE_SIZE};
 pub use view::{Image, Residency, Stats, StreamProgress, UploadOptions, View};
-pub use volume::{Direction, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};
+pub use volume::{Direction, ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

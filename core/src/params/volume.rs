@@ -2,10 +2,35 @@
 //! geometry that places the index grid in the world (spacing, origin, direction).
 
 use crate::error::{Error, Result};
+use std::sync::Arc;
 
-/// Scalar storage, one variant per VTK scalar type the renderer accepts.
-/// Components are interleaved (`c0 c1 … c0 c1 …`), x fastest, then y, then z.
-#[derive(Clone, Debug, PartialEq)]
+/// Scalar values that are not held in memory: read from a file, or computed, in
+/// contiguous runs as the renderer needs them. The renderer reads a volume by whole
+/// x-rows (the min–max grid once at upload, each brick when it becomes resident), so a
+/// source is never asked for the whole volume at once.
+pub trait ScalarSource: Send + Sync + std::fmt::Debug {
+    /// The type the values have (and are stored on the device as).
+    fn scalar_type(&self) -> ScalarType;
+    /// Number of values (points × components).
+    fn len(&self) -> usize;
+    /// Whether there are no values.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Reads the values `start .. start + out.len()` (components interleaved as in
+    /// [`Scalars`]) into `out`. Every value must be exactly representable by
+    /// [`ScalarSource::scalar_type`]. The range lies within `len()`.
+    fn read(&self, start: usize, out: &mut [f64]) -> std::io::Result<()>;
+}
+
+/// Scalar storage, one variant per VTK scalar type the renderer accepts, or a
+/// [`ScalarSource`] read in runs. Components are interleaved (`c0 c1 … c0 c1 …`), x
+/// fastest, then y, then z.
+///
+/// Sources are not scanned for NaN and infinite values by [`VolumeData::validate`] (that
+/// would read the whole volume each time a builder method validates); the upload reads
+/// every value once for the min–max grid and refuses such a value there.
+#[derive(Clone, Debug)]
 pub enum Scalars {
     U8(Vec<u8>),
     I8(Vec<i8>),
@@ -15,6 +40,27 @@ pub enum Scalars {
     I32(Vec<i32>),
     F32(Vec<f32>),
     F64(Vec<f64>),
+    Source(Arc<dyn ScalarSource>),
+}
+
+impl PartialEq for Scalars {
+    /// In-memory arrays compare by value; sources only by identity (comparing them by
+    /// value would read both whole).
+    fn eq(&self, other: &Scalars) -> bool {
+        use Scalars::*;
+        match (self, other) {
+            (U8(a), U8(b)) => a == b,
+            (I8(a), I8(b)) => a == b,
+            (U16(a), U16(b)) => a == b,
+            (I16(a), I16(b)) => a == b,
+            (U32(a), U32(b)) => a == b,
+            (I32(a), I32(b)) => a == b,
+            (F32(a), F32(b)) => a == b,
+            (F64(a), F64(b)) => a == b,
+            (Source(a), Source(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
 }
 
 /// The scalar type of a [`Scalars`] array.
@@ -64,6 +110,7 @@ macro_rules! each_scalars {
             Scalars::I32($v) => $body,
             Scalars::F32($v) => $body,
             Scalars::F64($v) => $body,
+            Scalars::Source($v) => $body,
         }
     };
 }
@@ -85,9 +132,60 @@ impl Scalars {
             Scalars::I32(_) => ScalarType::I32,
             Scalars::F32(_) => ScalarType::F32,
             Scalars::F64(_) => ScalarType::F64,
+            Scalars::Source(s) => s.scalar_type(),
         }
     }
+
+    /// The source, for scalars that are not in memory.
+    pub fn source(&self) -> Option<&Arc<dyn ScalarSource>> {
+        match self {
+            Scalars::Source(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Reads the values `start .. start + out.len()` into `out`: one call to a source for
+    /// the whole run (a positioned read of a file, say), a conversion for arrays in memory.
+    pub fn read_run(&self, start: usize, out: &mut [f64]) -> Result<()> {
+        fn conv<T: Copy + Into<f64>>(v: &[T], start: usize, out: &mut [f64]) {
+            let n = out.len();
+            for (o, &x) in out.iter_mut().zip(&v[start..start + n]) {
+                *o = x.into();
+            }
+        }
+        match self {
+            Scalars::U8(v) => conv(v, start, out),
+            Scalars::I8(v) => conv(v, start, out),
+            Scalars::U16(v) => conv(v, start, out),
+            Scalars::I16(v) => conv(v, start, out),
+            Scalars::U32(v) => conv(v, start, out),
+            Scalars::I32(v) => conv(v, start, out),
+            Scalars::F32(v) => conv(v, start, out),
+            Scalars::F64(v) => out.copy_from_slice(&v[start..start + out.len()]),
+            Scalars::Source(s) => {
+                if start + out.len() > s.len() {
+                    return Err(Error::InvalidVolume(format!(
+                        "values {start}..{} asked of a source of {} values",
+                        start + out.len(),
+                        s.len()
+                    )));
+                }
+                s.read(start, out).map_err(|e| {
+                    Error::Source(format!(
+                        "values {start}..{} of {s:?}: {e}",
+                        start + out.len()
+                    ))
+                })?
+            }
+        }
+        Ok(())
+    }
+
     /// Value `i` (flat index into the interleaved array) as f64.
+    ///
+    /// # Panics
+    /// If a source fails to read the value ([`Scalars::read_run`] returns the error
+    /// instead). Reading a source one value at a time is slow: read runs.
     #[inline]
     pub fn get(&self, i: usize) -> f64 {
         match self {
@@ -99,6 +197,13 @@ impl Scalars {
             Scalars::U32(v) => v[i] as f64,
             Scalars::I32(v) => v[i] as f64,
             Scalars::F32(v) => v[i] as f64,
+            Scalars::Source(_) => {
+                let mut out = [0.0];
+                if let Err(e) = self.read_run(i, &mut out) {
+                    panic!("{e}");
+                }
+                out[0]
+            }
         }
     }
 }
@@ -209,22 +314,29 @@ impl VolumeData {
             )));
         }
         if let Some(i) = self.first_non_finite() {
-            let c = self.components as usize;
-            let p = i / c;
-            let nx = self.dims[0] as usize;
-            let ny = self.dims[1] as usize;
-            return Err(Error::InvalidVolume(format!(
-                "scalar at point ({}, {}, {}) component {} is {} (NaN and infinite values are not renderable)",
-                p % nx,
-                (p / nx) % ny,
-                p / (nx * ny),
-                i % c,
-                self.scalars.get(i)
-            )));
+            return Err(self.non_finite(i, self.scalars.get(i)));
         }
         Ok(())
     }
 
+    /// The error for the non-finite `value` at flat index `i`.
+    pub(crate) fn non_finite(&self, i: usize, value: f64) -> Error {
+        let c = self.components as usize;
+        let p = i / c;
+        let nx = self.dims[0] as usize;
+        let ny = self.dims[1] as usize;
+        Error::InvalidVolume(format!(
+            "scalar at point ({}, {}, {}) component {} is {} (NaN and infinite values are not renderable)",
+            p % nx,
+            (p / nx) % ny,
+            p / (nx * ny),
+            i % c,
+            value
+        ))
+    }
+
+    /// The first NaN or infinite value of in-memory data (a source's values are checked
+    /// as the upload reads them: see [`Scalars`]).
     fn first_non_finite(&self) -> Option<usize> {
         match &self.scalars {
             Scalars::F32(v) => v.iter().position(|x| !x.is_finite()),
@@ -234,17 +346,45 @@ impl VolumeData {
     }
 
     /// Minimum and maximum of component `c`.
+    ///
+    /// # Panics
+    /// If a source fails to read ([`VolumeData::try_range`] returns the error instead).
     pub fn range(&self, c: u32) -> [f64; 2] {
+        match self.try_range(c) {
+            Ok(r) => r,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// [`VolumeData::range`], reading a source in runs of whole x-rows.
+    pub fn try_range(&self, c: u32) -> Result<[f64; 2]> {
         let nc = self.components as usize;
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         let n = self.num_points();
+        if self.scalars.source().is_some() {
+            let row = self.dims[0] as usize * nc;
+            let rows_per_read = (1 << 16) / row + 1;
+            let mut buf = vec![0.0; rows_per_read * row];
+            let total = n * nc;
+            let mut start = 0;
+            while start < total {
+                let len = buf.len().min(total - start);
+                self.scalars.read_run(start, &mut buf[..len])?;
+                for &v in buf[..len].iter().skip(c as usize).step_by(nc) {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+                start += len;
+            }
+            return Ok([lo, hi]);
+        }
         for p in 0..n {
             let v = self.scalars.get(p * nc + c as usize);
             lo = lo.min(v);
             hi = hi.max(v);
         }
-        [lo, hi]
+        Ok([lo, hi])
     }
 
     /// Value of component `c` at point (i, j, k).

@@ -290,13 +290,50 @@ pub fn plan_bricks(
 
 /// Texel bytes of the `size` points from `lo` (index space; points outside the volume take
 /// the nearest edge point's value, as a clamping sampler reads them) in the chosen storage.
-pub fn brick_texels(v: &VolumeData, layout: &Layout, lo: [i64; 3], size: [u32; 3]) -> Vec<u8> {
+/// In-memory data is read value by value; a source in one run per x-row (the row's points
+/// the brick covers), so that a file source makes one positioned read per row. Errors are
+/// a source's read failures.
+pub fn brick_texels(
+    v: &VolumeData,
+    layout: &Layout,
+    lo: [i64; 3],
+    size: [u32; 3],
+) -> Result<Vec<u8>> {
     let nc = v.components as usize;
     let ch = layout.channels as usize;
     let n: usize = size.iter().map(|&d| d as usize).product();
     let mut out = Vec::with_capacity(n * layout.texel_bytes as usize);
     let (nx, ny) = (v.dims[0] as usize, v.dims[1] as usize);
     let at = |a: usize, i: u32| (lo[a] + i as i64).clamp(0, v.dims[a] as i64 - 1) as usize;
+    let push = |out: &mut Vec<u8>, val: f64, c: usize| match layout.storage {
+        Storage::Unorm8 { offset } => out.push((val + offset).round().clamp(0.0, 255.0) as u8),
+        Storage::Unorm16 { offset } => out
+            .extend_from_slice(&((val + offset).round().clamp(0.0, 65535.0) as u16).to_le_bytes()),
+        Storage::Float32 => out.extend_from_slice(&(val as f32).to_le_bytes()),
+        Storage::Float16Normalized => {
+            let t = (val - layout.shift[c] as f64) / layout.scale[c] as f64;
+            out.extend_from_slice(&half::f16::from_f64(t).to_le_bytes());
+        }
+    };
+    if v.scalars.source().is_some() {
+        // The x-run of points the brick reads on each row (clamped into the volume).
+        let (x0, x1) = (at(0, 0), at(0, size[0] - 1));
+        let mut row_vals = vec![0.0; (x1 - x0 + 1) * nc];
+        for k in 0..size[2] {
+            for j in 0..size[1] {
+                let row = (at(2, k) * ny + at(1, j)) * nx;
+                v.scalars.read_run((row + x0) * nc, &mut row_vals)?;
+                for i in 0..size[0] {
+                    let p = (at(0, i) - x0) * nc;
+                    for c in 0..ch {
+                        let val = if c < nc { row_vals[p + c] } else { 0.0 };
+                        push(&mut out, val, c);
+                    }
+                }
+            }
+        }
+        return Ok(out);
+    }
     for k in 0..size[2] {
         for j in 0..size[1] {
             let row = (at(2, k) * ny + at(1, j)) * nx;
@@ -304,24 +341,12 @@ pub fn brick_texels(v: &VolumeData, layout: &Layout, lo: [i64; 3], size: [u32; 3
                 let p = (row + at(0, i)) * nc;
                 for c in 0..ch {
                     let val = if c < nc { v.scalars.get(p + c) } else { 0.0 };
-                    match layout.storage {
-                        Storage::Unorm8 { offset } => {
-                            out.push((val + offset).round().clamp(0.0, 255.0) as u8)
-                        }
-                        Storage::Unorm16 { offset } => out.extend_from_slice(
-                            &((val + offset).round().clamp(0.0, 65535.0) as u16).to_le_bytes(),
-                        ),
-                        Storage::Float32 => out.extend_from_slice(&(val as f32).to_le_bytes()),
-                        Storage::Float16Normalized => {
-                            let t = (val - layout.shift[c] as f64) / layout.scale[c] as f64;
-                            out.extend_from_slice(&half::f16::from_f64(t).to_le_bytes());
-                        }
-                    }
+                    push(&mut out, val, c);
                 }
             }
         }
     }
-    out
+    Ok(out)
 }
 
 /// Min–max of each component over occupancy blocks of [`BLOCK_SIZE`] cells: block b holds
@@ -333,7 +358,11 @@ pub struct MinMaxGrid {
 }
 
 impl MinMaxGrid {
-    pub fn new(v: &VolumeData) -> MinMaxGrid {
+    /// Reads every point once. In-memory data is read value by value; a source in runs of
+    /// whole x-rows, whose values are checked here for NaN and infinity (the only time the
+    /// upload reads them all; see [`crate::Scalars`]). Errors: such a value, or a source's
+    /// read failure.
+    pub fn new(v: &VolumeData) -> Result<MinMaxGrid> {
         let s = BLOCK_SIZE;
         let dims = v.dims.map(|d| d.saturating_sub(1).max(1).div_ceil(s));
         let nc = v.components;
@@ -341,36 +370,35 @@ impl MinMaxGrid {
         let mut ranges = vec![[f32::INFINITY, f32::NEG_INFINITY]; nblocks * nc as usize];
         // Reduce along x into per-(row, block) ranges first, then spread over y and z.
         let (nx, ny, nz) = (v.dims[0], v.dims[1], v.dims[2]);
+        let source = v.scalars.source().is_some();
+        let mut row_vals = vec![0.0; if source { (nx * nc) as usize } else { 0 }];
         for k in 0..nz {
             let bz_lo = (k.saturating_sub(1) / s).min(dims[2] - 1);
             let bz_hi = (k / s).min(dims[2] - 1);
             for j in 0..ny {
                 let by_lo = (j.saturating_sub(1) / s).min(dims[1] - 1);
                 let by_hi = (j / s).min(dims[1] - 1);
-                for bx in 0..dims[0] {
-                    let i0 = bx * s;
-                    let i1 = (bx * s + s).min(nx - 1);
-                    for c in 0..nc {
-                        let mut lo = f32::INFINITY;
-                        let mut hi = f32::NEG_INFINITY;
-                        for i in i0..=i1 {
-                            let val = v.value(i, j, k, c) as f32;
-                            lo = lo.min(val);
-                            hi = hi.max(val);
-                        }
-                        for bz in bz_lo..=bz_hi {
-                            for by in by_lo..=by_hi {
-                                let b = ((bz * dims[1] + by) * dims[0] + bx) as usize;
-                                let r = &mut ranges[b * nc as usize + c as usize];
-                                r[0] = r[0].min(lo);
-                                r[1] = r[1].max(hi);
-                            }
-                        }
+                let mut row = RowRanges {
+                    dims,
+                    nc,
+                    x_last: nx - 1,
+                    bz: [bz_lo, bz_hi],
+                    by: [by_lo, by_hi],
+                    ranges: &mut ranges,
+                };
+                if source {
+                    let start = (k as usize * ny as usize + j as usize) * row_vals.len();
+                    v.scalars.read_run(start, &mut row_vals)?;
+                    if let Some(i) = row_vals.iter().position(|x| !x.is_finite()) {
+                        return Err(v.non_finite(start + i, row_vals[i]));
                     }
+                    row.reduce(|i, c| row_vals[(i * nc + c) as usize] as f32);
+                } else {
+                    row.reduce(|i, c| v.value(i, j, k, c) as f32);
                 }
             }
         }
-        MinMaxGrid { dims, ranges }
+        Ok(MinMaxGrid { dims, ranges })
     }
 
     /// Component `c`'s range per block as the device samples it: the data's own values
@@ -395,6 +423,45 @@ impl MinMaxGrid {
                 }
             })
             .collect()
+    }
+}
+
+/// One x-row's share of the min–max grid: the blocks its points belong to.
+struct RowRanges<'a> {
+    dims: [u32; 3],
+    nc: u32,
+    x_last: u32,
+    bz: [u32; 2],
+    by: [u32; 2],
+    ranges: &'a mut [[f32; 2]],
+}
+
+impl RowRanges<'_> {
+    /// Folds the row's values (`value(i, c)`) into the ranges of the blocks holding them.
+    #[inline]
+    fn reduce(&mut self, value: impl Fn(u32, u32) -> f32) {
+        let (s, dims, nc) = (BLOCK_SIZE, self.dims, self.nc);
+        for bx in 0..dims[0] {
+            let i0 = bx * s;
+            let i1 = (bx * s + s).min(self.x_last);
+            for c in 0..nc {
+                let mut lo = f32::INFINITY;
+                let mut hi = f32::NEG_INFINITY;
+                for i in i0..=i1 {
+                    let val = value(i, c);
+                    lo = lo.min(val);
+                    hi = hi.max(val);
+                }
+                for bz in self.bz[0]..=self.bz[1] {
+                    for by in self.by[0]..=self.by[1] {
+                        let b = ((bz * dims[1] + by) * dims[0] + bx) as usize;
+                        let r = &mut self.ranges[b * nc as usize + c as usize];
+                        r[0] = r[0].min(lo);
+                        r[1] = r[1].max(hi);
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -459,7 +526,7 @@ mod tests {
             shift: [0.0; 4],
         };
         assert_eq!(
-            brick_texels(&v, &layout, [-2, 0, 0], [7, 1, 1]),
+            brick_texels(&v, &layout, [-2, 0, 0], [7, 1, 1]).unwrap(),
             vec![10, 10, 10, 20, 30, 30, 30]
         );
     }

@@ -164,7 +164,7 @@ impl Resources {
             scale,
             shift,
         };
-        let minmax = MinMaxGrid::new(v);
+        let minmax = MinMaxGrid::new(v)?;
         let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
         let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
         let gradients = wants_gradients(v, &opts);
@@ -195,7 +195,10 @@ impl Resources {
         let components = v.components;
         let index_to_data = v.index_to_data();
         let (host, whole) = if grid.len() == 1 {
-            (None, Some(bricks::brick_texels(v, &layout, [0; 3], v.dims)))
+            (
+                None,
+                Some(bricks::brick_texels(v, &layout, [0; 3], v.dims)?),
+            )
         } else {
             (Some(host.into_shared()), None)
         };
@@ -553,7 +556,7 @@ fn upload_bricks(
             &vol.layout,
             grid.slot_origin_point(grid.cell(i)),
             grid.slot,
-        );
+        )?;
         let origin = [sx * grid.slot[0], sy * grid.slot[1], sz * grid.slot[2]];
         upload_region(
             &ctx.queue,

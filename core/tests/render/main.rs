@@ -17,6 +17,7 @@ mod common;
 mod compositing;
 mod reference;
 mod silhouettes;
+mod sources;
 mod state;
 
 use common::raycast::to_pixel;
