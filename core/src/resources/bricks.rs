@@ -53,11 +53,9 @@ pub(crate) fn channels_for(components: u32) -> u32 {
     }
 }
 
-/// Picks the storage for a volume on a device.
-pub fn choose_storage(
-    v: &VolumeData,
-    info: &DeviceInfo,
-) -> (Storage, wgpu::TextureFormat, u32, [f32; 4], [f32; 4]) {
+/// Picks the storage for a volume on a device: its layout (the float16 fallback reads the
+/// data range: an error if a source fails to read).
+pub fn choose_storage(v: &VolumeData, info: &DeviceInfo) -> Result<Layout> {
     use wgpu::TextureFormat as F;
     let ch = channels_for(v.components);
     let pick = |f1: F, f2: F, f4: F| match ch {
@@ -96,7 +94,7 @@ pub fn choose_storage(
         ),
         _ => {
             for c in 0..v.components {
-                let [lo, hi] = v.range(c);
+                let [lo, hi] = v.try_range(c)?;
                 let w = if hi > lo { hi - lo } else { 1.0 };
                 scale[c as usize] = w as f32;
                 shift[c as usize] = lo as f32;
@@ -108,7 +106,14 @@ pub fn choose_storage(
             )
         }
     };
-    (storage, format, bytes * ch, scale, shift)
+    Ok(Layout {
+        storage,
+        format,
+        texel_bytes: bytes * ch,
+        channels: ch,
+        scale,
+        shift,
+    })
 }
 
 /// How the volume is cut into bricks and where they live in the pool texture. One brick is

@@ -141,7 +141,8 @@ impl Resources {
         let v = host.data();
         v.validate()?;
         let info = &ctx.info;
-        let (storage, format, texel_bytes, scale, shift) = bricks::choose_storage(v, info);
+        let layout = bricks::choose_storage(v, info)?;
+        let texel_bytes = layout.texel_bytes;
         let max_pool = info.limits.max_texture_dimension_3d;
         let max_brick = opts.max_brick_points.unwrap_or(max_pool);
         let max_bytes = opts
@@ -156,14 +157,6 @@ impl Resources {
             max_bytes,
             SLOT_POINTS,
         )?;
-        let layout = Layout {
-            storage,
-            format,
-            texel_bytes,
-            channels: bricks::channels_for(v.components),
-            scale,
-            shift,
-        };
         let minmax = MinMaxGrid::new(v)?;
         let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
         let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
