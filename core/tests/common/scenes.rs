@@ -102,3 +102,15 @@ pub fn with_clip_plane(base: RenderParams, origin: DVec3, normal: DVec3) -> Rend
         ..base
     }
 }
+
+/// An oblique view of `vol` (azimuth 30°, elevation 20°), `size` pixels square: rays cross
+/// the volume's axes, and a bricked volume's faces, at an angle.
+pub fn oblique(vol: &VolumeData, size: u32) -> View {
+    let b = vol.bounds();
+    let mut view = View::fit(b, size, size);
+    view.camera.azimuth(30.0);
+    view.camera.elevation(20.0);
+    view.camera.orthogonalize_view_up();
+    view.camera.reset_clipping_range(b);
+    view
+}

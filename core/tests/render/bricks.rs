@@ -13,7 +13,7 @@ use crate::common::gpu::{pt_params, renderer, set_bricked, trace};
 use crate::common::images::{save_enlarged, save_rgb};
 use crate::common::metrics::{corner_accessibility, flip, footprint, image_diff, srgb8};
 use crate::common::scenes::{
-    blob_transfer, blob_volume, component_transfer, radial, shaded, volume, white,
+    blob_transfer, blob_volume, component_transfer, oblique, radial, shaded, volume, white,
 };
 use ferrovol_core::*;
 use glam::DVec3;
@@ -94,17 +94,6 @@ fn compare(name: &str, bricks: usize, one: &Image, split: &Image, levels: u8) ->
          channels off by more than 1"
     );
     (max > levels).then(|| format!("{name}: max {max}/255 ({off} channels > 1)"))
-}
-
-/// An oblique view of `vol`, `size` pixels square: rays cross brick faces at an angle.
-fn oblique(vol: &VolumeData, size: u32) -> View {
-    let b = vol.bounds();
-    let mut view = View::fit(b, size, size);
-    view.camera.azimuth(30.0);
-    view.camera.elevation(20.0);
-    view.camera.orthogonalize_view_up();
-    view.camera.reset_clipping_range(b);
-    view
 }
 
 /// Every ray-casting blend mode and volumetric shadows, one brick against 125 bricks of a

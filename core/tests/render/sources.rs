@@ -3,7 +3,7 @@
 //! and uint16 storage; a source's NaN and its read failures are errors of the upload.
 
 use crate::common::gpu::{renderer, set_bricked};
-use crate::common::scenes::{component_transfer, shaded};
+use crate::common::scenes::{component_transfer, oblique, shaded};
 use ferrovol_core::*;
 use std::sync::Arc;
 
@@ -37,16 +37,6 @@ fn transfer(v: &VolumeData) -> TransferFunction {
     ))
 }
 
-fn view_of(v: &VolumeData) -> View {
-    let b = v.bounds();
-    let mut view = View::fit(b, 64, 64);
-    view.camera.azimuth(30.0);
-    view.camera.elevation(20.0);
-    view.camera.orthogonalize_view_up();
-    view.camera.reset_clipping_range(b);
-    view
-}
-
 #[test]
 fn a_source_renders_as_its_values_in_memory() {
     let mut r = renderer();
@@ -55,7 +45,7 @@ fn a_source_renders_as_its_values_in_memory() {
         assert!(source.scalars.source().is_some());
         let memory = in_memory(&source);
         r.set_transfer_function(&transfer(&memory)).unwrap();
-        let view = view_of(&memory);
+        let view = oblique(&memory, 64);
         let mut images = Vec::new();
         for vol in [&memory, &source] {
             r.set_volume(vol).unwrap();
