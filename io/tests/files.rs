@@ -1,35 +1,13 @@
 //! The path API on real files: detached data files next to their headers, and messages
 //! that start with the path of the file that was wrong.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ferrovol_core::Scalars;
 use ferrovol_io::{read_volume, Format, ReadError};
 
-/// A fresh folder under the system temp folder, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("ferrovol-io-{}-{tag}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(dir.join("sub")).unwrap();
-        TempDir(dir)
-    }
-
-    /// Writes `bytes` to `name` in the folder and returns the full path.
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let p = self.0.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::TempDir;
 
 /// Checks that reading fails with a message that starts with `path` and `words`.
 fn assert_fails(r: Result<ferrovol_core::VolumeData, ReadError>, path: &Path, words: &str) {

@@ -1,34 +1,15 @@
 //! Image files: environment maps read (with what is wrong said), the maps' radiance as the
 //! renderer sees it, and frames written as PNG.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ferrovol_core::{Context, Environment, EnvironmentSource, Image, Renderer};
 use ferrovol_io::image::{
     over_background, parse_environment, read_environment, read_environment_cube, write_png,
 };
 
-/// A fresh folder under the system temp folder, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("ferrovol-io-{}-{tag}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::TempDir;
 
 /// The error's message, checked for each of `words`.
 fn error_with<T, E: std::fmt::Display>(res: Result<T, E>, words: &[&str]) -> String {

@@ -2,35 +2,13 @@
 //! byte orders) gives the values `read_volume` reads into memory; a data file shorter
 //! than its header says is an error that names it, never a panic.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ferrovol_core::VolumeData;
 use ferrovol_io::{open_volume, read_volume};
 
-/// A fresh folder under the system temp folder, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let dir =
-            std::env::temp_dir().join(format!("ferrovol-io-inplace-{}-{tag}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let p = self.0.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::TempDir;
 
 /// Every value of `v`, read in runs of 7 (so runs cross rows and the end).
 fn values(v: &VolumeData) -> Vec<f64> {
