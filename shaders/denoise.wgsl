@@ -1,5 +1,5 @@
-// Edge-aware à-trous denoising of the path tracer's progressive image (Dammertz et al.,
-// "Edge-Avoiding À-Trous Wavelet Transform for fast Global Illumination Filtering", HPG
+// Edge-aware à-trous denoising of the path tracer's progressive image, the per-pixel means
+// pathtrace_show.wgsl wrote (Dammertz et al., "Edge-Avoiding À-Trous Wavelet Transform for fast Global Illumination Filtering", HPG
 // 2010): a few iterations of a 5×5 B3-spline kernel whose taps spread 1, 2, 4, ... pixels
 // apart, each tap weighted down where the guide differs: the mean normal at the paths' first
 // collision, their mean depth there, and the colour itself. The guide comes from the path
@@ -8,16 +8,13 @@
 struct Denoise {
     // the pixels filtered: x0, y0, x1, y1 (exclusive; the path tracer's rectangle)
     rect: vec4<u32>,
-    // x: image width, y: unused, z: tap spacing (pixels), w: flags (DENOISE_*)
+    // x: image width, y: unused, z: tap spacing (pixels), w: 1 in the last iteration (write
+    // the output image as well)
     size: vec4<u32>,
-    // x: 1 / paths per pixel (reading the accumulated sums), y: colour edge-stopping scale,
-    // z: normal exponent, w: depth edge-stopping scale (world units)
+    // x: unused, y: colour edge-stopping scale, z: normal exponent, w: depth edge-stopping
+    // scale (world units)
     params: vec4<f32>,
 }
-
-// Flags (size.w), declared from Rust (gpu::uniforms): DENOISE_FROM_SUMS, the source holds
-// sums over the paths (the accumulation): scale by params.x; DENOISE_LAST, the last
-// iteration: write the output image as well.
 
 @group(0) @binding(0) var<uniform> dn: Denoise;
 @group(0) @binding(1) var<storage, read> src: array<vec4<f32>>;
@@ -27,14 +24,6 @@ struct Denoise {
 // Per pixel, summed over the paths: rgb radiance, a coverage (to turn guide.w into a mean).
 @group(0) @binding(4) var<storage, read> accum: array<vec4<f32>>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
-
-fn pixel(i: u32) -> vec4<f32> {
-    var v = src[i];
-    if ((dn.size.w & DENOISE_FROM_SUMS) != 0u) {
-        v = v * dn.params.x;
-    }
-    return v;
-}
 
 // The guide of pixel i: unit mean normal (0 where no path met the medium) and mean depth.
 fn guide_at(i: u32) -> vec4<f32> {
@@ -54,7 +43,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let i = px.y * w + px.x;
-    let c = pixel(i);
+    let c = src[i];
     let gc = guide_at(i);
     let step = i32(dn.size.z);
     var kernel = array<f32, 3>(0.375, 0.25, 0.0625);
@@ -67,7 +56,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let j = u32(q.y) * w + u32(q.x);
-            let cq = pixel(j);
+            let cq = src[j];
             let gq = guide_at(j);
             var wt = kernel[abs(dx)] * kernel[abs(dy)];
             // normals and depths where both pixels met the medium (a pixel that did not is
@@ -86,7 +75,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let v = sum / max(wsum, 1e-12);
     dst[i] = v;
-    if ((dn.size.w & DENOISE_LAST) != 0u) {
+    if (dn.size.w != 0u) {
         let a = clamp(v.a, 0.0, 1.0);
         textureStore(out_color, vec2<i32>(px), vec4<f32>(clamp(v.rgb, vec3<f32>(0.0), vec3<f32>(a)), a));
     }

@@ -1,6 +1,7 @@
 // Progressive Monte Carlo path tracing of the volume as a participating medium: one path
-// per pixel per dispatch, added to the sums of the paths before (accum). A frame is several
-// dispatches: on lavapipe every loop iteration of an invocation draws on one budget of
+// per pixel per dispatch, added to the sums of the paths before (accum, moments), over the
+// whole rectangle or over one of its 16 interleaved subsets (options.w: every 4th pixel
+// from an offset; pathtrace_show.wgsl shows the result). A frame is several dispatches: on lavapipe every loop iteration of an invocation draws on one budget of
 // 65535 (llvmpipe's loop limiter), after which all its loops stop, so an invocation traces
 // one path and no more (several per invocation lost paths, measured).
 //
@@ -39,8 +40,8 @@ struct PathTrace {
     surface: vec4<f32>,         // x gradient threshold ψ (world units; 3e38: none), y stochastic blend rate k (0: the hard switch), z GGX roughness, w Fresnel reflectance at normal incidence
     lobe: vec4<f32>,            // x transmitted share of the BSDF's non-specular part, y its Phong exponent, zw unused
     counts: vec4<u32>,          // x paths per primary ray, y paths accumulated before this one, z most scattering events, w seed
-    options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, z scattering regions (PT_SCATTER_*), w unused
-    rect: vec4<u32>,            // pixels traced: x0, y0, x1, y1 (exclusive)
+    options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, z scattering regions (PT_SCATTER_*), w pixels traced: stride | x offset << 8 | y offset << 16 within rect
+    rect: vec4<u32>,            // the frame's pixels: x0, y0, x1, y1 (exclusive)
 }
 
 // Pipeline constants: the code of the BSDF and of the scattering regions (HYBRID) and of
@@ -61,8 +62,9 @@ const PT_MAX_STEPS: u32 = 1000000u;
 
 // Per pixel: the sums of radiance (rgb) and of coverage (a) over all paths so far.
 @group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
-@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
+// Per pixel: x the paths so far, y the sum of their squared luminances, z the window depth
+// where the centre ray enters the medium's segment (1 until a path met the medium).
+@group(0) @binding(5) var<storage, read_write> moments: array<vec4<f32>>;
 @group(0) @binding(7) var<uniform> pt_ubo: PathTrace;
 // A private copy filled by the entry point, as lib/common.wgsl's `frame`.
 var<private> pt: PathTrace;
@@ -445,7 +447,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
     enter_volume();
     pt = pt_ubo;
-    let px = gid.xy + pt.rect.xy;
+    let lattice = pt.options.w;
+    let offset = vec2<u32>((lattice >> 8u) & 0xffu, (lattice >> 16u) & 0xffu);
+    let px = pt.rect.xy + offset + gid.xy * (lattice & 0xffu);
     if (px.x >= pt.rect.z || px.y >= pt.rect.w) {
         return;
     }
@@ -454,9 +458,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ (pt.counts.y / pt.counts.x));
     let secondary = rng_seed(idx, pcg_hash(pt.counts.w ^ 0x68e31da4u) ^ pt.counts.y);
     let ray = ray_through(image_ndc(vec2<f32>(px) + rand2(&rng)));
-    var sum = trace(ray, px, &rng, secondary);
+    let path = trace(ray, px, &rng, secondary);
+    let lum = dot(path.rgb, vec3<f32>(0.2126, 0.7152, 0.0722));
+    var sum = path;
+    var m = vec4<f32>(1.0, lum * lum, 1.0, 0.0);
     if (pt.counts.y > 0u) {
         sum = sum + accum[idx];
+        m = vec4<f32>(m.xy + moments[idx].xy, 1.0, 0.0);
     }
     accum[idx] = sum;
     if (GUIDE && (pt.options.x & PT_FLAG_GUIDE) != 0u) {
@@ -466,18 +474,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         guide[idx] = gs;
     }
-    let mean = sum / f32(pt.counts.y + 1u);
-    // Premultiplied output: radiance beyond the coverage is clipped, as an 8-bit image must.
-    let a = clamp(mean.a, 0.0, 1.0);
-    textureStore(out_color, vec2<i32>(px), vec4<f32>(clamp(mean.rgb, vec3<f32>(0.0), vec3<f32>(a)), a));
     // Depth: where the pixel's centre ray enters the medium's segment, once any path met it.
-    var depth = 1.0;
-    if (a > 0.0) {
+    if (sum.a > 0.0) {
         let centre = make_ray(px);
         let seg = ray_segment(centre, px);
         if (seg.x < seg.y) {
-            depth = distance_to_depth(centre, seg.x);
+            m.z = distance_to_depth(centre, seg.x);
         }
     }
-    textureStore(out_depth, vec2<i32>(px), vec4<f32>(depth, 0.0, 0.0, 0.0));
+    moments[idx] = m;
 }

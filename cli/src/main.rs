@@ -271,6 +271,7 @@ impl PathTraceArgs {
             background,
             denoise: self.denoise,
             seed: self.seed,
+            ..PathTraceParams::default()
         };
         p.validate()?;
         Ok(p)

@@ -6,9 +6,9 @@ use crate::error::{Error, Result};
 use crate::gpu::interop::{OutputPath, SharedOutput};
 use crate::gpu::Context;
 use crate::params::{
-    BlendMode, BsdfParams, CubeImage, Environment, GBuffer, Image, IsoParams, PathTraceParams,
-    RenderParams, Residency, Stats, StreamProgress, TransferFunction, UploadOptions, View,
-    VolumeData,
+    BlendMode, BsdfParams, Convergence, CubeImage, Environment, GBuffer, Image, IsoParams,
+    PathTraceParams, RenderParams, Residency, Stats, StreamProgress, TransferFunction,
+    UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
 use crate::passes::frame::FrameInput;
@@ -183,7 +183,17 @@ impl Renderer {
 
     /// Paths per pixel the last path-traced frame shows (0 before the first).
     pub fn accumulated_samples(&self) -> u32 {
-        self.pt.as_ref().map_or(0, |p| p.samples)
+        self.pt.as_ref().map_or(0, |p| p.samples())
+    }
+
+    /// How far the path tracer's accumulation has come, with its estimated error (waits for
+    /// the last frame and reads the accumulation back: a cost to pay on demand, not every
+    /// frame). Zeros before the first path-traced frame.
+    pub fn convergence(&self) -> Result<Convergence> {
+        match &self.pt {
+            Some(p) => p.convergence(&self.ctx),
+            None => Ok(Convergence::default()),
+        }
     }
 
     /// Starts the accumulation over at the next path-traced frame.

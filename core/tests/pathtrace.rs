@@ -682,3 +682,152 @@ fn denoiser_lowers_the_error_and_keeps_the_accumulation() {
     // the same paths (same seed): the accumulation is the unfiltered one
     assert_eq!(raw, filtered, "the denoiser changed the accumulation");
 }
+
+/// Pixels of `img` with any coverage.
+fn covered(img: &Image) -> usize {
+    img.rgba.chunks(4).filter(|p| p[3] > 0).count()
+}
+
+#[test]
+fn time_budgets_trace_subsets_to_the_same_image() {
+    let vol = ball(20, 9.0);
+    let tf = medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0);
+    let (mut r, view) = scene(&vol, tf, white_sky(), 48);
+    let whole = PathTraceParams {
+        samples_per_frame: 2,
+        ..Default::default()
+    };
+    let reference = trace(&mut r, &view, &whole, 2);
+    let converged = r.read_image().unwrap();
+    // A budget no sixteenth fits: each frame adds exactly one (the least a frame adds).
+    let p = PathTraceParams {
+        time_budget: 1e-9,
+        max_samples: 2,
+        ..whole
+    };
+    r.set_path_tracing(&p).unwrap();
+    r.reset_accumulation();
+    let mut frames = 0;
+    let mut means = vec![];
+    let mut first_coverage = 0;
+    while r.accumulated_samples() < 2 {
+        r.render(&view, &pt_params(), None).unwrap();
+        frames += 1;
+        if frames == 1 {
+            first_coverage = covered(&r.read_image().unwrap());
+            save(&r.read_image().unwrap(), "pathtrace-first-sixteenth");
+        }
+        if frames % 8 == 0 {
+            means.push(r.convergence().unwrap().mean_paths_per_pixel);
+        }
+    }
+    let same = r.read_accumulation().unwrap() == reference;
+    println!(
+        "one sixteenth per frame: {frames} frames for 2 passes; mean paths per pixel every \
+         8 frames {means:?}; the first frame shows {first_coverage} covered pixels against \
+         {} converged; accumulation equal to whole passes: {same}",
+        covered(&converged)
+    );
+    assert_eq!(frames, 32);
+    assert!(same, "subsets trace the same paths as whole passes");
+    assert_eq!(r.read_image().unwrap().rgba, converged.rgba);
+    for (i, m) in means.iter().enumerate() {
+        // (the rectangle's sides need not be multiples of 4: subsets differ slightly in size)
+        let expected = (i + 1) as f32 * 0.5;
+        assert!(
+            (m - expected).abs() < 0.05,
+            "{m} paths per pixel, not {expected}"
+        );
+    }
+    // The first sixteenth shows every pixel from a traced neighbour: about the coverage of
+    // the converged image (its edge is 4 pixels coarse).
+    let ratio = first_coverage as f64 / covered(&converged) as f64;
+    assert!((0.85..=1.15).contains(&ratio), "coverage ratio {ratio}");
+    // A budget that holds everything: a frame adds samples_per_frame passes and no more.
+    r.set_path_tracing(&PathTraceParams {
+        time_budget: 100.0,
+        max_samples: 0,
+        samples_per_frame: 3,
+        ..whole
+    })
+    .unwrap();
+    r.reset_accumulation();
+    r.render(&view, &pt_params(), None).unwrap();
+    assert_eq!(r.accumulated_samples(), 3);
+}
+
+#[test]
+fn the_error_estimate_follows_the_measured_error() {
+    let vol = ball(20, 9.0);
+    let tf = medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0);
+    let sky = Environment::hemisphere([0.9, 0.95, 1.0], [0.3, 0.25, 0.2]);
+    let (mut r, view) = scene(&vol, tf, Some(sky), 24);
+    let p = |seed: u32| PathTraceParams {
+        samples_per_frame: 256,
+        seed,
+        anisotropy: 0.3,
+        ..Default::default()
+    };
+    let lum = |v: &[f32; 4]| 0.2126 * v[0] as f64 + 0.7152 * v[1] as f64 + 0.0722 * v[2] as f64;
+    let reference = trace(&mut r, &view, &p(1), 2048);
+    let mut rows = vec![];
+    for spp in [4u32, 16, 64] {
+        let img = trace(&mut r, &view, &p(2), spp);
+        let c = r.convergence().unwrap();
+        let (mut se, mut mean, mut n) = (0.0, 0.0, 0);
+        for (a, b) in img.iter().zip(&reference) {
+            if a[3] > 0.0 {
+                se += (lum(a) - lum(b)).powi(2);
+                mean += lum(a);
+                n += 1;
+            }
+        }
+        let measured = (se / n as f64).sqrt() / (mean / n as f64);
+        let estimate = c.relative_error.expect("two paths or more") as f64;
+        println!(
+            "{spp:3} paths per pixel: estimated relative error {estimate:.4}, measured against \
+             2048 paths {measured:.4}"
+        );
+        assert_eq!(c.paths_per_pixel, spp);
+        rows.push((estimate, measured));
+    }
+    for (estimate, measured) in &rows {
+        // (the estimate is per pixel from a handful of paths; the measurement carries the
+        // reference's own noise: within a factor of 1.5 either way)
+        let q = estimate / measured;
+        assert!((0.67..=1.5).contains(&q), "estimate / measured = {q}");
+    }
+    let fall = rows[0].0 / rows[2].0;
+    println!("estimate at 4 over estimate at 64 paths: {fall:.2} (1/√spp: 4)");
+    assert!((3.0..=5.0).contains(&fall), "{fall}");
+}
+
+#[test]
+fn the_denoised_preview_gives_way_to_the_accumulation() {
+    let vol = ball(20, 9.0);
+    let tf = medium([0.9, 0.7, 0.5], 0.0, 0.6, 2.0);
+    let (mut r, view) = scene(&vol, tf, white_sky(), 32);
+    let plain = PathTraceParams {
+        samples_per_frame: 2,
+        ..Default::default()
+    };
+    let preview = PathTraceParams {
+        denoise_until: 4,
+        ..plain
+    };
+    let shown = |r: &mut Renderer, p: &PathTraceParams, spp: u32| {
+        trace(r, &view, p, spp);
+        r.read_image().unwrap().rgba
+    };
+    let (plain2, preview2) = (shown(&mut r, &plain, 2), shown(&mut r, &preview, 2));
+    let (plain4, preview4) = (shown(&mut r, &plain, 4), shown(&mut r, &preview, 4));
+    let differ = |a: &[u8], b: &[u8]| a.iter().zip(b).filter(|(x, y)| x != y).count();
+    println!(
+        "denoised until 4 paths per pixel: {} bytes differ from the plain image at 2 paths, \
+         {} at 4",
+        differ(&plain2, &preview2),
+        differ(&plain4, &preview4)
+    );
+    assert!(differ(&plain2, &preview2) > plain2.len() / 10);
+    assert_eq!(plain4, preview4);
+}

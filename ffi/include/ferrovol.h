@@ -608,7 +608,39 @@ typedef struct FvPathTraceParams {
    * unfiltered).
    */
   bool denoise;
+  /**
+   * Seconds a frame may spend tracing (0: no limit: samples_per_frame paths per pixel
+   * each frame). With a budget a frame adds as many sixteenths of a path per pixel as fit
+   * (16 interleaved pixel subsets; during the first pass untraced pixels show a traced
+   * neighbour), at least one sixteenth, at most samples_per_frame paths per pixel.
+   */
+  float time_budget;
+  /**
+   * Denoise the shown image while pixels have fewer than this many paths (a preview; 0:
+   * only as `denoise` says).
+   */
+  uint32_t denoise_until;
 } FvPathTraceParams;
+
+/**
+ * How far the path tracer's accumulation has come. Thread use: plain data.
+ */
+typedef struct FvConvergence {
+  /**
+   * Paths every pixel has (the passes completed).
+   */
+  uint32_t paths_per_pixel;
+  /**
+   * Paths per pixel on average, counting the pixels of the pass under way.
+   */
+  float mean_paths_per_pixel;
+  /**
+   * Estimated relative error of the shown image: each covered pixel's standard error of
+   * its mean luminance, RMS over the covered pixels, over their mean luminance; −1 before
+   * every pixel has two paths.
+   */
+  float relative_error;
+} FvConvergence;
 
 /**
  * One exported image, for glCreateMemoryObjectsEXT + glImportMemoryFdEXT(size,
@@ -900,6 +932,13 @@ enum FvStatus fv_renderer_set_path_tracing(struct FvRenderer *renderer,
  * a frame after any change of camera, data, transfer function or settings starts over.
  */
 enum FvStatus fv_renderer_accumulated_samples(const struct FvRenderer *renderer, uint32_t *samples);
+
+/**
+ * How far the path tracer's accumulation has come (zeros before the first path-traced
+ * frame). Waits for the last frame and reads the accumulation back: call it when the
+ * figure is wanted, not every frame.
+ */
+enum FvStatus fv_renderer_convergence(const struct FvRenderer *renderer, struct FvConvergence *out);
 
 /**
  * Renders a `width × height` frame. `depth` (NULL for none) holds `depth_count` =

@@ -260,6 +260,14 @@ public:
     check(fv_renderer_accumulated_samples(h_.get(), &n));
     return n;
   }
+  /// How far the path tracer's accumulation has come (waits for the GPU and reads the
+  /// accumulation back: ask when the figure is wanted).
+  FvConvergence convergence() const {
+    FvConvergence c{};
+    check(fv_renderer_convergence(h_.get(), &c));
+    return c;
+  }
+
   void prepare_targets(uint32_t width, uint32_t height) {
     check(fv_renderer_prepare_targets(h_.get(), width, height));
   }

@@ -256,6 +256,14 @@ pub struct FvPathTraceParams {
     /// Show the image through the edge-aware à-trous denoiser (the accumulation stays
     /// unfiltered).
     pub denoise: bool,
+    /// Seconds a frame may spend tracing (0: no limit: samples_per_frame paths per pixel
+    /// each frame). With a budget a frame adds as many sixteenths of a path per pixel as fit
+    /// (16 interleaved pixel subsets; during the first pass untraced pixels show a traced
+    /// neighbour), at least one sixteenth, at most samples_per_frame paths per pixel.
+    pub time_budget: f32,
+    /// Denoise the shown image while pixels have fewer than this many paths (a preview; 0:
+    /// only as `denoise` says).
+    pub denoise_until: u32,
 }
 
 impl FvPathTraceParams {
@@ -284,6 +292,8 @@ impl FvPathTraceParams {
             } as u32,
             attenuation: d.attenuation,
             denoise: d.denoise,
+            time_budget: d.time_budget,
+            denoise_until: d.denoise_until,
         }
     }
 }
@@ -306,6 +316,7 @@ impl ToCore for FvPathTraceParams {
         let p = PathTraceParams {
             samples_per_frame: self.samples_per_frame,
             max_samples: self.max_samples,
+            time_budget: self.time_budget,
             secondary_rays: self.secondary_rays,
             max_bounces: self.max_bounces,
             anisotropy: self.anisotropy,
@@ -322,6 +333,7 @@ impl ToCore for FvPathTraceParams {
             environment_light: self.environment_light,
             background: self.background,
             denoise: self.denoise,
+            denoise_until: self.denoise_until,
             seed: self.seed,
         };
         p.validate()?;

@@ -284,6 +284,25 @@ pub unsafe extern "C" fn fv_renderer_accumulated_samples(
     })
 }
 
+/// How far the path tracer's accumulation has come (zeros before the first path-traced
+/// frame). Waits for the last frame and reads the accumulation back: call it when the
+/// figure is wanted, not every frame.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_convergence(
+    renderer: *const FvRenderer,
+    out: *mut FvConvergence,
+) -> FvStatus {
+    with_renderer_ref(renderer, |r| {
+        let c = r.r.convergence()?;
+        *mut_ref(out, "convergence")? = FvConvergence {
+            paths_per_pixel: c.paths_per_pixel,
+            mean_paths_per_pixel: c.mean_paths_per_pixel,
+            relative_error: c.relative_error.unwrap_or(-1.0),
+        };
+        Ok(())
+    })
+}
+
 /// Renders a `width × height` frame. `depth` (NULL for none) holds `depth_count` =
 /// width·height window depths (0 near … 1 far, rows top to bottom) of opaque geometry
 /// that stops rays. Returns once the work is submitted; read the result with

@@ -272,6 +272,20 @@ pub struct FvResidency {
     pub dense_bytes: u64,
 }
 
+/// How far the path tracer's accumulation has come. Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FvConvergence {
+    /// Paths every pixel has (the passes completed).
+    pub paths_per_pixel: u32,
+    /// Paths per pixel on average, counting the pixels of the pass under way.
+    pub mean_paths_per_pixel: f32,
+    /// Estimated relative error of the shown image: each covered pixel's standard error of
+    /// its mean luminance, RMS over the covered pixels, over their mean luminance; −1 before
+    /// every pixel has two paths.
+    pub relative_error: f32,
+}
+
 /// A C description that converts, validated, into its core type.
 pub trait ToCore {
     type Core;

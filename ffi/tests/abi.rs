@@ -568,8 +568,9 @@ fn path_tracing_accumulates_and_refuses_bad_settings() {
         let mut pt: FvPathTraceParams = std::mem::zeroed();
         lib.ok(defaults(&mut pt));
         type Edit = fn(&mut FvPathTraceParams);
-        let cases: [(Edit, &str); 8] = [
+        let cases: [(Edit, &str); 9] = [
             (|p| p.anisotropy = 1.0, "anisotropy 1"),
+            (|p| p.time_budget = -1.0, "time budget -1"),
             (|p| p.samples_per_frame = 0, "0 paths per pixel"),
             (|p| p.scatter_regions = 7, "not an FvScatterRegions"),
             (|p| p.roughness = 0.0, "roughness 0"),
@@ -609,6 +610,19 @@ fn path_tracing_accumulates_and_refuses_bad_settings() {
     }
     println!("accumulated paths per pixel: {counts:?} (camera moved before the last)");
     assert_eq!(counts, vec![2, 4, 6, 2]);
+    let convergence = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvConvergence) -> FvStatus>(
+        "fv_renderer_convergence",
+    );
+    let mut c = ferrovol::FvConvergence::default();
+    // SAFETY: a valid handle; the out-pointer is checked for NULL.
+    unsafe {
+        lib.ok(convergence(s.r, &mut c));
+        lib.expect(convergence(s.r, null_mut()), Null, "convergence is NULL");
+    }
+    println!("convergence after 2 paths per pixel: {c:?}");
+    assert_eq!(c.paths_per_pixel, 2);
+    assert_eq!(c.mean_paths_per_pixel, 2.0);
+    assert!(c.relative_error > 0.0 && c.relative_error.is_finite());
 }
 
 /// A bricked volume keeps only the bricks something visible lies in, reports it through

@@ -75,6 +75,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../../shaders/phase_test.wgsl"),
     ),
     (
+        "pathtrace_show.wgsl",
+        include_str!("../../../shaders/pathtrace_show.wgsl"),
+    ),
+    (
         "denoise.wgsl",
         include_str!("../../../shaders/denoise.wgsl"),
     ),
@@ -91,6 +95,7 @@ pub const PASSES: &[&str] = &[
     "deferred.wgsl",
     "environment.wgsl",
     "pathtrace.wgsl",
+    "pathtrace_show.wgsl",
     "denoise.wgsl",
     "gradient.wgsl",
     "phase_test.wgsl",

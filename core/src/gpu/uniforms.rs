@@ -113,6 +113,14 @@ pub struct DenoiseUniforms {
     pub params: [f32; 4],
 }
 
+/// The uniforms of what the path tracer shows (`Show` in shaders/pathtrace_show.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ShowUniforms {
+    pub rect: [u32; 4],
+    pub size: [u32; 4],
+}
+
 /// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -188,10 +196,6 @@ pub const PT_SCATTER_EVERYWHERE: u32 = 3;
 /// (σ ≤ 9.2 per unit distance).
 pub const PT_MAX_OPACITY: f64 = 0.9999;
 
-/// Denoiser iteration flags.
-pub const DENOISE_FROM_SUMS: u32 = 1;
-pub const DENOISE_LAST: u32 = 2;
-
 /// The flag word with each `(on, bit)` pair's bit set where `on`.
 pub fn flag_bits(flags: &[(bool, u32)]) -> u32 {
     flags
@@ -241,8 +245,6 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("PT_SCATTER_BETWEEN", Wgsl::U32(PT_SCATTER_BETWEEN)),
     ("PT_SCATTER_EVERYWHERE", Wgsl::U32(PT_SCATTER_EVERYWHERE)),
     ("PT_MAX_OPACITY", Wgsl::F32(PT_MAX_OPACITY as f32)),
-    ("DENOISE_FROM_SUMS", Wgsl::U32(DENOISE_FROM_SUMS)),
-    ("DENOISE_LAST", Wgsl::U32(DENOISE_LAST)),
 ];
 
 /// The WGSL declarations of [`WGSL_CONSTANTS`], one line each.
@@ -389,6 +391,8 @@ mod layout_tests {
         );
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
+        let m = module("pathtrace_show.wgsl");
+        check!(m, "Show", ShowUniforms, [rect, size]);
         let m = module("phase_test.wgsl");
         check!(
             m,

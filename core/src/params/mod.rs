@@ -20,7 +20,7 @@ pub use iso::{
     SpecularMode, MAX_ISO_VALUES, MAX_SCATTER_SAMPLES,
 };
 pub use light::{Light, LightSpace};
-pub use pathtrace::{BsdfParams, PathTraceParams, ScatterRegions};
+pub use pathtrace::{BsdfParams, Convergence, PathTraceParams, ScatterRegions};
 pub use render::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
     MAX_CLIP_PLANES, MAX_LIGHTS,

@@ -92,6 +92,19 @@ impl BsdfParams {
     }
 }
 
+/// How far the path tracer's accumulation has come ([`Renderer::convergence`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Convergence {
+    /// Paths every pixel has (the passes completed).
+    pub paths_per_pixel: u32,
+    /// Paths per pixel on average, counting the pixels of the pass under way.
+    pub mean_paths_per_pixel: f32,
+    /// The shown image's estimated relative error: each covered pixel's standard error of
+    /// its mean luminance (from the paths' second moment), RMS over the pixels the medium
+    /// covers, over their mean luminance; `None` before every pixel has two paths.
+    pub relative_error: Option<f32>,
+}
+
 /// How the path tracer samples (set with [`Renderer::set_path_tracing`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTraceParams {
@@ -100,6 +113,13 @@ pub struct PathTraceParams {
     /// Paths per pixel after which frames stop adding any and show the converged image
     /// again (a still render's budget); 0: no limit.
     pub max_samples: u32,
+    /// Seconds a frame may spend tracing (0: no limit, each frame adds `samples_per_frame`
+    /// paths per pixel). With a budget a frame adds as many sixteenths of a path per pixel
+    /// as fit (16 interleaved subsets of the pixels; during the first pass the pixels not
+    /// traced yet show a traced neighbour), at least one sixteenth and at most
+    /// `samples_per_frame` paths per pixel; the time per sixteenth is measured as frames
+    /// go.
+    pub time_budget: f32,
     /// Secondary rays per primary ray, 1 to [`MAX_SAMPLES_PER_FRAME`] (the lecture's ray
     /// budget P × S: each group of S consecutive paths of a pixel shares its jittered
     /// camera ray and first collision, and differs from there on; 1: independent paths).
@@ -130,6 +150,9 @@ pub struct PathTraceParams {
     /// (shaders/denoise.wgsl), guided by the normal and depth at the paths' first
     /// collision. The accumulation ([`Renderer::read_accumulation`]) stays unfiltered.
     pub denoise: bool,
+    /// Show the image through the denoiser while the pixels have fewer than this many paths
+    /// (a preview that gives way to the unfiltered image; 0: only as `denoise` says).
+    pub denoise_until: u32,
     /// Seed of the random streams (a different seed gives an independent image).
     pub seed: u32,
 }
@@ -139,6 +162,7 @@ impl Default for PathTraceParams {
         PathTraceParams {
             samples_per_frame: 4,
             max_samples: 0,
+            time_budget: 0.0,
             secondary_rays: 1,
             max_bounces: 64,
             anisotropy: 0.0,
@@ -150,6 +174,7 @@ impl Default for PathTraceParams {
             environment_light: 1.0,
             background: false,
             denoise: false,
+            denoise_until: 0,
             seed: 0,
         }
     }
@@ -193,6 +218,12 @@ impl PathTraceParams {
                 "stochastic blend rate k {} must be finite and non-negative (0: the hard \
                  switch)",
                 self.stochastic_blend
+            ));
+        }
+        if !(self.time_budget.is_finite() && self.time_budget >= 0.0) {
+            return bad(format!(
+                "time budget {} s must be finite and non-negative (0: no budget)",
+                self.time_budget
             ));
         }
         self.bsdf.validate()?;

@@ -7,7 +7,7 @@ use crate::gpu::binding::{
 };
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::single_group_pipeline;
-use crate::gpu::uniforms::{DenoiseUniforms, DENOISE_FROM_SUMS, DENOISE_LAST, UNIFORM_STRIDE};
+use crate::gpu::uniforms::{DenoiseUniforms, UNIFORM_STRIDE};
 use crate::gpu::Context;
 
 /// Iterations of the à-trous denoiser (taps 1, 2 and 4 pixels apart).
@@ -21,6 +21,7 @@ const DENOISE_DEPTH_SIGMA: f32 = 16.0;
 
 /// What the denoiser reads and writes.
 pub(crate) struct DenoiseOutputs<'a> {
+    /// The accumulation (its coverage sums turn the guide's depth sums into means).
     pub accum: &'a wgpu::Buffer,
     pub guide: &'a wgpu::Buffer,
     pub images: [&'a wgpu::Buffer; 2],
@@ -28,7 +29,7 @@ pub(crate) struct DenoiseOutputs<'a> {
 }
 
 /// The denoiser (shaders/denoise.wgsl): an edge-avoiding à-trous filter of the path
-/// tracer's accumulation guided by the first collisions' normals and depths.
+/// tracer's shown means guided by the first collisions' normals and depths.
 pub(crate) struct DenoisePass {
     bgl: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
@@ -67,10 +68,10 @@ impl DenoisePass {
         })
     }
 
-    /// Records the denoiser's iterations over `rect`: the accumulation's means (scale[0] = 1 /
-    /// paths) filtered into the ping-pong images, the last also into the output colour. The
-    /// colour edge-stopping scale shrinks each iteration (Dammertz et al. halve it); depths are
-    /// compared per `scale[1]` (the sample distance) times the tap spacing.
+    /// Records the denoiser's iterations over `rect`: the means in `images[0]` filtered back
+    /// and forth between the two images, the last iteration also into the output colour. The
+    /// colour edge-stopping scale shrinks each iteration (Dammertz et al. halve it); depths
+    /// are compared per `step` (the sample distance) times the tap spacing.
     pub fn encode(
         &self,
         ctx: &Context,
@@ -78,25 +79,19 @@ impl DenoisePass {
         out: &DenoiseOutputs<'_>,
         rect: [u32; 4],
         width: u32,
-        scale: [f32; 2],
+        step: f32,
     ) {
         let mut blocks = vec![0u8; (UNIFORM_STRIDE * DENOISE_ITERATIONS as u64) as usize];
         for i in 0..DENOISE_ITERATIONS {
-            let mut flags = 0;
-            if i == 0 {
-                flags |= DENOISE_FROM_SUMS;
-            }
-            if i + 1 == DENOISE_ITERATIONS {
-                flags |= DENOISE_LAST;
-            }
+            let last = u32::from(i + 1 == DENOISE_ITERATIONS);
             let u = DenoiseUniforms {
                 rect,
-                size: [width, 0, 1 << i, flags],
+                size: [width, 0, 1 << i, last],
                 params: [
-                    scale[0],
+                    0.0,
                     DENOISE_COLOR_SIGMA * 0.5f32.powf(i as f32 * 0.5),
                     DENOISE_NORMAL_POWER,
-                    DENOISE_DEPTH_SIGMA * scale[1],
+                    DENOISE_DEPTH_SIGMA * step,
                 ],
             };
             let at = (UNIFORM_STRIDE * i as u64) as usize;
@@ -120,19 +115,18 @@ impl DenoisePass {
         };
         let [a, b] = out.images;
         let gr = groups(rect);
-        let bind_groups = [bind(out.accum, a), bind(a, b), bind(b, a)];
+        let bind_groups = [bind(a, b), bind(b, a)];
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("denoise"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
         for i in 0..DENOISE_ITERATIONS {
-            let g = if i == 0 {
-                &bind_groups[0]
-            } else {
-                &bind_groups[1 + (i as usize + 1) % 2]
-            };
-            pass.set_bind_group(0, g, &[(UNIFORM_STRIDE * i as u64) as u32]);
+            pass.set_bind_group(
+                0,
+                &bind_groups[i as usize % 2],
+                &[(UNIFORM_STRIDE * i as u64) as u32],
+            );
             pass.dispatch_workgroups(gr[0], gr[1], 1);
         }
     }

@@ -14,11 +14,14 @@
 //! cropping regions empty the medium where they crop.
 //!
 //! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
-//! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before,
-//! until anything that changes the image changes (camera, lights, size, render or path
-//! tracing parameters but the paths per frame and the budget, volume, transfer function,
+//! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before
+//! (or, with a [`PathTraceParams::time_budget`], as many sixteenths of a path per pixel as
+//! the budget holds: the pixels in 16 interleaved subsets, timed as they go), until anything
+//! that changes the image changes (camera, lights, size, render or path tracing parameters
+//! but the paths per frame, the budget and the preview, volume, transfer function,
 //! environment), or until [`PathTraceParams::max_samples`]; the count is
-//! [`Renderer::accumulated_samples`]. The environment is the one
+//! [`Renderer::accumulated_samples`], the estimated error [`Renderer::convergence`]. The
+//! frame shows each pixel's mean (pathtrace_show.wgsl), through the denoiser when asked. The environment is the one
 //! [`Renderer::set_environment`](crate::Renderer::set_environment) built (the procedural sky
 //! by default).
 //!
@@ -32,24 +35,70 @@ use crate::gpu::binding::{
     storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
+use crate::gpu::pipeline::{
+    encode_single_group, pipeline_variant, single_group_pipeline, PipelineCache,
+};
 use crate::gpu::readback::read_buffer;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{
-    flag_bits, PathTraceUniforms, PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE,
-    PT_MAX_OPACITY, TABLE_SIZE, UNIFORM_STRIDE,
+    flag_bits, PathTraceUniforms, ShowUniforms, PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND,
+    PT_FLAG_GUIDE, PT_MAX_OPACITY, TABLE_SIZE, UNIFORM_STRIDE,
 };
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, CubeImage, GradientMethod, Interpolation, PathTraceParams, RenderParams,
-    ScatterRegions, Shading,
+    BlendMode, Convergence, CubeImage, GradientMethod, Interpolation, PathTraceParams,
+    RenderParams, ScatterRegions, Shading,
 };
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
+use std::time::Instant;
+
+/// Subsets of a pass: the pixels of each 4×4 cell in Bayer order (every 4th pixel first,
+/// then the rest of every 2nd, ...), as (x, y) offsets in the cell.
+const SUBSETS: [(u32, u32); 16] = [
+    (0, 0),
+    (2, 2),
+    (2, 0),
+    (0, 2),
+    (1, 1),
+    (3, 3),
+    (3, 1),
+    (1, 3),
+    (1, 0),
+    (3, 2),
+    (3, 0),
+    (1, 2),
+    (0, 1),
+    (2, 3),
+    (2, 1),
+    (0, 3),
+];
+/// Sixteenths of a path per pixel in one pass.
+const UNITS: u64 = SUBSETS.len() as u64;
+/// Most dispatches one submission holds (one uniform block each): whole passes, and the
+/// subsets before and after them.
+const MAX_DISPATCHES: u64 = MAX_SAMPLES_PER_FRAME as u64 + 2 * UNITS;
+
+/// Four floats per pixel, rows top to bottom.
+type Pixels = Vec<[f32; 4]>;
+
+/// The per-pixel buffers of an accumulation, all of one size.
+struct Accumulation {
+    width: u32,
+    height: u32,
+    /// Sums of radiance (rgb) and coverage (a) over the paths.
+    sums: wgpu::Buffer,
+    /// Paths, sum of squared luminances, depth (pathtrace.wgsl: moments).
+    moments: wgpu::Buffer,
+    /// The denoiser's guide sums.
+    guide: wgpu::Buffer,
+    /// The shown means, then the denoiser's other ping-pong image.
+    images: [wgpu::Buffer; 2],
+}
 
 const _: () = assert!(std::mem::size_of::<PathTraceUniforms>() as u64 <= UNIFORM_STRIDE);
 
@@ -58,10 +107,9 @@ pub(crate) struct PathTracePass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<PathTraceVariant>,
     uniforms: wgpu::Buffer,
-    /// Per pixel: sums of radiance and coverage over the accumulated paths.
-    accum: Option<(u32, u32, wgpu::Buffer)>,
-    /// Per pixel, the same size: the denoiser's guide sums, then its two ping-pong images.
-    denoise_buffers: Option<[wgpu::Buffer; 3]>,
+    accum: Option<Accumulation>,
+    /// What shows the accumulation (pathtrace_show.wgsl): layout, pipeline, uniforms.
+    show: (wgpu::BindGroupLayout, wgpu::ComputePipeline, wgpu::Buffer),
     denoise: Option<DenoisePass>,
     /// The environment's sampling distribution: (environment generation, texels per face
     /// edge, cumulative probabilities).
@@ -71,7 +119,12 @@ pub(crate) struct PathTracePass {
     majorants: Option<((u32, u32), wgpu::TextureView, f32)>,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
-    pub samples: u32,
+    /// Sixteenths of a path per pixel accumulated (passes × 16 + subsets of the next).
+    units: u64,
+    /// Seconds one sixteenth took when last measured (frames with a time budget).
+    unit_seconds: Option<f64>,
+    /// The pixels the accumulation covers (x0, y0, x1, y1).
+    rect: [u32; 4],
 }
 
 impl PathTracePass {
@@ -86,8 +139,7 @@ impl PathTracePass {
                 texture_entry(1, false, V::D2),
                 buffer_entry(2, B::Storage { read_only: false }),
                 texture_entry(4, false, V::D2),
-                storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-                storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
+                buffer_entry(5, B::Storage { read_only: false }),
                 dynamic_uniform_entry::<PathTraceUniforms>(7),
                 texture_entry(11, true, V::Cube),
                 sampler_entry(13),
@@ -105,32 +157,52 @@ impl PathTracePass {
         let uniforms = uniform_buffer(
             ctx,
             "path tracing uniforms",
-            UNIFORM_STRIDE * MAX_SAMPLES_PER_FRAME as u64,
+            UNIFORM_STRIDE * MAX_DISPATCHES,
         );
+        let (show_bgl, show_pipeline) = single_group_pipeline(
+            ctx,
+            "pathtrace_show.wgsl",
+            "path tracing image",
+            &[
+                buffer_entry(0, B::Uniform),
+                buffer_entry(1, B::Storage { read_only: true }),
+                buffer_entry(2, B::Storage { read_only: true }),
+                buffer_entry(3, B::Storage { read_only: false }),
+                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+                storage_texture_entry(5, wgpu::TextureFormat::R32Float, V::D2),
+            ],
+        )?;
+        let show_uniforms = uniform_buffer(ctx, "path tracing image uniforms", UNIFORM_STRIDE);
         Ok(PathTracePass {
             bgl,
             pipelines,
             uniforms,
             accum: None,
-            denoise_buffers: None,
+            show: (show_bgl, show_pipeline, show_uniforms),
             denoise: None,
             env_dist: None,
             majorants: None,
             key: String::new(),
-            samples: 0,
+            units: 0,
+            unit_seconds: None,
+            rect: [0; 4],
         })
+    }
+
+    /// Paths every pixel has (the passes completed).
+    pub fn samples(&self) -> u32 {
+        (self.units / UNITS) as u32
     }
 
     fn ensure_accum(&mut self, ctx: &Context, width: u32, height: u32) -> Result<()> {
         if self
             .accum
             .as_ref()
-            .is_some_and(|(w, h, _)| *w == width && *h == height)
+            .is_some_and(|a| a.width == width && a.height == height)
         {
             return Ok(());
         }
         self.accum = None;
-        self.denoise_buffers = None;
         let pixel_buffer = |label| {
             ctx.checked("allocating the path tracing accumulation", || {
                 buffer(
@@ -143,14 +215,18 @@ impl PathTracePass {
                 )
             })
         };
-        let buf = pixel_buffer("path tracing accumulation")?;
-        self.denoise_buffers = Some([
-            pixel_buffer("denoiser guide")?,
-            pixel_buffer("denoiser image A")?,
-            pixel_buffer("denoiser image B")?,
-        ]);
-        self.accum = Some((width, height, buf));
-        self.samples = 0;
+        self.accum = Some(Accumulation {
+            width,
+            height,
+            sums: pixel_buffer("path tracing accumulation")?,
+            moments: pixel_buffer("path tracing moments")?,
+            guide: pixel_buffer("denoiser guide")?,
+            images: [
+                pixel_buffer("path tracing image")?,
+                pixel_buffer("denoiser image")?,
+            ],
+        });
+        self.units = 0;
         Ok(())
     }
 }
@@ -252,7 +328,7 @@ impl PathTracePass {
 
     /// Starts the accumulation over at the next path-traced frame.
     pub fn reset_accumulation(&mut self) {
-        self.samples = 0;
+        self.units = 0;
         self.key.clear();
     }
 
@@ -340,10 +416,13 @@ impl PathTracePass {
         };
         let depth_input = !matches!(depth, DepthSource::None);
         let frame = frame::frame(res, view, &lit, step, depth_input)?.uniforms;
-        // (the paths per frame are not part of what the image converges to)
+        // (the paths per frame, the budget and the preview are not part of what the image
+        // converges to)
         let converges_to = PathTraceParams {
             samples_per_frame: 0,
             max_samples: 0,
+            time_budget: 0.0,
+            denoise_until: 0,
             ..pp
         };
         let key = format!(
@@ -353,34 +432,35 @@ impl PathTracePass {
             res.generation
         );
         let nearest = params.interpolation == Interpolation::Nearest;
+        let guided = pp.denoise || pp.denoise_until > 0;
         let variant = PathTraceVariant {
             nearest,
             hybrid: pp.gradient_threshold.is_finite()
                 || pp.stochastic_blend > 0.0
                 || pp.scatter != ScatterRegions::Everywhere,
-            guide: pp.denoise,
+            guide: guided,
             forward_diff: params.gradient == GradientMethod::Forward,
             single_brick,
             crop: params.cropping.is_some(),
         };
         let pipeline = self.pipelines.get(ctx, variant)?;
         self.ensure_accum(ctx, view.width, view.height)?;
-        if pp.denoise && self.denoise.is_none() {
+        if guided && self.denoise.is_none() {
             self.denoise = Some(DenoisePass::new(ctx)?);
         }
         if self.key != key || depth_input {
             // (a host's depth may change from frame to frame without telling)
             self.key = key;
-            self.samples = 0;
+            self.units = 0;
         }
-        let before = self.samples;
-        let add = if pp.max_samples > 0 {
-            pp.samples_per_frame
-                .min(pp.max_samples.saturating_sub(before))
+        let before = self.units;
+        let limit = if pp.max_samples > 0 {
+            pp.max_samples as u64 * UNITS
         } else {
-            pp.samples_per_frame
+            u64::MAX
         };
-        if add == 0 {
+        let wanted = (pp.samples_per_frame as u64 * UNITS).min(limit.saturating_sub(before));
+        if wanted == 0 {
             // The budget is reached: the output images hold the converged frame.
             res.stats.frames += 1;
             return Ok(());
@@ -405,31 +485,21 @@ impl PathTracePass {
             pp.bsdf.fresnel,
         ];
         u.lobe = [pp.bsdf.transmission, pp.bsdf.lobe_exponent(), 0.0, 0.0];
-        u.counts = [pp.secondary_rays, before, pp.max_bounces, pp.seed];
+        u.counts = [pp.secondary_rays, 0, pp.max_bounces, pp.seed];
         let (_, dist_size, dist) = self.env_dist.as_ref().expect("built above");
         let (_, majorant_buf, _) = self.majorants.as_ref().expect("built above");
         let flags = flag_bits(&[
             (pp.background, PT_FLAG_BACKGROUND),
             (pp.attenuation, PT_FLAG_ATTENUATION),
-            (pp.denoise, PT_FLAG_GUIDE),
+            (guided, PT_FLAG_GUIDE),
         ]);
         u.options = [flags, *dist_size, pp.scatter.code(), 0];
         u.rect = rect;
         let q = &ctx.queue;
         q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
-        // One path per pixel per dispatch, each with its own uniforms (the path index).
-        let mut blocks = vec![0u8; (UNIFORM_STRIDE * add as u64) as usize];
-        for i in 0..add {
-            u.counts[1] = before + i;
-            let at = (UNIFORM_STRIDE * i as u64) as usize;
-            blocks[at..at + std::mem::size_of::<PathTraceUniforms>()]
-                .copy_from_slice(bytemuck::bytes_of(&u));
-        }
-        q.write_buffer(&self.uniforms, 0, &blocks);
         let t = res.targets.as_ref().expect("allocated above");
         let (_, tables) = res.tables.as_ref().expect("built above");
-        let (_, _, accum) = self.accum.as_ref().expect("allocated above");
-        let [guide, ping, pong] = self.denoise_buffers.as_ref().expect("allocated above");
+        let acc = self.accum.as_ref().expect("allocated above");
         let cube_sampler = res.cube_sampler()?;
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
@@ -440,85 +510,264 @@ impl PathTracePass {
             entries: &[
                 bind(0, res.frame_buf.as_entire_binding()),
                 bind(1, wgpu::BindingResource::TextureView(&tables.view)),
-                bind(2, accum.as_entire_binding()),
+                bind(2, acc.sums.as_entire_binding()),
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
-                bind(5, wgpu::BindingResource::TextureView(&color_view)),
-                bind(6, wgpu::BindingResource::TextureView(&depth_view)),
+                bind(5, acc.moments.as_entire_binding()),
                 bind_block::<PathTraceUniforms>(7, &self.uniforms),
                 bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
                 bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
                 bind(14, dist.as_entire_binding()),
                 bind(15, wgpu::BindingResource::TextureView(majorant_buf)),
-                bind(16, guide.as_entire_binding()),
+                bind(16, acc.guide.as_entire_binding()),
             ],
         });
         let brick = res.volume()?.bind_group(nearest);
+        let budget = pp.time_budget as f64;
+        let start = Instant::now();
+        let mut added = 0;
+        while added < wanted {
+            // Sixteenths this submission traces: all that are wanted without a budget, else
+            // as many as the time left holds at the last measured rate (at least one a frame).
+            let n = match (budget > 0.0, self.unit_seconds) {
+                (false, _) => wanted - added,
+                (true, None) => 1,
+                (true, Some(t)) => {
+                    let left = budget - start.elapsed().as_secs_f64();
+                    let fit = (left / t).floor().max(0.0) as u64;
+                    fit.max(u64::from(added == 0)).min(wanted - added)
+                }
+            };
+            if n == 0 {
+                break;
+            }
+            let mut enc = ctx
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("path-traced frame"),
+                });
+            if before + added == 0 {
+                // A new accumulation: no pixel has paths (the shown image reads the counts).
+                enc.clear_buffer(&acc.moments, 0, None);
+                if guided {
+                    enc.clear_buffer(&acc.guide, 0, None);
+                }
+            }
+            let dispatches = plan_dispatches(before + added, n);
+            let mut blocks = vec![0u8; UNIFORM_STRIDE as usize * dispatches.len()];
+            for (i, d) in dispatches.iter().enumerate() {
+                u.counts[1] = d.pass;
+                u.options[3] = d.lattice();
+                let at = UNIFORM_STRIDE as usize * i;
+                blocks[at..at + std::mem::size_of::<PathTraceUniforms>()]
+                    .copy_from_slice(bytemuck::bytes_of(&u));
+            }
+            q.write_buffer(&self.uniforms, 0, &blocks);
+            if rect[2] > rect[0] && rect[3] > rect[1] {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("path tracing"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(1, brick, &[]);
+                for (i, d) in dispatches.iter().enumerate() {
+                    pass.set_bind_group(0, &bg, &[(UNIFORM_STRIDE * i as u64) as u32]);
+                    let gr = d.groups(rect);
+                    pass.dispatch_workgroups(gr[0], gr[1], 1);
+                }
+            }
+            let timed = Instant::now();
+            ctx.checked("rendering the path-traced frame", || {
+                q.submit([enc.finish()]);
+            })?;
+            added += n;
+            if budget > 0.0 {
+                ctx.wait_idle()?;
+                self.unit_seconds = Some(timed.elapsed().as_secs_f64() / n as f64);
+            }
+        }
+        self.units = before + added;
+        self.rect = rect;
         let mut enc = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("path-traced frame"),
+                label: Some("path-traced image"),
             });
         if rect != full {
             clear_outputs(&mut enc, &color_view, &depth_view);
-            if before == 0 {
-                // (pixels outside the rectangle keep no sums of an earlier accumulation)
-                enc.clear_buffer(accum, 0, None);
-                enc.clear_buffer(guide, 0, None);
-            }
         }
         if rect[2] > rect[0] && rect[3] > rect[1] {
-            let gr = groups(rect);
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("path tracing"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(1, brick, &[]);
-            for i in 0..add {
-                pass.set_bind_group(0, &bg, &[(UNIFORM_STRIDE * i as u64) as u32]);
-                pass.dispatch_workgroups(gr[0], gr[1], 1);
-            }
-        }
-        if pp.denoise && rect[2] > rect[0] && rect[3] > rect[1] {
-            let out = DenoiseOutputs {
-                accum,
-                guide,
-                images: [ping, pong],
-                color: &color_view,
+            let (show_bgl, show_pipeline, show_uniforms) = &self.show;
+            let su = ShowUniforms {
+                rect,
+                size: [view.width, 0, 0, 0],
             };
-            let n = (before + add) as f32;
-            self.denoise.as_ref().expect("created above").encode(
+            q.write_buffer(show_uniforms, 0, bytemuck::bytes_of(&su));
+            encode_single_group(
                 ctx,
                 &mut enc,
-                &out,
-                rect,
-                view.width,
-                [1.0 / n, step as f32],
+                "path tracing image",
+                (show_bgl, show_pipeline),
+                &[
+                    bind(0, show_uniforms.as_entire_binding()),
+                    bind(1, acc.sums.as_entire_binding()),
+                    bind(2, acc.moments.as_entire_binding()),
+                    bind(3, acc.images[0].as_entire_binding()),
+                    bind(4, wgpu::BindingResource::TextureView(&color_view)),
+                    bind(5, wgpu::BindingResource::TextureView(&depth_view)),
+                ],
+                {
+                    let [x, y] = groups(rect);
+                    [x, y, 1]
+                },
             );
+            if pp.denoise || self.samples() < pp.denoise_until {
+                let out = DenoiseOutputs {
+                    accum: &acc.sums,
+                    guide: &acc.guide,
+                    images: [&acc.images[0], &acc.images[1]],
+                    color: &color_view,
+                };
+                self.denoise.as_ref().expect("created above").encode(
+                    ctx,
+                    &mut enc,
+                    &out,
+                    rect,
+                    view.width,
+                    step as f32,
+                );
+            }
         }
-        ctx.checked("rendering the path-traced frame", || {
+        ctx.checked("showing the path-traced frame", || {
             q.submit([enc.finish()]);
         })?;
-        self.samples = before + add;
         res.stats.frames += 1;
         Ok(())
     }
 
+    /// Waits for the last path-traced frame and reads its sums and moments back.
+    fn read_sums(&self, ctx: &Context) -> Result<(Pixels, Pixels)> {
+        let acc = match &self.accum {
+            Some(acc) if self.units > 0 => acc,
+            _ => {
+                return Err(Error::InvalidParameter(
+                    "no path-traced frame has been rendered yet".into(),
+                ))
+            }
+        };
+        let sums = read_buffer(ctx, &acc.sums)?;
+        let moments = read_buffer(ctx, &acc.moments)?;
+        Ok((
+            bytemuck::cast_slice::<u8, [f32; 4]>(&sums).to_vec(),
+            bytemuck::cast_slice::<u8, [f32; 4]>(&moments).to_vec(),
+        ))
+    }
+
     /// Waits for the last path-traced frame and returns its per-pixel mean over the
     /// accumulated paths, rows top to bottom: radiance (rgb, linear, not clipped) and the
-    /// fraction of paths that met the medium (a; 1 everywhere with the background on).
+    /// fraction of paths that met the medium (a; 1 everywhere with the background on);
+    /// zero where no path was traced.
     pub fn read_accumulation(&self, ctx: &Context) -> Result<Vec<[f32; 4]>> {
-        if self.samples == 0 {
-            return Err(Error::InvalidParameter(
-                "no path-traced frame has been rendered yet".into(),
-            ));
-        }
-        let (_, _, buf) = self.accum.as_ref().expect("allocated with the first frame");
-        let bytes = read_buffer(ctx, buf)?;
-        let n = self.samples as f32;
-        Ok(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes)
+        let (sums, moments) = self.read_sums(ctx)?;
+        Ok(sums
             .iter()
-            .map(|v| v.map(|c| c / n))
+            .zip(&moments)
+            .map(|(s, m)| {
+                if m[0] > 0.0 {
+                    s.map(|c| c / m[0])
+                } else {
+                    [0.0; 4]
+                }
+            })
             .collect())
     }
+
+    /// Waits for the last path-traced frame and estimates how far it has converged.
+    pub fn convergence(&self, ctx: &Context) -> Result<Convergence> {
+        if self.units == 0 {
+            return Ok(Convergence::default());
+        }
+        let (sums, moments) = self.read_sums(ctx)?;
+        let traced: f64 = moments.iter().map(|m| m[0] as f64).sum();
+        let passes = self.samples();
+        let [x0, y0, x1, y1] = self.rect;
+        let in_rect = ((x1 - x0) as f64 * (y1 - y0) as f64).max(1.0);
+        let mut variance = 0.0;
+        let mut luminance = 0.0;
+        let mut covered = 0usize;
+        for (s, m) in sums.iter().zip(&moments) {
+            let n = m[0] as f64;
+            if n < 2.0 || s[3] <= 0.0 {
+                continue;
+            }
+            let mean = (0.2126 * s[0] as f64 + 0.7152 * s[1] as f64 + 0.0722 * s[2] as f64) / n;
+            let spread = (m[1] as f64 / n - mean * mean).max(0.0) * n / (n - 1.0);
+            variance += spread / n;
+            luminance += mean;
+            covered += 1;
+        }
+        let relative_error = (passes >= 2 && covered > 0 && luminance > 0.0).then(|| {
+            let c = covered as f64;
+            ((variance / c).sqrt() / (luminance / c)) as f32
+        });
+        Ok(Convergence {
+            paths_per_pixel: passes,
+            mean_paths_per_pixel: (traced / in_rect) as f32,
+            relative_error,
+        })
+    }
+}
+
+/// One dispatch of the path tracer: one more path for the pixels of pass `pass`, all of the
+/// rectangle's or one subset's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Dispatch {
+    pass: u32,
+    subset: Option<usize>,
+}
+
+impl Dispatch {
+    /// The pixels traced (PathTrace.options.w): stride | x offset << 8 | y offset << 16.
+    fn lattice(&self) -> u32 {
+        match self.subset {
+            None => 1,
+            Some(i) => {
+                let (x, y) = SUBSETS[i];
+                4 | x << 8 | y << 16
+            }
+        }
+    }
+
+    /// Workgroups (8 × 8) covering the pixels traced in `rect`.
+    fn groups(&self, rect: [u32; 4]) -> [u32; 2] {
+        match self.subset {
+            None => groups(rect),
+            Some(i) => {
+                let (x, y) = SUBSETS[i];
+                let along = |lo: u32, hi: u32, off: u32| (hi - lo).saturating_sub(off).div_ceil(4);
+                groups([0, 0, along(rect[0], rect[2], x), along(rect[1], rect[3], y)])
+            }
+        }
+    }
+}
+
+/// The dispatches that trace sixteenths `from .. from + n` of the accumulation: whole passes
+/// where a pass starts and ends inside the range, single subsets elsewhere.
+fn plan_dispatches(from: u64, n: u64) -> Vec<Dispatch> {
+    let mut out = Vec::new();
+    let mut at = from;
+    let end = from + n;
+    while at < end {
+        let pass = (at / UNITS) as u32;
+        if at.is_multiple_of(UNITS) && end - at >= UNITS {
+            out.push(Dispatch { pass, subset: None });
+            at += UNITS;
+        } else {
+            out.push(Dispatch {
+                pass,
+                subset: Some((at % UNITS) as usize),
+            });
+            at += 1;
+        }
+    }
+    out
 }
