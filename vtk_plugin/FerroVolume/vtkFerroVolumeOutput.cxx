@@ -4,6 +4,7 @@
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeDepthReader.h"
 #include "vtkFerroVolumeMapper.h"
+#include "vtkLogger.h"
 #include "vtkMatrix4x4.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLQuadHelper.h"
@@ -24,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <vector>
 
 void vtkFerroVolumeSetSampling(vtkTextureObject* texture, bool linear)
@@ -220,12 +222,13 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
   if (preference != vtkFerroVolumeMapper::OUTPUT_PATH_READBACK)
   {
     std::string ignored;
+    vtkFerroVolumeOutputChoice choice;
     this->Path = vtkFerroVolumeSharedOutput::Create(*vtkFerroVolumeContext::Acquire(ignored),
-      renderer, preference == vtkFerroVolumeMapper::OUTPUT_PATH_SHARED, this->PathReason);
-    if (!this->Path && preference == vtkFerroVolumeMapper::OUTPUT_PATH_SHARED)
+      renderer, preference == vtkFerroVolumeMapper::OUTPUT_PATH_SHARED, choice);
+    this->PathReason = choice.Reason;
+    if (!this->Path)
     {
-      vtkWarningWithObjectMacro(
-        self, << "shared output unavailable, frames go through the CPU: " << this->PathReason);
+      this->AnnounceReadback(self, choice.Reason, choice.Warn);
     }
   }
   else
@@ -243,6 +246,29 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
   this->Path.reset(new ReadbackOutput);
 #endif
 }
+
+#if FERROVOL_HAVE_SHARED_OUTPUT
+void vtkFerroVolumeOutput::AnnounceReadback(
+  vtkObject* self, const std::string& reason, bool warn)
+{
+  if (warn)
+  {
+    if (this->Warned.insert(reason).second)
+    {
+      vtkWarningWithObjectMacro(
+        self, << "shared output unavailable, frames go through the CPU: " << reason);
+    }
+    return;
+  }
+  static std::mutex mutex;
+  static std::set<std::string> noted;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (noted.insert(reason).second)
+  {
+    vtkLog(INFO, "vtkFerroVolumeMapper: frames go through the CPU (readback): " << reason);
+  }
+}
+#endif
 
 bool vtkFerroVolumeOutput::Render(vtkObject* self, int preference, ferrovol::Renderer& renderer,
   const vtkFerroVolumeFrameRequest& req, std::string& error, std::string& warning)

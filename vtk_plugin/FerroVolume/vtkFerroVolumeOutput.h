@@ -5,9 +5,10 @@
 //     ferrovol's read_frame and glTexImage2D (a CPU copy each way);
 //   shared (vtkFerroVolumeSharedOutput): ferrovol's images imported with
 //     GL_EXT_memory_object_fd, no copy (when ferrovol.h has the shared output path).
-// vtkFerroVolumeOutput picks the path, falls back to the readback for good when the shared
-// one fails, and composites the frame: one full-screen quad, premultiplied blending,
-// gl_FragDepth from the volume's depth. Internal to the FerroVolume module (not wrapped).
+// vtkFerroVolumeOutput picks the path (vtkFerroVolumeChooseOutput's rule), says once why
+// frames go through the CPU, falls back to the readback for good when the shared one fails,
+// and composites the frame: one full-screen quad, premultiplied blending, gl_FragDepth from
+// the volume's depth. Internal to the FerroVolume module (not wrapped).
 #ifndef vtkFerroVolumeOutput_h
 #define vtkFerroVolumeOutput_h
 
@@ -16,6 +17,7 @@
 #include "ferrovol.hpp"
 
 #include <memory>
+#include <set>
 #include <string>
 
 class vtkObject;
@@ -101,12 +103,17 @@ private:
   void Choose(vtkObject* self, int preference, ferrovol::Renderer& renderer,
     vtkOpenGLRenderWindow* win);
   void UseReadback(ferrovol::Renderer& renderer);
+  // Says why frames go through the CPU: with `warn`, a warning on `self`, once per mapper
+  // for each reason; otherwise an INFO line in VTK's log, once per process for each reason
+  // (the reason names the device and the OpenGL renderer, so another OpenGL is said again).
+  void AnnounceReadback(vtkObject* self, const std::string& reason, bool warn);
 
   std::unique_ptr<vtkFerroVolumeFramePath> Path;
   int Preference = -1;
   // weak: a window destroyed behind our back reads as null, and its GL names are forgotten
   vtkWeakPointer<vtkOpenGLRenderWindow> PathWindow;
   std::string PathReason;
+  std::set<std::string> Warned;
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
   vtkWeakPointer<vtkOpenGLRenderWindow> QuadWindow;
 };

@@ -10,8 +10,8 @@
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 
+#include <algorithm>
 #include <array>
-#include <cstring>
 
 namespace
 {
@@ -67,68 +67,83 @@ bool HasStencil(GLenum format)
 {
   return format == GL_DEPTH24_STENCIL8 || format == GL_DEPTH32F_STENCIL8;
 }
-} // namespace
 
-std::unique_ptr<vtkFerroVolumeSharedOutput> vtkFerroVolumeSharedOutput::Create(
-  const ferrovol::Context& ctx, ferrovol::Renderer& renderer, bool anyDevice, std::string& reason)
+// What vtkFerroVolumeChooseOutput decides from: ferrovol's device and the current OpenGL
+// context.
+vtkFerroVolumeOutputFacts Facts(const ferrovol::Context& ctx, bool forced)
 {
-  FvAdapterInfo info;
+  vtkFerroVolumeOutputFacts f;
+  f.Forced = forced;
+  const GLubyte* glRenderer = glGetString(GL_RENDERER);
+  f.GLRenderer = glRenderer ? reinterpret_cast<const char*>(glRenderer) : "no GL_RENDERER";
+  f.GLHasMemoryObjectFd = GLEW_EXT_memory_object_fd;
   try
   {
-    info = ctx.info();
+    f.AdapterName = ctx.info().name;
   }
   catch (const ferrovol::Error& e)
   {
-    reason = "no adapter information: " + e.message();
-    return nullptr;
-  }
-  if (!anyDevice && !info.is_cpu)
-  {
-    reason = std::string("memory is shared automatically only with a CPU device (lavapipe); ") +
-      info.name + " is not one: SetOutputPathToShared() to share anyway";
-    return nullptr;
-  }
-  if (!GLEW_EXT_memory_object_fd)
-  {
-    reason = "this OpenGL context has no GL_EXT_memory_object_fd";
-    return nullptr;
+    f.AdapterName = "unnamed";
+    f.ExportProblem = vtkFerroVolumeFailure("describe its device", e);
+    return f;
   }
   if (!ctx.can_share())
   {
-    reason = std::string("the device cannot export memory: ") + fv_last_error();
-    return nullptr;
+    f.ExportProblem = fv_last_error();
+    return f;
   }
-  ferrovol::Context::Uuids uuids{};
-  if (!vtkFerroVolumeCall("tell its device UUIDs", reason, [&] { uuids = ctx.uuids(); }))
+  try
   {
-    return nullptr;
+    const ferrovol::Context::Uuids uuids = ctx.uuids();
+    std::copy(uuids.device, uuids.device + 16, f.VulkanDevice.begin());
+    std::copy(uuids.driver, uuids.driver + 16, f.VulkanDriver.begin());
+  }
+  catch (const ferrovol::Error& e)
+  {
+    f.ExportProblem = vtkFerroVolumeFailure("tell its device UUIDs", e);
+    return f;
+  }
+  if (!f.GLHasMemoryObjectFd)
+  {
+    return f; // the UUID queries belong to GL_EXT_memory_object
   }
   vtkOpenGLClearErrorMacro();
-  GLubyte glDriver[16] = { 0 };
-  glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT, glDriver);
+  glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT, f.GLDriver.data());
   GLint devices = 0;
   glGetIntegerv(GL_NUM_DEVICE_UUIDS_EXT, &devices);
-  bool sameDevice = false;
-  for (GLint i = 0; i < devices && !sameDevice; ++i)
+  f.GLDevices.resize(static_cast<size_t>(std::max(devices, 0)));
+  for (GLint i = 0; i < devices; ++i)
   {
-    GLubyte glDevice[16] = { 0 };
-    glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, i, glDevice);
-    sameDevice = std::memcmp(glDevice, uuids.device, 16) == 0;
+    glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, static_cast<GLuint>(i), f.GLDevices[i].data());
   }
-  if (glGetError() != GL_NO_ERROR || !sameDevice || std::memcmp(glDriver, uuids.driver, 16) != 0)
+  if (glGetError() != GL_NO_ERROR)
   {
-    reason = "OpenGL runs on another device or driver than ferrovol (device/driver UUIDs "
-             "differ)";
+    f.GLDevices.clear(); // read as "none reported"
+  }
+  return f;
+}
+} // namespace
+
+std::unique_ptr<vtkFerroVolumeSharedOutput> vtkFerroVolumeSharedOutput::Create(
+  const ferrovol::Context& ctx, ferrovol::Renderer& renderer, bool forced,
+  vtkFerroVolumeOutputChoice& choice)
+{
+  choice = vtkFerroVolumeChooseOutput(Facts(ctx, forced));
+  if (!choice.Shared)
+  {
     return nullptr;
   }
-  if (!vtkFerroVolumeCall("share its output", reason,
+  std::string error;
+  if (!vtkFerroVolumeCall("share its output", error,
         [&] { renderer.set_output_path(FV_OUTPUT_PATH_SHARED); }))
   {
+    // Everything said it would work: a failure here is worth a warning in any case.
+    choice.Shared = false;
+    choice.Reason = error;
+    choice.Warn = true;
     return nullptr;
   }
-  std::unique_ptr<vtkFerroVolumeSharedOutput> out(new vtkFerroVolumeSharedOutput);
-  reason = std::string("zero copy: ") + info.name + " (Vulkan) and OpenGL share the frame";
-  return out;
+  return std::unique_ptr<vtkFerroVolumeSharedOutput>(new vtkFerroVolumeSharedOutput);
 }
 
 vtkFerroVolumeSharedOutput::~vtkFerroVolumeSharedOutput()

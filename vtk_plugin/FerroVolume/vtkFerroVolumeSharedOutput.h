@@ -1,14 +1,16 @@
 // vtkFerroVolumeSharedOutput: the zero-copy frame path. ferrovol renders into Vulkan memory
 // that OpenGL imports (ferrovol's shared images → glImportMemoryFdEXT →
 // glTexStorageMem2DEXT). VTK's depth goes into ferrovol's depth input image on the GPU (a
-// blit and one full-screen pass). No semaphores (llvmpipe has no GL_EXT_semaphore_fd):
-// glFinish before ferrovol reads what GL wrote, and ferrovol's finish before GL samples what
-// ferrovol wrote. Compiled when ferrovol.h has the shared output path
-// (FERROVOL_HAVE_SHARED_OUTPUT). Internal to the FerroVolume module (not wrapped).
+// blit and one full-screen pass). Synchronised by CPU waits, as ferrovol exports no
+// semaphores (docs/ARCHITECTURE.md says why): glFinish before ferrovol reads what GL wrote,
+// and ferrovol's finish before GL samples what ferrovol wrote. Compiled when ferrovol.h has
+// the shared output path (FERROVOL_HAVE_SHARED_OUTPUT). Internal to the FerroVolume module
+// (not wrapped).
 #ifndef vtkFerroVolumeSharedOutput_h
 #define vtkFerroVolumeSharedOutput_h
 
 #include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumeOutputChoice.h"
 #include "vtkSmartPointer.h"
 #include "vtk_glew.h"
 
@@ -18,11 +20,11 @@
 class vtkFerroVolumeSharedOutput : public vtkFerroVolumeFramePath
 {
 public:
-  // A shared output for this renderer, or nullptr with the reason (the window's OpenGL
-  // context is current). `anyDevice`: share with a GPU device too (only a CPU device,
-  // lavapipe, otherwise).
+  // A shared output for this renderer where vtkFerroVolumeChooseOutput allows one (the
+  // window's OpenGL context is current), or nullptr; `choice` says why either way. `forced`:
+  // the user asked for the shared path (a refusal is then a warning).
   static std::unique_ptr<vtkFerroVolumeSharedOutput> Create(const ferrovol::Context& ctx,
-    ferrovol::Renderer& renderer, bool anyDevice, std::string& reason);
+    ferrovol::Renderer& renderer, bool forced, vtkFerroVolumeOutputChoice& choice);
 
   ~vtkFerroVolumeSharedOutput() override;
 

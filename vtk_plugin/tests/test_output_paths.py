@@ -1,7 +1,13 @@
 """The two ways frames reach OpenGL give the same pixels: shared memory (zero copy, Vulkan
 memory imported with GL_EXT_memory_object_fd) and CPU readback. Also with opaque geometry
 (depth in), a reduced image sample distance, window resizes (images re-imported), several
-viewports, and single-sampled windows (no multisample resolve of the depth)."""
+viewports, and single-sampled windows (no multisample resolve of the depth). The automatic
+choice shares wherever forcing the shared path works; without GL_EXT_memory_object_fd it
+reads back and says why once (the rule itself: TestFerroVolumeOutputChoice.cxx)."""
+import json
+import os
+import subprocess
+import sys
 import unittest
 
 import numpy as np
@@ -126,9 +132,46 @@ class OutputPaths(unittest.TestCase):
             names.append(m.GetOutputPathName())
         fvtest.log("  switching: %s; automatic chose %s (%s)"
                    % (names, names[2], m.GetOutputPathReason()))
-        self.assertEqual(names[:2], ["shared", "readback"])
-        self.assertEqual(names[3], "shared")
+        self.assertEqual(names, ["shared", "readback", "shared", "shared"])
+        self.assertRegex(m.GetOutputPathReason(),
+                         r"^zero copy: .* device UUID [0-9a-f]{8}(-[0-9a-f]{4}){3}-[0-9a-f]{12}, "
+                         r"driver UUID ")
         self.assertEqual(m.GetVolumeUploadCount(), 1)  # the path is not the volume
+
+
+class ReadbackFallback(unittest.TestCase):
+    """Mesa's OpenGL with GL_EXT_memory_object_fd hidden (output_fallback.py, a process of
+    its own): automatic mappers read back with the extension named, say so once per process
+    in VTK's log and raise no warning; a mapper forced to share warns once, however often it
+    chooses its path."""
+
+    def test_without_memory_object_fd(self):
+        env = dict(os.environ, MESA_EXTENSION_OVERRIDE="-GL_EXT_memory_object_fd")
+        env.pop("FERROVOL_OUTPUT_PATH", None)
+        here = os.path.dirname(os.path.abspath(__file__))
+        run = subprocess.run([sys.executable, os.path.join(here, "output_fallback.py")],
+                             env=env, cwd=here, capture_output=True, text=True, timeout=180)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        report = json.loads(run.stdout.splitlines()[-1])
+        if "Mesa" not in report["vendor"]:
+            self.skipTest("OpenGL is not Mesa's (%s): MESA_EXTENSION_OVERRIDE cannot hide "
+                          "the extension" % report["vendor"])
+        notes = [line for line in run.stderr.splitlines()
+                 if "frames go through the CPU (readback)" in line]
+        fvtest.log("  without GL_EXT_memory_object_fd: %s; %d log line(s), forced: %d warning(s)"
+                   % (report["automatic"]["reason"], len(notes),
+                      len(report["forced"]["warnings"])))
+        for name in ("automatic", "automatic2", "forced"):
+            r = report[name]
+            self.assertEqual(r["path"], "readback", name)
+            self.assertIn("has no GL_EXT_memory_object_fd", r["reason"], name)
+            self.assertEqual(r["errors"], [], name)
+        self.assertEqual(report["automatic"]["warnings"], [])
+        self.assertEqual(report["automatic2"]["warnings"], [])
+        self.assertEqual(len(notes), 1, "\n".join(notes))
+        self.assertIn(report["automatic"]["reason"], notes[0])
+        self.assertEqual(len(report["forced"]["warnings"]), 1, report["forced"]["warnings"])
+        self.assertIn(report["forced"]["reason"], report["forced"]["warnings"][0])
 
 
 if __name__ == "__main__":

@@ -4,8 +4,10 @@
 //!
 //! What the host does (OpenGL, once per [`SharedOutput::generation`]):
 //!
-//! 1. compare [`Context::device_uuids`] with `glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, 0)`
-//!    and `glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT)`; import only when both match;
+//! 1. compare [`Context::device_uuids`] with GL's device UUIDs
+//!    (`glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, i)` for i below `GL_NUM_DEVICE_UUIDS_EXT`)
+//!    and `glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT)`; import only when the device is one of
+//!    GL's and the drivers are equal, whether the device is a GPU or a CPU;
 //! 2. per image of [`Renderer::shared_output`](crate::Renderer::shared_output):
 //!    `glCreateMemoryObjectsEXT`, `glMemoryObjectParameterivEXT(GL_DEDICATED_MEMORY_OBJECT_EXT,
 //!    GL_TRUE)` (the allocations are dedicated), `glImportMemoryFdEXT(mem, size,
@@ -15,15 +17,16 @@
 //!
 //! Per frame: [`Renderer::render`](crate::Renderer::render), then
 //! [`Renderer::finish`](crate::Renderer::finish) before GL samples the colour and depth. That
-//! CPU wait is the synchronisation: no semaphores are exported, because the GL this path is
-//! tested on (Mesa's llvmpipe) has no `GL_EXT_semaphore_fd`. Likewise, GL must be done with
-//! the images (`glFinish`) before the next `render`, and done writing the depth input before
+//! CPU wait is the synchronisation: no semaphores are exported (docs/ARCHITECTURE.md says what
+//! wgpu 30 lacks for that and why it stays so). Likewise, GL must be done with the images
+//! (`glFinish`) before the next `render`, and done writing the depth input before
 //! [`Renderer::render_with_shared_depth`](crate::Renderer::render_with_shared_depth).
 //!
 //! No image layout transitions or queue family transfers are made for the other API: the
-//! images stay in whatever layout wgpu last used. That is sound where layouts do not change
-//! the memory (lavapipe/llvmpipe, where this is tested); elsewhere a host would need
-//! semaphores with layouts (`glWaitSemaphoreEXT`), which this path does not offer yet.
+//! images stay in whatever layout wgpu last used. That changes nothing where layouts do not
+//! change the memory (lavapipe/llvmpipe, where this is tested); on a GPU the host relies on
+//! its GL reading the images as they are, which comparing them with
+//! [`Renderer::read_image`](crate::Renderer::read_image) checks there.
 //!
 //! Row 0 of every image is the top row of the frame (wgpu's convention); GL's texture row 0
 //! is its bottom row, so the host flips when it draws.

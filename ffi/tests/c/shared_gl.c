@@ -1,8 +1,11 @@
 /* The zero-copy path as a C host uses it: OpenGL (EGL, Mesa's surfaceless platform, no
- * window) imports ferrovol's shared colour image with GL_EXT_memory_object_fd after
- * comparing device and driver UUIDs, and must read exactly the pixels that
- * fv_renderer_read_frame returns. Exit 0: identical; 77: no usable EGL/GL interop here
- * (the test reports it as skipped); anything else: failure.
+ * window) imports ferrovol's shared colour image with GL_EXT_memory_object_fd and must read
+ * exactly the pixels that fv_renderer_read_frame returns. It shares under the VTK mapper's
+ * rule (vtk_plugin/FerroVolume/vtkFerroVolumeOutputChoice.h), on a GPU as on a CPU device:
+ * GL has GL_EXT_memory_object_fd, the device can export memory, the Vulkan device UUID is
+ * one of GL's device UUIDs and the driver UUIDs are equal. Synchronised by CPU waits
+ * (fv_renderer_finish, glFinish). Exit 0: identical; 77: no usable EGL/GL interop here;
+ * anything else: failure.
  * Built with -std=c11 -Wall -Wextra -Werror -pedantic by ffi/tests/c_program.rs. */
 #define EGL_EGLEXT_PROTOTYPES
 #include <EGL/egl.h>
@@ -52,6 +55,13 @@ static int open_gl(void) {
   return 0;
 }
 
+static void print_uuid(const char *what, const uint8_t *uuid) {
+  printf("%s ", what);
+  for (int i = 0; i < 16; ++i)
+    printf("%02x", uuid[i]);
+  printf("\n");
+}
+
 static int has_extension(const char *name) {
   LOAD(PFNGLGETSTRINGIPROC, glGetStringi);
   GLint n = 0;
@@ -84,13 +94,25 @@ int main(void) {
   FvRenderer *r = NULL;
   /* Created while our GL context is current, as a VTK mapper does: must not disturb it. */
   FV(fv_context_new(&ctx));
+  if (!fv_context_can_share(ctx)) {
+    printf("skipped: the device cannot export memory: %s\n", fv_last_error());
+    return SKIP;
+  }
   uint8_t vk_device[16], vk_driver[16], gl_device[GL_UUID_SIZE_EXT], gl_driver[GL_UUID_SIZE_EXT];
   FV(fv_context_uuids(ctx, &vk_device, &vk_driver));
-  glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, 0, gl_device);
+  print_uuid("Vulkan device UUID", vk_device);
+  print_uuid("Vulkan driver UUID", vk_driver);
   glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT, gl_driver);
-  printf("UUIDs (vulkan/gl) device %.16s / %.16s, driver %.16s / %.16s\n", (const char *)vk_device,
-         (const char *)gl_device, (const char *)vk_driver, (const char *)gl_driver);
-  if (memcmp(vk_device, gl_device, 16) != 0 || memcmp(vk_driver, gl_driver, 16) != 0) {
+  print_uuid("GL driver UUID    ", gl_driver);
+  GLint gl_devices = 0;
+  glGetIntegerv(GL_NUM_DEVICE_UUIDS_EXT, &gl_devices);
+  int same_device = 0;
+  for (GLint i = 0; i < gl_devices; ++i) {
+    glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, (GLuint)i, gl_device);
+    print_uuid("GL device UUID    ", gl_device);
+    same_device |= memcmp(vk_device, gl_device, 16) == 0;
+  }
+  if (!same_device || memcmp(vk_driver, gl_driver, 16) != 0) {
     printf("skipped: GL and Vulkan are different devices or drivers\n");
     return SKIP;
   }
