@@ -138,7 +138,7 @@ pub unsafe extern "C" fn fv_volume_range(
                 v.data.components
             )));
         }
-        *out = v.data.range(component);
+        *out = v.data.try_range(component)?;
         Ok(())
     })
 }
