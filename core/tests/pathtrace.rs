@@ -831,3 +831,26 @@ fn the_denoised_preview_gives_way_to_the_accumulation() {
     assert!(differ(&plain2, &preview2) > plain2.len() / 10);
     assert_eq!(plain4, preview4);
 }
+
+#[test]
+fn opaque_depth_restarts_only_when_it_changes() {
+    let vol = volume([8, 8, 8], |x, _, _| x / 7.0);
+    let (mut r, view) = scene(&vol, medium([0.8; 3], 0.0, 0.5, 1.0), None, 16);
+    r.set_path_tracing(&PathTraceParams {
+        samples_per_frame: 2,
+        ..Default::default()
+    })
+    .unwrap();
+    r.reset_accumulation();
+    let mut depth = vec![1.0f32; 16 * 16];
+    let mut counts = vec![];
+    for i in 0..5 {
+        if i == 2 {
+            depth[100] = 0.5;
+        }
+        r.render(&view, &pt_params(), Some(&depth)).unwrap();
+        counts.push(r.accumulated_samples());
+    }
+    println!("accumulated paths per pixel with a depth input: {counts:?} (one pixel's depth changed before the third frame)");
+    assert_eq!(counts, vec![2, 4, 2, 4, 6]);
+}

@@ -79,6 +79,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../../shaders/pathtrace_show.wgsl"),
     ),
     (
+        "depth_changed.wgsl",
+        include_str!("../../../shaders/depth_changed.wgsl"),
+    ),
+    (
         "denoise.wgsl",
         include_str!("../../../shaders/denoise.wgsl"),
     ),
@@ -96,6 +100,7 @@ pub const PASSES: &[&str] = &[
     "environment.wgsl",
     "pathtrace.wgsl",
     "pathtrace_show.wgsl",
+    "depth_changed.wgsl",
     "denoise.wgsl",
     "gradient.wgsl",
     "phase_test.wgsl",

@@ -121,6 +121,13 @@ pub struct ShowUniforms {
     pub size: [u32; 4],
 }
 
+/// The depth comparison's uniforms (`DepthCompare` in shaders/depth_changed.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DepthCompareUniforms {
+    pub size: [u32; 4],
+}
+
 /// The environment passes' uniforms (`EnvBuild` in shaders/environment.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -393,6 +400,8 @@ mod layout_tests {
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
         let m = module("pathtrace_show.wgsl");
         check!(m, "Show", ShowUniforms, [rect, size]);
+        let m = module("depth_changed.wgsl");
+        check!(m, "DepthCompare", DepthCompareUniforms, [size]);
         let m = module("phase_test.wgsl");
         check!(
             m,

@@ -3,6 +3,7 @@
 //! reaches back into the renderer.
 
 pub(crate) mod denoise;
+pub(crate) mod depth_check;
 pub(crate) mod dvr;
 pub(crate) mod frame;
 pub(crate) mod iso;

@@ -28,6 +28,7 @@
 //! The first component is the medium (other components are not read).
 
 use super::denoise::{DenoiseOutputs, DenoisePass};
+use super::depth_check::DepthCheck;
 use super::frame::{self, groups, FrameInput};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
@@ -111,6 +112,8 @@ pub(crate) struct PathTracePass {
     /// What shows the accumulation (pathtrace_show.wgsl): layout, pipeline, uniforms.
     show: (wgpu::BindGroupLayout, wgpu::ComputePipeline, wgpu::Buffer),
     denoise: Option<DenoisePass>,
+    /// Whether the host's depth input changed (created with the first frame that has one).
+    depth_check: Option<DepthCheck>,
     /// The environment's sampling distribution: (environment generation, texels per face
     /// edge, cumulative probabilities).
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
@@ -180,6 +183,7 @@ impl PathTracePass {
             accum: None,
             show: (show_bgl, show_pipeline, show_uniforms),
             denoise: None,
+            depth_check: None,
             env_dist: None,
             majorants: None,
             key: String::new(),
@@ -448,8 +452,20 @@ impl PathTracePass {
         if guided && self.denoise.is_none() {
             self.denoise = Some(DenoisePass::new(ctx)?);
         }
-        if self.key != key || depth_input {
-            // (a host's depth may change from frame to frame without telling)
+        // (a host's depth may change from frame to frame without telling: compare it)
+        let depth_changed = if depth_input {
+            if self.depth_check.is_none() {
+                self.depth_check = Some(DepthCheck::new(ctx)?);
+            }
+            let t = res.targets.as_ref().expect("allocated above");
+            self.depth_check
+                .as_mut()
+                .expect("created above")
+                .changed(ctx, &t.depth_in)?
+        } else {
+            false
+        };
+        if self.key != key || depth_changed {
             self.key = key;
             self.units = 0;
         }
