@@ -64,8 +64,8 @@ def scene(reader, size, configure):
     win.AddRenderer(ren)
     ren.ResetCamera()
     cam = ren.GetActiveCamera()
+    cam.Elevation(-90)  # from the front (-y), as the CLI's --elevation -90 --view-up z
     cam.SetViewUp(0, 0, 1)
-    cam.Elevation(-90)
     cam.OrthogonalizeViewUp()
     cam.Azimuth(30)
     ren.ResetCamera()

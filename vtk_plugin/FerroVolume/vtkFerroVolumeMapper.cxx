@@ -12,6 +12,8 @@
 //                               vtkFerroVolumeSharedOutput: zero copy) and one full-screen
 //                               quad composites it (premultiplied blending, gl_FragDepth from
 //                               ferrovol's depth)
+//   vtkFerroVolumeRefinement    progressive path tracing: whether a render is, its time
+//                               budget, the interactor timer that renders again
 //   vtkFerroVolumeContext       the process-wide ferrovol device
 #include "vtkFerroVolumeMapper.h"
 
@@ -20,6 +22,7 @@
 #include "vtkFerroVolumeInputHelper.h"
 #include "vtkFerroVolumeLookupTables.h"
 #include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumeRefinement.h"
 #include "vtkFerroVolumeSettings.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
@@ -32,6 +35,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -46,8 +50,12 @@ public:
   vtkFerroVolumeLookupTables Tables;
   vtkFerroVolumeSettings Settings;
   vtkFerroVolumeOutput Output;
+  vtkFerroVolumeRefinement Refinement;
   // warnings said once per mapper
   std::set<std::string> Warned;
+  // the convergence read back for the frame counted `ConvergenceFrame` (stats().frames)
+  std::optional<FvConvergence> Convergence;
+  uint32_t ConvergenceFrame = 0;
 
   ~vtkInternals() { this->FreeRenderer(); }
 
@@ -78,6 +86,7 @@ public:
     this->Input.Reset();
     this->Tables.Reset();
     this->Settings.Reset();
+    this->Convergence.reset();
   }
 
   // The renderer's counters; false before the first frame.
@@ -90,6 +99,30 @@ public:
     try
     {
       s = this->Renderer->stats();
+      return true;
+    }
+    catch (const ferrovol::Error&)
+    {
+      return false;
+    }
+  }
+
+  // The path tracer's convergence, read back once per frame; false before the first frame.
+  bool ReadConvergence(FvConvergence& c)
+  {
+    FvStats s;
+    if (!this->Stats(s))
+    {
+      return false;
+    }
+    try
+    {
+      if (!this->Convergence || this->ConvergenceFrame != s.frames)
+      {
+        this->Convergence = this->Renderer->convergence();
+        this->ConvergenceFrame = s.frames;
+      }
+      c = *this->Convergence;
       return true;
     }
     catch (const ferrovol::Error&)
@@ -133,6 +166,9 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , InteractiveSamplesPerPixel(1)
   , PathTracingBounces(64)
   , PathTracingDenoise(0)
+  , PathTracingDenoiseUntil(16)
+  , ProgressiveMode(PROGRESSIVE_AUTOMATIC)
+  , PathTracingTimeBudget(0.0)
   , VolumetricScatteringBlending(0.0)
   , GlobalIlluminationReach(0.0)
   , SecondaryRays(1)
@@ -145,6 +181,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , Transmission(0.0)
   , TransmissionConeAngle(30.0)
   , LastRenderDrew(0)
+  , LastRenderProgressive(0)
   , LastRenderSize{ 0, 0 }
   , Internals(new vtkInternals)
 {
@@ -185,6 +222,19 @@ int vtkFerroVolumeMapper::GetAccumulatedSamples()
   }
 }
 
+double vtkFerroVolumeMapper::GetMeanAccumulatedSamples()
+{
+  FvConvergence c;
+  return this->Internals->ReadConvergence(c) ? static_cast<double>(c.mean_paths_per_pixel)
+                                             : -1.0;
+}
+
+double vtkFerroVolumeMapper::GetPathTracingError()
+{
+  FvConvergence c;
+  return this->Internals->ReadConvergence(c) ? static_cast<double>(c.relative_error) : -1.0;
+}
+
 int vtkFerroVolumeMapper::GetFrameCount()
 {
   FvStats s;
@@ -214,6 +264,7 @@ const char* vtkFerroVolumeMapper::GetFerrovolVersion()
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 {
+  this->Internals->Refinement.Stop();
   this->Internals->Output.ReleaseGraphicsResources(window);
   this->Internals->FreeRenderer();
   this->Superclass::ReleaseGraphicsResources(window);
@@ -223,7 +274,9 @@ void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   this->LastRenderDrew = 0;
+  this->LastRenderProgressive = 0;
   vtkInternals* in = this->Internals;
+  in->Refinement.Begin();
   if (!ren || !vol || ren->GetSelector())
   {
     return; // (hardware selection passes are not supported: nothing is drawn into them)
@@ -252,7 +305,32 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     vtkErrorMacro(<< error);
     return;
   }
-  switch (in->Settings.Apply(this, ren, vol, *in->Renderer, in->Warned, error))
+  // Progressive path tracing: what is left of the render's budget for the tracing.
+  const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
+  const bool progressive = pathTrace && in->Refinement.IsProgressive(this->ProgressiveMode, win);
+  if (!progressive)
+  {
+    in->Refinement.Stop();
+  }
+  // The preview is denoised while the accumulation is short of PathTracingDenoiseUntil, as
+  // it is after a change (which interactive renders usually follow).
+  const uint32_t denoiseUntil = vtkFerroVolumeSettings::DenoiseUntil(this);
+  double traceBudget = 0.0;
+  if (progressive)
+  {
+    uint32_t before = 0;
+    if (!vtkFerroVolumeCall("count the accumulated paths", error,
+          [&] { before = in->Renderer->accumulated_samples(); }))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+    const bool denoised = this->PathTracingDenoise ||
+      (denoiseUntil > 0 && (before < denoiseUntil || win->GetDesiredUpdateRate() > 1.0));
+    traceBudget = in->Refinement.TraceBudget(
+      vtkFerroVolumeRefinement::FrameBudget(this->PathTracingTimeBudget, win), denoised);
+  }
+  switch (in->Settings.Apply(this, ren, vol, *in->Renderer, traceBudget, in->Warned, error))
   {
     case vtkFerroVolumeSettings::Result::Failed:
       vtkErrorMacro(<< error);
@@ -319,6 +397,31 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   timer->StopTimer();
   this->TimeToDraw = timer->GetElapsedTime();
   this->LastRenderDrew = 1;
+  if (progressive)
+  {
+    // Refine while the accumulation is short of SamplesPerPixel.
+    uint32_t samples = 0;
+    if (!vtkFerroVolumeCall("count the accumulated paths", error,
+          [&] { samples = in->Renderer->accumulated_samples(); }))
+    {
+      vtkErrorMacro(<< error);
+      in->Refinement.Stop();
+      return;
+    }
+    const uint32_t target = static_cast<uint32_t>(this->SamplesPerPixel);
+    in->Refinement.End(samples < target, this->PathTracingDenoise || samples < denoiseUntil,
+      req.RenderW, req.RenderH);
+    if (!in->Refinement.Continue(win, samples, target) && in->Warned.insert("restarts").second)
+    {
+      vtkWarningMacro(<< "path tracing starts over at every render (something the image "
+                         "depends on changes each time, such as opaque geometry moved on "
+                         "every render), so the view stops refining itself at "
+                      << samples
+                      << " paths per pixel; render with ProgressiveModeToOff for "
+                         "SamplesPerPixel paths");
+    }
+    this->LastRenderProgressive = 1;
+  }
 }
 
 //------------------------------------------------------------------------------------------
@@ -363,6 +466,13 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "InteractiveSamplesPerPixel: " << this->InteractiveSamplesPerPixel << "\n";
   os << indent << "PathTracingBounces: " << this->PathTracingBounces << "\n";
   os << indent << "PathTracingDenoise: " << this->PathTracingDenoise << "\n";
+  os << indent << "PathTracingDenoiseUntil: " << this->PathTracingDenoiseUntil << "\n";
+  os << indent << "ProgressiveMode: "
+     << (this->ProgressiveMode == PROGRESSIVE_ON
+            ? "on"
+            : this->ProgressiveMode == PROGRESSIVE_OFF ? "off" : "automatic")
+     << "\n";
+  os << indent << "PathTracingTimeBudget: " << this->PathTracingTimeBudget << "\n";
   os << indent << "VolumetricScatteringBlending: " << this->VolumetricScatteringBlending << "\n";
   os << indent << "GlobalIlluminationReach: " << this->GlobalIlluminationReach << "\n";
   os << indent << "SecondaryRays: " << this->SecondaryRays << "\n";
@@ -375,6 +485,7 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Transmission: " << this->Transmission << "\n";
   os << indent << "TransmissionConeAngle: " << this->TransmissionConeAngle << "\n";
   os << indent << "LastRenderDrew: " << this->LastRenderDrew << "\n";
+  os << indent << "LastRenderProgressive: " << this->LastRenderProgressive << "\n";
   os << indent << "LastRenderSize: " << this->LastRenderSize[0] << " x "
      << this->LastRenderSize[1] << "\n";
   os << indent << "OutputPath: " << this->OutputPath << " (active: " << this->GetOutputPathName()

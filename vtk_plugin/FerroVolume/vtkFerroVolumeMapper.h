@@ -33,9 +33,8 @@
  * - path tracing (SetRenderModeToPathTrace): the transfer function read as a scattering
  *   medium (opacity per ScalarOpacityUnitDistance as extinction, colour as albedo),
  *   Henyey–Greenstein scattering with the property's ScatteringAnisotropy, lit by the
- *   environment map and the renderer's directional lights; SamplesPerPixel paths per pixel
- *   on still renders, InteractiveSamplesPerPixel while the window renders interactively
- *   (DesiredUpdateRate above 1), accumulated while nothing changes;
+ *   environment map and the renderer's directional lights, the paths accumulated while
+ *   nothing changes (see "Path tracing: progressive or not" below);
  *
  * The volume is uploaded again only when the input scalars change, the tables only when the
  * property changes; camera changes never upload anything (GetVolumeUploadCount,
@@ -44,6 +43,39 @@
  * Frames travel from ferrovol to OpenGL either through memory both APIs share (zero copy:
  * Vulkan external memory imported with GL_EXT_memory_object_fd) or by a CPU readback; see
  * SetOutputPath and GetOutputPathName / GetOutputPathReason.
+ *
+ * Path tracing: progressive or not. A render is progressive when ProgressiveMode is ON, or
+ * AUTOMATIC (the default) and the render window has an interactor that is enabled and runs
+ * timers: the platform interactors (X, Win32, Cocoa) and Qt's QVTKInteractor do, as in
+ * ParaView's GUI, in pvpython and in any VTK program that starts an interactor; pvbatch's
+ * vtkGenericRenderWindowInteractor does not, and batch scripts that render offscreen or
+ * capture with vtkWindowToImageFilter usually create no interactor.
+ * - Progressive: every render, still or interactive, traces for the time budget
+ *   (PathTracingTimeBudget; automatic: 1/DesiredUpdateRate of the window, at most 0.1 s)
+ *   less what the rest of the render takes (the most of the last 4 renders, counted apart
+ *   with and without the denoiser) but at least half of it, adding as many paths per pixel
+ *   as fit (in sixteenths of a path, at least one), up to SamplesPerPixel, and returns.
+ *   Where the rest of the render takes longer than half the budget (large windows on a CPU
+ *   device such as lavapipe), renders take longer than the budget. While the accumulation is
+ *   short of SamplesPerPixel and the window rests (DesiredUpdateRate at most 1), a one-shot
+ *   timer of the interactor renders again through interactor->Render() (ParaView turns that
+ *   into a still render of the view), so the image refines without the application's help.
+ *   Refining stops when SamplesPerPixel is reached, while the user interacts (the end of
+ *   the interaction renders and it resumes), when the window or the interactor goes away
+ *   (ReleaseGraphicsResources and the destructor remove the timer and the observer), and
+ *   after 16 renders of the timer that got the accumulation no further, as when something
+ *   the image depends on changes at every render (one warning). A screenshot shows what has
+ *   accumulated so far: use SetProgressiveModeToOff for a converged one.
+ * - Not progressive: a still render traces SamplesPerPixel paths per pixel before it
+ *   returns; an interactive render (DesiredUpdateRate above 1) adds
+ *   InteractiveSamplesPerPixel.
+ * Either way the accumulation restarts when what it converges to changes (camera, data,
+ * property, transfer functions, lights, environment, mapper settings, window size, the
+ * depth of opaque geometry) and only then: a render with nothing changed, a Modified() that
+ * leaves values equal and renders of other renderers add to it.
+ * While it holds fewer than PathTracingDenoiseUntil paths per pixel the image shown is
+ * denoised (the accumulation stays unfiltered). GetAccumulatedSamples,
+ * GetMeanAccumulatedSamples and GetPathTracingError say how far it is.
  */
 
 #ifndef vtkFerroVolumeMapper_h
@@ -290,10 +322,10 @@ public:
 
   ///@{
   /**
-   * Path tracing: paths per pixel of a still render (default 64; a render traces what is
-   * missing, at most 4096 at once, and renders after that show the converged image), and
-   * per interactive frame (default 1); PathTracingBounces scattering events at most per
-   * path (default 64).
+   * Path tracing: paths per pixel the accumulation converges to (default 64; a render that
+   * is not progressive traces what is missing, at most 4096 at once, and renders after that
+   * show the converged image), paths an interactive render adds when not progressive
+   * (default 1); PathTracingBounces scattering events at most per path (default 64).
    */
   vtkSetClampMacro(SamplesPerPixel, int, 1, 1000000);
   vtkGetMacro(SamplesPerPixel, int);
@@ -305,12 +337,50 @@ public:
 
   ///@{
   /**
-   * Path tracing: show the progressive image through the edge-aware a-trous denoiser
-   * (guided by the normal and depth where the paths first meet the medium; default off).
+   * Path tracing: show the image through the edge-aware a-trous denoiser (guided by the
+   * normal and depth where the paths first meet the medium): always with PathTracingDenoise
+   * on (default off), otherwise while the accumulation holds fewer than
+   * PathTracingDenoiseUntil paths per pixel (default 16; 0: never), and never once it holds
+   * SamplesPerPixel. The accumulation itself stays unfiltered.
    */
   vtkSetMacro(PathTracingDenoise, vtkTypeBool);
   vtkGetMacro(PathTracingDenoise, vtkTypeBool);
   vtkBooleanMacro(PathTracingDenoise, vtkTypeBool);
+  vtkSetClampMacro(PathTracingDenoiseUntil, int, 0, 1000000);
+  vtkGetMacro(PathTracingDenoiseUntil, int);
+  ///@}
+
+  enum ProgressiveModes
+  {
+    PROGRESSIVE_AUTOMATIC = 0,
+    PROGRESSIVE_ON = 1,
+    PROGRESSIVE_OFF = 2
+  };
+
+  ///@{
+  /**
+   * Path tracing: whether renders trace within a time budget and the view refines itself
+   * (see "Path tracing: progressive or not" in the class documentation). AUTOMATIC (the
+   * default): where the window has an interactor that runs timers; ON: always (without such
+   * an interactor the application renders again to refine); OFF: never (a still render
+   * traces SamplesPerPixel paths before it returns).
+   */
+  vtkSetClampMacro(ProgressiveMode, int, PROGRESSIVE_AUTOMATIC, PROGRESSIVE_OFF);
+  vtkGetMacro(ProgressiveMode, int);
+  void SetProgressiveModeToAutomatic() { this->SetProgressiveMode(PROGRESSIVE_AUTOMATIC); }
+  void SetProgressiveModeToOn() { this->SetProgressiveMode(PROGRESSIVE_ON); }
+  void SetProgressiveModeToOff() { this->SetProgressiveMode(PROGRESSIVE_OFF); }
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing, progressive renders: seconds one Render() may take, tracing included
+   * (0, the default: 1/DesiredUpdateRate of the render window, at most 0.1 s, so a resting
+   * window answers the user within a tenth of a second). A render traces at least a
+   * sixteenth of a path per pixel, which may take longer on a slow device.
+   */
+  vtkSetClampMacro(PathTracingTimeBudget, double, 0.0, 3600.0);
+  vtkGetMacro(PathTracingTimeBudget, double);
   ///@}
 
   ///@{
@@ -396,10 +466,21 @@ public:
   vtkGetMacro(TransmissionConeAngle, double);
   ///@}
 
+  ///@{
   /**
-   * Path tracing: the paths per pixel the last frame shows (-1 before the first frame).
+   * Path tracing, how far the accumulation is: GetAccumulatedSamples, the paths per pixel
+   * every pixel has (complete passes; -1 before the first frame, cheap);
+   * GetMeanAccumulatedSamples, the mean over the pixels, counting the pass under way;
+   * GetPathTracingError, the estimated relative RMS error of the image shown (the standard
+   * error of each pixel's mean luminance, RMS over the pixels the volume covers, over their
+   * mean luminance; -1 below 2 paths per pixel). The last two wait for the device and read
+   * the accumulation back (once per frame, however often they are asked; -1 before the
+   * first frame).
    */
   int GetAccumulatedSamples();
+  double GetMeanAccumulatedSamples();
+  double GetPathTracingError();
+  ///@}
 
   enum OutputPaths
   {
@@ -441,6 +522,11 @@ public:
    * the volume was outside the view).
    */
   vtkGetMacro(LastRenderDrew, vtkTypeBool);
+
+  /**
+   * Whether the last Render() was progressive (path tracing within a time budget).
+   */
+  vtkGetMacro(LastRenderProgressive, vtkTypeBool);
 
   /**
    * Size in pixels of the last frame ferrovol rendered (the viewport divided by the image
@@ -515,6 +601,9 @@ protected:
   int InteractiveSamplesPerPixel;
   int PathTracingBounces;
   vtkTypeBool PathTracingDenoise;
+  int PathTracingDenoiseUntil;
+  int ProgressiveMode;
+  double PathTracingTimeBudget;
   double VolumetricScatteringBlending;
   double GlobalIlluminationReach;
   int SecondaryRays;
@@ -527,6 +616,7 @@ protected:
   double Transmission;
   double TransmissionConeAngle;
   vtkTypeBool LastRenderDrew;
+  vtkTypeBool LastRenderProgressive;
   int LastRenderSize[2];
 
 private:

@@ -187,8 +187,8 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
 }
 
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
-  vtkRenderer* ren, vtkVolume* vol, ferrovol::Renderer& renderer, std::set<std::string>& warned,
-  std::string& error)
+  vtkRenderer* ren, vtkVolume* vol, ferrovol::Renderer& renderer, double traceBudget,
+  std::set<std::string>& warned, std::string& error)
 {
   vtkVolumeProperty* prop = vol->GetProperty();
   FvRenderParams& params = this->Params;
@@ -285,7 +285,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     }
   }
   if (this->Blend == FV_BLEND_MODE_PATH_TRACE &&
-    !this->SetUpPathTracing(self, ren, vol, renderer, error))
+    !this->SetUpPathTracing(self, ren, vol, renderer, traceBudget, error))
   {
     return Result::Failed;
   }
@@ -323,6 +323,12 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
   }
   return vtkFerroVolumeCall(
     "use the renderer's lights", error, [&] { renderer.set_lights(lights); });
+}
+
+uint32_t vtkFerroVolumeSettings::DenoiseUntil(vtkFerroVolumeMapper* self)
+{
+  return static_cast<uint32_t>(
+    std::min(self->GetPathTracingDenoiseUntil(), self->GetSamplesPerPixel()));
 }
 
 void vtkFerroVolumeSettings::Reset()
@@ -363,11 +369,13 @@ bool vtkFerroVolumeSettings::UseEnvironment(
 }
 
 // Gives the renderer the path tracing settings: the property's ScatteringAnisotropy, the
-// mapper's budget (the still budget, or InteractiveSamplesPerPixel per frame while the
-// window renders interactively), bounces and environment (weight 1; background when
+// mapper's budget (progressive: `traceBudget` seconds of paths toward SamplesPerPixel;
+// otherwise the still budget, or InteractiveSamplesPerPixel per frame while the window
+// renders interactively), the preview denoising (until PathTracingDenoiseUntil paths, never
+// past SamplesPerPixel), bounces and environment (weight 1; background when
 // EnvironmentBackground is on).
 bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren,
-  vtkVolume* vol, ferrovol::Renderer& renderer, std::string& error)
+  vtkVolume* vol, ferrovol::Renderer& renderer, double traceBudget, std::string& error)
 {
   FvPathTraceParams pt;
   if (!vtkFerroVolumeCall("use the path tracing settings", error,
@@ -377,17 +385,23 @@ bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRen
   }
   vtkRenderWindow* win = ren->GetRenderWindow();
   const bool interactive = win && win->GetDesiredUpdateRate() > 1.0;
-  if (interactive)
+  const uint32_t spp = static_cast<uint32_t>(self->GetSamplesPerPixel());
+  if (interactive && !(traceBudget > 0.0))
   {
     pt.samples_per_frame = static_cast<uint32_t>(self->GetInteractiveSamplesPerPixel());
     pt.max_samples = 0;
   }
   else
   {
-    pt.samples_per_frame = static_cast<uint32_t>(std::min(self->GetSamplesPerPixel(), 4096));
-    pt.max_samples = static_cast<uint32_t>(self->GetSamplesPerPixel());
+    pt.samples_per_frame = std::min(spp, 4096u);
+    pt.max_samples = spp;
+    pt.time_budget = static_cast<float>(traceBudget);
+  }
+  if (!interactive)
+  {
     pt.secondary_rays = static_cast<uint32_t>(self->GetSecondaryRays());
   }
+  pt.denoise_until = DenoiseUntil(self);
   pt.max_bounces = static_cast<uint32_t>(self->GetPathTracingBounces());
   const double psi = self->GetGradientThreshold();
   pt.gradient_threshold = psi >= static_cast<double>(FLT_MAX)

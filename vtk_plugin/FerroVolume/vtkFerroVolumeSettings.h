@@ -29,14 +29,21 @@ public:
     Ready
   };
   // Gives the renderer the frame's parameters (and the isosurfaces, path tracing settings
-  // and environment in those modes). `warned`: the warnings said once per mapper.
+  // and environment in those modes). `traceBudget`: seconds a progressive render's path
+  // tracing may take, 0 when the render is not progressive. `warned`: the warnings said
+  // once per mapper.
   Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
-    ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+    ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
+    std::string& error);
 
   // Gives the renderer the camera VTK draws the opaque geometry with (for a vw × vh
   // viewport) and the renderer's lights.
   bool ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw, int vh,
     ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+
+  // Paths per pixel below which the path-traced image shown is denoised as a preview:
+  // PathTracingDenoiseUntil, never past SamplesPerPixel (a converged image is unfiltered).
+  static uint32_t DenoiseUntil(vtkFerroVolumeMapper* self);
 
   // Whether the last frame shows the environment behind the volume: it then covers the
   // whole viewport.
@@ -48,7 +55,7 @@ public:
 private:
   bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
   bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
-    ferrovol::Renderer& renderer, std::string& error);
+    ferrovol::Renderer& renderer, double traceBudget, std::string& error);
   Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol,
     ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
 

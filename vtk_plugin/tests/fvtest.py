@@ -45,6 +45,13 @@ def wavelet(n=31, maximum=None):
     return src
 
 
+def roughness(img):
+    """Mean |pixel - mean of its 4 neighbours| inside the image (noise, in levels)."""
+    c = img[1:-1, 1:-1]
+    n = (img[:-2, 1:-1] + img[2:, 1:-1] + img[1:-1, :-2] + img[1:-1, 2:]) / 4.0
+    return float(np.abs(c - n).mean())
+
+
 def image_from_array(arr, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), name="scalars",
                      cells=False, vtk_type=None):
     """vtkImageData from a numpy array indexed [z, y, x] or [z, y, x, component]."""

@@ -9,7 +9,7 @@ import vtk
 
 import ferrovol
 import fvtest
-from fvtest import coverage, log, save, wavelet
+from fvtest import coverage, log, roughness, save, wavelet
 
 
 def view(cam):
@@ -113,11 +113,6 @@ class PathTrace(unittest.TestCase):
         self.assertGreater(d, 0.3)
 
     def test_denoiser_smooths_the_image(self):
-        def roughness(img):
-            # mean |pixel - mean of its 4 neighbours| inside the image
-            c = img[1:-1, 1:-1]
-            n = (img[:-2, 1:-1] + img[2:, 1:-1] + img[1:-1, :-2] + img[1:-1, 2:]) / 4.0
-            return float(np.abs(c - n).mean())
         noisy = self.scene(configure=lambda m: m.SetSamplesPerPixel(4)).render()
         smooth = self.scene(configure=lambda m: (m.SetSamplesPerPixel(4),
                                                  m.PathTracingDenoiseOn())).render()

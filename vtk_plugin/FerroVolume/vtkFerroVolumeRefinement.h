@@ -1,0 +1,110 @@
+// vtkFerroVolumeRefinement: progressive path tracing. Decides whether a render traces within
+// a time budget (the rule is stated in vtkFerroVolumeMapper.h), gives the tracing of each
+// progressive render what is left of the budget once the rest of the render is counted, and,
+// while the accumulation is short of SamplesPerPixel and the camera rests, asks the window's
+// interactor for the next render with a one-shot timer. Internal to the FerroVolume module
+// (not wrapped).
+#ifndef vtkFerroVolumeRefinement_h
+#define vtkFerroVolumeRefinement_h
+
+#include "vtkNew.h"
+#include "vtkWeakPointer.h"
+
+#include <chrono>
+
+class vtkCallbackCommand;
+class vtkObject;
+class vtkRenderWindow;
+class vtkRenderWindowInteractor;
+
+class vtkFerroVolumeRefinement
+{
+public:
+  vtkFerroVolumeRefinement();
+  vtkFerroVolumeRefinement(const vtkFerroVolumeRefinement&) = delete;
+  vtkFerroVolumeRefinement& operator=(const vtkFerroVolumeRefinement&) = delete;
+  ~vtkFerroVolumeRefinement();
+
+  // Whether renders into `win` trace within a time budget: `mode` (a
+  // vtkFerroVolumeMapper::ProgressiveModes value) is ON, or AUTOMATIC and the window has an
+  // interactor that can refine it (see CanRefine).
+  bool IsProgressive(int mode, vtkRenderWindow* win);
+
+  // A render's whole time budget in seconds: `budget` when positive, otherwise
+  // 1/DesiredUpdateRate of `win`, at most MaxAutomaticBudget.
+  static double FrameBudget(double budget, vtkRenderWindow* win);
+  static constexpr double MaxAutomaticBudget = 0.1;
+
+  // Marks the start of a render.
+  void Begin();
+
+  // Seconds the tracing of this render may take: `frame` less the time since Begin and the
+  // time a budget-limited render spends after its tracing (the most of the last
+  // AfterTraceRenders, counted apart for renders that are `denoised`, as this one is
+  // expected to be, and those that are not: the denoiser, the readback and the compositing
+  // follow the tracing), and at least MinTraceShare of `frame`: where the rest of the render
+  // takes longer (large windows on a CPU device), renders exceed the budget but still trace.
+  double TraceBudget(double frame, bool denoised);
+  static constexpr double MinTraceShare = 0.5;
+  static constexpr int AfterTraceRenders = 4;
+
+  // Marks the end of a progressive render of `width` × `height` pixels, `denoised` or not,
+  // whose tracing was given TraceBudget's seconds. What the render spent beyond that is
+  // recorded for the next ones when the tracing took its budget (`limited`: the
+  // accumulation is short of its target) and the size is the last render's (a new size
+  // allocates images and textures).
+  void End(bool limited, bool denoised, int width, int height);
+
+  // After a progressive render into `win` that left `samples` complete passes of `target`:
+  // while fewer and the window rests (DesiredUpdateRate at most 1), makes sure a one-shot
+  // timer of its interactor will render it again (interactor->Render(), so that
+  // applications which route renders through the interactor's RenderEvent, as ParaView
+  // does, render the whole view); otherwise cancels the pending timer. Returns false when
+  // it stops because the accumulation restarts by itself: each render adds at least a
+  // sixteenth of a path per pixel, so StallLimit renders in a row asked for by the timer
+  // without more complete passes than ever before mean that they start over.
+  bool Continue(vtkRenderWindow* win, unsigned int samples, unsigned int target);
+  static constexpr int StallLimit = 16;
+
+  // Cancels the pending timer and stops observing the interactor.
+  void Stop();
+
+private:
+  using Clock = std::chrono::steady_clock;
+
+  // Whether `iren` is enabled and creates timers (platform interactors do; a
+  // vtkGenericRenderWindowInteractor whose application handles no timers, as pvbatch's,
+  // does not). Tried once per interactor.
+  bool CanRefine(vtkRenderWindowInteractor* iren);
+  static void OnTimer(vtkObject* caller, unsigned long event, void* self, void* timerId);
+
+  // The interactor observed (TimerEvent) and the window its timer renders.
+  vtkWeakPointer<vtkRenderWindowInteractor> Interactor;
+  vtkWeakPointer<vtkRenderWindow> Window;
+  vtkNew<vtkCallbackCommand> Callback;
+  unsigned long ObserverTag = 0;
+  // The pending one-shot timer, and the last one that fired: X's interactor keeps a fired
+  // one-shot timer in its map until it is destroyed, which is safe only outside its own
+  // TimerEvent (the next one does it).
+  int TimerId = 0;
+  int FiredId = 0;
+  // Whether the render under way was asked for by the timer; how many such renders in a
+  // row left fewer complete passes than Best, the most since the last other render.
+  bool TimerRender = false;
+  int Stalled = 0;
+  unsigned int Best = 0;
+
+  vtkWeakPointer<vtkRenderWindowInteractor> Probed;
+  bool ProbedCanRefine = false;
+
+  Clock::time_point Start;
+  Clock::time_point TraceStart;
+  double Traced = 0.0;
+  // Seconds after the tracing of the last AfterTraceRenders budget-limited renders, without
+  // and with the denoiser, and where the next one goes.
+  double AfterTrace[2][AfterTraceRenders] = {};
+  int AfterTraceNext[2] = {};
+  int Size[2] = { 0, 0 };
+};
+
+#endif
