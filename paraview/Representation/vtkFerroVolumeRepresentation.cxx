@@ -13,6 +13,7 @@
 #include "vtkPVLODVolume.h"
 #include "vtkPVView.h"
 #include "vtkPointData.h"
+#include "vtkRenderWindow.h"
 #include "vtkScalarsToColors.h"
 #include "vtkTrivialProducer.h"
 #include "vtkVolumeMapper.h"
@@ -207,6 +208,22 @@ void vtkFerroVolumeRepresentation::SetPathTracingDenoise(int denoise)
   this->GetFerroVolumeMapper()->SetPathTracingDenoise(denoise);
 }
 
+void vtkFerroVolumeRepresentation::SetPathTracingDenoiseUntil(int paths)
+{
+  this->GetFerroVolumeMapper()->SetPathTracingDenoiseUntil(paths);
+}
+
+void vtkFerroVolumeRepresentation::SetPathTracingTimeBudget(double seconds)
+{
+  this->GetFerroVolumeMapper()->SetPathTracingTimeBudget(seconds);
+}
+
+void vtkFerroVolumeRepresentation::SetProgressiveMode(int mode)
+{
+  this->ProgressiveMode = mode;
+  this->GetFerroVolumeMapper()->SetProgressiveMode(mode);
+}
+
 void vtkFerroVolumeRepresentation::SetSecondaryRays(int value)
 {
   this->GetFerroVolumeMapper()->SetSecondaryRays(value);
@@ -300,6 +317,22 @@ int vtkFerroVolumeRepresentation::GetFerrovolTableUploadCount()
 }
 
 //------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::GetFerrovolAccumulatedSamples()
+{
+  return this->GetFerroVolumeMapper()->GetAccumulatedSamples();
+}
+
+double vtkFerroVolumeRepresentation::GetFerrovolMeanAccumulatedSamples()
+{
+  return this->GetFerroVolumeMapper()->GetMeanAccumulatedSamples();
+}
+
+double vtkFerroVolumeRepresentation::GetFerrovolPathTracingError()
+{
+  return this->GetFerroVolumeMapper()->GetPathTracingError();
+}
+
+//------------------------------------------------------------------------------------------
 int vtkFerroVolumeRepresentation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -330,6 +363,14 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
   if (request_type == vtkPVView::REQUEST_RENDER())
   {
     this->ApplyVectorMode();
+    // A screenshot is a converged image: its render traces the whole budget. ParaView
+    // renders a capture with the window's buffer swapping off (vtkSMViewProxy::
+    // CaptureWindowInternal), in the GUI, pvpython and pvbatch alike.
+    vtkPVView* view = vtkPVView::SafeDownCast(inInfo->Get(vtkPVView::VIEW()));
+    vtkRenderWindow* window = view ? view->GetRenderWindow() : nullptr;
+    const bool capture = window && !window->GetSwapBuffers();
+    this->GetFerroVolumeMapper()->SetProgressiveMode(
+      capture ? vtkFerroVolumeMapper::PROGRESSIVE_OFF : this->ProgressiveMode);
   }
   return 1;
 }

@@ -130,6 +130,8 @@ public:
   void SetSamplesPerPixel(int samples);
   void SetPathTracingBounces(int bounces);
   void SetPathTracingDenoise(int denoise);
+  void SetPathTracingDenoiseUntil(int paths);
+  void SetPathTracingTimeBudget(double seconds);
   void SetSecondaryRays(int value);
   void SetGradientThreshold(double value);
   void SetStochasticBlend(double value);
@@ -140,6 +142,14 @@ public:
   void SetTransmission(double value);
   void SetTransmissionConeAngle(double value);
   ///@}
+
+  /**
+   * Path tracing: the mapper's progressive mode (automatic 0, on 1, off 2). Renders of a
+   * screenshot (SaveScreenshot, CaptureImage: ParaView renders them with the window's buffer
+   * swapping off, in the GUI, pvpython and pvbatch) are never progressive: they trace
+   * SamplesPerPixel paths per pixel.
+   */
+  void SetProgressiveMode(int mode);
 
   /**
    * The mapper this representation renders with.
@@ -161,6 +171,18 @@ public:
   int* GetFerrovolLastRenderSize() VTK_SIZEHINT(2);
   int GetFerrovolVolumeUploadCount();
   int GetFerrovolTableUploadCount();
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing, for information-only properties: paths per pixel every pixel has (-1
+   * before the first frame), their mean counting the pass under way, and the estimated
+   * relative error of the image shown (-1 below 2 paths per pixel); see
+   * vtkFerroVolumeMapper::GetPathTracingError.
+   */
+  int GetFerrovolAccumulatedSamples();
+  double GetFerrovolMeanAccumulatedSamples();
+  double GetFerrovolPathTracingError();
   ///@}
 
 protected:
@@ -197,6 +219,8 @@ protected:
   std::string Adapter;
   std::string OutputPath;
   int LastRenderSize[2] = { 0, 0 };
+  // the progressive mode set through the property (screenshots render with it off)
+  int ProgressiveMode = 0;
 
   // ApplyVectorMode()'s single-component image, its producer and what it was made from.
   vtkSmartPointer<vtkImageData> VectorModeImage;

@@ -60,6 +60,8 @@ step wavelet       pvbatch $T/test_wavelet.py
 step cranium       pvbatch $T/test_cranium.py
 step properties    pvbatch $T/test_properties.py
 step screenshot    pvbatch $T/test_screenshot.py
+step progressive-pvpython pvpython $T/test_progressive.py
+step progressive-pvbatch  pvbatch $T/test_progressive.py
 step mpi-serial    pvbatch $T/test_mpi.py serial
 step "mpi-n$RANKS" "${MPIEXEC[@]}" pvbatch --symmetric $T/test_mpi.py distributed
 end=$(date +%s)
