@@ -842,6 +842,7 @@ fn opaque_depth_restarts_only_when_it_changes() {
     })
     .unwrap();
     r.reset_accumulation();
+    let restarts = r.stats().accumulation_restarts;
     let mut depth = vec![1.0f32; 16 * 16];
     let mut counts = vec![];
     for i in 0..5 {
@@ -853,4 +854,5 @@ fn opaque_depth_restarts_only_when_it_changes() {
     }
     println!("accumulated paths per pixel with a depth input: {counts:?} (one pixel's depth changed before the third frame)");
     assert_eq!(counts, vec![2, 4, 2, 4, 6]);
+    assert_eq!(r.stats().accumulation_restarts - restarts, 2);
 }

@@ -684,6 +684,11 @@ typedef struct FvStats {
    * Bricks the volume was split into (1 when it fits in one texture).
    */
   uint32_t bricks;
+  /**
+   * Times the path tracer's accumulation started over (anything it converges to
+   * changed, or the first path-traced frame).
+   */
+  uint32_t accumulation_restarts;
 } FvStats;
 
 /**

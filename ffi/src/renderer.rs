@@ -461,6 +461,7 @@ pub unsafe extern "C" fn fv_renderer_stats(
             table_uploads: s.table_uploads,
             frames: s.frames,
             bricks: r.r.brick_count() as u32,
+            accumulation_restarts: s.accumulation_restarts,
         };
         Ok(())
     })

@@ -253,6 +253,9 @@ pub struct FvStats {
     pub frames: u32,
     /// Bricks the volume was split into (1 when it fits in one texture).
     pub bricks: u32,
+    /// Times the path tracer's accumulation started over (anything it converges to
+    /// changed, or the first path-traced frame).
+    pub accumulation_restarts: u32,
 }
 
 /// How much of the volume is on the device. A volume too large for one texture is split

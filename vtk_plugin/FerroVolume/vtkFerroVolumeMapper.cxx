@@ -316,6 +316,14 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   // it is after a change (which interactive renders usually follow).
   const uint32_t denoiseUntil = vtkFerroVolumeSettings::DenoiseUntil(this);
   double traceBudget = 0.0;
+  // (restarts of the accumulation before this render: the refinement stops when the renders
+  // it asks for keep starting over)
+  FvStats statsBefore{};
+  if (progressive && !in->Stats(statsBefore))
+  {
+    vtkErrorMacro(<< "the renderer's counters are unavailable: " << fv_last_error());
+    return;
+  }
   if (progressive)
   {
     uint32_t before = 0;
@@ -411,7 +419,11 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     const uint32_t target = static_cast<uint32_t>(this->SamplesPerPixel);
     in->Refinement.End(samples < target, this->PathTracingDenoise || samples < denoiseUntil,
       req.RenderW, req.RenderH);
-    if (!in->Refinement.Continue(win, samples, target) && in->Warned.insert("restarts").second)
+    FvStats statsAfter{};
+    const bool restarted =
+      !in->Stats(statsAfter) || statsAfter.accumulation_restarts != statsBefore.accumulation_restarts;
+    if (!in->Refinement.Continue(win, samples, target, restarted) &&
+      in->Warned.insert("restarts").second)
     {
       vtkWarningMacro(<< "path tracing starts over at every render (something the image "
                          "depends on changes each time, such as opaque geometry moved on "

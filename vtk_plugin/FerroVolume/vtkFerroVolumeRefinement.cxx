@@ -103,11 +103,9 @@ void vtkFerroVolumeRefinement::End(bool limited, bool denoised, int width, int h
 }
 
 bool vtkFerroVolumeRefinement::Continue(
-  vtkRenderWindow* win, unsigned int samples, unsigned int target)
+  vtkRenderWindow* win, unsigned int samples, unsigned int target, bool restarted)
 {
-  const bool stalled = this->TimerRender && samples <= this->Best;
-  this->Stalled = stalled ? this->Stalled + 1 : 0;
-  this->Best = stalled ? this->Best : samples;
+  this->Stalled = this->TimerRender && restarted ? this->Stalled + 1 : 0;
   this->TimerRender = false;
   vtkRenderWindowInteractor* iren = win ? win->GetInteractor() : nullptr;
   if (!iren || iren != this->Interactor || win != this->Window)

@@ -55,16 +55,16 @@ public:
   // allocates images and textures).
   void End(bool limited, bool denoised, int width, int height);
 
-  // After a progressive render into `win` that left `samples` complete passes of `target`:
-  // while fewer and the window rests (DesiredUpdateRate at most 1), makes sure a one-shot
-  // timer of its interactor will render it again (interactor->Render(), so that
-  // applications which route renders through the interactor's RenderEvent, as ParaView
-  // does, render the whole view); otherwise cancels the pending timer. Returns false when
-  // it stops because the accumulation restarts by itself: each render adds at least a
-  // sixteenth of a path per pixel, so StallLimit renders in a row asked for by the timer
-  // without more complete passes than ever before mean that they start over.
-  bool Continue(vtkRenderWindow* win, unsigned int samples, unsigned int target);
-  static constexpr int StallLimit = 16;
+  // After a progressive render into `win` that left `samples` complete passes of `target`
+  // (`restarted`: the render started the accumulation over): while fewer and the window
+  // rests (DesiredUpdateRate at most 1), makes sure a one-shot timer of its interactor will
+  // render it again (interactor->Render(), so that applications which route renders
+  // through the interactor's RenderEvent, as ParaView does, render the whole view);
+  // otherwise cancels the pending timer. Returns false when it stops because the
+  // accumulation restarts by itself: StallLimit renders in a row asked for by the timer
+  // that each started over.
+  bool Continue(vtkRenderWindow* win, unsigned int samples, unsigned int target, bool restarted);
+  static constexpr int StallLimit = 4;
 
   // Cancels the pending timer and stops observing the interactor.
   void Stop();
@@ -89,10 +89,9 @@ private:
   int TimerId = 0;
   int FiredId = 0;
   // Whether the render under way was asked for by the timer; how many such renders in a
-  // row left fewer complete passes than Best, the most since the last other render.
+  // row started the accumulation over.
   bool TimerRender = false;
   int Stalled = 0;
-  unsigned int Best = 0;
 
   vtkWeakPointer<vtkRenderWindowInteractor> Probed;
   bool ProbedCanRefine = false;

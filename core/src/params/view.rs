@@ -64,6 +64,9 @@ pub struct Stats {
     /// Passes of streamed frames (frames whose bricks exceed the memory budget take one
     /// pass per group of bricks the pool holds).
     pub streamed_passes: u32,
+    /// Times the path tracer's accumulation started over (anything it converges to
+    /// changed, or the first frame).
+    pub accumulation_restarts: u32,
 }
 
 /// Called after each pass of a streamed frame is submitted: (passes so far, passes in the

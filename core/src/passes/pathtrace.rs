@@ -468,6 +468,7 @@ impl PathTracePass {
         if self.key != key || depth_changed {
             self.key = key;
             self.units = 0;
+            res.stats.accumulation_restarts += 1;
         }
         let before = self.units;
         let limit = if pp.max_samples > 0 {
