@@ -544,13 +544,19 @@ impl PathTracePass {
         let mut added = 0;
         while added < wanted {
             // Sixteenths this submission traces: all that are wanted without a budget, else
-            // as many as the time left holds at the last measured rate (at least one a frame).
+            // as many as half the time left holds at the last measured rate, or one where
+            // only one fits (at least one a frame): a machine that gets busier mid-frame
+            // then overshoots by a fraction of what is left, not of the whole budget.
             let n = match (budget > 0.0, self.unit_seconds) {
                 (false, _) => wanted - added,
                 (true, None) => 1,
                 (true, Some(t)) => {
-                    let left = budget - start.elapsed().as_secs_f64();
-                    let fit = (left / t).floor().max(0.0) as u64;
+                    let left = (budget - start.elapsed().as_secs_f64()) / t;
+                    let fit = if left >= 2.0 {
+                        (0.5 * left).floor() as u64
+                    } else {
+                        u64::from(left >= 1.0)
+                    };
                     fit.max(u64::from(added == 0)).min(wanted - added)
                 }
             };
