@@ -63,8 +63,8 @@
  *   Refining stops when SamplesPerPixel is reached, while the user interacts (the end of
  *   the interaction renders and it resumes), when the window or the interactor goes away
  *   (ReleaseGraphicsResources and the destructor remove the timer and the observer), and
- *   after 16 renders of the timer that got the accumulation no further, as when something
- *   the image depends on changes at every render (one warning). A screenshot shows what has
+ *   after 4 renders of the timer in a row that each started the accumulation over, as when
+ *   something the image depends on changes at every render (one warning). A screenshot shows what has
  *   accumulated so far: use SetProgressiveModeToOff for a converged one.
  * - Not progressive: a still render traces SamplesPerPixel paths per pixel before it
  *   returns; an interactive render (DesiredUpdateRate above 1) adds
