@@ -22,8 +22,51 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 vtkStandardNewMacro(vtkFerroVolumeRepresentation);
+
+namespace
+{
+// vtkVolumeMapper::BlendModes as ParaView's panel names them; nullptr for other values.
+const char* BlendModeName(int mode)
+{
+  switch (mode)
+  {
+    case vtkVolumeMapper::COMPOSITE_BLEND:
+      return "Composite";
+    case vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND:
+      return "Maximum Intensity";
+    case vtkVolumeMapper::MINIMUM_INTENSITY_BLEND:
+      return "Minimum Intensity";
+    case vtkVolumeMapper::AVERAGE_INTENSITY_BLEND:
+      return "Average Intensity";
+    case vtkVolumeMapper::ADDITIVE_BLEND:
+      return "Additive";
+    case vtkVolumeMapper::ISOSURFACE_BLEND:
+      return "Isosurface";
+    case vtkVolumeMapper::SLICE_BLEND:
+      return "Slice";
+    default:
+      return nullptr;
+  }
+}
+
+// A blend mode for a message: its name in quotes, or its number.
+std::string QuotedBlendMode(int mode)
+{
+  const char* name = BlendModeName(mode);
+  return name ? "\"" + std::string(name) + "\"" : std::to_string(mode);
+}
+
+// "Volume Rendering Mode" (vtkSmartVolumeMapper's requested render modes) as ParaView's
+// UniformGridVolumeRepresentation XML names them.
+std::string RenderModeName(int mode)
+{
+  static const char* const names[] = { "Smart", "Ray Cast Only", "GPU Based", "OSPRay Based" };
+  return mode >= 0 && mode < 4 ? "\"" + std::string(names[mode]) + "\"" : std::to_string(mode);
+}
+}
 
 //------------------------------------------------------------------------------------------
 vtkFerroVolumeRepresentation::vtkFerroVolumeRepresentation()
@@ -44,22 +87,35 @@ vtkFerroVolumeMapper* vtkFerroVolumeRepresentation::GetFerroVolumeMapper()
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::SetFerrovolBlendMode(int mode)
 {
-  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ISOSURFACE_BLEND)
+  if (mode != FOLLOW_BLEND_MODE &&
+    (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ISOSURFACE_BLEND))
   {
     vtkErrorMacro(<< "FerrovolBlendMode " << mode
-                  << " is not one of composite (0), maximum (1), minimum (2), average (3), "
-                     "additive (4) or isosurface (5); keeping "
+                  << " is not one of follow Blend Mode (-1), composite (0), maximum (1), "
+                     "minimum (2), average (3), additive (4) or isosurface (5); keeping "
                   << this->FerrovolBlendMode << ".");
     return;
   }
   this->FerrovolBlendMode = mode;
-  this->VolumeMapper->SetBlendMode(mode);
 }
 
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::SetBlendMode(int mode)
 {
   this->SharedBlendMode = mode;
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetRequestedRenderMode(int mode)
+{
+  this->RequestedRenderMode = mode;
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroVolumeRepresentation::DrawnBlendMode() const
+{
+  return this->FerrovolBlendMode == FOLLOW_BLEND_MODE ? this->SharedBlendMode
+                                                      : this->FerrovolBlendMode;
 }
 
 //------------------------------------------------------------------------------------------
@@ -467,14 +523,75 @@ void vtkFerroVolumeRepresentation::ApplyVectorMode()
 }
 
 //------------------------------------------------------------------------------------------
+bool vtkFerroVolumeRepresentation::WarnAboutSettings(int drawn)
+{
+  std::vector<std::string> warnings;
+  bool draw = true;
+  // Path tracing does not read the blend mode: none of the blend-mode warnings apply.
+  const int renderMode = this->GetFerroVolumeMapper()->GetRenderMode();
+  if (renderMode != vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE)
+  {
+    if (drawn == vtkVolumeMapper::SLICE_BLEND)
+    {
+      warnings.emplace_back("Blend Mode \"Slice\" (the volume cut by its Slice Type) is not "
+                            "supported by ferrovol yet: the volume is hidden. Choose Composite "
+                            "or Isosurface, or draw slices with the \"Volume\" or \"Slice\" "
+                            "representation.");
+      draw = false;
+    }
+    else if (!BlendModeName(drawn))
+    {
+      warnings.emplace_back("Blend Mode " + std::to_string(drawn) +
+        " is not one of vtkVolumeMapper's blend modes (0-6): the volume is hidden.");
+      draw = false;
+    }
+    if (this->FerrovolBlendMode != FOLLOW_BLEND_MODE &&
+      this->SharedBlendMode != vtkVolumeMapper::COMPOSITE_BLEND &&
+      this->SharedBlendMode != this->FerrovolBlendMode)
+    {
+      warnings.emplace_back("Ferrovol Blend Mode " + QuotedBlendMode(this->FerrovolBlendMode) +
+        " overrides Blend Mode " + QuotedBlendMode(this->SharedBlendMode) +
+        ". Set Ferrovol Blend Mode to \"Follow Blend Mode\" to draw what Blend Mode says.");
+    }
+  }
+  if (this->UseTransfer2D)
+  {
+    warnings.emplace_back("\"Use 2D Transfer Function\" is not supported by ferrovol yet: the "
+                          "volume is hidden while it is on. Turn it off to draw with the colour "
+                          "map and the opacity function.");
+    draw = false;
+  }
+  if (this->RequestedRenderMode != 0)
+  {
+    warnings.emplace_back("Volume Rendering Mode " + RenderModeName(this->RequestedRenderMode) +
+      " chooses among ParaView's own volume mappers; \"Ferrovol Volume\" always renders "
+      "with ferrovol (Ferrovol Render Mode chooses ray casting or path tracing).");
+  }
+  for (const std::string& warning : warnings)
+  {
+    if (std::find(this->SettingsWarnings.begin(), this->SettingsWarnings.end(), warning) ==
+      this->SettingsWarnings.end())
+    {
+      vtkWarningMacro(<< "\"Ferrovol Volume\": " << warning);
+    }
+  }
+  this->SettingsWarnings = warnings;
+  return draw;
+}
+
+//------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::UpdateMapperParameters()
 {
   this->Superclass::UpdateMapperParameters();
 
-  // The shared "BlendMode" went nowhere (see SetBlendMode); the Ferrovol one decides.
-  this->VolumeMapper->SetBlendMode(this->FerrovolBlendMode);
+  const int drawn = this->DrawnBlendMode();
+  const bool drawable =
+    drawn >= vtkVolumeMapper::COMPOSITE_BLEND && drawn <= vtkVolumeMapper::ISOSURFACE_BLEND;
+  // Slice or a value that is no blend mode: the mapper gets composite, which path tracing
+  // ignores; ray casting hides the volume (WarnAboutSettings).
+  this->VolumeMapper->SetBlendMode(drawable ? drawn : vtkVolumeMapper::COMPOSITE_BLEND);
 
-  if (!this->InputIsImageData)
+  if (!this->WarnAboutSettings(drawn) || !this->InputIsImageData)
   {
     this->Actor->SetVisibility(false);
   }
@@ -485,7 +602,9 @@ void vtkFerroVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FerrovolBlendMode: " << this->FerrovolBlendMode << "\n";
-  os << indent << "SharedBlendMode (ignored): " << this->SharedBlendMode << "\n";
+  os << indent << "BlendMode (shared): " << this->SharedBlendMode << "\n";
+  os << indent << "RequestedRenderMode (shared, not used): " << this->RequestedRenderMode
+     << "\n";
   os << indent << "InputIsImageData: " << this->InputIsImageData << "\n";
   os << indent << "FerroVolumeMapper:\n";
   this->VolumeMapper->PrintSelf(os, indent.GetNextIndent());

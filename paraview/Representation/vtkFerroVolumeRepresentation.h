@@ -8,16 +8,20 @@
  * coefficients, ScalarOpacityUnitDistance, InterpolationType, cropping, the array selection,
  * ghost-cell cropping, the outline on ranks without data and, under MPI, ordered compositing
  * of the ranks' translucent images from the bounds of each rank's piece
- * (vtkPVRenderView::USE_BOUNDS_FOR_REDISTRIBUTION; see paraview/README.md).
+ * (vtkPVRenderView::USE_BOUNDS_FOR_REDISTRIBUTION; see paraview/README.md). The shared
+ * settings ferrovol does not draw (Blend Mode Slice, 2D transfer functions, Volume Rendering
+ * Mode) give a warning; paraview/README.md lists what ferrovol does with every property of
+ * "Volume".
  *
  * The server-manager XML (FerrovolRepresentation.xml) adds it to UniformGridRepresentation
  * as "Ferrovol Volume" and shares the standard volume properties with "Volume". ferrovol's
  * own settings come as separate properties ("Ferrovol" group):
  *
- * - FerrovolBlendMode: vtkVolumeMapper::BlendModes composite, maximum, minimum, average,
- *   additive and isosurface (the iso-values are the shared "IsosurfaceValues"). The shared
- *   "BlendMode" property (Composite / Isosurface / Slice, for ParaView's own mapper) is
- *   ignored here: see SetBlendMode();
+ * - FerrovolBlendMode extends ParaView's own "BlendMode" (Composite / Isosurface / Slice,
+ *   shared with "Volume", as are the "IsosurfaceValues"): its default, FOLLOW_BLEND_MODE, draws
+ *   what BlendMode says; maximum, minimum, average and additive (and, for scripts written
+ *   before, composite and isosurface) override it. Slice is not drawn by ferrovol: a warning
+ *   says so and the volume is hidden (see UpdateMapperParameters());
  * - the isosurface shading of vtkFerroVolumeMapper: environment lighting and map,
  *   background, specular sampling, ambient occlusion, shininess from the gradient, Fresnel;
  * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
@@ -42,6 +46,7 @@
 #include "vtkSmartPointer.h" // for ivar
 
 #include <string> // for ivar
+#include <vector> // for ivar
 
 class vtkFerroVolumeMapper;
 class vtkImageData;
@@ -55,11 +60,20 @@ public:
   vtkTypeMacro(vtkFerroVolumeRepresentation, vtkImageVolumeRepresentation);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  /**
+   * FerrovolBlendMode's default: draw the shared BlendMode (not one of vtkVolumeMapper's).
+   */
+  enum
+  {
+    FOLLOW_BLEND_MODE = -1
+  };
+
   ///@{
   /**
-   * ferrovol's blend mode, a vtkVolumeMapper::BlendModes value: COMPOSITE_BLEND (0, the
-   * default), MAXIMUM_INTENSITY_BLEND (1), MINIMUM_INTENSITY_BLEND (2),
-   * AVERAGE_INTENSITY_BLEND (3), ADDITIVE_BLEND (4) or ISOSURFACE_BLEND (5).
+   * ferrovol's blend mode: FOLLOW_BLEND_MODE (the default: the shared BlendMode decides) or a
+   * vtkVolumeMapper::BlendModes value that overrides it: COMPOSITE_BLEND (0),
+   * MAXIMUM_INTENSITY_BLEND (1), MINIMUM_INTENSITY_BLEND (2), AVERAGE_INTENSITY_BLEND (3),
+   * ADDITIVE_BLEND (4) or ISOSURFACE_BLEND (5).
    */
   void SetFerrovolBlendMode(int mode);
   vtkGetMacro(FerrovolBlendMode, int);
@@ -67,10 +81,18 @@ public:
 
   /**
    * Hides vtkImageVolumeRepresentation::SetBlendMode, the target of the "BlendMode" property
-   * this representation shares with "Volume" (Composite / Isosurface / Slice). The value is
-   * kept for PrintSelf but not passed to the mapper: FerrovolBlendMode decides.
+   * this representation shares with "Volume" (Composite / Isosurface / Slice; any
+   * vtkVolumeMapper::BlendModes value from C++ or SetElement). Kept here and applied in
+   * UpdateMapperParameters() unless FerrovolBlendMode overrides it.
    */
   void SetBlendMode(int mode);
+
+  /**
+   * Hides vtkImageVolumeRepresentation::SetRequestedRenderMode ("Volume Rendering Mode":
+   * which of ParaView's own mappers "Volume" uses). ferrovol always renders this
+   * representation; a mode other than Smart (0) gives a warning that says so.
+   */
+  void SetRequestedRenderMode(int mode);
 
   ///@{
   /**
@@ -209,12 +231,35 @@ protected:
 
   /**
    * The superclass's work (array selection, scalar mode, cropping planes, independent
-   * components), then ferrovol's settings; hides the volume when the input is not image data.
+   * components, the transfer-function mode), then the blend mode ferrovol draws (see
+   * DrawnBlendMode()). Hides the volume when the input is not image data, when ray casting
+   * in blend mode Slice or in a value that is no vtkVolumeMapper mode, or with "Use 2D
+   * Transfer Function" on (Slice and 2D transfer functions: not supported by ferrovol yet);
+   * WarnAboutSettings() says so.
    */
   void UpdateMapperParameters() override;
 
-  int FerrovolBlendMode = 0;
+  /**
+   * FerrovolBlendMode, or the shared BlendMode when FerrovolBlendMode is FOLLOW_BLEND_MODE.
+   */
+  int DrawnBlendMode() const;
+
+  /**
+   * Warns (vtkWarningMacro) about each shared "Volume" setting this representation does not
+   * draw as "Volume" would: when ray casting, the drawn blend mode Slice (and so its Slice
+   * Type) or a value that is no vtkVolumeMapper blend mode, and a FerrovolBlendMode that
+   * disagrees with a Blend Mode other than Composite; always, "Use 2D Transfer Function" and
+   * a "Volume Rendering Mode" other than Smart. Called while rendering, so only a visible
+   * "Ferrovol Volume" speaks; says each warning once while it applies. Returns false when the
+   * volume must be hidden.
+   */
+  bool WarnAboutSettings(int drawn);
+
+  int FerrovolBlendMode = FOLLOW_BLEND_MODE;
   int SharedBlendMode = 0;
+  int RequestedRenderMode = 0;
+  // the warnings that applied at the last render (each said once while it applies)
+  std::vector<std::string> SettingsWarnings;
   bool InputIsImageData = true;
   std::string Adapter;
   std::string OutputPath;

@@ -188,18 +188,17 @@ def compare(name, a, b, min_ssim=None, min_psnr=None, failures=None, expect_fail
 
 def render_both(view, disp, blend, tag, failures):
     """Renders disp as ParaView's "Volume" and as "Ferrovol Volume" with one blend mode
-    (vtkVolumeMapper's enum) into OUT_DIR/<tag>-vtk.png and <tag>-ferrovol.png; records a
-    failure when the ferrovol mapper did not draw. Returns {representation: image}."""
+    (vtkVolumeMapper's enum, set on the shared BlendMode; Ferrovol Blend Mode follows it)
+    into OUT_DIR/<tag>-vtk.png and <tag>-ferrovol.png; records a failure when the ferrovol
+    mapper did not draw. Returns {representation: image}."""
+    # The BlendMode domain lists only Composite/Isosurface/Slice; the property itself passes
+    # any vtkVolumeMapper blend mode to both representations.
+    disp.GetProperty("BlendMode").SetElement(0, blend)
+    disp.FerrovolBlendMode = "Follow Blend Mode"
+    disp.UpdateVTKObjects()
     imgs = {}
     for rep in ("Volume", "Ferrovol Volume"):
         disp.Representation = rep
-        if rep == "Volume":
-            # The stock BlendMode domain lists only Composite/Isosurface/Slice; the
-            # property itself passes any vtkVolumeMapper blend mode to the mapper.
-            disp.GetProperty("BlendMode").SetElement(0, blend)
-        else:
-            disp.FerrovolBlendMode = blend
-        disp.UpdateVTKObjects()
         Render(view)
         name = "%s-%s" % (tag, "ferrovol" if rep != "Volume" else "vtk")
         imgs[rep], _, dt = screenshot(view, name)

@@ -59,6 +59,7 @@ step load          /usr/bin/python3 $T/test_load.py
 step wavelet       pvbatch $T/test_wavelet.py
 step cranium       pvbatch $T/test_cranium.py
 step properties    pvbatch $T/test_properties.py
+step volume-properties pvbatch $T/test_volume_properties.py
 step screenshot    pvbatch $T/test_screenshot.py
 step progressive-pvpython pvpython $T/test_progressive.py
 step progressive-pvbatch  pvbatch $T/test_progressive.py

@@ -7,9 +7,10 @@
    the representation list of a Wavelet's display (the domain the GUI's representation
    combo box shows) and one frame drawn by ferrovol.
 In 1-3 the properties panel's groups are checked too: with "Ferrovol Volume" the panel
-shows the Ferrovol group and the standard volume properties ferrovol honours (Shade,
-opacity, unit distance, cropping, isosurface values), and not those it ignores (BlendMode,
-render mode); "Volume" keeps all of its own.
+shows the Ferrovol group and the standard volume properties ferrovol draws (Shade, opacity,
+unit distance, cropping, Blend Mode and Ferrovol Blend Mode, isosurface values), and not
+those it warns about (Volume Rendering Mode, Slice Type, 2D transfer functions); "Volume"
+keeps all of its own.
 
 Run with any Python 3 (it starts pvpython, pvbatch and paraview itself):
     FERROVOL_PV_PLUGIN_DIR=build/paraview/lib/paraview-5.11/plugins/Ferrovol python3 test_load.py
@@ -58,12 +59,17 @@ for i in range(p.GetNumberOfPropertyGroups()):
         if g.GetProperty(k) is not None:
             group[p.GetPropertyName(g.GetProperty(k))] = values(g.GetHints())
 shown = ["Shade", "ScalarOpacityFunction", "ScalarOpacityUnitDistance", "UseCropping",
-         "CroppingOrigin", "IsosurfaceValues", "FerrovolBlendMode", "FerrovolSampleDistance",
-         "FerrovolUseJittering", "FerrovolEnvironmentLighting", "FerrovolAmbientOcclusionSamples"]
-hidden = ["BlendMode", "VolumeRenderingMode"]
+         "CroppingOrigin", "IsosurfaceValues", "BlendMode", "FerrovolBlendMode",
+         "FerrovolSampleDistance", "FerrovolUseJittering", "FerrovolEnvironmentLighting",
+         "FerrovolAmbientOcclusionSamples"]
+hidden = ["VolumeRenderingMode", "SliceFunction", "UseTransfer2D"]
+# Ferrovol Blend Mode sits in a group "Volume" shows too; its own hint shows it for
+# "Ferrovol Volume" only.
+fbm = p.GetProperty("FerrovolBlendMode")
+own = values(fbm.GetHints()) if fbm is not None else []
 panel = all("Ferrovol Volume" in group.get(n, []) for n in shown) and not any(
     "Ferrovol Volume" in group.get(n, []) for n in hidden) and all(
-    "Volume" in group.get(n, []) for n in shown[:6] + hidden)
+    "Volume" in group.get(n, []) for n in shown[:7] + hidden) and own == ["Ferrovol Volume"]
 print("RESULT loaded=%s has_proxy=%s panel=%s reps=%s" % (
     "Ferrovol" in loaded,
     servermanager.ProxyManager().SMProxyManager.GetProxyDefinitionManager().HasDefinition(

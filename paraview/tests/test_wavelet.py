@@ -66,7 +66,6 @@ disp.GetProperty("BlendMode").SetElement(0, 0)
 
 # The thresholds must be able to fail: half the opacity has to fall under the composite ones.
 disp.Shade = 0
-disp.FerrovolBlendMode = 0
 ref = T.read_png(os.path.join(T.OUT_DIR, "wavelet-composite-vtk.png"))
 pwf.Points = [37.35, 0.0, 0.5, 0.0, 276.8, 0.4, 0.5, 0.0]
 Render(view)
