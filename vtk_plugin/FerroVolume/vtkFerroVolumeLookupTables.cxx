@@ -2,6 +2,7 @@
 
 #include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
+#include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkMatrix4x4.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkVolume.h"
@@ -75,9 +76,34 @@ double Clamp01(double v)
   return std::min(1.0, std::max(0.0, v));
 }
 
-// Colour of component `c` as (x, r, g, b) nodes at `xs`.
+// Where a function is read for each table position `xs` under vtkGPUVolumeRayCastMapper's
+// NATIVE range type: VTK 9.2 builds the table over the function's own range [flo, fhi] but
+// looks it up by the sample's position in the data range [dlo, dhi] (clamped to it), so a
+// value s reads the function at flo + (s − dlo) / (dhi − dlo) · (fhi − flo).
+std::vector<double> NativePositions(
+  const std::vector<double>& xs, double dlo, double dhi, const double frange[2])
+{
+  std::vector<double> out(xs.size());
+  for (size_t i = 0; i < xs.size(); ++i)
+  {
+    const double t = dhi > dlo ? std::min(1.0, std::max(0.0, (xs[i] - dlo) / (dhi - dlo))) : 0.0;
+    out[i] = frange[0] + t * (frange[1] - frange[0]);
+  }
+  return out;
+}
+
+// How a table reads its function: SCALAR (the function at the table positions themselves)
+// or NATIVE over the data range [DataLo, DataHi] the lookup is normalised by.
+struct Lookup
+{
+  bool Native = false;
+  double DataLo = 0.0;
+  double DataHi = 0.0;
+};
+
+// Colour of component `c` as (x, r, g, b) nodes at `xs` (spanning [lo, hi]).
 void ColorNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
-  const std::vector<double>& xs, std::vector<double>& pts)
+  const std::vector<double>& xs, const Lookup& lookup, std::vector<double>& pts)
 {
   const int m = static_cast<int>(xs.size());
   std::vector<double> rgb(static_cast<size_t>(3) * m, 0.0);
@@ -88,6 +114,16 @@ void ColorNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
     if (g->GetSize() < 1)
     {
       Ramp(xs, lo, hi, 1.0, gray.data());
+    }
+    else if (lookup.Native)
+    {
+      double frange[2];
+      g->GetRange(frange);
+      const std::vector<double> at = NativePositions(xs, lookup.DataLo, lookup.DataHi, frange);
+      for (int i = 0; i < m; ++i)
+      {
+        gray[i] = g->GetValue(at[i]);
+      }
     }
     else
     {
@@ -110,6 +146,15 @@ void ColorNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
         rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = ramp[i];
       }
     }
+    else if (lookup.Native)
+    {
+      const std::vector<double> at =
+        NativePositions(xs, lookup.DataLo, lookup.DataHi, ctf->GetRange());
+      for (int i = 0; i < m; ++i)
+      {
+        ctf->GetColor(at[i], rgb.data() + 3 * i);
+      }
+    }
     else
     {
       SampleColor(ctf, lo, hi, m, rgb.data());
@@ -126,9 +171,9 @@ void ColorNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
   }
 }
 
-// Scalar opacity of component `c` as (x, opacity) nodes at `xs`.
+// Scalar opacity of component `c` as (x, opacity) nodes at `xs` (spanning [lo, hi]).
 void OpacityNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
-  const std::vector<double>& xs, std::vector<double>& pts)
+  const std::vector<double>& xs, const Lookup& lookup, std::vector<double>& pts)
 {
   const int m = static_cast<int>(xs.size());
   std::vector<double> values(m, 0.0);
@@ -136,6 +181,15 @@ void OpacityNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
   if (sof->GetSize() < 1)
   {
     Ramp(xs, lo, hi, 0.5, values.data());
+  }
+  else if (lookup.Native)
+  {
+    const std::vector<double> at =
+      NativePositions(xs, lookup.DataLo, lookup.DataHi, sof->GetRange());
+    for (int i = 0; i < m; ++i)
+    {
+      values[i] = sof->GetValue(at[i]);
+    }
   }
   else
   {
@@ -153,17 +207,25 @@ void OpacityNodes(vtkVolumeProperty* prop, int c, double lo, double hi,
 // vtkOpenGLVolumeGradientOpacityTable) evaluates the function at
 //   g_vtk = meanSpacing · |∇s|   (central differences, ∇ in data coordinates)
 // clamped to [0, 0.25 · (max − min)] of the component's data range, the table spanning
-// exactly that. ferrovol's x axis is |∇s| in scalar units per world unit, so the nodes
-// move to x = g_vtk · gradientScale, gradientScale = 1 / (meanSpacing · volume matrix
-// scale); ferrovol clamps beyond the last node just as VTK clamps. A constant 1 (VTK's
-// default function) changes nothing: `pts` is then empty (gradient opacity off).
+// exactly that (NATIVE: the table spans [0, 0.25 · the function's own range] and is looked
+// up the same way, so the function is read at g_vtk · its range / the data range). ferrovol's
+// x axis is |∇s| in scalar units per world unit, so the nodes move to
+// x = g_vtk · gradientScale, gradientScale = 1 / (meanSpacing · volume matrix scale);
+// ferrovol clamps beyond the last node just as VTK clamps. A constant 1 (VTK's default
+// function) changes nothing: `pts` is then empty (gradient opacity off).
 void GradientOpacityNodes(vtkPiecewiseFunction* gof, const std::array<double, 2>& dataRange,
-  double gradientScale, std::vector<double>& pts)
+  bool native, double gradientScale, std::vector<double>& pts)
 {
   const double range = dataRange[1] - dataRange[0];
   const double gmax = 0.25 * (range != 0.0 ? range : 1.0);
+  double span = gmax;
+  if (native && gof->GetSize() > 0)
+  {
+    const double* frange = gof->GetRange();
+    span = 0.25 * (frange[1] - frange[0]);
+  }
   std::vector<double> values(TableSize, 1.0);
-  gof->GetTable(0.0, range != 0.0 ? gmax : 0.0, TableSize, values.data());
+  gof->GetTable(0.0, range != 0.0 ? span : 0.0, TableSize, values.data());
   bool allOne = true;
   pts.resize(static_cast<size_t>(2) * TableSize);
   for (int i = 0; i < TableSize; ++i)
@@ -180,7 +242,8 @@ void GradientOpacityNodes(vtkPiecewiseFunction* gof, const std::array<double, 2>
 }
 
 bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
-  const vtkFerroVolumeInputHelper::Ranges& ranges, double gradientScale,
+  const vtkFerroVolumeInputHelper::Ranges& ranges,
+  const vtkFerroVolumeLookupTables::RangeTypes& types, double gradientScale,
   std::unique_ptr<ferrovol::TransferFunction>& tf, std::string& error)
 {
   const bool independent = comps == 1 || prop->GetIndependentComponents();
@@ -201,9 +264,10 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
   std::vector<double> xs, pts;
   for (int c = 0; c < n; ++c)
   {
-    // Table ranges as vtkGPUVolumeRayCastMapper (SCALAR range type, its default): each
-    // component's data range; dependent components take colour from component 0 and
-    // opacity from the last one, and share one table here, spanning both ranges.
+    // Table ranges as vtkGPUVolumeRayCastMapper: each component's data range; dependent
+    // components take colour from component 0 and opacity from the last one, and share
+    // one table here, spanning both ranges. The NATIVE range types read the functions as
+    // VTK does (NativePositions), relative to the range of the component looked up.
     double lo = ranges[c][0], hi = ranges[c][1];
     const int opacityComp = independent ? c : comps - 1;
     if (!independent)
@@ -213,13 +277,18 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
     }
     TablePositions(lo, hi, xs);
     const uint32_t component = static_cast<uint32_t>(c);
-    ColorNodes(prop, c, lo, hi, xs, pts);
+    const int colorComp = independent ? c : 0;
+    const Lookup colorLookup{ types.Color == vtkGPUVolumeRayCastMapper::NATIVE,
+      ranges[colorComp][0], ranges[colorComp][1] };
+    const Lookup opacityLookup{ types.ScalarOpacity == vtkGPUVolumeRayCastMapper::NATIVE,
+      ranges[opacityComp][0], ranges[opacityComp][1] };
+    ColorNodes(prop, c, lo, hi, xs, colorLookup, pts);
     if (!vtkFerroVolumeCall(
           "set the colour transfer function", error, [&] { tf->set_color(component, pts); }))
     {
       return false;
     }
-    OpacityNodes(prop, c, lo, hi, xs, pts);
+    OpacityNodes(prop, c, lo, hi, xs, opacityLookup, pts);
     if (!vtkFerroVolumeCall(
           "set the scalar opacity function", error, [&] { tf->set_opacity(component, pts); }) ||
       !vtkFerroVolumeCall("set the scalar opacity unit distance", error, [&] {
@@ -232,8 +301,8 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
     const int goIndex = independent ? c : 0;
     if (prop->HasGradientOpacity(goIndex) && !prop->GetDisableGradientOpacity(goIndex))
     {
-      GradientOpacityNodes(
-        prop->GetStoredGradientOpacity(goIndex), ranges[opacityComp], gradientScale, pts);
+      GradientOpacityNodes(prop->GetStoredGradientOpacity(goIndex), ranges[opacityComp],
+        types.GradientOpacity == vtkGPUVolumeRayCastMapper::NATIVE, gradientScale, pts);
       if (!vtkFerroVolumeCall("set the gradient opacity function", error,
             [&] { tf->set_gradient_opacity(component, pts); }))
       {
@@ -248,7 +317,7 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
 bool vtkFerroVolumeLookupTables::Key::operator==(const Key& o) const
 {
   return this->Property == o.Property && this->PropertyMTime == o.PropertyMTime &&
-    this->Components == o.Components && this->Ranges == o.Ranges &&
+    this->Components == o.Components && this->Ranges == o.Ranges && this->Types == o.Types &&
     this->GradientScale == o.GradientScale;
 }
 
@@ -258,7 +327,8 @@ double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
 }
 
 bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
-  const vtkFerroVolumeInputHelper& input, ferrovol::Renderer& renderer, std::string& error)
+  const vtkFerroVolumeInputHelper& input, const RangeTypes& rangeTypes,
+  ferrovol::Renderer& renderer, std::string& error)
 {
   vtkVolumeProperty* prop = volume->GetProperty();
   if (prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_1D)
@@ -278,6 +348,7 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   key.PropertyMTime = prop->GetMTime();
   key.Components = input.GetComponents();
   key.Ranges = input.GetRanges();
+  key.Types = rangeTypes;
   key.GradientScale = 1.0 / (input.GetMeanSpacing() * matrixScale);
   if (this->Uploaded && *this->Uploaded == key)
   {
@@ -285,7 +356,8 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   }
   this->Uploaded.reset();
   std::unique_ptr<ferrovol::TransferFunction> tf;
-  if (!BuildTransferFunction(prop, key.Components, key.Ranges, key.GradientScale, tf, error) ||
+  if (!BuildTransferFunction(
+        prop, key.Components, key.Ranges, key.Types, key.GradientScale, tf, error) ||
     !vtkFerroVolumeCall(
       "set the transfer function", error, [&] { renderer.set_transfer_function(*tf); }))
   {

@@ -1,8 +1,9 @@
 // vtkFerroVolumeLookupTables: vtkVolumeProperty → ferrovol's transfer function (colour,
 // scalar opacity, gradient opacity per component), sampled with VTK's own GetTable over the
-// ranges vtkGPUVolumeRayCastMapper uses so that ferrovol's tables equal VTK's; uploaded only
-// when the property (or its functions), the data ranges or the gradient scale changed.
-// Internal to the FerroVolume module (not wrapped).
+// ranges vtkGPUVolumeRayCastMapper uses (its transfer function range types included) so
+// that ferrovol's tables equal VTK's; uploaded only when the property (or its functions),
+// the data ranges, the range types or the gradient scale changed. Internal to the
+// FerroVolume module (not wrapped).
 #ifndef vtkFerroVolumeLookupTables_h
 #define vtkFerroVolumeLookupTables_h
 
@@ -23,11 +24,26 @@ public:
   // The volume's matrix scale (cube root of |det|): world units per data unit.
   static double MatrixScale(vtkVolume* volume);
 
+  // vtkGPUVolumeRayCastMapper's ColorRangeType, ScalarOpacityRangeType and
+  // GradientOpacityRangeType (SCALAR or NATIVE).
+  struct RangeTypes
+  {
+    int Color = 0;
+    int ScalarOpacity = 0;
+    int GradientOpacity = 0;
+
+    bool operator==(const RangeTypes& o) const
+    {
+      return this->Color == o.Color && this->ScalarOpacity == o.ScalarOpacity &&
+        this->GradientOpacity == o.GradientOpacity;
+    }
+  };
+
   // Gives the renderer the tables of the volume's property over the input's ranges when
   // anything they are made from changed; false with the reason when the property or the
   // volume's matrix cannot be rendered.
   bool Update(vtkVolume* volume, const vtkFerroVolumeInputHelper& input,
-    ferrovol::Renderer& renderer, std::string& error);
+    const RangeTypes& rangeTypes, ferrovol::Renderer& renderer, std::string& error);
 
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }
@@ -40,6 +56,7 @@ private:
     vtkMTimeType PropertyMTime = 0;
     int Components = 0;
     vtkFerroVolumeInputHelper::Ranges Ranges{};
+    RangeTypes Types;
     double GradientScale = 0.0;
 
     bool operator==(const Key& o) const;

@@ -1,6 +1,6 @@
-// vtkFerroVolumeMapper: a vtkVolumeMapper that ray casts with ferrovol (C ABI, ffi/include/
-// ferrovol.h, through the RAII wrapper ferrovol.hpp) and composites the frame into VTK's
-// OpenGL framebuffer. The work is split into units, as VTK splits its own GPU mapper:
+// vtkFerroVolumeMapper: a vtkGPUVolumeRayCastMapper that ray casts with ferrovol (C ABI,
+// ffi/include/ferrovol.h, through the RAII wrapper ferrovol.hpp) and composites the frame into
+// VTK's OpenGL framebuffer. The work is split into units, as VTK splits its own GPU mapper:
 //   vtkFerroVolumeInputHelper   input → ferrovol volume, only when the scalars (array, MTime,
 //                               geometry) changed
 //   vtkFerroVolumeLookupTables  property → ferrovol transfer function, only when the property
@@ -12,6 +12,8 @@
 //                               vtkFerroVolumeSharedOutput: zero copy) and one full-screen
 //                               quad composites it (premultiplied blending, gl_FragDepth from
 //                               ferrovol's depth)
+//   vtkFerroVolumeRenderToImage RenderToImage: the frame into the mapper's own colour and
+//                               depth textures instead of the window
 //   vtkFerroVolumeRefinement    progressive path tracing: whether a render is, its time
 //                               budget, the interactor timer that renders again
 //   vtkFerroVolumeContext       the process-wide ferrovol device
@@ -23,13 +25,18 @@
 #include "vtkFerroVolumeLookupTables.h"
 #include "vtkFerroVolumeOutput.h"
 #include "vtkFerroVolumeRefinement.h"
+#include "vtkFerroVolumeRenderToImage.h"
 #include "vtkFerroVolumeSettings.h"
+#include "vtkCommand.h"
 #include "vtkImageData.h"
+#include "vtkMatrix4x4.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkPointData.h"
 #include "vtkRenderer.h"
 #include "vtkTimerLog.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkVolume.h"
 
 #include <algorithm>
@@ -50,6 +57,7 @@ public:
   vtkFerroVolumeLookupTables Tables;
   vtkFerroVolumeSettings Settings;
   vtkFerroVolumeOutput Output;
+  vtkFerroVolumeRenderToImage Image;
   vtkFerroVolumeRefinement Refinement;
   // warnings said once per mapper
   std::set<std::string> Warned;
@@ -74,11 +82,35 @@ public:
     });
   }
 
+  // Each pass of a streamed frame is a ProgressEvent while ReportProgress is on.
   static void StreamProgress(void* mapper, uint32_t done, uint32_t total)
   {
-    static_cast<vtkFerroVolumeMapper*>(mapper)->UpdateProgress(
-      static_cast<double>(done) / static_cast<double>(total));
+    vtkFerroVolumeMapper* self = static_cast<vtkFerroVolumeMapper*>(mapper);
+    if (self->GetReportProgress())
+    {
+      self->UpdateProgress(static_cast<double>(done) / static_cast<double>(total));
+    }
   }
+
+  // The input selected and uploaded (on change) within the mapper's memory budget, and the
+  // property's tables (on change); false with the reason.
+  bool Prepare(vtkFerroVolumeMapper* self, vtkVolume* vol, std::string& error)
+  {
+    const vtkIdType bytes = self->GetMaxMemoryInBytes();
+    const uint64_t budget = bytes > 0
+      ? static_cast<uint64_t>(static_cast<double>(bytes) * self->GetMaxMemoryFraction())
+      : 0;
+    vtkFerroVolumeLookupTables::RangeTypes types;
+    types.Color = self->GetColorRangeType();
+    types.ScalarOpacity = self->GetScalarOpacityRangeType();
+    types.GradientOpacity = self->GetGradientOpacityRangeType();
+    return this->Input.Select(self, error) && this->MakeRenderer(self, error) &&
+      this->Input.Upload(*this->Renderer, budget, error) &&
+      this->Tables.Update(vol, this->Input, types, *this->Renderer, error);
+  }
+
+  // A warning said once per mapper for `key`.
+  bool FirstTime(const std::string& key) { return this->Warned.insert(key).second; }
 
   void FreeRenderer()
   {
@@ -134,13 +166,7 @@ public:
 
 //------------------------------------------------------------------------------------------
 vtkFerroVolumeMapper::vtkFerroVolumeMapper()
-  : AutoAdjustSampleDistances(1)
-  , SampleDistance(1.0f)
-  , ImageSampleDistance(1.0f)
-  , UseJittering(0)
-  , EmptySpaceSkipping(1)
-  , MaxMemoryInBytes(0)
-  , MaxMemoryFraction(0.75f)
+  : EmptySpaceSkipping(1)
   , OutputPath(OUTPUT_PATH_AUTOMATIC)
   , EnvironmentLighting(0.0)
   , EnvironmentMap(nullptr)
@@ -169,8 +195,6 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , PathTracingDenoiseUntil(16)
   , ProgressiveMode(PROGRESSIVE_AUTOMATIC)
   , PathTracingTimeBudget(0.0)
-  , VolumetricScatteringBlending(0.0)
-  , GlobalIlluminationReach(0.0)
   , SecondaryRays(1)
   , GradientThreshold(VTK_DOUBLE_MAX)
   , StochasticBlend(0.0)
@@ -185,6 +209,9 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , LastRenderSize{ 0, 0 }
   , Internals(new vtkInternals)
 {
+  // ferrovol's default: the device's limit (vtkGPUVolumeRayCastMapper's constructor probed
+  // the GPU's memory, 128 MiB when it found none).
+  this->MaxMemoryInBytes = 0;
 }
 
 vtkFerroVolumeMapper::~vtkFerroVolumeMapper()
@@ -266,12 +293,114 @@ void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 {
   this->Internals->Refinement.Stop();
   this->Internals->Output.ReleaseGraphicsResources(window);
+  this->Internals->Image.ReleaseGraphicsResources();
   this->Internals->FreeRenderer();
   this->Superclass::ReleaseGraphicsResources(window);
 }
 
 //------------------------------------------------------------------------------------------
+int vtkFerroVolumeMapper::IsRenderSupported(
+  vtkRenderWindow* vtkNotUsed(window), vtkVolumeProperty* vtkNotUsed(property))
+{
+  std::string error;
+  return vtkFerroVolumeContext::Acquire(error) ? 1 : 0;
+}
+
+void vtkFerroVolumeMapper::GetReductionRatio(double ratio[3])
+{
+  ratio[0] = ratio[1] = ratio[2] = 1.0;
+}
+
+bool vtkFerroVolumeMapper::PreLoadData(vtkRenderer* vtkNotUsed(ren), vtkVolume* vol)
+{
+  std::string error;
+  if (!vol)
+  {
+    vtkErrorMacro(<< "PreLoadData needs the vtkVolume whose property gives the tables");
+    return false;
+  }
+  if (!this->Internals->Prepare(this, vol, error))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  return true;
+}
+
+void vtkFerroVolumeMapper::GetColorImage(vtkImageData* image)
+{
+  vtkFerroVolumeRenderToImage::ToImage(this->Internals->Image.ColorTexture(), image);
+}
+
+void vtkFerroVolumeMapper::GetDepthImage(vtkImageData* image)
+{
+  vtkFerroVolumeRenderToImage::ToImage(this->Internals->Image.DepthTexture(), image);
+}
+
+vtkTextureObject* vtkFerroVolumeMapper::GetColorTexture()
+{
+  return this->Internals->Image.ColorTexture();
+}
+
+vtkTextureObject* vtkFerroVolumeMapper::GetDepthTexture()
+{
+  return this->Internals->Image.DepthTexture();
+}
+
+void vtkFerroVolumeMapper::SetSharedDepthTexture(vtkTextureObject* texture)
+{
+  if (texture && this->Internals->FirstTime("shared-depth-texture"))
+  {
+    vtkWarningMacro(<< "SetSharedDepthTexture is not supported by ferrovol, which reads VTK's "
+                       "depth buffer itself: the texture is not used");
+  }
+}
+
+void vtkFerroVolumeMapper::SetPartitions(unsigned short x, unsigned short y, unsigned short z)
+{
+  if ((x != 1 || y != 1 || z != 1) && this->Internals->FirstTime("partitions"))
+  {
+    vtkWarningMacro(<< "SetPartitions(" << x << ", " << y << ", " << z
+                    << ") is not used: ferrovol splits a volume over the memory budget "
+                       "(MaxMemoryInBytes × MaxMemoryFraction) into bricks itself");
+  }
+}
+
+void vtkFerroVolumeMapper::PreRender(vtkRenderer* vtkNotUsed(ren), vtkVolume* vtkNotUsed(vol),
+  double vtkNotUsed(datasetBounds)[6], double vtkNotUsed(scalarRange)[2],
+  int vtkNotUsed(numberOfScalarComponents), unsigned int vtkNotUsed(numberOfLevels))
+{
+}
+
+void vtkFerroVolumeMapper::RenderBlock(
+  vtkRenderer* vtkNotUsed(ren), vtkVolume* vtkNotUsed(vol), unsigned int vtkNotUsed(level))
+{
+}
+
+void vtkFerroVolumeMapper::PostRender(
+  vtkRenderer* vtkNotUsed(ren), int vtkNotUsed(numberOfScalarComponents))
+{
+}
+
+//------------------------------------------------------------------------------------------
 void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  if (this->GeneratingCanonicalView)
+  {
+    this->GPURender(ren, vol);
+    return;
+  }
+  this->InvokeEvent(vtkCommand::VolumeMapperRenderStartEvent, nullptr);
+  vtkNew<vtkTimerLog> timer;
+  timer->StartTimer();
+  this->GPURender(ren, vol);
+  timer->StopTimer();
+  this->TimeToDraw = timer->GetElapsedTime();
+  this->InvokeEvent(vtkCommand::VolumeMapperRenderEndEvent, nullptr);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
 {
   this->LastRenderDrew = 0;
   this->LastRenderProgressive = 0;
@@ -287,24 +416,18 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     vtkErrorMacro(<< "vtkFerroVolumeMapper needs an OpenGL render window (vtkOpenGLRenderWindow)");
     return;
   }
-  vtkNew<vtkTimerLog> timer;
-  timer->StartTimer();
 
   // Blend mode, input, volume (on change), tables (on change), frame parameters.
   std::string error;
-  if (!in->Settings.SelectBlendMode(this, error) || !in->Input.Select(this, error) ||
-    !in->MakeRenderer(this, error) ||
-    !in->Input.Upload(*in->Renderer,
-      this->MaxMemoryInBytes > 0
-        ? static_cast<uint64_t>(static_cast<double>(this->MaxMemoryInBytes) *
-            this->MaxMemoryFraction)
-        : 0,
-      error) ||
-    !in->Tables.Update(vol, in->Input, *in->Renderer, error))
+  if (!in->Settings.SelectBlendMode(this, error) || !in->Prepare(this, vol, error))
   {
     vtkErrorMacro(<< error);
     return;
   }
+  vtkImageData* image = in->Input.GetImage();
+  // GetTransformedInput and GetBoundsFromPort see the input, as after the base class's
+  // validation.
+  this->CloneInput(image, 0);
   // Progressive path tracing: what is left of the render's budget for the tracing.
   const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
   const bool progressive = pathTrace && in->Refinement.IsProgressive(this->ProgressiveMode, win);
@@ -338,7 +461,8 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     traceBudget = in->Refinement.TraceBudget(
       vtkFerroVolumeRefinement::FrameBudget(this->PathTracingTimeBudget, win), denoised);
   }
-  switch (in->Settings.Apply(this, ren, vol, *in->Renderer, traceBudget, in->Warned, error))
+  switch (
+    in->Settings.Apply(this, ren, vol, image, *in->Renderer, traceBudget, in->Warned, error))
   {
     case vtkFerroVolumeSettings::Result::Failed:
       vtkErrorMacro(<< error);
@@ -364,11 +488,13 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  // Render at the (possibly reduced) resolution, through the output path.
-  const float isd = this->AutoAdjustSampleDistances ? 1.0f : this->ImageSampleDistance;
-  req.RenderW = std::max(1, static_cast<int>(req.ViewportW / isd));
-  req.RenderH = std::max(1, static_cast<int>(req.ViewportH / isd));
+  // Render at the resolution ImageSampleDistance reduces the viewport to (whether
+  // AutoAdjustSampleDistances is on or off, as VTK 9.2), through the output path.
+  req.RenderW = std::max(1, static_cast<int>(req.ViewportW / this->ImageSampleDistance));
+  req.RenderH = std::max(1, static_cast<int>(req.ViewportH / this->ImageSampleDistance));
   req.UseDepth = vtkFerroVolumeDepthReader::SceneHasOpaqueGeometry(ren, vol);
+  req.ColorScale = 1.0f / this->FinalColorWindow;
+  req.ColorBias = 0.5f - this->FinalColorLevel / this->FinalColorWindow;
   std::string warning;
   if (!in->Output.Render(this, this->OutputPath, *in->Renderer, req, error, warning))
   {
@@ -382,28 +508,64 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->LastRenderSize[0] = req.RenderW;
   this->LastRenderSize[1] = req.RenderH;
 
-  // Composite over the part of the viewport the volume can cover.
-  int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
-  if (!in->Settings.CoversViewport())
+  if (this->RenderToImage)
   {
-    const double* spacing = in->Input.GetImage()->GetSpacing();
-    const double pad = vtkFerroVolumeLookupTables::MatrixScale(vol) *
-      std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
-    vtkFerroVolumeOutput::ProjectedRect(ren, vol, pad, req.ViewportW, req.ViewportH, rect);
-  }
-  switch (in->Output.Composite(req, rect, error))
-  {
-    case vtkFerroVolumeOutput::Composited::Failed:
+    // The frame goes into the images, not the window.
+    int depthType = this->DepthImageScalarType;
+    if (!vtkFerroVolumeRenderToImage::IsDepthType(depthType))
+    {
+      if (in->FirstTime("depth-image-type"))
+      {
+        vtkWarningMacro(<< "DepthImageScalarType " << depthType
+                        << " is not supported (unsigned char, unsigned short and float are): "
+                           "the depth image is float");
+      }
+      depthType = VTK_FLOAT;
+    }
+    vtkNew<vtkMatrix4x4> boxToClip;
+    vtkFerroVolumeRenderToImage::BoxToClip(ren, vol, image, boxToClip);
+    if (!in->Image.Capture(req, in->Output.ColorTexture(), in->Output.DepthTexture(), depthType,
+          boxToClip, this->ClampDepthToBackface != 0, error))
+    {
       vtkErrorMacro(<< error);
       return;
-    case vtkFerroVolumeOutput::Composited::OffScreen:
-      this->LastRenderDrew = 1; // nothing to composite
-      return;
-    case vtkFerroVolumeOutput::Composited::Drawn:
-      break;
+    }
   }
-  timer->StopTimer();
-  this->TimeToDraw = timer->GetElapsedTime();
+  else
+  {
+    // Composite over the part of the viewport the volume can cover.
+    int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
+    if (!in->Settings.CoversViewport())
+    {
+      const double* spacing = image->GetSpacing();
+      const double pad = vtkFerroVolumeLookupTables::MatrixScale(vol) *
+        std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
+      vtkFerroVolumeOutput::ProjectedRect(ren, vol, pad, req.ViewportW, req.ViewportH, rect);
+    }
+    switch (in->Output.Composite(req, rect, error))
+    {
+      case vtkFerroVolumeOutput::Composited::Failed:
+        vtkErrorMacro(<< error);
+        return;
+      case vtkFerroVolumeOutput::Composited::OffScreen:
+        this->LastRenderDrew = 1; // nothing to composite
+        return;
+      case vtkFerroVolumeOutput::Composited::Drawn:
+        break;
+    }
+    if (this->GeneratingCanonicalView && this->CanonicalViewImageData)
+    {
+      // CreateCanonicalView: the window as drawn so far (its other props are hidden).
+      int dims[3];
+      this->CanonicalViewImageData->GetDimensions(dims);
+      vtkUnsignedCharArray* pixels = vtkUnsignedCharArray::SafeDownCast(
+        this->CanonicalViewImageData->GetPointData()->GetScalars());
+      if (pixels && pixels->GetNumberOfComponents() == 3)
+      {
+        win->GetPixelData(0, 0, dims[0] - 1, dims[1] - 1, 0, pixels, 0);
+      }
+    }
+  }
   this->LastRenderDrew = 1;
   if (progressive)
   {
@@ -439,14 +601,22 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
 {
+  // (vtkGPUVolumeRayCastMapper prints the sample distances, the final colour, the mask,
+  // the memory budget and ReportProgress)
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "AutoAdjustSampleDistances: " << this->AutoAdjustSampleDistances << "\n";
-  os << indent << "SampleDistance: " << this->SampleDistance << "\n";
-  os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
+  os << indent << "LockSampleDistanceToInputSpacing: " << this->LockSampleDistanceToInputSpacing
+     << "\n";
   os << indent << "UseJittering: " << this->UseJittering << "\n";
+  os << indent << "UseDepthPass: " << this->UseDepthPass << " (not supported)\n";
+  os << indent << "RenderToImage: " << this->RenderToImage << "\n";
+  os << indent << "DepthImageScalarType: " << this->DepthImageScalarType << "\n";
+  os << indent << "ClampDepthToBackface: " << this->ClampDepthToBackface << "\n";
+  os << indent << "ColorRangeType: " << this->ColorRangeType << "\n";
+  os << indent << "ScalarOpacityRangeType: " << this->ScalarOpacityRangeType << "\n";
+  os << indent << "GradientOpacityRangeType: " << this->GradientOpacityRangeType << "\n";
+  os << indent << "Transfer2DYAxisArray: "
+     << (this->Transfer2DYAxisArray ? this->Transfer2DYAxisArray : "(none)") << "\n";
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
-  os << indent << "MaxMemoryInBytes: " << this->MaxMemoryInBytes << "\n";
-  os << indent << "MaxMemoryFraction: " << this->MaxMemoryFraction << "\n";
   os << indent << "EnvironmentLighting: " << this->EnvironmentLighting << "\n";
   os << indent << "EnvironmentMap: "
      << (this->EnvironmentMap && *this->EnvironmentMap ? this->EnvironmentMap : "(sky)") << "\n";

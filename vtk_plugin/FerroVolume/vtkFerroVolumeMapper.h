@@ -3,7 +3,16 @@
  * @brief   vtkVolumeMapper that ray casts with ferrovol (Rust, wgpu) and composites the
  *          result into VTK's OpenGL framebuffer.
  *
- * A drop-in replacement for vtkGPUVolumeRayCastMapper on vtkImageData inputs:
+ * A drop-in replacement for vtkGPUVolumeRayCastMapper on vtkImageData inputs, and a
+ * subclass of it: code that holds a vtkGPUVolumeRayCastMapper (or checks IsA) takes it, and
+ * every public method of vtkGPUVolumeRayCastMapper and vtkOpenGLGPUVolumeRayCastMapper is
+ * here, either honoured or answered by a warning (once per mapper and setting) that names
+ * what ferrovol does not support (masks, the depth pass, partitions, a shared depth
+ * texture, the 2D transfer function's Y axis, time-driven image sample distances). Render
+ * is ferrovol's own (the base class's would refuse scalar types ferrovol renders); it fires
+ * VolumeMapperRenderStartEvent and VolumeMapperRenderEndEvent as the base class does. No
+ * object factory override is registered: vtkGPUVolumeRayCastMapper::New() still makes
+ * VTK's mapper. What it draws:
  *
  * - input: point or cell scalars (ScalarMode, SelectScalarArray), every numeric VTK scalar
  *   type, 1 to 4 components, origin, spacing and direction matrix; cell data is rendered as
@@ -24,8 +33,25 @@
  *   optionally by an environment map (diffuse irradiance and a specular lobe), with
  *   ambient occlusion and a shininess that follows the gradient magnitude; see the
  *   Environment*, Specular*, AmbientOcclusion*, Shininess* and Fresnel settings;
- * - vtkGPUVolumeRayCastMapper's sampling settings with the same meaning:
- *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering;
+ * - vtkGPUVolumeRayCastMapper's settings with the same meaning: AutoAdjustSampleDistances
+ *   (the smallest world spacing; not time-driven), SampleDistance,
+ *   LockSampleDistanceToInputSpacing, ImageSampleDistance, UseJittering, FinalColorWindow /
+ *   FinalColorLevel, the transfer function range types (SCALAR, NATIVE), ReportProgress,
+ *   RenderToImage with GetColorImage / GetDepthImage / GetColorTexture / GetDepthTexture,
+ *   DepthImageScalarType and ClampDepthToBackface, IsRenderSupported (1 where a ferrovol
+ *   device opens), PreLoadData;
+ * - device memory: at most MaxMemoryInBytes × MaxMemoryFraction bytes, as
+ *   vtkGPUVolumeRayCastMapper's settings, but ferrovol's default MaxMemoryInBytes is 0, the
+ *   device's limit (the base class's constructor probes the GPU, 128 MiB when it finds
+ *   none); the fraction defaults to 0.75. A larger volume is split into bricks of which only
+ *   those a frame needs are on the device; when even those exceed the budget, ray casting
+ *   and isosurfaces stream them in several passes of one frame (the same image; each pass
+ *   fires the ProgressEvent while ReportProgress is on) and path tracing, volumetric shadows
+ *   and isosurface ambient occlusion report the sizes. Takes effect at the next upload;
+ * - volumetric shadows (single scattering) with vtkGPUVolumeRayCastMapper's
+ *   VolumetricScatteringBlending and GlobalIlluminationReach, in the composite blend mode
+ *   with Shade on and at least one light, the anisotropy being the property's
+ *   ScatteringAnisotropy; one-component volumes that fit in one 3D texture;
  * - the renderer's lights (headlight, light kit, scene lights; at most 8 switched on);
  * - opaque geometry: rays stop at VTK's depth buffer, and the volume writes its own depth
  *   (first visible sample) so that later passes composite against it.
@@ -82,57 +108,22 @@
 #define vtkFerroVolumeMapper_h
 
 #include "vtkFerroVolumeModule.h" // For export macro
-#include "vtkVolumeMapper.h"
+#include "vtkGPUVolumeRayCastMapper.h"
 
+class vtkImageData;
+class vtkRenderWindow;
 class vtkRenderer;
+class vtkTextureObject;
 class vtkVolume;
+class vtkVolumeProperty;
 class vtkWindow;
 
-class VTKFERROVOLUME_EXPORT vtkFerroVolumeMapper : public vtkVolumeMapper
+class VTKFERROVOLUME_EXPORT vtkFerroVolumeMapper : public vtkGPUVolumeRayCastMapper
 {
 public:
   static vtkFerroVolumeMapper* New();
-  vtkTypeMacro(vtkFerroVolumeMapper, vtkVolumeMapper);
+  vtkTypeMacro(vtkFerroVolumeMapper, vtkGPUVolumeRayCastMapper);
   void PrintSelf(ostream& os, vtkIndent indent) override;
-
-  ///@{
-  /**
-   * As vtkGPUVolumeRayCastMapper: when on (the default), the sample distance along rays is
-   * the smallest voxel spacing in world coordinates and ImageSampleDistance is ignored; when
-   * off, SampleDistance and ImageSampleDistance are used.
-   */
-  vtkSetClampMacro(AutoAdjustSampleDistances, vtkTypeBool, 0, 1);
-  vtkGetMacro(AutoAdjustSampleDistances, vtkTypeBool);
-  vtkBooleanMacro(AutoAdjustSampleDistances, vtkTypeBool);
-  ///@}
-
-  ///@{
-  /**
-   * World distance between samples along a ray when AutoAdjustSampleDistances is off
-   * (default 1.0, as vtkGPUVolumeRayCastMapper). Must be positive.
-   */
-  vtkSetMacro(SampleDistance, float);
-  vtkGetMacro(SampleDistance, float);
-  ///@}
-
-  ///@{
-  /**
-   * Pixels per ray along each screen axis when AutoAdjustSampleDistances is off: 2 renders
-   * a quarter of the rays and scales the image up linearly (default 1).
-   */
-  vtkSetClampMacro(ImageSampleDistance, float, 0.1f, 100.0f);
-  vtkGetMacro(ImageSampleDistance, float);
-  ///@}
-
-  ///@{
-  /**
-   * Offset each ray's first sample by a per-pixel fraction of a step, trading wood-grain
-   * artifacts for noise (default off).
-   */
-  vtkSetClampMacro(UseJittering, vtkTypeBool, 0, 1);
-  vtkGetMacro(UseJittering, vtkTypeBool);
-  vtkBooleanMacro(UseJittering, vtkTypeBool);
-  ///@}
 
   ///@{
   /**
@@ -142,22 +133,6 @@ public:
   vtkSetClampMacro(EmptySpaceSkipping, vtkTypeBool, 0, 1);
   vtkGetMacro(EmptySpaceSkipping, vtkTypeBool);
   vtkBooleanMacro(EmptySpaceSkipping, vtkTypeBool);
-  ///@}
-
-  ///@{
-  /**
-   * The device memory the volume may take, as vtkGPUVolumeRayCastMapper's settings: at most
-   * MaxMemoryInBytes × MaxMemoryFraction bytes (MaxMemoryInBytes 0, the default: the
-   * device's limit; the fraction defaults to 0.75). A larger volume is split into bricks of
-   * which only those a frame needs are on the device; when even those exceed the budget,
-   * ray casting and isosurfaces stream them in several passes of one frame (the same image)
-   * and path tracing, volumetric shadows and isosurface ambient occlusion report the sizes.
-   * Takes effect at the next upload.
-   */
-  vtkSetMacro(MaxMemoryInBytes, vtkIdType);
-  vtkGetMacro(MaxMemoryInBytes, vtkIdType);
-  vtkSetClampMacro(MaxMemoryFraction, float, 0.1f, 1.0f);
-  vtkGetMacro(MaxMemoryFraction, float);
   ///@}
 
   ///@{
@@ -385,21 +360,6 @@ public:
 
   ///@{
   /**
-   * Volumetric shadows (single scattering) in the composite blend mode with Shade on and
-   * at least one light, with vtkGPUVolumeRayCastMapper's meaning: VolumetricScatteringBlending
-   * 0 (default) off, up to 1 the volumetric share grows where gradient and opacity are
-   * small, 2 volumetric only; GlobalIlluminationReach from 0 (shadow rays about one step
-   * long, the default) to 1 (across the volume). The anisotropy is the property's
-   * ScatteringAnisotropy. Needs a one-component volume that fits in one 3D texture.
-   */
-  vtkSetClampMacro(VolumetricScatteringBlending, double, 0.0, 2.0);
-  vtkGetMacro(VolumetricScatteringBlending, double);
-  vtkSetClampMacro(GlobalIlluminationReach, double, 0.0, 1.0);
-  vtkGetMacro(GlobalIlluminationReach, double);
-  ///@}
-
-  ///@{
-  /**
    * Path tracing, the ray budget: each SecondaryRays consecutive paths of a pixel share
    * their camera ray and first collision (SamplesPerPixel = primary x secondary rays;
    * default 1, independent paths). Interactive frames use independent paths.
@@ -492,11 +452,12 @@ public:
   ///@{
   /**
    * How frames travel from ferrovol to OpenGL.
-   * AUTOMATIC (default): shared memory (zero copy) where this build, the device and the
-   * OpenGL context allow it (GL_EXT_memory_object_fd, same device and driver UUIDs) and the
-   * device is a CPU device (Mesa's lavapipe with llvmpipe: ferrovol shares images without
-   * semaphores or layout transitions, which is sound there); CPU readback otherwise.
-   * READBACK: always through the CPU. SHARED: shared memory wherever it is supported.
+   * AUTOMATIC (default): shared memory (zero copy) wherever OpenGL has
+   * GL_EXT_memory_object_fd, ferrovol's device can export memory and the Vulkan device and
+   * driver UUIDs are OpenGL's, on a GPU or a CPU device alike (NVIDIA's Vulkan with NVIDIA's
+   * GL, lavapipe with llvmpipe); CPU readback otherwise, the reason going to VTK's log once.
+   * READBACK: always through the CPU. SHARED: the same rule, and a refusal (memory is not
+   * shared across devices or drivers) is a warning, once per mapper for each reason.
    * Takes effect at the next frame; GetOutputPathName says which path is active.
    */
   vtkSetClampMacro(OutputPath, int, OUTPUT_PATH_AUTOMATIC, OUTPUT_PATH_SHARED);
@@ -556,9 +517,82 @@ public:
   static const char* GetFerrovolVersion();
 
   /**
-   * Renders the volume into the renderer's viewport (called by vtkVolume).
+   * Renders the volume into the renderer's viewport (called by vtkVolume): fires
+   * VolumeMapperRenderStartEvent, renders (GPURender), records TimeToDraw and fires
+   * VolumeMapperRenderEndEvent, as vtkGPUVolumeRayCastMapper::Render does, without its input
+   * validation (ferrovol renders every numeric scalar type, VTK_CHAR, VTK_BIT and
+   * VTK_ID_TYPE included). While CreateCanonicalView renders, no events are fired and the
+   * rendered pixels become the canonical view.
    */
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
+
+  /**
+   * The render itself: uploads what changed, renders with ferrovol and composites the frame
+   * into the viewport (or, with RenderToImage on, into the images GetColorImage and
+   * GetDepthImage return). Errors are reported with vtkErrorMacro and nothing is drawn.
+   */
+  void GPURender(vtkRenderer* ren, vtkVolume* vol) override;
+
+  /**
+   * 1 when ferrovol's device opens (GetAdapterDescription names it), 0 otherwise; neither
+   * the window nor the property changes that.
+   */
+  int IsRenderSupported(vtkRenderWindow* window, vtkVolumeProperty* property) override;
+
+  /**
+   * 1, 1, 1: ferrovol never resamples the input; a volume over the memory budget is bricked
+   * and streamed instead.
+   */
+  void GetReductionRatio(double ratio[3]) override;
+
+  /**
+   * Uploads the input and the property's transfer functions now, so that the first render
+   * does not; true on success (false with an error as a render would report it).
+   */
+  bool PreLoadData(vtkRenderer* ren, vtkVolume* vol);
+
+  ///@{
+  /**
+   * RenderToImage: the last frame rendered with RenderToImage on, as
+   * vtkOpenGLGPUVolumeRayCastMapper gives it. The colour image is RGBA unsigned char: the
+   * premultiplied colour after FinalColorWindow/Level where rays meet the volume's box,
+   * (255, 255, 255, 0) elsewhere. The depth image has one component of DepthImageScalarType:
+   * the window depth of the first visible sample, 1 where there is none (with
+   * ClampDepthToBackface, the depth where the ray enters the volume's box, which is what
+   * VTK 9.2 draws under that name). Both are
+   * the size ferrovol rendered (the viewport divided by the image sample distance), rows
+   * bottom to top. Before such a frame the images are left as they are and the textures
+   * are null; the textures belong to the window rendered into.
+   */
+  void GetColorImage(vtkImageData* image) override;
+  void GetDepthImage(vtkImageData* image) override;
+  vtkTextureObject* GetColorTexture();
+  vtkTextureObject* GetDepthTexture();
+  ///@}
+
+  /**
+   * vtkOpenGLGPUVolumeRayCastMapper's passes. ferrovol renders in one pass (no depth pass),
+   * so GetCurrentPass is always RenderPass.
+   */
+  enum Passes
+  {
+    RenderPass,
+    DepthPass = 1
+  };
+  int GetCurrentPass() { return RenderPass; }
+
+  /**
+   * vtkOpenGLGPUVolumeRayCastMapper's shared depth texture: not supported (ferrovol reads
+   * VTK's depth buffer itself). A texture given here is not used, with a warning.
+   */
+  void SetSharedDepthTexture(vtkTextureObject* texture);
+
+  /**
+   * vtkOpenGLGPUVolumeRayCastMapper's partitions of a large volume: not needed (ferrovol
+   * bricks and streams a volume over the memory budget). Anything but 1, 1, 1 is not used,
+   * with a warning.
+   */
+  void SetPartitions(unsigned short x, unsigned short y, unsigned short z);
 
   /**
    * Frees the OpenGL resources and the ferrovol renderer; the next Render() uploads again.
@@ -569,13 +603,18 @@ protected:
   vtkFerroVolumeMapper();
   ~vtkFerroVolumeMapper() override;
 
-  vtkTypeBool AutoAdjustSampleDistances;
-  float SampleDistance;
-  float ImageSampleDistance;
-  vtkTypeBool UseJittering;
+  ///@{
+  /**
+   * vtkGPUVolumeRayCastMapper's pure virtual hooks for AMR rendering, which nothing in
+   * VTK 9.2 calls: empty, as vtkOpenGLGPUVolumeRayCastMapper's are.
+   */
+  void PreRender(vtkRenderer* ren, vtkVolume* vol, double datasetBounds[6],
+    double scalarRange[2], int numberOfScalarComponents, unsigned int numberOfLevels) override;
+  void RenderBlock(vtkRenderer* ren, vtkVolume* vol, unsigned int level) override;
+  void PostRender(vtkRenderer* ren, int numberOfScalarComponents) override;
+  ///@}
+
   vtkTypeBool EmptySpaceSkipping;
-  vtkIdType MaxMemoryInBytes;
-  float MaxMemoryFraction;
   int OutputPath;
   double EnvironmentLighting;
   char* EnvironmentMap;
@@ -604,8 +643,6 @@ protected:
   int PathTracingDenoiseUntil;
   int ProgressiveMode;
   double PathTracingTimeBudget;
-  double VolumetricScatteringBlending;
-  double GlobalIlluminationReach;
   int SecondaryRays;
   double GradientThreshold;
   double StochasticBlend;
@@ -625,6 +662,9 @@ private:
 
   class vtkInternals;
   vtkInternals* Internals;
+  // (reads vtkVolumeMapper::SpacingAdjustedSampleDistance for
+  // LockSampleDistanceToInputSpacing)
+  friend class vtkFerroVolumeSettings;
 };
 
 #endif

@@ -163,6 +163,8 @@ const char* CompositeFragmentShader = R"(//VTK::System::Dec
 in vec2 texCoord;
 uniform sampler2D fvColor;
 uniform sampler2D fvDepth;
+uniform float fvColorScale;
+uniform float fvColorBias;
 //VTK::Output::Dec
 void main()
 {
@@ -173,6 +175,8 @@ void main()
   {
     discard;
   }
+  // FinalColorWindow / FinalColorLevel, as vtkGPUVolumeRayCastMapper's finalizeRayCast
+  color.rgb = color.rgb * fvColorScale + fvColorBias * color.a;
   gl_FragData[0] = color;
   gl_FragDepth = texture(fvDepth, tc).r;
 }
@@ -195,6 +199,16 @@ vtkFerroVolumeOutput::~vtkFerroVolumeOutput()
 const char* vtkFerroVolumeOutput::Name() const
 {
   return this->Path ? this->Path->Name() : "none";
+}
+
+vtkTextureObject* vtkFerroVolumeOutput::ColorTexture() const
+{
+  return this->Path ? this->Path->ColorTexture() : nullptr;
+}
+
+vtkTextureObject* vtkFerroVolumeOutput::DepthTexture() const
+{
+  return this->Path ? this->Path->DepthTexture() : nullptr;
 }
 
 void vtkFerroVolumeOutput::UseReadback(ferrovol::Renderer& renderer)
@@ -341,6 +355,8 @@ vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Composite(
   depth->Activate();
   this->Quad->Program->SetUniformi("fvColor", color->GetTextureUnit());
   this->Quad->Program->SetUniformi("fvDepth", depth->GetTextureUnit());
+  this->Quad->Program->SetUniformf("fvColorScale", req.ColorScale);
+  this->Quad->Program->SetUniformf("fvColorBias", req.ColorBias);
   this->Quad->Render();
   depth->Deactivate();
   color->Deactivate();

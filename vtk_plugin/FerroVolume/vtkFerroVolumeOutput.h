@@ -37,6 +37,11 @@ struct vtkFerroVolumeFrameRequest
   // Whether opaque geometry may be in VTK's depth buffer; without any, the buffer holds only
   // its clear value and the frame is rendered without a depth input (no copy pass).
   bool UseDepth;
+  // FinalColorWindow / FinalColorLevel as VTK's ray caster applies them to the final
+  // premultiplied colour: rgb · ColorScale + ColorBias · alpha, ColorScale = 1 / window,
+  // ColorBias = 1/2 − level / window (1 and 0 by default: unchanged).
+  float ColorScale = 1.0f;
+  float ColorBias = 0.0f;
 };
 
 // Linear (colour) or nearest (depth) filtering, clamped to the edges.
@@ -79,7 +84,7 @@ public:
     Drawn
   };
   // Draws the last frame over the viewport, scissored to `rect` (x, y, w, h relative to the
-  // viewport).
+  // viewport), its colour scaled by req's ColorScale and ColorBias.
   Composited Composite(
     const vtkFerroVolumeFrameRequest& req, const int rect[4], std::string& error);
 
@@ -94,6 +99,11 @@ public:
   // "shared", "readback", or "none" before the first frame.
   const char* Name() const;
   const std::string& Reason() const { return this->PathReason; }
+
+  // The last frame's colour (premultiplied RGBA) and depth textures, rows top to bottom;
+  // nullptr before the first frame.
+  vtkTextureObject* ColorTexture() const;
+  vtkTextureObject* DepthTexture() const;
 
   // Frees the GL resources with `window`'s context current; a window other than the one
   // drawn into, or nullptr, forgets the GL names instead.

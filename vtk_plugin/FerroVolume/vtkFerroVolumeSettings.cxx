@@ -5,6 +5,7 @@
 #include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeMapper.h"
+#include "vtkImageData.h"
 #include "vtkLight.h"
 #include "vtkLightCollection.h"
 #include "vtkMatrix3x3.h"
@@ -176,6 +177,7 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
   if (mode == std::end(modes))
   {
     error = "blend mode " + std::to_string(self->GetBlendMode()) +
+      (self->GetBlendMode() == vtkVolumeMapper::SLICE_BLEND ? " (SLICE_BLEND)" : "") +
       " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
       "additive and isosurface are): nothing is drawn";
     return false;
@@ -187,8 +189,8 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
 }
 
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
-  vtkRenderer* ren, vtkVolume* vol, ferrovol::Renderer& renderer, double traceBudget,
-  std::set<std::string>& warned, std::string& error)
+  vtkRenderer* ren, vtkVolume* vol, vtkImageData* input, ferrovol::Renderer& renderer,
+  double traceBudget, std::set<std::string>& warned, std::string& error)
 {
   vtkVolumeProperty* prop = vol->GetProperty();
   FvRenderParams& params = this->Params;
@@ -219,19 +221,44 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   }
   if (!self->GetAutoAdjustSampleDistances())
   {
-    const float distance = self->GetSampleDistance();
-    if (!(distance > 0.0f) || !std::isfinite(distance))
+    if (self->GetLockSampleDistanceToInputSpacing())
     {
-      error = "SampleDistance " + std::to_string(distance) +
-        " must be positive (or turn AutoAdjustSampleDistances on)";
-      return Result::Failed;
+      // vtkOpenGLGPUVolumeRayCastMapper: vtkVolumeMapper::SpacingAdjustedSampleDistance of
+      // the input's spacing (by magnitude) and extent, whatever SampleDistance says.
+      double spacing[3];
+      int extent[6];
+      input->GetSpacing(spacing);
+      input->GetExtent(extent);
+      for (double& s : spacing)
+      {
+        s = std::fabs(s);
+      }
+      params.sample_distance =
+        static_cast<float>(self->SpacingAdjustedSampleDistance(spacing, extent));
     }
-    params.sample_distance = distance;
+    else
+    {
+      const float distance = self->GetSampleDistance();
+      if (!(distance > 0.0f) || !std::isfinite(distance))
+      {
+        error = "SampleDistance " + std::to_string(distance) +
+          " must be positive (or turn AutoAdjustSampleDistances on)";
+        return Result::Failed;
+      }
+      params.sample_distance = distance;
+    }
   }
   params.jitter = self->GetUseJittering() != 0;
   const bool isosurface = this->Blend == FV_BLEND_MODE_ISOSURFACE;
   params.shade =
     prop->GetShade(0) != 0 && (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface);
+  this->WarnUnsupported(self, warned);
+  if (self->GetComputeNormalFromOpacity() && params.shade &&
+    warned.insert("normal-from-opacity").second)
+  {
+    vtkWarningWithObjectMacro(self, << "ComputeNormalFromOpacity is not supported by ferrovol "
+                                       "yet: shading normals come from the scalar gradient");
+  }
   params.ambient = static_cast<float>(prop->GetAmbient(0));
   params.diffuse = static_cast<float>(prop->GetDiffuse(0));
   params.specular = static_cast<float>(prop->GetSpecular(0));
@@ -323,6 +350,49 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
   }
   return vtkFerroVolumeCall(
     "use the renderer's lights", error, [&] { renderer.set_lights(lights); });
+}
+
+void vtkFerroVolumeSettings::WarnUnsupported(
+  vtkFerroVolumeMapper* self, std::set<std::string>& warned) const
+{
+  if (self->GetMaskInput() && warned.insert("mask").second)
+  {
+    vtkWarningWithObjectMacro(self, << "MaskInput is not supported by ferrovol yet (binary "
+                                       "masks and label maps, with MaskType and "
+                                       "MaskBlendFactor): the volume is drawn unmasked");
+  }
+  if (self->GetUseDepthPass() && this->Blend == FV_BLEND_MODE_COMPOSITE &&
+    warned.insert("depth-pass").second)
+  {
+    vtkWarningWithObjectMacro(self, << "UseDepthPass (rays starting at the surface of "
+                                       "DepthPassContourValues) is not supported by ferrovol: "
+                                       "rays start where they enter the volume");
+  }
+  if (self->GetTransfer2DYAxisArray() && warned.insert("transfer-2d-y").second)
+  {
+    vtkWarningWithObjectMacro(self, << "Transfer2DYAxisArray '" << self->GetTransfer2DYAxisArray()
+                                    << "' is not used: ferrovol has no 2D transfer functions");
+  }
+  if (self->GetAutoAdjustSampleDistances() &&
+    (self->GetMinimumImageSampleDistance() != 1.0f ||
+      self->GetMaximumImageSampleDistance() != 10.0f) &&
+    warned.insert("image-sample-distance-range").second)
+  {
+    vtkWarningWithObjectMacro(self, << "MinimumImageSampleDistance and "
+                                       "MaximumImageSampleDistance are not used: ferrovol's "
+                                       "AutoAdjustSampleDistances is not driven by the render "
+                                       "time (ImageSampleDistance is not adjusted)");
+  }
+  for (int port = 1; port < self->GetNumberOfInputPorts(); ++port)
+  {
+    if (self->GetNumberOfInputConnections(port) > 0 &&
+      warned.insert("port-" + std::to_string(port)).second)
+    {
+      vtkWarningWithObjectMacro(self, << "the input on port " << port
+                                      << " is not drawn: ferrovol renders one volume, the "
+                                         "input on port 0 (no vtkMultiVolume)");
+    }
+  }
 }
 
 uint32_t vtkFerroVolumeSettings::DenoiseUntil(vtkFerroVolumeMapper* self)

@@ -12,6 +12,7 @@
 #include <string>
 
 class vtkFerroVolumeMapper;
+class vtkImageData;
 class vtkRenderer;
 class vtkVolume;
 
@@ -29,10 +30,11 @@ public:
     Ready
   };
   // Gives the renderer the frame's parameters (and the isosurfaces, path tracing settings
-  // and environment in those modes). `traceBudget`: seconds a progressive render's path
-  // tracing may take, 0 when the render is not progressive. `warned`: the warnings said
-  // once per mapper.
-  Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
+  // and environment in those modes), and warns about the mapper's settings ferrovol does not
+  // support. `input`: the image rendered (LockSampleDistanceToInputSpacing reads its
+  // spacing and extent). `traceBudget`: seconds a progressive render's path tracing may
+  // take, 0 when the render is not progressive. `warned`: the warnings said once per mapper.
+  Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol, vtkImageData* input,
     ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
     std::string& error);
 
@@ -53,6 +55,9 @@ public:
   void Reset();
 
 private:
+  // Warns, once per mapper and setting, about each vtkGPUVolumeRayCastMapper setting in
+  // effect that ferrovol does not honour.
+  void WarnUnsupported(vtkFerroVolumeMapper* self, std::set<std::string>& warned) const;
   bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
   bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
     ferrovol::Renderer& renderer, double traceBudget, std::string& error);

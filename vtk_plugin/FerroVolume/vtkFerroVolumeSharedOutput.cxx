@@ -210,6 +210,10 @@ void vtkFerroVolumeSharedOutput::ReleaseGraphicsResources(vtkWindow* window)
     this->Forget();
     return;
   }
+  // OpenGL may still be reading the imported memory (a frame composited outside the
+  // window's own Render, which ends with a finish): let it finish before the renderer, and
+  // with it the memory, goes.
+  glFinish();
   this->DeleteImports();
   if (this->CopyFbo)
   {

@@ -3,7 +3,9 @@
 //   - an opaque sphere in front of the volume shows, one behind it is hidden;
 //   - camera changes upload nothing, a property change uploads the tables only, a modified
 //     input uploads the volume;
-//   - bad input raises an ErrorEvent with a message, draws nothing, and does not crash.
+//   - bad input raises an ErrorEvent with a message, draws nothing, and does not crash;
+//   - code written for vtkGPUVolumeRayCastMapper takes it: set through a base pointer,
+//     RenderToImage leaves the window alone and fills GetColorImage / GetDepthImage.
 // Prints what it measured; exits non-zero on the first failed check.
 #include "vtkFerroVolumeMapper.h"
 
@@ -11,6 +13,7 @@
 #include <vtkCamera.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkCommand.h>
+#include <vtkGPUVolumeRayCastMapper.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPiecewiseFunction.h>
@@ -275,6 +278,33 @@ void TestErrors()
     CHECK(!s.Mapper->GetLastRenderDrew(), "drew with zero spacing");
   }
 }
+void TestAsGPUVolumeRayCastMapper()
+{
+  Scene s;
+  vtkGPUVolumeRayCastMapper* gpu = vtkGPUVolumeRayCastMapper::SafeDownCast(s.Mapper);
+  CHECK(gpu != nullptr, "not a vtkGPUVolumeRayCastMapper");
+  if (!gpu)
+  {
+    return;
+  }
+  CHECK(gpu->IsRenderSupported(s.Window, nullptr) == 1, "render not supported");
+  gpu->RenderToImageOn();
+  gpu->SetDepthImageScalarTypeToUnsignedShort();
+  s.Window->Render();
+  const double cov = s.Coverage();
+  vtkNew<vtkImageData> color, depth;
+  gpu->GetColorImage(color);
+  gpu->GetDepthImage(depth);
+  int dims[3];
+  color->GetDimensions(dims);
+  std::printf("as vtkGPUVolumeRayCastMapper*: RenderToImage %d x %d (%s depth), window "
+              "covered %.1f%%\n",
+    dims[0], dims[1], depth->GetScalarTypeAsString(), 100 * cov);
+  CHECK(dims[0] == 160 && dims[1] == 160, "colour image %d x %d", dims[0], dims[1]);
+  CHECK(depth->GetScalarType() == VTK_UNSIGNED_SHORT, "depth image of type %s",
+    depth->GetScalarTypeAsString());
+  CHECK(cov == 0.0, "RenderToImage drew into the window (%.3f)", cov);
+}
 } // namespace
 
 int main()
@@ -285,6 +315,7 @@ int main()
   TestSphereOcclusion();
   TestUploadCounters();
   TestErrors();
+  TestAsGPUVolumeRayCastMapper();
   std::printf("%s (%d failure(s))\n", failures ? "FAILED" : "passed", failures);
   return failures ? 1 : 0;
 }

@@ -170,12 +170,13 @@ class Settings(unittest.TestCase):
         full, m1 = self.render(isd(1.0), size=(160, 160))
         half, m2 = self.render(isd(2.0), size=(160, 160))
         quarter, m4 = self.render(isd(4.0), size=(160, 160))
-        ignored, ma = self.render(isd(4.0, auto=True), size=(160, 160))
-        save("settings-image-sample-distance", full, half, quarter)
+        # applied with AutoAdjustSampleDistances on too, as VTK 9.2 applies it
+        auto, ma = self.render(isd(4.0, auto=True), size=(160, 160))
+        save("settings-image-sample-distance", full, half, quarter, auto)
         sizes = [tuple(m.GetLastRenderSize()) for m in (m1, m2, m4, ma)]
         fvtest.log("  image sample distance 1/2/4/4 with auto adjust: rendered %s; SSIM to "
                    "full 1/2: %.3f, 1/4: %.3f" % (sizes, ssim(full, half), ssim(full, quarter)))
-        self.assertEqual(sizes, [(160, 160), (80, 80), (40, 40), (160, 160)])
+        self.assertEqual(sizes, [(160, 160), (80, 80), (40, 40), (40, 40)])
         self.assertGreater(ssim(full, half), 0.85)
         self.assertLess(ssim(full, quarter), ssim(full, half))
         self.assertGreater(coverage(quarter), 0.8 * coverage(full))
