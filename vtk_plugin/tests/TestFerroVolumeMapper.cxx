@@ -29,26 +29,14 @@
 #include <vtkVolumeProperty.h>
 #include <vtkWindowToImageFilter.h>
 
+#include "FerroVolumeTestCheck.h"
+
 #include <cmath>
 #include <cstdio>
 #include <string>
 
 namespace
 {
-int failures = 0;
-
-#define CHECK(cond, ...)                                                                         \
-  do                                                                                             \
-  {                                                                                              \
-    if (!(cond))                                                                                 \
-    {                                                                                            \
-      std::printf("FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);                               \
-      std::printf(__VA_ARGS__);                                                                  \
-      std::printf("\n");                                                                         \
-      ++failures;                                                                                \
-    }                                                                                            \
-  } while (0)
-
 class ErrorCatcher : public vtkCommand
 {
 public:

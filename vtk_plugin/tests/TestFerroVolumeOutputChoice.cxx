@@ -11,25 +11,13 @@
 // Prints each choice; exits non-zero on the first failed check.
 #include "vtkFerroVolumeOutputChoice.h"
 
+#include "FerroVolumeTestCheck.h"
+
 #include <cstdio>
 #include <string>
 
 namespace
 {
-int failures = 0;
-
-#define CHECK(cond, ...)                                                                         \
-  do                                                                                             \
-  {                                                                                              \
-    if (!(cond))                                                                                 \
-    {                                                                                            \
-      std::printf("FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond);                               \
-      std::printf(__VA_ARGS__);                                                                  \
-      std::printf("\n");                                                                         \
-      ++failures;                                                                                \
-    }                                                                                            \
-  } while (0)
-
 // A UUID whose bytes are `first`, first + 1, …
 vtkFerroVolumeUuid Uuid(uint8_t first)
 {
