@@ -15,13 +15,15 @@
 #               (tests/regression/); report: build/regression/index.html; then the
 #               ParaView tests with 4 MPI ranks
 #   make regression-quick  the subset of it that `make test` runs
+#   make fuzz-smoke  every fuzz target of the readers 20 s on its corpus (docs/FUZZING.md);
+#               `make test` runs it
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
 .PHONY: deps build demo test lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
-        regression regression-quick
+        regression regression-quick fuzz-smoke
 
 deps:
 	@bash scripts/install-deps.sh
@@ -81,6 +83,8 @@ demo: build
 lint: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
+	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
+	$(CARGO) clippy --locked --manifest-path fuzz/Cargo.toml --all-targets -- -D warnings
 	python3 scripts/check-core-layers.py
 	python3 scripts/check-architecture-doc.py
 
@@ -89,9 +93,15 @@ lint: deps
 test: lint
 	$(CARGO) build --locked -p ferrovol-ffi
 	$(CARGO) test --locked --workspace
+	$(MAKE) fuzz-smoke
 	$(MAKE) vtk-test
 	$(MAKE) paraview-test
 	$(MAKE) regression-quick
+
+# The readers' fuzz targets (fuzz/, docs/FUZZING.md) built with coverage and run by AFL++
+# for 20 s each on the committed corpus: fails on a crash, a hang or a heap bound exceeded.
+fuzz-smoke: deps
+	scripts/fuzz.sh smoke 20
 
 # The regression suite (tests/regression/README.md): every scene of tests/regression/scenes.py
 # rendered by vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper and

@@ -15,6 +15,9 @@ PKGS+=(python3-scipy)
 # (tests/ferrovol_testing/flip.py).
 # libdouble-conversion-dev: find_package(ParaView COMPONENTS RemotingViews ...) (paraview/)
 # pulls in VTK::IOCore, whose CMake package requires double-conversion's headers.
+PKGS+=(afl++)
+# afl++: afl-fuzz and the runtime (/usr/lib/afl/afl-compiler-rt.o) the readers' fuzz
+# targets link (scripts/fuzz.sh, `make fuzz-smoke`); it brings clang-14 with it.
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,8 +1,9 @@
 //! Transfer functions as JSON.
 //!
 //! `{"color": [[x, r, g, b], …], "opacity": [[x, a], …], "gradient_opacity": [[g, a], …],
-//! "unit_distance": 1.0}`; x in scalar units, g in scalar units per world unit;
-//! gradient_opacity and unit_distance are optional.
+//! "unit_distance": 1.0}`; x in scalar units, g in scalar units per world unit, both
+//! within ±[`MAX_POSITION`]; r, g, b and a from 0 to 1; gradient_opacity and
+//! unit_distance are optional.
 
 use ferrovol_core::{ComponentTransfer, Piecewise, TransferFunction};
 
@@ -12,6 +13,11 @@ use crate::ReadError;
 fn error(message: String) -> ReadError {
     Problem::TransferFunction(message).into()
 }
+
+/// The largest position (x or g) a point may have: the renderer samples the functions
+/// between their end points into tables of 32-bit floats, so the span of the points must
+/// be a finite 32-bit float.
+pub const MAX_POSITION: f64 = 1e38;
 
 /// The points of `key` in `v`, each `[x, v1, …, vN]`; `None` if `v` has no `key`.
 fn points<const N: usize>(
@@ -41,6 +47,17 @@ fn points<const N: usize>(
                 "point {i} has {} numbers, expected {}",
                 nums.len(),
                 N + 1
+            )));
+        }
+        if nums[0].abs() > MAX_POSITION {
+            return Err(bad(format!(
+                "point {i} is at {:?}, beyond ±{MAX_POSITION:e} (the range the renderer's 32-bit tables span)",
+                nums[0]
+            )));
+        }
+        if let Some(v) = nums[1..].iter().find(|v| !(0.0..=1.0).contains(*v)) {
+            return Err(bad(format!(
+                "point {i} has the value {v:?}; colours and opacities go from 0 to 1"
             )));
         }
         let mut val = [0f32; N];

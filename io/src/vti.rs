@@ -623,12 +623,13 @@ fn read_binary(
             )))
         }
     }
-    let mut sizes = Vec::with_capacity(usize::try_from(nblocks).unwrap_or(0).min(1 << 16));
+    // `nblocks` and `nbytes` come from the header: both vectors grow with the sizes and
+    // blocks actually read.
+    let mut sizes = Vec::new();
     for _ in 0..nblocks {
         sizes.push(uint(src, "compression header")?);
     }
-    // `nbytes` comes from the header: grow with the data actually inflated.
-    let mut out = Vec::with_capacity(nbytes.min(1 << 26));
+    let mut out = Vec::new();
     for (i, &csize) in sizes.iter().enumerate() {
         let usize_of = |v: u64| usize::try_from(v).map_err(|_| mismatch(v));
         let compressed_block = take(

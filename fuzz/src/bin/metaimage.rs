@@ -1,0 +1,7 @@
+//! MetaImage: `.mha` (data after the header) and `.mhd` with a detached data file (after
+//! the input's data-file mark, see `split_data_file`).
+fn main() {
+    ferrovol_fuzz::fuzz(|input| {
+        ferrovol_fuzz::parse_with_data_file(ferrovol_io::Format::MetaImage, input, "fuzz.mha")
+    });
+}
