@@ -17,13 +17,15 @@
 #   make regression-quick  the subset of it that `make test` runs
 #   make fuzz-smoke  every fuzz target of the readers 20 s on its corpus (docs/FUZZING.md);
 #               `make test` runs it
+#   make soak   10 000 renders of vtkFerroVolumeMapper while everything changes: memory flat
+#               (a 3000-render version is in make vtk-test); plot: docs/img/soak-memory.svg
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
 .PHONY: deps build demo test lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
-        regression regression-quick fuzz-smoke
+        regression regression-quick fuzz-smoke soak
 
 deps:
 	@bash scripts/install-deps.sh
@@ -132,6 +134,13 @@ bench-vtk: vtk
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 1 >/dev/null
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5 --multisamples 0
+
+# The soak test (vtk_plugin/tests/soak.py): 10 000 renders of vtkFerroVolumeMapper while
+# everything changes; fails on an error or memory growth over 5%, plots the memory curve.
+soak: vtk
+	mkdir -p build/soak
+	. build/env.sh && cd vtk_plugin/tests && ../../scripts/with-xvfb.sh /usr/bin/python3 soak.py \
+	  --renders 10000 --csv ../../build/soak/soak.csv --svg ../../docs/img/soak-memory.svg
 
 # The README's pictures.
 pictures: build

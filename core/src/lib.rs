@@ -25,7 +25,7 @@ pub mod synth;
 
 pub use error::{Error, Result};
 pub use gpu::interop::{DeviceUuids, OutputPath, SharedImage, SharedOutput};
-pub use gpu::{Context, DeviceInfo};
+pub use gpu::{Context, DeviceInfo, DeviceMemory};
 pub use params::environment::{cube_direction, cube_face_coords, FACE_NAMES};
 pub use params::*;
 pub use renderer::Renderer;

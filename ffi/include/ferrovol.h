@@ -289,6 +289,20 @@ typedef struct FvAdapterInfo {
 } FvAdapterInfo;
 
 /**
+ * What a context holds on its device now (every renderer on it together), from wgpu's
+ * own counters: live buffers, texture views and bind groups, and the device memory bound
+ * to buffers and textures (images exported to the host not included). A host watches
+ * these stay flat over a long session. Thread use: plain data.
+ */
+typedef struct FvDeviceMemory {
+  uint64_t buffers;
+  uint64_t texture_views;
+  uint64_t bind_groups;
+  uint64_t buffer_bytes;
+  uint64_t texture_bytes;
+} FvDeviceMemory;
+
+/**
  * A VTK camera. Matrices are column-major (OpenGL order: element (row r, column c) at
  * index 4·c + r). Thread use: plain data.
  */
@@ -791,6 +805,12 @@ enum FvStatus fv_context_uuids(const struct FvContext *ctx,
  * in fv_last_error() when not).
  */
 bool fv_context_can_share(const struct FvContext *ctx);
+
+/**
+ * Fills `*memory` with the buffers, texture views, bind groups and device memory the
+ * context holds now.
+ */
+enum FvStatus fv_context_device_memory(const struct FvContext *ctx, struct FvDeviceMemory *memory);
 
 /**
  * Waits for the last frame and copies it to the CPU. `*out` receives the frame.

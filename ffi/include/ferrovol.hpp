@@ -84,6 +84,12 @@ public:
     check(fv_context_uuids(h_.get(), &u.device, &u.driver));
     return u;
   }
+  /// The buffers, texture views, bind groups and device memory the context holds now.
+  FvDeviceMemory device_memory() const {
+    FvDeviceMemory m{};
+    check(fv_context_device_memory(h_.get(), &m));
+    return m;
+  }
   FvContext *get() const noexcept { return h_.get(); }
 
 private:

@@ -106,3 +106,24 @@ pub unsafe extern "C" fn fv_context_can_share(ctx: *const FvContext) -> bool {
     });
     can
 }
+
+/// Fills `*memory` with the buffers, texture views, bind groups and device memory the
+/// context holds now.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_device_memory(
+    ctx: *const FvContext,
+    memory: *mut FvDeviceMemory,
+) -> FvStatus {
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        let m = c.ctx.device_memory();
+        *mut_ref(memory, "memory")? = FvDeviceMemory {
+            buffers: m.buffers,
+            texture_views: m.texture_views,
+            bind_groups: m.bind_groups,
+            buffer_bytes: m.buffer_bytes,
+            texture_bytes: m.texture_bytes,
+        };
+        Ok(())
+    })
+}

@@ -275,6 +275,20 @@ pub struct FvResidency {
     pub dense_bytes: u64,
 }
 
+/// What a context holds on its device now (every renderer on it together), from wgpu's
+/// own counters: live buffers, texture views and bind groups, and the device memory bound
+/// to buffers and textures (images exported to the host not included). A host watches
+/// these stay flat over a long session. Thread use: plain data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FvDeviceMemory {
+    pub buffers: u64,
+    pub texture_views: u64,
+    pub bind_groups: u64,
+    pub buffer_bytes: u64,
+    pub texture_bytes: u64,
+}
+
 /// How far the path tracer's accumulation has come. Thread use: plain data.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]

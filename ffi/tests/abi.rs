@@ -731,3 +731,68 @@ fn streamed_frames_report_progress() {
     );
     assert!(streamed.chunks(4).any(|p| p[3] > 50), "drawn");
 }
+
+/// The context's device memory counters: a renderer's frames allocate once (repeated
+/// frames hold the same buffers and textures), and a renderer freed and made again holds no
+/// more than the first one did.
+#[test]
+fn device_memory_stays_flat_over_frames_and_renderers() {
+    type Memory = unsafe extern "C" fn(H, *mut ferrovol::FvDeviceMemory) -> FvStatus;
+    let lib = Lib::open();
+    let n = 16usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    let mut s = Session::new(&lib);
+    let memory = lib.f::<Memory>("fv_context_device_memory");
+    let read = |s: &Session| {
+        let mut m = ferrovol::FvDeviceMemory::default();
+        // SAFETY: a valid context and out-pointer.
+        unsafe { lib.ok(memory(s.ctx, &mut m)) };
+        m
+    };
+    // SAFETY: a NULL out-pointer is refused, not written.
+    unsafe { lib.expect(memory(s.ctx, null_mut()), Null, "memory") };
+    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
+        &[0.0, 0.0, 15.0, 1.0],
+    );
+    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    s.frame(24, 24);
+    let first = read(&s);
+    for _ in 0..5 {
+        s.frame(24, 24);
+    }
+    let again = read(&s);
+    println!("after one frame {first:?}\nafter six       {again:?}");
+    assert!(first.texture_views > 0 && first.texture_bytes > 0 && first.buffers > 0);
+    assert_eq!(
+        (again.buffers, again.texture_views, again.bind_groups),
+        (first.buffers, first.texture_views, first.bind_groups)
+    );
+    assert_eq!(
+        (again.buffer_bytes, again.texture_bytes),
+        (first.buffer_bytes, first.texture_bytes)
+    );
+    for _ in 0..3 {
+        // SAFETY: the renderer came from fv_renderer_new and is replaced by a new one.
+        unsafe {
+            lib.f::<Free>("fv_renderer_free")(s.r);
+            s.r = null_mut();
+            lib.ok(lib.f::<NewRenderer>("fv_renderer_new")(s.ctx, &mut s.r));
+            lib.ok(lib.f::<SetH>("fv_renderer_set_volume")(s.r, s.volume));
+        }
+        s.set_transfer_function(
+            &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
+            &[0.0, 0.0, 15.0, 1.0],
+        );
+        s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+        s.frame(24, 24);
+        s.frame(24, 24);
+    }
+    let renewed = read(&s);
+    println!("after three new renderers {renewed:?}");
+    assert!(
+        renewed.buffer_bytes + renewed.texture_bytes <= first.buffer_bytes + first.texture_bytes,
+        "{renewed:?} holds more than {first:?}"
+    );
+}

@@ -51,6 +51,18 @@ const char* vtkFerroVolumeContext::Description()
   return Get().Desc.c_str();
 }
 
+FvDeviceMemory vtkFerroVolumeContext::DeviceMemory()
+{
+  vtkFerroVolumeContext& self = Get();
+  std::lock_guard<std::mutex> lock(self.Mutex);
+  FvDeviceMemory m{};
+  if (self.Context && fv_context_device_memory(self.Context->get(), &m) != FV_STATUS_OK)
+  {
+    m = FvDeviceMemory{};
+  }
+  return m;
+}
+
 std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e)
 {
   std::ostringstream s;

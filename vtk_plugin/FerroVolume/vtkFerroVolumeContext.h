@@ -19,6 +19,10 @@ public:
   // "name (backend, driver)" of the device, "" when none could be opened.
   static const char* Description();
 
+  // What the device holds now; all zero when no mapper has opened it (it is not opened for
+  // this).
+  static FvDeviceMemory DeviceMemory();
+
 private:
   static vtkFerroVolumeContext& Get();
 

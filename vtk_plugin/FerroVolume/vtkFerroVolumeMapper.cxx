@@ -288,6 +288,18 @@ const char* vtkFerroVolumeMapper::GetFerrovolVersion()
   return fv_version();
 }
 
+vtkTypeInt64 vtkFerroVolumeMapper::GetDeviceMemoryInUse()
+{
+  const FvDeviceMemory m = vtkFerroVolumeContext::DeviceMemory();
+  return static_cast<vtkTypeInt64>(m.buffer_bytes + m.texture_bytes);
+}
+
+vtkTypeInt64 vtkFerroVolumeMapper::GetDeviceObjectsInUse()
+{
+  const FvDeviceMemory m = vtkFerroVolumeContext::DeviceMemory();
+  return static_cast<vtkTypeInt64>(m.buffers + m.texture_views + m.bind_groups);
+}
+
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 {

@@ -516,6 +516,18 @@ public:
    */
   static const char* GetFerrovolVersion();
 
+  ///@{
+  /**
+   * What ferrovol holds on its GPU device now, every mapper of the process together (wgpu's
+   * own counters): the bytes of device memory bound to its buffers and textures, and its
+   * live GPU objects (buffers, texture views, bind groups). Both stay flat over a long
+   * session; 0 before any mapper has opened the device. Images shared with OpenGL are not
+   * counted (OpenGL owns them).
+   */
+  static vtkTypeInt64 GetDeviceMemoryInUse();
+  static vtkTypeInt64 GetDeviceObjectsInUse();
+  ///@}
+
   /**
    * Renders the volume into the renderer's viewport (called by vtkVolume): fires
    * VolumeMapperRenderStartEvent, renders (GPURender), records TimeToDraw and fires

@@ -24,6 +24,20 @@ pub struct DeviceInfo {
     pub timestamps: bool,
 }
 
+/// What lives on the device now, from wgpu's own counters (every renderer of the context
+/// together): buffers, texture views and bind groups, and the device memory bound to
+/// buffers and textures (not counting images exported to a host, whose memory the host
+/// owns). Textures are counted by their views and bytes: wgpu's texture count is not kept
+/// for textures it creates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DeviceMemory {
+    pub buffers: u64,
+    pub texture_views: u64,
+    pub bind_groups: u64,
+    pub buffer_bytes: u64,
+    pub texture_bytes: u64,
+}
+
 /// An adapter, a device and its queue. `Send + Sync`; clones share the same device.
 #[derive(Clone)]
 pub struct Context {
@@ -193,6 +207,19 @@ impl Context {
         polled
             .map(|_| ())
             .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+    }
+
+    /// The buffers, textures and device memory the context holds now.
+    pub fn device_memory(&self) -> DeviceMemory {
+        let hal = self.device.get_internal_counters().hal;
+        let read = |c: &wgpu::wgt::InternalCounter| c.read().max(0) as u64;
+        DeviceMemory {
+            buffers: read(&hal.buffers),
+            texture_views: read(&hal.texture_views),
+            bind_groups: read(&hal.bind_groups),
+            buffer_bytes: read(&hal.buffer_memory),
+            texture_bytes: read(&hal.texture_memory),
+        }
     }
 
     /// [`Error::DeviceLost`] once the driver has reported the device lost.

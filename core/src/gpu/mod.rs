@@ -13,4 +13,4 @@ pub mod shaders;
 pub(crate) mod texture;
 pub(crate) mod uniforms;
 
-pub use context::{Context, DeviceInfo};
+pub use context::{Context, DeviceInfo, DeviceMemory};
