@@ -296,6 +296,7 @@ impl Renderer {
         params: &RenderParams,
         depth: DepthSource<'_>,
     ) -> Result<()> {
+        self.ctx.check_lost("rendering")?;
         let (ctx, res) = (&self.ctx, &mut self.res);
         let input = |res| FrameInput {
             ctx,

@@ -813,6 +813,14 @@ bool fv_context_can_share(const struct FvContext *ctx);
 enum FvStatus fv_context_device_memory(const struct FvContext *ctx, struct FvDeviceMemory *memory);
 
 /**
+ * Loses the context's device on purpose, as a driver reset or a removed GPU would, so a
+ * host can test its recovery (the role of WebGL's WEBGL_lose_context): every later call
+ * on the context and its renderers returns FV_STATUS_DEVICE_LOST; free them and create a
+ * new context. NULL is ignored.
+ */
+void fv_context_lose_device(const struct FvContext *ctx);
+
+/**
  * Waits for the last frame and copies it to the CPU. `*out` receives the frame.
  */
 enum FvStatus fv_renderer_read_frame(const struct FvRenderer *renderer, struct FvFrame **out);

@@ -90,6 +90,8 @@ public:
     check(fv_context_device_memory(h_.get(), &m));
     return m;
   }
+  /// Loses the device on purpose, to test recovery (see fv_context_lose_device).
+  void lose_device() const noexcept { fv_context_lose_device(h_.get()); }
   FvContext *get() const noexcept { return h_.get(); }
 
 private:

@@ -127,3 +127,16 @@ pub unsafe extern "C" fn fv_context_device_memory(
         Ok(())
     })
 }
+
+/// Loses the context's device on purpose, as a driver reset or a removed GPU would, so a
+/// host can test its recovery (the role of WebGL's WEBGL_lose_context): every later call
+/// on the context and its renderers returns FV_STATUS_DEVICE_LOST; free them and create a
+/// new context. NULL is ignored.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_lose_device(ctx: *const FvContext) {
+    guard_value((), || {
+        if let Ok(c) = const_ref(ctx, "ctx") {
+            c.ctx.lose_device();
+        }
+    })
+}

@@ -796,3 +796,44 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
         "{renewed:?} holds more than {first:?}"
     );
 }
+
+/// A lost device (fv_context_lose_device, as a driver reset would): the renderer's next
+/// frame returns FV_STATUS_DEVICE_LOST with a message saying what to do, and a new context
+/// and renderer draw the same frame as before.
+#[test]
+fn device_loss_is_reported_and_a_new_context_draws() {
+    let lib = Lib::open();
+    let n = 16usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    let scene = |s: &mut Session| {
+        s.set_volume([16, 16, 16], FvScalarType::F32, &data);
+        s.set_transfer_function(
+            &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
+            &[0.0, 0.0, 15.0, 1.0],
+        );
+        s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    };
+    let mut s = Session::new(&lib);
+    scene(&mut s);
+    let before = s.frame(24, 24).to_vec();
+    assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    let render = lib.f::<Render>("fv_renderer_render");
+    // SAFETY: a valid context (NULL is ignored) and renderer.
+    unsafe {
+        lib.f::<unsafe extern "C" fn(H)>("fv_context_lose_device")(null_mut());
+        lib.f::<unsafe extern "C" fn(H)>("fv_context_lose_device")(s.ctx);
+        lib.expect(
+            render(s.r, 24, 24, null(), 0),
+            FvStatus::DeviceLost,
+            "create a new context",
+        );
+    }
+    drop(s);
+    let mut fresh = Session::new(&lib);
+    scene(&mut fresh);
+    assert_eq!(
+        fresh.frame(24, 24),
+        &before[..],
+        "a new context draws the same frame"
+    );
+}

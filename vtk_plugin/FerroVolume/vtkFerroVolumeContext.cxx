@@ -17,7 +17,7 @@ const ferrovol::Context* vtkFerroVolumeContext::Acquire(std::string& error)
     self.Tried = true;
     try
     {
-      // Never deleted: see Acquire's comment.
+      // Deleted only when lost: see Acquire's comment.
       self.Context = new ferrovol::Context();
     }
     catch (const ferrovol::Error& e)
@@ -44,6 +44,35 @@ const ferrovol::Context* vtkFerroVolumeContext::Acquire(std::string& error)
   return self.Context;
 }
 
+unsigned vtkFerroVolumeContext::Generation()
+{
+  vtkFerroVolumeContext& self = Get();
+  std::lock_guard<std::mutex> lock(self.Mutex);
+  return self.Losses;
+}
+
+void vtkFerroVolumeContext::Lost()
+{
+  vtkFerroVolumeContext& self = Get();
+  std::lock_guard<std::mutex> lock(self.Mutex);
+  delete self.Context;
+  self.Context = nullptr;
+  ++self.Losses;
+  self.Tried = false;
+  self.Error.clear();
+  self.Desc.clear();
+}
+
+void vtkFerroVolumeContext::LoseDevice()
+{
+  vtkFerroVolumeContext& self = Get();
+  std::lock_guard<std::mutex> lock(self.Mutex);
+  if (self.Context)
+  {
+    self.Context->lose_device();
+  }
+}
+
 const char* vtkFerroVolumeContext::Description()
 {
   std::string error;
@@ -67,5 +96,10 @@ std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e)
 {
   std::ostringstream s;
   s << "ferrovol could not " << what << " (" << fv_status_name(e.status()) << "): " << e.message();
+  if (e.status() == FV_STATUS_DEVICE_LOST)
+  {
+    vtkFerroVolumeContext::Lost();
+    s << " (ferrovol opens a new device at the next render)";
+  }
   return s.str();
 }

@@ -11,10 +11,22 @@
 class vtkFerroVolumeContext
 {
 public:
-  // Opens the device on first use and keeps it for the life of the process: renderers
-  // created from it keep the device alive, and tearing a Vulkan device down from static
-  // destructors at exit is fragile. nullptr, with the reason in `error`, when there is none.
+  // Opens the device on first use and keeps it for the life of the process (or until it is
+  // lost): renderers created from it keep the device alive, and tearing a Vulkan device down
+  // from static destructors at exit is fragile. nullptr, with the reason in `error`, when
+  // there is none.
   static const ferrovol::Context* Acquire(std::string& error);
+
+  // Counts the devices lost: a renderer made under an older generation was made on a device
+  // since lost, and is made again.
+  static unsigned Generation();
+
+  // Forgets a lost device (a call failed with FV_STATUS_DEVICE_LOST): the next Acquire opens
+  // a new one. Renderers keep the old device alive until they are freed.
+  static void Lost();
+
+  // Loses the device on purpose, to test recovery (fv_context_lose_device).
+  static void LoseDevice();
 
   // "name (backend, driver)" of the device, "" when none could be opened.
   static const char* Description();
@@ -28,12 +40,14 @@ private:
 
   std::mutex Mutex;
   const ferrovol::Context* Context = nullptr;
+  unsigned Losses = 0;
   bool Tried = false;
   std::string Error;
   std::string Desc;
 };
 
-// "ferrovol could not <what> (FV_STATUS_…): <the library's message>".
+// "ferrovol could not <what> (FV_STATUS_…): <the library's message>"; a lost device is
+// forgotten (vtkFerroVolumeContext::Lost) and the message says a new one is opened.
 std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e);
 
 // Runs `call` (ferrovol.hpp calls); when one fails, says so in `error` (see

@@ -53,6 +53,8 @@ class vtkFerroVolumeMapper::vtkInternals
 {
 public:
   std::unique_ptr<ferrovol::Renderer> Renderer;
+  // vtkFerroVolumeContext::Generation() when the renderer was made
+  unsigned RendererGeneration = 0;
   vtkFerroVolumeInputHelper Input;
   vtkFerroVolumeLookupTables Tables;
   vtkFerroVolumeSettings Settings;
@@ -69,13 +71,22 @@ public:
 
   // The renderer, created on first use from the process-wide device; the passes of a
   // streamed frame (a volume over the memory budget) report to `self`'s progress.
+  // Whether the renderer was made on a device since lost.
+  bool RendererLost() const
+  {
+    return this->Renderer && this->RendererGeneration != vtkFerroVolumeContext::Generation();
+  }
+
+  // A renderer made on a device since lost is made again (with its input and tables).
   bool MakeRenderer(vtkFerroVolumeMapper* self, std::string& error)
   {
-    if (this->Renderer)
+    if (this->Renderer && !this->RendererLost())
     {
       return true;
     }
+    this->FreeRenderer();
     const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(error);
+    this->RendererGeneration = vtkFerroVolumeContext::Generation();
     return ctx && vtkFerroVolumeCall("create a renderer", error, [&] {
       this->Renderer.reset(new ferrovol::Renderer(*ctx));
       this->Renderer->set_progress(&vtkInternals::StreamProgress, self);
@@ -288,6 +299,11 @@ const char* vtkFerroVolumeMapper::GetFerrovolVersion()
   return fv_version();
 }
 
+void vtkFerroVolumeMapper::LoseDevice()
+{
+  vtkFerroVolumeContext::LoseDevice();
+}
+
 vtkTypeInt64 vtkFerroVolumeMapper::GetDeviceMemoryInUse()
 {
   const FvDeviceMemory m = vtkFerroVolumeContext::DeviceMemory();
@@ -427,6 +443,15 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     vtkErrorMacro(<< "vtkFerroVolumeMapper needs an OpenGL render window (vtkOpenGLRenderWindow)");
     return;
+  }
+
+  // After a device loss the output's images (imported from the lost device) go with the
+  // renderer; both are made again below.
+  if (in->RendererLost())
+  {
+    in->Output.ReleaseGraphicsResources(win);
+    in->Image.ReleaseGraphicsResources();
+    in->FreeRenderer();
   }
 
   // Blend mode, input, volume (on change), tables (on change), frame parameters.

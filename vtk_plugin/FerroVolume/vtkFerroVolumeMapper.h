@@ -516,6 +516,14 @@ public:
    */
   static const char* GetFerrovolVersion();
 
+  /**
+   * Loses ferrovol's GPU device on purpose, as a driver reset or a removed GPU would, to test
+   * a host's recovery (the role of WebGL's WEBGL_lose_context). The next render of every
+   * mapper fails with a vtkErrorMacro saying the device was lost; the render after it opens
+   * a new device, uploads the input again and draws.
+   */
+  static void LoseDevice();
+
   ///@{
   /**
    * What ferrovol holds on its GPU device now, every mapper of the process together (wgpu's

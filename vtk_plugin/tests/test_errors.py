@@ -202,6 +202,26 @@ class ErrorCases(unittest.TestCase):
         self.expect_error(["cropping planes"], configure=bad)
         self.recover(lambda m: m.CroppingOff())
 
+    def test_empty_extent(self):
+        img = vtk.vtkImageData()
+        img.SetExtent(0, -1, 0, -1, 0, -1)
+        s = vtk.vtkFloatArray()
+        s.SetName("scalars")
+        img.GetPointData().SetScalars(s)
+        self.expect_error(["empty"], data=img)
+        self.recover()
+
+    # -- device faults ---------------------------------------------------------------------------
+    def test_device_loss(self):
+        before = self.scene.render()
+        ferrovol.vtkFerroVolumeMapper.LoseDevice()
+        self.expect_error(["device lost", "opens a new device"])
+        self.recover()
+        after = self.scene.render()
+        fvtest.log("  device loss -> redrawn on a new device, max difference %d levels"
+                   % np.abs(after.astype(int) - before.astype(int)).max())
+        np.testing.assert_array_equal(after, before)
+
     # -- degenerate volumes that do render ------------------------------------------------------
     def test_single_voxel(self):
         self.mapper.SetInputData(image_from_array(np.full((1, 1, 1), 200.0, np.float32),

@@ -222,6 +222,17 @@ impl Context {
         }
     }
 
+    /// Loses the device on purpose, as a driver reset or a removed GPU would, so that a host
+    /// can test its recovery (the role of WebGL's `WEBGL_lose_context`): the device is
+    /// destroyed and every later call on this context, its clones and their renderers fails
+    /// with [`Error::DeviceLost`]. A new context works as before.
+    pub fn lose_device(&self) {
+        if let Ok(mut l) = self.lost.lock() {
+            l.get_or_insert_with(|| "the device was lost on request (lose_device)".into());
+        }
+        self.device.destroy();
+    }
+
     /// [`Error::DeviceLost`] once the driver has reported the device lost.
     pub fn check_lost(&self, what: &str) -> Result<()> {
         match self.lost.lock().map(|l| l.clone()) {
