@@ -250,6 +250,11 @@ fn volume_errors() {
     zero_spacing.spacing[1] = 0.0;
     let mut singular = d;
     singular.direction = [0.0; 9];
+    let mut huge_spacing = d;
+    huge_spacing.spacing[2] = 1e308;
+    let mut far_origin = d;
+    far_origin.origin[0] = -1e39;
+    far_origin.spacing[0] = 1e-300;
     let mut nan = data.clone();
     nan[5] = f32::NAN;
     // SAFETY (all calls below): arguments follow the header; invalid ones are the test.
@@ -274,6 +279,8 @@ fn volume_errors() {
             (desc([0, 2, 2], 1, f32_type), 0, Invalid, "empty volume"),
             (zero_spacing, 32, Invalid, "spacing along y"),
             (singular, 32, Invalid, "singular"),
+            (huge_spacing, 32, Invalid, "bounds along z are [0e0, 1e308]"),
+            (far_origin, 32, Invalid, "bounds along x are [-1e39, -1e39]"),
         ] {
             lib.expect(new(&desc, bytes, len, &mut v), want, needle);
         }
@@ -309,6 +316,20 @@ fn transfer_function_errors() {
         lib.expect(opacity(tf, 0, nan.as_ptr(), 1), Invalid, "opacity points");
         lib.expect(gradient(tf, 2, pts.as_ptr(), 1), Invalid, "component 2");
         lib.expect(gradient(tf, 0, nan.as_ptr(), 1), Invalid, "gradient");
+        // Positions beyond ±1e38 made the table sampling panic; refused, naming the point.
+        let far = [0.0, 0.0, 0.0, 0.0, 1e308, 1.0, 1.0, 1.0];
+        lib.expect(
+            color(tf, 0, far.as_ptr(), 2),
+            Invalid,
+            "point 1 is at 1e308",
+        );
+        let far = [-1e308, 1.0];
+        lib.expect(
+            opacity(tf, 0, far.as_ptr(), 1),
+            Invalid,
+            "point 0 is at -1e308",
+        );
+        lib.expect(gradient(tf, 0, far.as_ptr(), 1), Invalid, "beyond ±1e38");
         lib.ok(gradient(tf, 0, null(), 0));
         lib.expect(unit(tf, 0, 0.0, 1.0), Invalid, "unit distance 0");
         lib.expect(unit(tf, 0, 1.0, -1.0), Invalid, "weight -1");

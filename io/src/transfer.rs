@@ -2,10 +2,10 @@
 //!
 //! `{"color": [[x, r, g, b], …], "opacity": [[x, a], …], "gradient_opacity": [[g, a], …],
 //! "unit_distance": 1.0}`; x in scalar units, g in scalar units per world unit, both
-//! within ±[`MAX_POSITION`]; r, g, b and a from 0 to 1; gradient_opacity and
+//! within ±[`ferrovol_core::MAX_TRANSFER_POSITION`]; r, g, b and a from 0 to 1; gradient_opacity and
 //! unit_distance are optional.
 
-use ferrovol_core::{ComponentTransfer, Piecewise, TransferFunction};
+use ferrovol_core::{ComponentTransfer, Error, Piecewise, TransferFunction};
 
 use crate::error::Problem;
 use crate::ReadError;
@@ -13,11 +13,6 @@ use crate::ReadError;
 fn error(message: String) -> ReadError {
     Problem::TransferFunction(message).into()
 }
-
-/// The largest position (x or g) a point may have: the renderer samples the functions
-/// between their end points into tables of 32-bit floats, so the span of the points must
-/// be a finite 32-bit float.
-pub const MAX_POSITION: f64 = 1e38;
 
 /// The points of `key` in `v`, each `[x, v1, …, vN]`; `None` if `v` has no `key`.
 fn points<const N: usize>(
@@ -49,12 +44,6 @@ fn points<const N: usize>(
                 N + 1
             )));
         }
-        if nums[0].abs() > MAX_POSITION {
-            return Err(bad(format!(
-                "point {i} is at {:?}, beyond ±{MAX_POSITION:e} (the range the renderer's 32-bit tables span)",
-                nums[0]
-            )));
-        }
         if let Some(v) = nums[1..].iter().find(|v| !(0.0..=1.0).contains(*v)) {
             return Err(bad(format!(
                 "point {i} has the value {v:?}; colours and opacities go from 0 to 1"
@@ -66,9 +55,12 @@ fn points<const N: usize>(
         }
         pts.push((nums[0], val));
     }
-    Piecewise::new(pts)
-        .map(Some)
-        .map_err(|e| bad(e.to_string()))
+    // Piecewise::new refuses empty lists, non-finite numbers and positions beyond
+    // ±MAX_TRANSFER_POSITION, naming the point.
+    Piecewise::new(pts).map(Some).map_err(|e| match e {
+        Error::InvalidTransferFunction(m) => bad(m),
+        other => bad(other.to_string()),
+    })
 }
 
 /// Parses a transfer function from JSON text (the format is in the module

@@ -26,6 +26,8 @@ pub use render::{
     MAX_CLIP_PLANES, MAX_LIGHTS,
 };
 pub(crate) use transfer::build_tables;
-pub use transfer::{ComponentTransfer, Piecewise, TransferFunction, TABLE_SIZE};
+pub use transfer::{
+    ComponentTransfer, Piecewise, TransferFunction, MAX_TRANSFER_POSITION, TABLE_SIZE,
+};
 pub use view::{Image, Residency, Stats, StreamProgress, UploadOptions, View};
 pub use volume::{Direction, ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

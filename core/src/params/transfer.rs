@@ -6,6 +6,11 @@ use crate::error::{Error, Result};
 /// Entries per lookup table. VTK's GPU mapper samples its tables at a similar resolution.
 pub use crate::gpu::uniforms::TABLE_SIZE;
 
+/// The largest position (x) a transfer-function point may have: the renderer samples the
+/// functions between their end points into tables of 32-bit floats, so the span of the
+/// points must be a finite 32-bit float.
+pub const MAX_TRANSFER_POSITION: f64 = 1e38;
+
 /// A piecewise-linear function of one variable (VTK's vtkPiecewiseFunction / the RGB
 /// channels of vtkColorTransferFunction): points sorted by x, clamped outside.
 #[derive(Clone, Debug, PartialEq)]
@@ -14,6 +19,8 @@ pub struct Piecewise<const N: usize> {
 }
 
 impl<const N: usize> Piecewise<N> {
+    /// Sorts `points` by x. Refuses an empty list, NaN or infinite numbers and positions
+    /// beyond ±[`MAX_TRANSFER_POSITION`]; the error names the point (its index in `points`).
     pub fn new(mut points: Vec<(f64, [f32; N])>) -> Result<Self> {
         if points.is_empty() {
             return Err(Error::InvalidTransferFunction(
@@ -26,6 +33,15 @@ impl<const N: usize> Piecewise<N> {
         {
             return Err(Error::InvalidTransferFunction(format!(
                 "non-finite value among the points {points:?}"
+            )));
+        }
+        if let Some((i, (x, _))) = points
+            .iter()
+            .enumerate()
+            .find(|(_, (x, _))| x.abs() > MAX_TRANSFER_POSITION)
+        {
+            return Err(Error::InvalidTransferFunction(format!(
+                "point {i} is at {x:?}, beyond ±{MAX_TRANSFER_POSITION:e} (the range the renderer's 32-bit tables span)"
             )));
         }
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -90,26 +106,25 @@ impl ComponentTransfer {
     pub fn table_range(&self) -> [f64; 2] {
         let c = self.color.range();
         let o = self.opacity.range();
-        let lo = c[0].min(o[0]);
-        let mut hi = c[1].max(o[1]);
-        if hi <= lo {
-            hi = lo + 1.0;
-        }
-        [lo, hi]
+        widen([c[0].min(o[0]), c[1].max(o[1])])
     }
 
     pub fn gradient_range(&self) -> [f64; 2] {
         match &self.gradient_opacity {
-            Some(g) => {
-                let r = g.range();
-                if r[1] > r[0] {
-                    r
-                } else {
-                    [r[0], r[0] + 1.0]
-                }
-            }
+            Some(g) => widen(g.range()),
             None => [0.0, 1.0],
         }
+    }
+}
+
+/// `[lo, hi]` itself when it has a width; for a single position, a range from `lo` of
+/// width 1 or, where 1 is below the resolution of `lo` (|lo| beyond 2^23), one 32-bit ulp
+/// of `lo`, so that `hi > lo` in both the f64 tables and the shader's f32 uniforms.
+fn widen([lo, hi]: [f64; 2]) -> [f64; 2] {
+    if hi > lo {
+        [lo, hi]
+    } else {
+        [lo, lo + (lo.abs() * f64::from(f32::EPSILON)).max(1.0)]
     }
 }
 
@@ -133,11 +148,14 @@ impl TransferFunction {
     }
 
     /// A grey ramp over `range` with opacity rising linearly from 0 to `max_opacity`.
+    ///
+    /// # Panics
+    /// If `range` is not finite or reaches beyond ±[`MAX_TRANSFER_POSITION`].
     pub fn ramp(range: [f64; 2], max_opacity: f32) -> Self {
-        let color =
-            Piecewise::new(vec![(range[0], [0.0; 3]), (range[1], [1.0; 3])]).expect("finite");
-        let opacity =
-            Piecewise::new(vec![(range[0], [0.0]), (range[1], [max_opacity])]).expect("finite");
+        let color = Piecewise::new(vec![(range[0], [0.0; 3]), (range[1], [1.0; 3])])
+            .expect("a finite range within ±MAX_TRANSFER_POSITION");
+        let opacity = Piecewise::new(vec![(range[0], [0.0]), (range[1], [max_opacity])])
+            .expect("a finite range within ±MAX_TRANSFER_POSITION");
         Self::single(ComponentTransfer::new(color, opacity))
     }
 
@@ -240,5 +258,56 @@ mod tests {
     fn empty_function_is_an_error() {
         assert!(Piecewise::<1>::new(vec![]).is_err());
         assert!(Piecewise::<1>::new(vec![(f64::NAN, [0.0])]).is_err());
+    }
+
+    /// Positions beyond ±1e38 made build_tables panic (a span of ±1e308 is infinite, the
+    /// sample positions NaN); every caller (JSON, C ABI, VTK through the C ABI) now gets an
+    /// error naming the point, and the widest accepted span samples to finite tables.
+    #[test]
+    fn positions_beyond_the_table_range_are_refused() {
+        for (points, want) in [
+            (
+                vec![(-1e308, [0.0]), (1e308, [1.0])],
+                "point 0 is at -1e308, beyond ±1e38",
+            ),
+            (
+                vec![(0.0, [0.0]), (3.5e38, [1.0])],
+                "point 1 is at 3.5e38, beyond ±1e38",
+            ),
+        ] {
+            let e = Piecewise::<1>::new(points).unwrap_err().to_string();
+            println!("{e}");
+            assert!(e.contains(want), "{e}");
+        }
+        fn widest<const N: usize>(v: [f32; N]) -> Piecewise<N> {
+            Piecewise::new(vec![(-1e38, v), (1e38, v)]).unwrap()
+        }
+        let mut c = ComponentTransfer::new(widest([1.0; 3]), widest([0.5]));
+        c.gradient_opacity = Some(widest([1.0]));
+        let tables = build_tables(&c, 1.0);
+        assert!(tables.iter().flatten().all(|x| x.is_finite()));
+    }
+
+    /// A single point where x + 1 == x (beyond 2^53) gave a table range of width 0: the
+    /// shader's 1 / width was infinite. The width is now at least one 32-bit ulp of x.
+    #[test]
+    fn single_point_ranges_have_width() {
+        for x in [0.0, -5.0, 1e10, 2f64.powi(53), 1e17, -1e30, 1e38, -1e38] {
+            let c = ComponentTransfer::new(
+                Piecewise::new(vec![(x, [1.0; 3])]).unwrap(),
+                Piecewise::new(vec![(x, [0.5])]).unwrap(),
+            );
+            let mut g = c.clone();
+            g.gradient_opacity = Some(Piecewise::new(vec![(x, [1.0])]).unwrap());
+            for [lo, hi] in [c.table_range(), g.gradient_range()] {
+                assert_eq!(lo, x);
+                assert!(hi > lo, "{x}: [{lo}, {hi}]");
+                assert!((hi as f32) > (lo as f32), "{x}: [{lo}, {hi}] in f32");
+                let inv = (1.0 / (hi - lo)) as f32;
+                assert!(inv.is_finite() && inv > 0.0, "{x}: 1 / width = {inv}");
+            }
+            let tables = build_tables(&g, 1.0);
+            assert!(tables.iter().flatten().all(|v| v.is_finite()), "{x}");
+        }
     }
 }

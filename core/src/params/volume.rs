@@ -227,6 +227,10 @@ pub struct VolumeData {
     pub scalars: Scalars,
 }
 
+/// The largest world coordinate (and extent) a volume's bounds may reach: the GPU
+/// computes positions in 32-bit floats.
+const MAX_COORDINATE: f64 = f32::MAX as f64;
+
 impl VolumeData {
     /// A volume with unit spacing, zero origin and identity direction. Validated.
     pub fn new(dims: [u32; 3], components: u32, scalars: Scalars) -> Result<Self> {
@@ -312,6 +316,26 @@ impl VolumeData {
             return Err(Error::InvalidVolume(format!(
                 "direction matrix {d:?} is singular (determinant {det})"
             )));
+        }
+        let b = self.bounds();
+        for axis in 0..3 {
+            let [lo, hi] = [b[2 * axis], b[2 * axis + 1]];
+            if !(lo.abs() <= MAX_COORDINATE
+                && hi.abs() <= MAX_COORDINATE
+                && hi - lo <= MAX_COORDINATE)
+            {
+                return Err(Error::InvalidVolume(format!(
+                    "the volume's bounds along {} are [{lo:e}, {hi:e}], beyond the 32-bit float \
+                     range (±{MAX_COORDINATE:.1e}) the GPU computes in: origin {:?}, spacing {:?}, \
+                     dimensions {}x{}x{}",
+                    ["x", "y", "z"][axis],
+                    self.origin,
+                    self.spacing,
+                    self.dims[0],
+                    self.dims[1],
+                    self.dims[2]
+                )));
+            }
         }
         if let Some(i) = self.first_non_finite() {
             return Err(self.non_finite(i, self.scalars.get(i)));
@@ -444,5 +468,54 @@ impl VolumeData {
             }
         }
         b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn volume(dims: [u32; 3]) -> VolumeData {
+        let n = dims.iter().map(|&d| d as usize).product();
+        VolumeData::new(dims, 1, Scalars::U8(vec![0; n])).unwrap()
+    }
+
+    /// Origins, spacings and dimensions whose bounds leave the 32-bit float range (or
+    /// overflow to infinity in f64) were accepted; they are refused, naming the axis.
+    #[test]
+    fn bounds_beyond_the_f32_range_are_refused() {
+        for (v, want) in [
+            (
+                volume([2, 2, 2]).with_spacing([1e308, 1.0, 1.0]),
+                "along x are [0e0, 1e308]",
+            ),
+            (
+                volume([2, 3, 2]).with_spacing([1.0, 1e308, 1.0]),
+                "along y are [0e0, inf]",
+            ),
+            (
+                volume([1, 1, 2])
+                    .with_origin([0.0, 0.0, 3e38])
+                    .and_then(|v| v.with_spacing([1.0, 1.0, 1e38])),
+                "along z",
+            ),
+            (
+                volume([4, 2, 2])
+                    .with_origin([-3e38, 0.0, 0.0])
+                    .and_then(|v| v.with_spacing([2e38, 1.0, 1.0])),
+                "along x are [-3e38, 3e38]",
+            ),
+            (volume([1, 1, 1]).with_origin([0.0, 1e39, 0.0]), "along y"),
+        ] {
+            let e = v.unwrap_err().to_string();
+            println!("{e}");
+            assert!(e.contains(want), "{e}");
+            assert!(e.contains("beyond the 32-bit float range"), "{e}");
+        }
+        let v = volume([2, 2, 2])
+            .with_origin([-1e38, 0.0, 0.0])
+            .and_then(|v| v.with_spacing([2e38, 1e30, 1.0]))
+            .expect("bounds within the f32 range");
+        assert_eq!(v.bounds()[..4], [-1e38, 1e38, 0.0, 1e30]);
     }
 }
