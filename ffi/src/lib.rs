@@ -14,6 +14,9 @@ mod frame;
 mod iso;
 mod renderer;
 mod status;
+/// cbindgen:ignore
+#[cfg(feature = "test-hooks")]
+mod test_hooks;
 mod transfer;
 mod types;
 mod volume;
@@ -23,6 +26,8 @@ pub use frame::*;
 pub use iso::*;
 pub use renderer::*;
 pub use status::*;
+#[cfg(feature = "test-hooks")]
+pub use test_hooks::*;
 pub use transfer::*;
 pub use types::*;
 pub use volume::*;
