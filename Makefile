@@ -19,13 +19,15 @@
 #               `make test` runs it
 #   make soak   10 000 renders of vtkFerroVolumeMapper while everything changes: memory flat
 #               (a 3000-render version is in make vtk-test); plot: docs/img/soak-memory.svg
+#   make sanitize  the C ABI's C/C++ test programs under ASan+UBSan+LSan and TSan, the C
+#               demo under valgrind (docs/RELIABILITY.md); `make test` runs it
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
 .PHONY: deps build demo test lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
-        regression regression-quick fuzz-smoke soak
+        regression regression-quick fuzz-smoke soak sanitize
 
 deps:
 	@bash scripts/install-deps.sh
@@ -95,6 +97,7 @@ lint: deps
 test: lint
 	$(CARGO) build --locked -p ferrovol-ffi
 	$(CARGO) test --locked --workspace
+	$(MAKE) sanitize
 	$(MAKE) fuzz-smoke
 	$(MAKE) vtk-test
 	$(MAKE) paraview-test
@@ -104,6 +107,12 @@ test: lint
 # for 20 s each on the committed corpus: fails on a crash, a hang or a heap bound exceeded.
 fuzz-smoke: deps
 	scripts/fuzz.sh smoke 20
+
+# ffi/tests/c under -fsanitize=address,undefined (LSan on) and -fsanitize=thread, and the
+# C demo at 32x32 under valgrind memcheck (scripts/sanitize.sh; run times in
+# docs/RELIABILITY.md); logs in build/sanitize.
+sanitize: deps
+	scripts/sanitize.sh
 
 # The regression suite (tests/regression/README.md): every scene of tests/regression/scenes.py
 # rendered by vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper and

@@ -18,6 +18,9 @@ PKGS+=(python3-scipy)
 PKGS+=(afl++)
 # afl++: afl-fuzz and the runtime (/usr/lib/afl/afl-compiler-rt.o) the readers' fuzz
 # targets link (scripts/fuzz.sh, `make fuzz-smoke`); it brings clang-14 with it.
+PKGS+=(valgrind)
+# valgrind: memcheck over the C ABI demo (scripts/sanitize.sh, `make sanitize`). The
+# sanitizer runtimes (libasan8, libubsan1, liblsan0, libtsan2) come with g++.
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,6 +1,7 @@
 /* Renders the Marschner-Lobb test volume through ferrovol's C ABI alone and writes a PNG.
  * Built with -std=c11 -Wall -Wextra -Werror -pedantic by ffi/tests/c_program.rs.
- * Usage: render_demo OUT.png */
+ * Usage: render_demo OUT.png [SIZE [N]]: a SIZE x SIZE image (default 320) of an N^3 volume
+ * (default 41); scripts/sanitize.sh runs it small under valgrind. */
 #include "ferrovol.h"
 #include "fv_report.h"
 
@@ -8,8 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define N 41
 
 #define CHECK(call)                                                            \
   do {                                                                         \
@@ -36,8 +35,10 @@ int main(int argc, char **argv) {
   FvTransferFunction *tf = NULL;
   FvFrame *frame = NULL;
   float *data = NULL;
-  if (argc != 2) {
-    fprintf(stderr, "usage: %s OUT.png\n", argv[0]);
+  int size = 320, n = 41;
+  if (argc < 2 || argc > 4 || (argc > 2 && (size = atoi(argv[2])) < 1) ||
+      (argc > 3 && (n = atoi(argv[3])) < 2)) {
+    fprintf(stderr, "usage: %s OUT.png [SIZE >= 1 [N >= 2]]\n", argv[0]);
     return 2;
   }
   if (fv_version_major() != FV_VERSION_MAJOR) {
@@ -45,15 +46,16 @@ int main(int argc, char **argv) {
     return 1;
   }
 
-  data = malloc(sizeof(float) * N * N * N);
+  const size_t points = (size_t)n * n * n;
+  data = malloc(sizeof(float) * points);
   if (!data) {
     return 1;
   }
-  for (int k = 0; k < N; ++k) {
-    for (int j = 0; j < N; ++j) {
-      for (int i = 0; i < N; ++i) {
-        double s = 2.0 / (N - 1);
-        data[(k * N + j) * N + i] = marschner_lobb(-1 + i * s, -1 + j * s, -1 + k * s);
+  for (int k = 0; k < n; ++k) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        double s = 2.0 / (n - 1);
+        data[((size_t)k * n + j) * n + i] = marschner_lobb(-1 + i * s, -1 + j * s, -1 + k * s);
       }
     }
   }
@@ -66,12 +68,12 @@ int main(int argc, char **argv) {
 
   FvVolumeDesc desc;
   memset(&desc, 0, sizeof desc);
-  desc.dims[0] = desc.dims[1] = desc.dims[2] = N;
+  desc.dims[0] = desc.dims[1] = desc.dims[2] = (uint32_t)n;
   desc.components = 1;
   desc.scalar_type = FV_SCALAR_TYPE_F32;
   desc.spacing[0] = desc.spacing[1] = desc.spacing[2] = 1.0;
   desc.direction[0] = desc.direction[4] = desc.direction[8] = 1.0;
-  CHECK(fv_volume_new(&desc, data, sizeof(float) * N * N * N, &volume));
+  CHECK(fv_volume_new(&desc, data, sizeof(float) * points, &volume));
   CHECK(fv_renderer_set_volume(renderer, volume));
 
   CHECK(fv_transfer_function_new(1, true, &tf));
@@ -83,7 +85,7 @@ int main(int argc, char **argv) {
 
   FvCamera cam;
   memset(&cam, 0, sizeof cam);
-  const double c = (N - 1) / 2.0;
+  const double c = (n - 1) / 2.0;
   const double elevation = 30.0 * 3.14159265358979323846 / 180.0;
   const double dist = 6.0 * c;
   cam.focal_point[0] = cam.focal_point[1] = cam.focal_point[2] = c;
@@ -114,7 +116,7 @@ int main(int argc, char **argv) {
   params.shade = true;
   CHECK(fv_renderer_set_params(renderer, &params));
 
-  CHECK(fv_renderer_render(renderer, 320, 320, NULL, 0));
+  CHECK(fv_renderer_render(renderer, (uint32_t)size, (uint32_t)size, NULL, 0));
   CHECK(fv_renderer_read_frame(renderer, &frame));
   uint32_t w = 0, h = 0;
   fv_frame_size(frame, &w, &h);
