@@ -12,4 +12,12 @@ static inline int fv_report(const char *what, FvStatus s) {
   return 1;
 }
 
+/* Runs a ferrovol call; on failure reports it and returns 1 from the calling function. */
+#define FV_TRY(call)                                                           \
+  do {                                                                         \
+    FvStatus s_ = (call);                                                      \
+    if (s_ != FV_STATUS_OK)                                                    \
+      return fv_report(#call, s_);                                             \
+  } while (0)
+
 #endif

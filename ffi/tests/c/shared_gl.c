@@ -26,13 +26,6 @@
 #define H 61
 #define SKIP 77
 
-#define FV(call)                                                               \
-  do {                                                                         \
-    FvStatus s_ = (call);                                                      \
-    if (s_ != FV_STATUS_OK)                                                    \
-      return fv_report(#call, s_);                                             \
-  } while (0)
-
 /* Loads a GL entry point through EGL (extension functions are not exported by libGL). */
 #define LOAD(type, name) type name = (type)eglGetProcAddress(#name)
 
@@ -93,13 +86,13 @@ int main(void) {
   FvContext *ctx = NULL;
   FvRenderer *r = NULL;
   /* Created while our GL context is current, as a VTK mapper does: must not disturb it. */
-  FV(fv_context_new(&ctx));
+  FV_TRY(fv_context_new(&ctx));
   if (!fv_context_can_share(ctx)) {
     printf("skipped: the device cannot export memory: %s\n", fv_last_error());
     return SKIP;
   }
   uint8_t vk_device[16], vk_driver[16], gl_device[GL_UUID_SIZE_EXT], gl_driver[GL_UUID_SIZE_EXT];
-  FV(fv_context_uuids(ctx, &vk_device, &vk_driver));
+  FV_TRY(fv_context_uuids(ctx, &vk_device, &vk_driver));
   print_uuid("Vulkan device UUID", vk_device);
   print_uuid("Vulkan driver UUID", vk_driver);
   glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT, gl_driver);
@@ -116,7 +109,7 @@ int main(void) {
     printf("skipped: GL and Vulkan are different devices or drivers\n");
     return SKIP;
   }
-  FV(fv_renderer_new(ctx, &r));
+  FV_TRY(fv_renderer_new(ctx, &r));
 
   /* A 16^3 int16 volume: a bright ball in a dim box. */
   int16_t data[16 * 16 * 16];
@@ -132,15 +125,15 @@ int main(void) {
   desc.spacing[0] = desc.spacing[1] = desc.spacing[2] = 1.0;
   desc.direction[0] = desc.direction[4] = desc.direction[8] = 1.0;
   FvVolume *v = NULL;
-  FV(fv_volume_new(&desc, data, sizeof data, &v));
-  FV(fv_renderer_set_volume(r, v));
+  FV_TRY(fv_volume_new(&desc, data, sizeof data, &v));
+  FV_TRY(fv_renderer_set_volume(r, v));
   FvTransferFunction *tf = NULL;
-  FV(fv_transfer_function_new(1, true, &tf));
+  FV_TRY(fv_transfer_function_new(1, true, &tf));
   const double color[] = {-300, 0.2, 0.3, 0.9, 1000, 1.0, 0.8, 0.3};
   const double opacity[] = {-300, 0.0, 1000, 0.6};
-  FV(fv_transfer_function_set_color(tf, 0, color, 2));
-  FV(fv_transfer_function_set_opacity(tf, 0, opacity, 2));
-  FV(fv_renderer_set_transfer_function(r, tf));
+  FV_TRY(fv_transfer_function_set_color(tf, 0, color, 2));
+  FV_TRY(fv_transfer_function_set_opacity(tf, 0, opacity, 2));
+  FV_TRY(fv_renderer_set_transfer_function(r, tf));
   FvCamera cam;
   memset(&cam, 0, sizeof cam);
   cam.focal_point[0] = cam.focal_point[1] = cam.focal_point[2] = 7.5;
@@ -152,12 +145,12 @@ int main(void) {
   cam.parallel_scale = 1;
   cam.clipping_range[0] = 10;
   cam.clipping_range[1] = 100;
-  FV(fv_renderer_set_camera(r, &cam));
+  FV_TRY(fv_renderer_set_camera(r, &cam));
 
-  FV(fv_renderer_set_output_path(r, FV_OUTPUT_PATH_SHARED));
-  FV(fv_renderer_prepare_targets(r, W, H));
+  FV_TRY(fv_renderer_set_output_path(r, FV_OUTPUT_PATH_SHARED));
+  FV_TRY(fv_renderer_prepare_targets(r, W, H));
   FvSharedImage img;
-  FV(fv_renderer_shared_image(r, FV_TARGET_COLOR, &img));
+  FV_TRY(fv_renderer_shared_image(r, FV_TARGET_COLOR, &img));
   printf("shared colour: fd %d, %llu bytes, %ux%u, format 0x%x, generation %llu\n", img.fd,
          (unsigned long long)img.size, img.width, img.height, img.gl_internal_format,
          (unsigned long long)img.generation);
@@ -181,14 +174,14 @@ int main(void) {
     return 1;
   }
 
-  FV(fv_renderer_render(r, W, H, NULL, 0));
-  FV(fv_renderer_finish(r));
+  FV_TRY(fv_renderer_render(r, W, H, NULL, 0));
+  FV_TRY(fv_renderer_finish(r));
   static uint8_t gl_pixels[W * H * 4];
   glFinish();
   glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, gl_pixels);
 
   FvFrame *frame = NULL;
-  FV(fv_renderer_read_frame(r, &frame));
+  FV_TRY(fv_renderer_read_frame(r, &frame));
   const uint8_t *cpu = fv_frame_rgba(frame);
   size_t differ = 0, opaque = 0;
   for (size_t i = 0; i < sizeof gl_pixels; ++i) {

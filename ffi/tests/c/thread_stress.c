@@ -28,13 +28,6 @@
 #define W 40
 #define H 32
 
-#define CHECK(call)                                                            \
-  do {                                                                         \
-    FvStatus s_ = (call);                                                      \
-    if (s_ != FV_STATUS_OK)                                                    \
-      return fv_report(#call, s_);                                             \
-  } while (0)
-
 static FvContext *ctx;
 static FvVolume *volume;
 static FvFrame *reference[CAMERAS];
@@ -70,25 +63,25 @@ static FvCamera camera(int c) {
 static int make_renderer(FvRenderer **renderer, FvTransferFunction **tf) {
   const double color[] = {0.0, 0.1, 0.2, 0.9, 128.0, 1.0, 0.6, 0.2, 255.0, 1.0, 1.0, 1.0};
   const double opacity[] = {0.0, 0.0, 60.0, 0.0, 255.0, 0.7};
-  CHECK(fv_renderer_new(ctx, renderer));
-  CHECK(fv_renderer_set_volume(*renderer, volume));
-  CHECK(fv_transfer_function_new(1, true, tf));
-  CHECK(fv_transfer_function_set_color(*tf, 0, color, 3));
-  CHECK(fv_transfer_function_set_opacity(*tf, 0, opacity, 3));
-  CHECK(fv_renderer_set_transfer_function(*renderer, *tf));
+  FV_TRY(fv_renderer_new(ctx, renderer));
+  FV_TRY(fv_renderer_set_volume(*renderer, volume));
+  FV_TRY(fv_transfer_function_new(1, true, tf));
+  FV_TRY(fv_transfer_function_set_color(*tf, 0, color, 3));
+  FV_TRY(fv_transfer_function_set_opacity(*tf, 0, opacity, 3));
+  FV_TRY(fv_renderer_set_transfer_function(*renderer, *tf));
   FvRenderParams params;
-  CHECK(fv_render_params_default(&params));
+  FV_TRY(fv_render_params_default(&params));
   params.shade = true;
-  CHECK(fv_renderer_set_params(*renderer, &params));
+  FV_TRY(fv_renderer_set_params(*renderer, &params));
   return 0;
 }
 
 /* Renders camera c with `renderer` into *frame. */
 static int render(FvRenderer *renderer, int c, FvFrame **frame) {
   FvCamera cam = camera(c);
-  CHECK(fv_renderer_set_camera(renderer, &cam));
-  CHECK(fv_renderer_render(renderer, W, H, NULL, 0));
-  CHECK(fv_renderer_read_frame(renderer, frame));
+  FV_TRY(fv_renderer_set_camera(renderer, &cam));
+  FV_TRY(fv_renderer_render(renderer, W, H, NULL, 0));
+  FV_TRY(fv_renderer_read_frame(renderer, frame));
   return 0;
 }
 
@@ -173,8 +166,8 @@ int main(int argc, char **argv) {
   desc.scalar_type = FV_SCALAR_TYPE_U8;
   desc.spacing[0] = desc.spacing[1] = desc.spacing[2] = 1.0;
   desc.direction[0] = desc.direction[4] = desc.direction[8] = 1.0;
-  CHECK(fv_context_new(&ctx));
-  CHECK(fv_volume_new(&desc, data, sizeof data, &volume));
+  FV_TRY(fv_context_new(&ctx));
+  FV_TRY(fv_volume_new(&desc, data, sizeof data, &volume));
 
   FvRenderer *main_renderer = NULL;
   FvTransferFunction *main_tf = NULL;
