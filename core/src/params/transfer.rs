@@ -27,22 +27,21 @@ impl<const N: usize> Piecewise<N> {
                 "a function needs at least one point".into(),
             ));
         }
-        if points
-            .iter()
-            .any(|(x, v)| !x.is_finite() || v.iter().any(|c| !c.is_finite()))
-        {
-            return Err(Error::InvalidTransferFunction(format!(
-                "non-finite value among the points {points:?}"
-            )));
-        }
-        if let Some((i, (x, _))) = points
-            .iter()
-            .enumerate()
-            .find(|(_, (x, _))| x.abs() > MAX_TRANSFER_POSITION)
-        {
-            return Err(Error::InvalidTransferFunction(format!(
-                "point {i} is at {x:?}, beyond ±{MAX_TRANSFER_POSITION:e} (the range the renderer's 32-bit tables span)"
-            )));
+        let problem = points.iter().enumerate().find_map(|(i, (x, v))| {
+            if !x.is_finite() || v.iter().any(|c| !c.is_finite()) {
+                Some(format!(
+                    "point {i} is ({x:?}, {v:?}); NaN and infinite numbers are not allowed"
+                ))
+            } else if x.abs() > MAX_TRANSFER_POSITION {
+                Some(format!(
+                    "point {i} is at {x:?}, beyond ±{MAX_TRANSFER_POSITION:e} (the range the renderer's 32-bit tables span)"
+                ))
+            } else {
+                None
+            }
+        });
+        if let Some(problem) = problem {
+            return Err(Error::InvalidTransferFunction(problem));
         }
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
         Ok(Piecewise { points })
@@ -273,6 +272,10 @@ mod tests {
             (
                 vec![(0.0, [0.0]), (3.5e38, [1.0])],
                 "point 1 is at 3.5e38, beyond ±1e38",
+            ),
+            (
+                vec![(0.0, [0.0]), (1.0, [f32::NAN]), (f64::INFINITY, [1.0])],
+                "point 1 is (1.0, [NaN]); NaN and infinite numbers are not allowed",
             ),
         ] {
             let e = Piecewise::<1>::new(points).unwrap_err().to_string();
