@@ -20,6 +20,13 @@ mkdir -p "$OUT"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/ferrovol-xdg-$(id -u)}"
 mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 
+# Mesa's drivers (lavapipe for Vulkan, Mesa's EGL/llvmpipe for GL) on every machine, GPU
+# or not: the suppressions and results hold for them, and a GPU driver's own leaks or
+# uninitialised reads are not ferrovol's. Set VK_DRIVER_FILES / __EGL_VENDOR_LIBRARY_FILENAMES
+# to check another driver.
+export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}"
+export __EGL_VENDOR_LIBRARY_FILENAMES="${__EGL_VENDOR_LIBRARY_FILENAMES:-/usr/share/glvnd/egl_vendor.d/50_mesa.json}"
+
 ${CARGO:-cargo} build --locked -p ferrovol-ffi
 [ -f "$LIB/libferrovol.so" ] || { echo "sanitize: $LIB/libferrovol.so is missing" >&2; exit 1; }
 
