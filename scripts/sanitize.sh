@@ -3,7 +3,7 @@
 # docs/RELIABILITY.md):
 #   asan      render_demo.c, raii_demo.cpp, thread_stress.c and shared_gl.c built with
 #             -fsanitize=address,undefined (LeakSanitizer on), run to a clean exit
-#   tsan      thread_stress.c built with -fsanitize=thread, 4 threads x 16 frames
+#   tsan      thread_stress.c built with -fsanitize=thread, 4 threads x 64 frames
 #   valgrind  render_demo.c (32x32 image of an 8^3 volume) under memcheck, leaks included
 # Usage: scripts/sanitize.sh [asan|tsan|valgrind]...   (all three without arguments)
 # libferrovol.so is the debug build (`cargo build -p ferrovol-ffi`): Rust code is not
@@ -75,7 +75,7 @@ asan() {
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   run render_demo-asan "$OUT/render_demo-asan" "$OUT/render_demo-asan.png"
   run raii_demo-asan "$OUT/raii_demo-asan" "$OUT/raii_demo-asan.png"
-  run thread_stress-asan "$OUT/thread_stress-asan" 8
+  run thread_stress-asan "$OUT/thread_stress-asan" 32
   run shared_gl-asan "$OUT/shared_gl-asan"
   unset ASAN_OPTIONS UBSAN_OPTIONS
 }
@@ -90,7 +90,7 @@ tsan() {
   local TAG=-tsan
   compile thread_stress.c cc c11 -fsanitize=thread -pthread
   TSAN_OPTIONS=halt_on_error=1:ignore_noninstrumented_modules=1:second_deadlock_stack=1 \
-    run thread_stress-tsan "$OUT/thread_stress-tsan" 16
+    run thread_stress-tsan "$OUT/thread_stress-tsan" 64
 }
 
 # Memcheck at a tiny size (valgrind emulates every instruction of lavapipe's shaders);

@@ -87,19 +87,19 @@ fn cpp_raii_wrapper_renders_and_throws() {
 }
 
 /// Handles shared between threads as the header allows (one context and volume, a renderer
-/// per thread, frames read concurrently, renderers moved): 4 threads × 8 frames, each
+/// per thread, frames read concurrently, renderers moved): 4 threads × 32 frames, each
 /// identical to the single-threaded reference. scripts/sanitize.sh runs it under
 /// ThreadSanitizer and AddressSanitizer.
 #[test]
 fn threads_share_context_and_volume_as_the_header_allows() {
     let exe = build("thread_stress.c", "cc", "c11", &["-pthread"]);
     let mut cmd = Command::new(&exe);
-    let run = cmd.arg("8").output().expect("run thread_stress");
+    let run = cmd.arg("32").output().expect("run thread_stress");
     let out = String::from_utf8_lossy(&run.stdout);
     println!("{out}{}", String::from_utf8_lossy(&run.stderr));
     assert_eq!(run.status.code(), Some(0), "{out}");
     assert!(
-        out.contains("4 threads x 8 rounds: 36 frames identical to the reference"),
+        out.contains("4 threads x 32 rounds: 132 frames identical to the reference"),
         "{out}"
     );
 }
