@@ -21,13 +21,15 @@
 #               (a 3000-render version is in make vtk-test); plot: docs/img/soak-memory.svg
 #   make sanitize  the C ABI's C/C++ test programs under ASan+UBSan+LSan and TSan, the C
 #               demo under valgrind (docs/RELIABILITY.md); `make test` runs it
+#   make vtk-asan  the VTK module built with ASan+UBSan (build/vtk-asan) and its CTest suite
+#               (all but the soak) run on it; `make test` runs it
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
 .PHONY: deps build demo test lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
-        regression regression-quick fuzz-smoke soak sanitize
+        regression regression-quick fuzz-smoke soak sanitize vtk-asan
 
 deps:
 	@bash scripts/install-deps.sh
@@ -53,6 +55,18 @@ vtk: deps
 vtk-test: vtk
 	@scripts/fetch-data.sh >/dev/null || echo "vtk-test: no build/data/cranium.vti; the examples render a synthetic volume"
 	env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(VTK_BUILD) --output-on-failure -j1
+
+# The VTK module, its wrapping, examples and C++ tests built with AddressSanitizer and UBSan
+# (FERROVOL_SANITIZE, vtk_plugin/CMakeLists.txt), and the CTest suite run on them (the Python
+# tests preload the runtimes); the soak is left to `make soak`.
+VTK_ASAN_BUILD := build/vtk-asan
+vtk-asan: deps
+	$(CARGO) build --release --locked -p ferrovol-ffi
+	cmake -G Ninja -S vtk_plugin -B $(VTK_ASAN_BUILD) -DPython3_EXECUTABLE=/usr/bin/python3 \
+	  -DFERROVOL_SANITIZE=ON >/dev/null
+	ninja -C $(VTK_ASAN_BUILD) -j2
+	env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(VTK_ASAN_BUILD) --output-on-failure -j1 \
+	  -E '^python.soak$$'
 
 # The ParaView plugin builds vtkFerroVolumeMapper from vtk_plugin/FerroVolume itself (it
 # does not need build/vtk) and writes build/paraview/env.sh (PV_PLUGIN_PATH); build/env.sh
@@ -100,6 +114,7 @@ test: lint
 	$(MAKE) sanitize
 	$(MAKE) fuzz-smoke
 	$(MAKE) vtk-test
+	$(MAKE) vtk-asan
 	$(MAKE) paraview-test
 	$(MAKE) regression-quick
 
