@@ -2,7 +2,8 @@
 #   make demo   render the built-in demo volume to build/demo.png
 #   make test   format, lint and run every test (installs what is missing first)
 #   make bench  VTK's GPU ray cast benchmark scene, ferrovol vs vtkGPUVolumeRayCastMapper
-#   make bench-vtk  the same scene in a VTK window: vtkFerroVolumeMapper vs vtkGPUVolumeRayCastMapper
+#   make bench-vtk  the same scene in a VTK window: vtkFerroVolumeMapper vs vtkGPUVolumeRayCastMapper,
+#               and the equal-fidelity table (time and error against converged references)
 #   make build  release build of the `ferrovol` command and the VTK module (make vtk)
 #   make vtk    vtkFerroVolumeMapper (C++ + Python package `ferrovol`) in build/vtk;
 #               writes build/env.sh: `. build/env.sh; /usr/bin/python3 -c "import vtk, ferrovol"`
@@ -153,11 +154,14 @@ bench: build
 
 # vtkFerroVolumeMapper (zero-copy shared path and readback path) against
 # vtkGPUVolumeRayCastMapper in a VTK window, the same benchmark scene, alternating rounds:
-# in VTK's default (multisampled) window, then in one without multisampling.
+# in VTK's default (multisampled) window, then in one without multisampling; then the
+# equal-fidelity table (bench/fidelity.py): frame time and error against each renderer's
+# converged reference, scene by scene.
 bench-vtk: vtk
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 1 >/dev/null
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5 --multisamples 0
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/fidelity.py
 
 # The soak test (vtk_plugin/tests/soak.py): 10 000 renders of vtkFerroVolumeMapper while
 # everything changes; fails on an error or memory growth over 5%, plots the memory curve.
