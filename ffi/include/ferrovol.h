@@ -32,9 +32,9 @@
 #define FV_MAX_ISO_VALUES 8
 
 /**
- * Maximum number of clipping planes in FvRenderParams.
+ * Maximum number of clipping planes in FvRenderParams (vtkGPUVolumeRayCastMapper's 8).
  */
-#define FV_MAX_CLIP_PLANES 6
+#define FV_MAX_CLIP_PLANES 8
 
 /**
  * Maximum number of lights with shading on.

@@ -189,8 +189,8 @@ pub struct FvPlane {
     pub normal: [f64; 3],
 }
 
-/// Maximum number of clipping planes in FvRenderParams.
-pub const FV_MAX_CLIP_PLANES: usize = 6;
+/// Maximum number of clipping planes in FvRenderParams (vtkGPUVolumeRayCastMapper's 8).
+pub const FV_MAX_CLIP_PLANES: usize = 8;
 /// Maximum number of lights with shading on.
 pub const FV_MAX_LIGHTS: usize = 8;
 

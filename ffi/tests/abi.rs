@@ -385,7 +385,7 @@ fn renderer_errors() {
             (|p| p.gradient_method = 9, "gradient_method 9"),
             (|p| p.sample_distance = -1.0, "sample_distance -1"),
             (|p| p.termination_threshold = 0.0, "termination threshold 0"),
-            (|p| p.clip_plane_count = 7, "clip_plane_count 7"),
+            (|p| p.clip_plane_count = 9, "clip_plane_count 9"),
             (|p| p.clip_plane_count = 1, "non-zero normal"),
             (
                 |p| {

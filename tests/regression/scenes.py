@@ -312,6 +312,23 @@ def crop_vtk_placed(planes, flags, n, center):
     return f
 
 
+def clip_planes_vtk_placed(planes, n, center):
+    """Clipping planes as clip_planes(), except that ferrovol gets them where VTK 9.2's GPU
+    mapper effectively puts them (every axis here has n points about `center`)."""
+    moved = tuple((tuple(center + (o - center) * n / (n - 1.0) for o in origin), normal)
+                  for origin, normal in planes)
+
+    def f(m):
+        clip_planes(*(moved if m.IsA("vtkFerroVolumeMapper") else planes))(m)
+    return f
+
+
+# Eight planes (the most vtkGPUVolumeRayCastMapper takes), each cutting one corner of the
+# wavelet 128^3 off.
+EIGHT_CORNER_PLANES = tuple(((30 * sx, 28 * sy, 26 * sz), (-sx, -sy, -sz))
+                            for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1))
+
+
 def average_range(lo, hi):
     def f(m):
         m.SetAverageIPScalarRange(lo, hi)
@@ -457,6 +474,19 @@ SCENES = [
     Scene("wavelet-clip-two-planes", "wavelet 128^3, two clipping planes (a wedge cut away)",
           "wavelet128", wavelet_tf("linear"), quick=True,
           configure=clip_planes(((0, 0, 0), (1, 0.3, 0)), ((0, 15, 0), (0.2, -1, 0.4))),
+          note=SAMPLING_NOTE),
+    Scene("wavelet-clip-eight-planes", "wavelet 128^3, eight clipping planes (the most "
+          "vtkGPUVolumeRayCastMapper takes): every corner of the cube cut off",
+          "wavelet128", wavelet_tf("linear"), quick=True,
+          configure=clip_planes(*EIGHT_CORNER_PLANES),
+          note=SAMPLING_NOTE + " VTK 9.2 maps clipping planes through the texture matrix "
+          "that also misplaces its cropping planes: they sit N/(N-1) farther from the "
+          "volume's centre than asked (here 128/127, about 0.4 voxel); ferrovol clips where "
+          "asked (control: -vtk-planes)."),
+    Scene("wavelet-clip-eight-planes-vtk-planes", "control: as wavelet-clip-eight-planes, but "
+          "ferrovol is given the planes where VTK 9.2 actually clips (c + (o - c) N/(N-1))",
+          "wavelet128", wavelet_tf("linear"), quick=True,
+          configure=clip_planes_vtk_placed(EIGHT_CORNER_PLANES, 128, -0.5),
           note=SAMPLING_NOTE),
     Scene("wavelet-sphere", "wavelet 128^3 with an opaque sphere intersecting it (depth "
           "in and out)", "wavelet128", wavelet_tf("linear"), quick=True,

@@ -283,8 +283,9 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     {
       if (warned.insert("planes").second)
       {
-        vtkWarningWithObjectMacro(
-          self, << count << " clipping planes: ferrovol uses the first " << FV_MAX_CLIP_PLANES);
+        vtkWarningWithObjectMacro(self,
+          << count << " clipping planes: ferrovol, as vtkGPUVolumeRayCastMapper, takes at most "
+          << FV_MAX_CLIP_PLANES << " and uses the first " << FV_MAX_CLIP_PLANES);
       }
       count = FV_MAX_CLIP_PLANES;
     }

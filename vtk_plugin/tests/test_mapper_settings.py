@@ -140,6 +140,38 @@ class Settings(unittest.TestCase):
         self.assertGreater(mean_diff(left, right), 5.0)
         self.assertEqual(mapper.GetClippingPlanes().GetNumberOfItems(), 2)
 
+    def test_eight_clipping_planes(self):
+        # Eight planes each cut one corner of the cube off (vtkGPUVolumeRayCastMapper takes 8);
+        # a ninth plane is beyond what VTK's mapper takes: a warning names the count.
+        corners = [((12 * sx, 12 * sy, 12 * sz), (-sx, -sy, -sz))
+                   for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+
+        def planes(n, extra=()):
+            def f(m):
+                for origin, normal in corners[:n] + list(extra):
+                    p = vtk.vtkPlane()
+                    p.SetOrigin(*origin)
+                    p.SetNormal(*normal)
+                    m.AddClippingPlane(p)
+            return f
+        images, warnings = {}, {}
+        for name, configure in (("7", planes(7)), ("8", planes(8)),
+                                ("9", planes(8, [((0, 0, 0), (1, 0, 0))]))):
+            scene, errors = fvtest.ferrovol_scene(self.src, tf_property(), configure,
+                                                  size=(120, 120), camera=view)
+            images[name] = scene.render()
+            self.assertEqual(errors.messages, [], name)
+            warnings[name] = errors.warnings
+        save("settings-clipping-eight", images["7"], images["8"], images["9"])
+        d78, d89 = mean_diff(images["7"], images["8"]), mean_diff(images["8"], images["9"])
+        fvtest.log("  clipping: 7 vs 8 planes %.2f, 8 vs 9 planes %.2f; warnings %s"
+                   % (d78, d89, warnings["9"]))
+        self.assertGreater(d78, 0.5)  # the eighth plane cuts its corner
+        self.assertEqual(d89, 0.0)    # the ninth is not used
+        self.assertEqual(warnings["7"] + warnings["8"], [])
+        self.assertEqual(len(warnings["9"]), 1)
+        self.assertIn("9 clipping planes", warnings["9"][0])
+
     def test_sample_distance(self):
         def sd(d):
             def f(m):

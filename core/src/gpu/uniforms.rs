@@ -38,7 +38,7 @@ pub struct FrameUniforms {
     pub average_range: [f32; 4],
     pub additive_scale: [f32; 4],
     pub scatter: [f32; 4],
-    pub clip: [[f32; 4]; 6],
+    pub clip: [[f32; 4]; MAX_CLIP_PLANES],
     pub lights: [GpuLight; 8],
     pub viewport: [u32; 4],
     pub mode: [u32; 4],
@@ -177,7 +177,7 @@ pub const PAGE_MISSING: u32 = 1 << 30;
 
 /// Most lights and clipping planes a frame takes (the sizes of Frame's arrays).
 pub const MAX_LIGHTS: usize = 8;
-pub const MAX_CLIP_PLANES: usize = 6;
+pub const MAX_CLIP_PLANES: usize = 8;
 /// Entries per transfer-function table.
 pub const TABLE_SIZE: usize = 1024;
 

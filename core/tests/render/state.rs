@@ -179,12 +179,12 @@ fn errors() {
             "sample distance",
         ),
         (
-            "7 clip planes",
+            "9 clip planes",
             RenderParams {
-                clip_planes: vec![plane; 7],
+                clip_planes: vec![plane; 9],
                 ..Default::default()
             },
-            "7 clipping planes",
+            "9 clipping planes",
         ),
         (
             "termination threshold 0",
