@@ -504,7 +504,8 @@ bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRen
 // environment when it changed. The surfaces' colours and opacities are the property's
 // colour and scalar opacity functions at the iso-values (first component), as
 // vtkGPUVolumeRayCastMapper's; Shade off draws flat colours (ambient 1, no diffuse or
-// specular light, no environment light).
+// specular light, no environment light). Without iso-values nothing is drawn, silently, as
+// vtkGPUVolumeRayCastMapper does.
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
   vtkFerroVolumeMapper* self, vtkVolume* vol, ferrovol::Renderer& renderer,
   std::set<std::string>& warned, std::string& error)
@@ -515,9 +516,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
   const int n = contours ? contours->GetNumberOfContours() : 0;
   if (n < 1)
   {
-    error = "the isosurface blend mode needs iso-values: set them with "
-            "volumeProperty->GetIsoSurfaceValues()->SetValue(0, value)";
-    return Result::Failed;
+    return Result::NothingVisible;
   }
   if (n > FV_MAX_ISO_VALUES && warned.insert("iso-count").second)
   {

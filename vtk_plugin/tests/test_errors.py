@@ -167,17 +167,6 @@ class ErrorCases(unittest.TestCase):
         self.recover()
 
     # -- unsupported settings ------------------------------------------------------------------
-    def test_isosurface_without_iso_values(self):
-        contours = self.scene.volume.GetProperty().GetIsoSurfaceValues()
-
-        def iso(m):
-            m.SetBlendModeToIsoSurface()
-            contours.SetNumberOfContours(0)
-        self.expect_error(["isosurface blend mode needs iso-values"], configure=iso)
-        self.assertEqual(len(self.errors.messages), 1)
-        contours.SetValue(0, 150.0)
-        self.recover(lambda m: m.SetBlendModeToComposite())
-
     def test_slice_blend_mode(self):
         self.expect_error(["blend mode"], configure=lambda m: m.SetBlendModeToSlice())
         self.recover(lambda m: m.SetBlendModeToComposite())

@@ -93,6 +93,37 @@ class Isosurface(unittest.TestCase):
         self.assertGreater(sil, 0.97)
         self.assertGreater(s, 0.92)
 
+    def test_no_iso_values_as_vtk_gpu(self):
+        """The isosurface blend mode without iso-values: vtkGPUVolumeRayCastMapper draws
+        nothing of the volume and says nothing; so does ferrovol (the sphere shows)."""
+        def no_values():
+            p = wavelet_iso()
+            p.GetIsoSurfaceValues().SetNumberOfContours(0)   # (VTK starts with one, at 0)
+            return p
+        def sphere():
+            return fvtest.sphere_actor((3, -3, 6), 24, (0.2, 0.9, 0.3))
+        images, messages = [], []
+        for m in (ferrovol.vtkFerroVolumeMapper(), vtk.vtkGPUVolumeRayCastMapper()):
+            m.SetBlendModeToIsoSurface()
+            errors = Errors(m)
+            scene = Scene(m, self.src, no_values(), camera=view, actors=[sphere()])
+            images.append(scene.render())
+            messages.append(errors.messages + errors.warnings)
+        ours, ref = images
+        # the same view with the sphere alone (the camera as the volume's scenes set it)
+        alone = Scene(vtk.vtkGPUVolumeRayCastMapper(), self.src, no_values(), camera=view,
+                      actors=[sphere()])
+        alone.renderer.RemoveVolume(alone.volume)
+        sphere_alone = alone.render()
+        s, p = fvtest.compare("iso-no-values-vs-vtk", ours, ref)
+        log("no iso-values: messages ferrovol %s, VTK %s; sphere coverage %.3f; "
+            "max |ferrovol - sphere alone| %.1f" % (messages[0], messages[1], coverage(ours),
+                                                   np.abs(ours - sphere_alone).max()))
+        self.assertEqual(messages, [[], []])
+        self.assertGreater(coverage(ours), 0.1)        # the sphere, not a black image
+        self.assertGreater(s, 0.999)
+        self.assertEqual(np.abs(ours - sphere_alone).max(), 0.0)  # nothing of the volume
+
     def test_surface_placement_on_a_sphere(self):
         """Both mappers' first-hit depth, unprojected, against the analytic sphere: VTK
         places the surface at the first sample past the crossing, ferrovol at the crossing."""
@@ -182,15 +213,8 @@ class Isosurface(unittest.TestCase):
         mapper.SetBlendModeToIsoSurface()
         errors = Errors(mapper)
         prop = fvtest.tf_property(interpolation="linear")
-        prop.GetIsoSurfaceValues().SetNumberOfContours(0)   # (VTK starts with one, at 0)
-        scene = Scene(mapper, self.src, prop, camera=view)
-        scene.render()
-        log("no iso-values:", errors.last())
-        self.assertIn("needs iso-values", errors.last())
-        self.assertFalse(mapper.GetLastRenderDrew())
-
-        errors.messages.clear()
         prop.GetIsoSurfaceValues().SetValue(0, 150.0)
+        scene = Scene(mapper, self.src, prop, camera=view)
         prop.ShadeOn()   # (environment light is lighting: Shade off draws flat colours)
         mapper.SetEnvironmentLighting(0.6)
         mapper.SetEnvironmentMap("/nonexistent/sky.hdr")
