@@ -28,6 +28,10 @@ override RANGE_SKIP: bool = false;
 override CROP: bool = false;
 // Volumetric shadows (lib/shadow.wgsl; one component, shading on).
 override VOLUMETRIC: bool = false;
+// VTK's ComputeNormalFromOpacity (independent components): shading normals from the gradient
+// of each component's step-corrected opacity, gradient opacity included, instead of the
+// scalar's. The scalar gradient still drives gradient opacity at the sample.
+override OPACITY_NORMAL: bool = false;
 // A streamed frame (its bricks exceed the memory budget): several passes, each with a group
 // of bricks resident, front to back. A ray marches until its next sample's brick waits for
 // a later pass (PAGE_MISSING), keeps its state in `state` and resumes there; misc.w holds
@@ -50,6 +54,52 @@ fn block_keeps_extremum(p: vec3<f32>, v: f32) -> bool {
         return r.y <= v;
     }
     return r.x >= v;
+}
+
+// Step-corrected opacity of every component at pool texture coordinate tc, times gradient
+// opacity when it is on (VTK's opacity of a neighbour in ComputeNormalFromOpacity).
+fn opacities_at(tc: vec3<f32>) -> vec4<f32> {
+    let s = scalars_at(tc);
+    var g: Gradient;
+    if (GRAD_OPACITY) {
+        g = gradient_tc(tc, s);
+    }
+    var a = vec4<f32>(0.0);
+    for (var c = 0u; c < NCOMP; c = c + 1u) {
+        a[c] = classify(c, s[c]).a;
+        if (GRAD_OPACITY) {
+            a[c] = a[c] * gradient_opacity(c, length(world_gradient(g, c)));
+        }
+    }
+    return a;
+}
+
+// Index-space gradient of every component's opacity at p: central differences over the six
+// neighbours one voxel away, as VTK's computeDensityGradient (zero in a non-resident
+// brick). With gradient opacity the neighbours' own gradients reach two voxels from p,
+// beyond a brick's apron: the pass takes this only for a volume of one brick.
+fn opacity_gradient_at(p: vec3<f32>) -> Gradient {
+    let tc = pool_coord(p);
+    var g: Gradient;
+    if (!SINGLE_BRICK && brick.empty) {
+        return g;
+    }
+    let dx = vec3<f32>(pool.inv_size.x, 0.0, 0.0);
+    let dy = vec3<f32>(0.0, pool.inv_size.y, 0.0);
+    let dz = vec3<f32>(0.0, 0.0, pool.inv_size.z);
+    g.x = 0.5 * (opacities_at(tc + dx) - opacities_at(tc - dx));
+    g.y = 0.5 * (opacities_at(tc + dy) - opacities_at(tc - dy));
+    g.z = 0.5 * (opacities_at(tc + dz) - opacities_at(tc - dz));
+    return g;
+}
+
+// The gradient whose direction shades a sample at p: the opacity's (OPACITY_NORMAL) or the
+// scalar's, g.
+fn shading_gradient(p: vec3<f32>, g: Gradient) -> Gradient {
+    if (OPACITY_NORMAL) {
+        return opacity_gradient_at(p);
+    }
+    return g;
 }
 
 // Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
@@ -84,15 +134,18 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
             return vec4<f32>(0.0);
         }
         if (need_grad) {
-            let g = world_gradient(gradient_at(p, s), 0u);
+            let gs = gradient_at(p, s);
+            let g = world_gradient(gs, 0u);
             let a = e.a;
             if (GRAD_OPACITY) {
                 e.a = e.a * gradient_opacity(0u, length(g));
             }
             if (SHADE) {
-                var rgb = shade(e.rgb, g, pos, view_dir);
+                let n = world_gradient(shading_gradient(p, gs), 0u);
+                var rgb = shade(e.rgb, n, pos, view_dir);
                 if (VOLUMETRIC) {
-                    rgb = volumetric_shade(e.rgb, a, g, rgb, p, pos, view_dir, GRAD_OPACITY);
+                    let gm = vtk_gradient_magnitude(n, OPACITY_NORMAL);
+                    rgb = volumetric_shade(e.rgb, a, gm, rgb, p, pos, view_dir, GRAD_OPACITY);
                 }
                 e = vec4<f32>(rgb, e.a);
             }
@@ -111,8 +164,12 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         return vec4<f32>(0.0);
     }
     var g: Gradient;
+    var gn: Gradient;
     if (need_grad) {
         g = gradient_at(p, s);
+        if (SHADE) {
+            gn = shading_gradient(p, g);
+        }
     }
     var rgb_sum = vec3<f32>(0.0);
     var a_sq = 0.0;
@@ -125,12 +182,11 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         }
         var rgb = entry[c].rgb;
         if (need_grad) {
-            let gw = world_gradient(g, c);
             if (GRAD_OPACITY) {
-                a = a * gradient_opacity(c, length(gw));
+                a = a * gradient_opacity(c, length(world_gradient(g, c)));
             }
             if (SHADE) {
-                rgb = shade(rgb, gw, pos, view_dir);
+                rgb = shade(rgb, world_gradient(gn, c), pos, view_dir);
             }
         }
         rgb_sum = rgb_sum + a * w * rgb;

@@ -450,6 +450,11 @@ typedef struct FvRenderParams {
    * (vtkVolumeProperty::ScatteringAnisotropy).
    */
   float scattering_anisotropy;
+  /**
+   * Shading normals from the gradient of the opacity instead of the scalar's
+   * (vtkVolumeMapper::ComputeNormalFromOpacity): composite, one or independent components.
+   */
+  bool normal_from_opacity;
 } FvRenderParams;
 
 /**

@@ -242,6 +242,9 @@ pub struct FvRenderParams {
     /// Henyey–Greenstein anisotropy of the volumetric term, [−1, 1]
     /// (vtkVolumeProperty::ScatteringAnisotropy).
     pub scattering_anisotropy: f32,
+    /// Shading normals from the gradient of the opacity instead of the scalar's
+    /// (vtkVolumeMapper::ComputeNormalFromOpacity): composite, one or independent components.
+    pub normal_from_opacity: bool,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -351,6 +354,7 @@ impl FvRenderParams {
             volumetric_scattering_blending: d.shading.volumetric_blending,
             global_illumination_reach: d.shading.global_illumination_reach,
             scattering_anisotropy: d.shading.scattering_anisotropy,
+            normal_from_opacity: d.shading.normal_from_opacity,
         }
     }
 }
@@ -411,6 +415,7 @@ impl ToCore for FvRenderParams {
                 volumetric_blending: self.volumetric_scattering_blending,
                 global_illumination_reach: self.global_illumination_reach,
                 scattering_anisotropy: self.scattering_anisotropy,
+                normal_from_opacity: self.normal_from_opacity,
             },
             cropping: self.cropping.then_some(Cropping {
                 planes: self.cropping_planes,

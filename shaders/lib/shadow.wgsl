@@ -110,11 +110,21 @@ fn shadow_phase(mu: f32) -> f32 {
     return (1.0 - g * g) / (d * sqrt(d));
 }
 
+// VTK's gradient magnitude in the volumetric blending, from the world gradient `grad` that
+// shades the sample: central differences over two voxels per unit length, of the normalised
+// scalar, or of the opacity where the normals come from the opacity (`of_opacity`).
+fn vtk_gradient_magnitude(grad: vec3<f32>, of_opacity: bool) -> f32 {
+    if (of_opacity) {
+        return 2.0 * length(grad);
+    }
+    return length(grad) * frame.scatter.w;
+}
+
 // The sample's colour with volumetric shadows: `color` the transfer function's colour, `a`
-// its step-corrected opacity (before gradient opacity), `grad` the world gradient,
-// `surface` the gradient-shaded colour, p the index-space point, pos the world point,
-// view_dir the ray's direction.
-fn volumetric_shade(color: vec3<f32>, a: f32, grad: vec3<f32>, surface: vec3<f32>,
+// its step-corrected opacity (before gradient opacity), `gm` VTK's gradient magnitude
+// (vtk_gradient_magnitude), `surface` the gradient-shaded colour, p the index-space point,
+// pos the world point, view_dir the ray's direction.
+fn volumetric_shade(color: vec3<f32>, a: f32, gm: f32, surface: vec3<f32>,
                     p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>, grad_opacity: bool) -> vec3<f32> {
     let pt = index_to_tex(p);
     let dt = length((frame.world_to_index * vec4<f32>(view_dir * frame.misc.x, 0.0)).xyz / frame.dims.xyz);
@@ -154,9 +164,6 @@ fn volumetric_shade(color: vec3<f32>, a: f32, grad: vec3<f32>, surface: vec3<f32
             v = v + ka * light.ambient.rgb;
         }
     }
-    // VTK's gradient magnitude here: central differences of the normalised scalar over
-    // two voxels, per unit length
-    let gm = length(grad) * frame.scatter.w;
     let b = frame.scatter.x;
     var w = b * exp(-b * gm * a);
     if (b >= 1.0) {

@@ -114,9 +114,14 @@ override PRECOMPUTED_GRADIENT: bool = false;
 // 6 samples and the 3.
 override FORWARD_DIFF: bool = false;
 
+// Pool texture coordinate of index-space point p (in the brick that holds it).
+fn pool_coord(p: vec3<f32>) -> vec3<f32> {
+    return (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
+}
+
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
-    let tc = (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
+    let tc = pool_coord(p);
     let v = textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
     if (SINGLE_BRICK) {
         return v;
@@ -140,11 +145,15 @@ struct Gradient {
     z: vec4<f32>,
 }
 
-// Index-space gradient of every component: central differences (6 samples) or forward
+// Index-space gradient of every component at p: central differences (6 samples) or forward
 // differences from the centre value s (3 samples).
 fn brick_gradient(p: vec3<f32>, s: vec4<f32>) -> Gradient {
-    // neighbours one voxel away, offset directly in texture coordinates
-    let tc = (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
+    return gradient_tc(pool_coord(p), s);
+}
+
+// Index-space gradient of every component at pool texture coordinate tc, whose scalars are
+// s: the neighbours one voxel away, offset directly in texture coordinates.
+fn gradient_tc(tc: vec3<f32>, s: vec4<f32>) -> Gradient {
     if (PRECOMPUTED_GRADIENT && !FORWARD_DIFF) {
         let d = textureSampleLevel(gradient_tex, volume_sampler, tc, 0.0).xyz;
         var g: Gradient;

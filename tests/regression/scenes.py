@@ -141,6 +141,12 @@ def wavelet_tf(interpolation="nearest", shade=False, unit_distance=1.0, opacity=
     return make
 
 
+# An opacity peak about the wavelet's middle values: the opacity's gradient turns over at
+# the peak, where the scalar's does not.
+WAVELET_PEAK_OPACITY = [(37.3531, 0.0), (130.0, 0.0), (160.0, 0.8), (190.0, 0.0),
+                        (276.829, 0.0)]
+
+
 def wavelet_gradient_opacity():
     p = wavelet_tf("linear")()
     g = vtk.vtkPiecewiseFunction()
@@ -344,6 +350,23 @@ def volumetric(blending, reach):
     return f
 
 
+def shaded(make_prop):
+    def make():
+        p = make_prop()
+        p.ShadeOn()
+        return p
+    return make
+
+
+def normal_from_opacity(*more):
+    """vtkVolumeMapper::ComputeNormalFromOpacity on, then each of `more` (mapper settings)."""
+    def f(m):
+        m.ComputeNormalFromOpacityOn()
+        for g in more:
+            g(m)
+    return f
+
+
 def anisotropic(make_prop, g):
     def make():
         p = make_prop()
@@ -432,6 +455,17 @@ SCENES = [
     Scene("wavelet-gradient-opacity", "wavelet 128^3, composite, linear, gradient opacity "
           "0..10 (VTK units)", "wavelet128", wavelet_gradient_opacity,
           note=SAMPLING_NOTE),
+    Scene("wavelet-gradient-opacity-normal-from-opacity", "wavelet 128^3, composite, linear, "
+          "gradient opacity 0..10 (VTK units), shaded with normals from the gradient of "
+          "opacity x gradient opacity (ComputeNormalFromOpacity)", "wavelet128",
+          shaded(wavelet_gradient_opacity), configure=normal_from_opacity(),
+          note=SAMPLING_NOTE),
+    Scene("wavelet-volumetric-normal-from-opacity", "wavelet 128^3, composite, linear, "
+          "volumetric shadows blended with gradient shading (VolumetricScatteringBlending "
+          "0.7, GlobalIlluminationReach 0.5), normals and the blending's gradient from the "
+          "opacity (ComputeNormalFromOpacity), opacity peak at 160", "wavelet128",
+          wavelet_tf("linear", shade=True, opacity=WAVELET_PEAK_OPACITY),
+          configure=normal_from_opacity(volumetric(0.7, 0.5)), note=SAMPLING_NOTE),
     Scene("wavelet-volumetric-headlight", "wavelet 128^3, composite, linear, volumetric "
           "shadows only (VolumetricScatteringBlending 2, GlobalIlluminationReach 0.5, "
           "anisotropy 0.3), headlight", "wavelet128",
@@ -531,6 +565,12 @@ SCENES = [
     Scene("ml-composite-shaded", "Marschner-Lobb 41^3, narrow opacity peak at 0.5, shaded "
           "(reconstruction and gradient quality)", "marschner_lobb", ml_tf(), quick=True,
           views=one(camera=orbit(0, 30)),
+          note=SAMPLING_NOTE + " Gradients: VTK's central difference spans N/(N-1) voxels "
+          "(41/40 here), ferrovol's exactly one."),
+    Scene("ml-composite-shaded-normal-from-opacity", "Marschner-Lobb 41^3, narrow opacity "
+          "peak at 0.5, shaded with normals from the opacity gradient "
+          "(ComputeNormalFromOpacity: they turn over past the peak)", "marschner_lobb",
+          ml_tf(), quick=True, views=one(camera=orbit(0, 30)), configure=normal_from_opacity(),
           note=SAMPLING_NOTE + " Gradients: VTK's central difference spans N/(N-1) voxels "
           "(41/40 here), ferrovol's exactly one."),
     Scene("ml-mip", "Marschner-Lobb 41^3, maximum intensity", "marschner_lobb",

@@ -189,8 +189,9 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
 }
 
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
-  vtkRenderer* ren, vtkVolume* vol, vtkImageData* input, ferrovol::Renderer& renderer,
-  double traceBudget, std::set<std::string>& warned, std::string& error)
+  vtkRenderer* ren, vtkVolume* vol, vtkImageData* input, int components,
+  ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
+  std::string& error)
 {
   vtkVolumeProperty* prop = vol->GetProperty();
   FvRenderParams& params = this->Params;
@@ -253,11 +254,21 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   params.shade =
     prop->GetShade(0) != 0 && (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface);
   this->WarnUnsupported(self, warned);
-  if (self->GetComputeNormalFromOpacity() && params.shade &&
-    warned.insert("normal-from-opacity").second)
+  if (self->GetComputeNormalFromOpacity() && params.shade)
   {
-    vtkWarningWithObjectMacro(self, << "ComputeNormalFromOpacity is not supported by ferrovol "
-                                       "yet: shading normals come from the scalar gradient");
+    // vtkGPUVolumeRayCastMapper's computeDensityGradient: normals from the opacity's
+    // gradient. ferrovol takes them in composite ray casting of one or independent
+    // components.
+    const bool dependent = components > 1 && !prop->GetIndependentComponents();
+    params.normal_from_opacity = !isosurface && !dependent;
+    if (!params.normal_from_opacity && warned.insert("normal-from-opacity").second)
+    {
+      vtkWarningWithObjectMacro(self, << "ComputeNormalFromOpacity: ferrovol takes normals "
+                                         "from the opacity in the composite blend mode of "
+                                         "one or independent components; "
+                                      << (isosurface ? "isosurfaces" : "dependent components")
+                                      << " are shaded with the scalar gradient");
+    }
   }
   params.ambient = static_cast<float>(prop->GetAmbient(0));
   params.diffuse = static_cast<float>(prop->GetDiffuse(0));

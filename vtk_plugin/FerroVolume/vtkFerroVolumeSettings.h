@@ -26,17 +26,17 @@ public:
   enum class Result
   {
     Failed,
-    NothingVisible, // every iso-value is transparent (warned once)
+    NothingVisible, // no iso-value, or every iso-value is transparent (warned once)
     Ready
   };
   // Gives the renderer the frame's parameters (and the isosurfaces, path tracing settings
   // and environment in those modes), and warns about the mapper's settings ferrovol does not
   // support. `input`: the image rendered (LockSampleDistanceToInputSpacing reads its
-  // spacing and extent). `traceBudget`: seconds a progressive render's path tracing may
+  // spacing and extent), `components` its scalars' components. `traceBudget`: seconds a progressive render's path tracing may
   // take, 0 when the render is not progressive. `warned`: the warnings said once per mapper.
   Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol, vtkImageData* input,
-    ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
-    std::string& error);
+    int components, ferrovol::Renderer& renderer, double traceBudget,
+    std::set<std::string>& warned, std::string& error);
 
   // Gives the renderer the camera VTK draws the opaque geometry with (for a vw × vh
   // viewport) and the renderer's lights.

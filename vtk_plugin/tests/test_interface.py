@@ -342,12 +342,9 @@ SETTINGS = {
                                  prepare=calls(("AddClippingPlane", plane))),
     "RemoveAllClippingPlanes": image(calls(("RemoveAllClippingPlanes",)),
                                      prepare=calls(("AddClippingPlane", plane))),
-    "SetComputeNormalFromOpacity": warned(calls(("SetComputeNormalFromOpacity", 1)),
-                                          "ComputeNormalFromOpacity"),
-    "ComputeNormalFromOpacityOn": warned(calls(("ComputeNormalFromOpacityOn",)),
-                                         "ComputeNormalFromOpacity"),
-    "ComputeNormalFromOpacityOff": state(calls(("ComputeNormalFromOpacityOff",)),
-                                         lambda m, r: m.GetComputeNormalFromOpacity() == 0,
+    "SetComputeNormalFromOpacity": image(calls(("SetComputeNormalFromOpacity", 1))),
+    "ComputeNormalFromOpacityOn": image(calls(("ComputeNormalFromOpacityOn",))),
+    "ComputeNormalFromOpacityOff": image(calls(("ComputeNormalFromOpacityOff",)),
                                          prepare=calls(("ComputeNormalFromOpacityOn",))),
 
     # vtkGPUVolumeRayCastMapper: sampling

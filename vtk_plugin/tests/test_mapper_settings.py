@@ -172,6 +172,39 @@ class Settings(unittest.TestCase):
         self.assertEqual(len(warnings["9"]), 1)
         self.assertIn("9 clipping planes", warnings["9"][0])
 
+    def test_normal_from_opacity(self):
+        # Composite: normals from the opacity's gradient, silently (an opacity peak turns
+        # them over past it); shaded isosurfaces keep the scalar gradient, with a warning.
+        peak = [(37.3531, 0.0), (130.0, 0.0), (160.0, 0.8), (190.0, 0.0), (276.829, 0.0)]
+
+        def shaded_peak():
+            p = tf_property(opacity=peak, interpolation="linear")
+            p.ShadeOn()
+            p.GetIsoSurfaceValues().SetValue(0, 160.0)
+            return p
+        images, warnings = {}, {}
+        for name, configure in (
+                ("scalar", None),
+                ("opacity", lambda m: m.ComputeNormalFromOpacityOn()),
+                ("iso-scalar", lambda m: m.SetBlendModeToIsoSurface()),
+                ("iso-opacity", lambda m: (m.SetBlendModeToIsoSurface(),
+                                           m.ComputeNormalFromOpacityOn()))):
+            scene, errors = fvtest.ferrovol_scene(self.src, shaded_peak(), configure,
+                                                  size=(120, 120), camera=view)
+            images[name] = scene.render()
+            self.assertEqual(errors.messages, [], name)
+            warnings[name] = errors.warnings
+        save("settings-normal-from-opacity", images["scalar"], images["opacity"])
+        d, d_iso = (mean_diff(images["scalar"], images["opacity"]),
+                    mean_diff(images["iso-scalar"], images["iso-opacity"]))
+        fvtest.log("  ComputeNormalFromOpacity: composite changes %.2f, isosurface %.2f; "
+                   "warnings %s" % (d, d_iso, warnings["iso-opacity"]))
+        self.assertGreater(d, 0.3)
+        self.assertEqual(d_iso, 0.0)
+        self.assertEqual(warnings["opacity"], [])
+        self.assertEqual(len(warnings["iso-opacity"]), 1)
+        self.assertIn("ComputeNormalFromOpacity", warnings["iso-opacity"][0])
+
     def test_sample_distance(self):
         def sd(d):
             def f(m):

@@ -82,6 +82,11 @@ pub struct Shading {
     /// Henyey–Greenstein anisotropy of the volumetric term, −1 to 1
     /// (vtkVolumeProperty::ScatteringAnisotropy).
     pub scattering_anisotropy: f32,
+    /// Shading normals from the gradient of the step-corrected opacity (the transfer
+    /// function's, times gradient opacity when on) instead of the scalar's, as
+    /// vtkVolumeMapper::ComputeNormalFromOpacity: composite ray casting, one or independent
+    /// components; isosurfaces and path tracing keep the scalar gradient.
+    pub normal_from_opacity: bool,
 }
 
 impl Default for Shading {
@@ -97,6 +102,7 @@ impl Default for Shading {
             volumetric_blending: 0.0,
             global_illumination_reach: 0.0,
             scattering_anisotropy: 0.0,
+            normal_from_opacity: false,
         }
     }
 }

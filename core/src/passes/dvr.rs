@@ -30,6 +30,7 @@ pipeline_variant! {
         positional_lights: bool => "POSITIONAL_LIGHTS",
         lights: u32 => "NUM_LIGHTS",
         volumetric: bool => "VOLUMETRIC",
+        opacity_normal: bool => "OPACITY_NORMAL",
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
@@ -106,6 +107,26 @@ impl DvrPass {
             && matches!(params.blend, BlendMode::Maximum | BlendMode::Minimum)
             && vol.components == 1
             && !streaming;
+        // ComputeNormalFromOpacity: composite and shaded; one or independent components.
+        let opacity_normal = params.shading.enabled
+            && params.shading.normal_from_opacity
+            && params.blend == BlendMode::Composite;
+        if opacity_normal && vol.components > 1 && !f.independent {
+            return Err(Error::Unsupported(format!(
+                "shading normals from the opacity gradient need one or independent components \
+                 (this volume has {} dependent ones): turn normal_from_opacity off",
+                vol.components
+            )));
+        }
+        if opacity_normal && f.gradient_opacity && !vol.single_brick() {
+            return Err(Error::Unsupported(
+                "shading normals from the opacity gradient with gradient opacity read two \
+                 voxels around each sample, beyond a brick's apron, and this volume is \
+                 bricked (larger than one texture or than the memory budget): turn gradient \
+                 opacity or normal_from_opacity off"
+                    .into(),
+            ));
+        }
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
@@ -120,6 +141,7 @@ impl DvrPass {
             positional_lights: f.positional_lights(),
             lights: f.lights(),
             volumetric: f.volumetric,
+            opacity_normal,
             precomputed_gradient: vol.gradients,
             forward_diff: params.gradient == GradientMethod::Forward,
             streaming,

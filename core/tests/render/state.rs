@@ -334,3 +334,83 @@ fn precomputed_gradients_equal_on_the_fly() {
         assert!(max <= 1, "precomputed gradients differ by {max} levels");
     }
 }
+
+/// Shading normals from the opacity's gradient (VTK's ComputeNormalFromOpacity): with an
+/// opacity peak the normals turn over past it, so the image changes; precomputed scalar
+/// gradients (which gradient opacity at the neighbours reads) give the on-the-fly image;
+/// a bricked volume draws the one-brick image, and refuses gradient opacity with it (the
+/// neighbours' gradients reach beyond a brick's apron).
+#[test]
+fn normals_from_opacity() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    let peak = crate::common::scenes::component_transfer(
+        &[(0.0, [0.9, 0.6, 0.2]), (1.0, [1.0, 1.0, 0.9])],
+        &[(0.0, 0.0), (0.2, 0.0), (0.3, 0.3), (0.4, 0.0), (1.0, 0.0)],
+        1.0,
+    );
+    let view = View::fit(vol.bounds(), 80, 80);
+    let from_opacity = |on: bool| {
+        let mut p = shaded();
+        p.shading.normal_from_opacity = on;
+        p
+    };
+    let render = |r: &mut Renderer, tf: &ComponentTransfer, pre: bool, bricks: Option<u32>| {
+        r.set_volume_with(
+            &vol,
+            UploadOptions {
+                max_brick_points: bricks,
+                precompute_gradients: Some(pre),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        r.set_transfer_function(&TransferFunction::single(tf.clone()))
+            .unwrap();
+        [false, true].map(|on| r.render_image(&view, &from_opacity(on)).unwrap())
+    };
+    let [scalar, opacity] = render(&mut r, &peak, false, None);
+    save_enlarged(&opacity, "normals_from_opacity");
+    let (mean, max) = image_diff(&scalar, &opacity);
+    println!(
+        "normals from opacity vs scalar: mean {mean:.3}/255, max {max}/255; {} pixels covered",
+        footprint(&opacity)
+    );
+    assert!(footprint(&opacity) > 1000);
+    // (means over the whole frame, a sixth of it covered)
+    assert!(
+        mean > 0.5 && max > 30,
+        "normals from the opacity change the image"
+    );
+
+    let [_, split] = render(&mut r, &peak, false, Some(16));
+    let (mean, max) = image_diff(&opacity, &split);
+    println!(
+        "{} bricks vs one: mean {mean:.4}/255, max {max}/255",
+        r.brick_count()
+    );
+    assert!(
+        max <= 2,
+        "bricked normals from opacity differ by {max} levels"
+    );
+
+    let mut graded = peak.clone();
+    graded.gradient_opacity = Some(piecewise1(&[(0.0, 0.2), (0.05, 1.0)]));
+    let [plain, fly] = render(&mut r, &graded, false, None);
+    let [_, pre] = render(&mut r, &graded, true, None);
+    let (mean_go, _) = image_diff(&plain, &fly);
+    let (mean, max) = image_diff(&fly, &pre);
+    println!(
+        "with gradient opacity: vs scalar normals mean {mean_go:.3}/255; precomputed vs \
+         on-the-fly mean {mean:.4}/255, max {max}/255"
+    );
+    assert!(mean_go > 0.5, "normals from the opacity change the image");
+    assert!(max <= 1, "precomputed gradients differ by {max} levels");
+
+    set_bricked(&mut r, &vol, 16);
+    assert_error(
+        r.render(&view, &from_opacity(true), None),
+        "normals from opacity, gradient opacity, bricked",
+        &["gradient opacity", "bricked"],
+    );
+}
