@@ -56,13 +56,14 @@ fn block_keeps_extremum(p: vec3<f32>, v: f32) -> bool {
     return r.x >= v;
 }
 
-// Step-corrected opacity of every component at pool texture coordinate tc, times gradient
-// opacity when it is on (VTK's opacity of a neighbour in ComputeNormalFromOpacity).
-fn opacities_at(tc: vec3<f32>) -> vec4<f32> {
+// Step-corrected opacity of every component at pool texture coordinate tc (index-space
+// point q), times gradient opacity when it is on (VTK's opacity of a neighbour in
+// ComputeNormalFromOpacity).
+fn opacities_at(tc: vec3<f32>, q: vec3<f32>) -> vec4<f32> {
     let s = scalars_at(tc);
     var g: Gradient;
     if (GRAD_OPACITY) {
-        g = gradient_tc(tc, s);
+        g = gradient_tc(tc, q, s);
     }
     var a = vec4<f32>(0.0);
     for (var c = 0u; c < NCOMP; c = c + 1u) {
@@ -87,9 +88,12 @@ fn opacity_gradient_at(p: vec3<f32>) -> Gradient {
     let dx = vec3<f32>(pool.inv_size.x, 0.0, 0.0);
     let dy = vec3<f32>(0.0, pool.inv_size.y, 0.0);
     let dz = vec3<f32>(0.0, 0.0, pool.inv_size.z);
-    g.x = 0.5 * (opacities_at(tc + dx) - opacities_at(tc - dx));
-    g.y = 0.5 * (opacities_at(tc + dy) - opacities_at(tc - dy));
-    g.z = 0.5 * (opacities_at(tc + dz) - opacities_at(tc - dz));
+    let ex = vec3<f32>(1.0, 0.0, 0.0);
+    let ey = vec3<f32>(0.0, 1.0, 0.0);
+    let ez = vec3<f32>(0.0, 0.0, 1.0);
+    g.x = 0.5 * (opacities_at(tc + dx, p + ex) - opacities_at(tc - dx, p - ex));
+    g.y = 0.5 * (opacities_at(tc + dy, p + ey) - opacities_at(tc - dy, p - ey));
+    g.z = 0.5 * (opacities_at(tc + dz, p + ez) - opacities_at(tc - dz, p - ez));
     return g;
 }
 

@@ -420,6 +420,12 @@ typedef struct FvRenderParams {
   uint32_t clip_plane_count;
   struct FvPlane clip_planes[FV_MAX_CLIP_PLANES];
   /**
+   * Gradients read clipped_voxel_value (per component, data units) at neighbours beyond a
+   * clipping plane (vtkVolumeProperty::UseClippedVoxelIntensity): composite mode.
+   */
+  bool clipped_voxel_enabled;
+  double clipped_voxel_value[4];
+  /**
    * Average blend mode: ignore samples outside average_range (AverageIPScalarRange).
    */
   bool average_range_enabled;

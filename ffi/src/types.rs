@@ -225,6 +225,10 @@ pub struct FvRenderParams {
     pub cropping_regions: u32,
     pub clip_plane_count: u32,
     pub clip_planes: [FvPlane; FV_MAX_CLIP_PLANES],
+    /// Gradients read clipped_voxel_value (per component, data units) at neighbours beyond a
+    /// clipping plane (vtkVolumeProperty::UseClippedVoxelIntensity): composite mode.
+    pub clipped_voxel_enabled: bool,
+    pub clipped_voxel_value: [f64; 4],
     /// Average blend mode: ignore samples outside average_range (AverageIPScalarRange).
     pub average_range_enabled: bool,
     pub average_range: [f64; 2],
@@ -346,6 +350,8 @@ impl FvRenderParams {
             cropping_regions: Cropping::SUBVOLUME,
             clip_plane_count: 0,
             clip_planes: [FvPlane::default(); FV_MAX_CLIP_PLANES],
+            clipped_voxel_enabled: false,
+            clipped_voxel_value: [0.0; 4],
             average_range_enabled: false,
             average_range: [0.0, 0.0],
             empty_space_skipping: d.empty_space_skipping,
@@ -428,6 +434,9 @@ impl ToCore for FvRenderParams {
                     normal: DVec3::from_array(p.normal),
                 })
                 .collect(),
+            clipped_voxel_value: self
+                .clipped_voxel_enabled
+                .then_some(self.clipped_voxel_value),
             average_range: self.average_range_enabled.then_some(self.average_range),
             empty_space_skipping: self.empty_space_skipping,
             depth_threshold: self.depth_threshold,

@@ -113,6 +113,9 @@ override PRECOMPUTED_GRADIENT: bool = false;
 // flag: lavapipe runs both sides of a branch on a uniform value, so a flag would cost the
 // 6 samples and the 3.
 override FORWARD_DIFF: bool = false;
+// VTK's UseClippedVoxelIntensity: a gradient's neighbour beyond a clipping plane reads
+// frame.clipped_value instead of the data (a pipeline constant of the DVR pass).
+override CLIPPED_VOXEL: bool = false;
 
 // Pool texture coordinate of index-space point p (in the brick that holds it).
 fn pool_coord(p: vec3<f32>) -> vec3<f32> {
@@ -148,13 +151,33 @@ struct Gradient {
 // Index-space gradient of every component at p: central differences (6 samples) or forward
 // differences from the centre value s (3 samples).
 fn brick_gradient(p: vec3<f32>, s: vec4<f32>) -> Gradient {
-    return gradient_tc(pool_coord(p), s);
+    return gradient_tc(pool_coord(p), p, s);
 }
 
-// Index-space gradient of every component at pool texture coordinate tc, whose scalars are
-// s: the neighbours one voxel away, offset directly in texture coordinates.
-fn gradient_tc(tc: vec3<f32>, s: vec4<f32>) -> Gradient {
-    if (PRECOMPUTED_GRADIENT && !FORWARD_DIFF) {
+// Whether index-space point q lies beyond a clipping plane.
+fn beyond_clip(q: vec3<f32>) -> bool {
+    for (var i = 0u; i < frame.counts.x; i = i + 1u) {
+        let pl = frame.clip[i];
+        if (dot(pl.xyz, q) + pl.w < 0.0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Scalars of a gradient's neighbour at pool texture coordinate tc, index-space point q.
+fn neighbour(tc: vec3<f32>, q: vec3<f32>) -> vec4<f32> {
+    if (CLIPPED_VOXEL && beyond_clip(q)) {
+        return frame.clipped_value;
+    }
+    return scalars_at(tc);
+}
+
+// Index-space gradient of every component at pool texture coordinate tc (index-space point
+// p), whose scalars are s: the neighbours one voxel away, offset directly in texture
+// coordinates.
+fn gradient_tc(tc: vec3<f32>, p: vec3<f32>, s: vec4<f32>) -> Gradient {
+    if (PRECOMPUTED_GRADIENT && !FORWARD_DIFF && !CLIPPED_VOXEL) {
         let d = textureSampleLevel(gradient_tex, volume_sampler, tc, 0.0).xyz;
         var g: Gradient;
         g.x = vec4<f32>(d.x, 0.0, 0.0, 0.0);
@@ -166,14 +189,17 @@ fn gradient_tc(tc: vec3<f32>, s: vec4<f32>) -> Gradient {
     let dy = vec3<f32>(0.0, pool.inv_size.y, 0.0);
     let dz = vec3<f32>(0.0, 0.0, pool.inv_size.z);
     var g: Gradient;
+    let ex = vec3<f32>(1.0, 0.0, 0.0);
+    let ey = vec3<f32>(0.0, 1.0, 0.0);
+    let ez = vec3<f32>(0.0, 0.0, 1.0);
     if (FORWARD_DIFF) {
-        g.x = scalars_at(tc + dx) - s;
-        g.y = scalars_at(tc + dy) - s;
-        g.z = scalars_at(tc + dz) - s;
+        g.x = neighbour(tc + dx, p + ex) - s;
+        g.y = neighbour(tc + dy, p + ey) - s;
+        g.z = neighbour(tc + dz, p + ez) - s;
     } else {
-        g.x = 0.5 * (scalars_at(tc + dx) - scalars_at(tc - dx));
-        g.y = 0.5 * (scalars_at(tc + dy) - scalars_at(tc - dy));
-        g.z = 0.5 * (scalars_at(tc + dz) - scalars_at(tc - dz));
+        g.x = 0.5 * (neighbour(tc + dx, p + ex) - neighbour(tc - dx, p - ex));
+        g.y = 0.5 * (neighbour(tc + dy, p + ey) - neighbour(tc - dy, p - ey));
+        g.z = 0.5 * (neighbour(tc + dz, p + ez) - neighbour(tc - dz, p - ez));
     }
     return g;
 }

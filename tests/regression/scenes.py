@@ -350,6 +350,28 @@ def volumetric(blending, reach):
     return f
 
 
+def clipped_voxel_intensity(make_prop, value):
+    """make_prop's property with UseClippedVoxelIntensity on at `value`."""
+    def make():
+        p = make_prop()
+        p.UseClippedVoxelIntensityOn()
+        p.SetClippedVoxelIntensity(value)
+        return p
+    return make
+
+
+def both(*configures):
+    def f(m):
+        for c in configures:
+            c(m)
+    return f
+
+
+# A clipping plane through the wavelet's centre facing the default orbit camera: the cut face
+# fills the view.
+FACING_PLANE = ((0, 0, 0), (-0.47, -0.34, -0.81))
+
+
 def shaded(make_prop):
     def make():
         p = make_prop()
@@ -521,6 +543,19 @@ SCENES = [
           "ferrovol is given the planes where VTK 9.2 actually clips (c + (o - c) N/(N-1))",
           "wavelet128", wavelet_tf("linear"), quick=True,
           configure=clip_planes_vtk_placed(EIGHT_CORNER_PLANES, 128, -0.5),
+          note=SAMPLING_NOTE),
+    Scene("wavelet-clip-clipped-voxel-intensity", "wavelet 128^3, shaded, a clipping plane "
+          "facing the camera, UseClippedVoxelIntensity at 40 (gradients see a low wall "
+          "beyond the plane: a lit cut face), sample distance 0.25", "wavelet128",
+          clipped_voxel_intensity(wavelet_tf("linear", shade=True), 40.0), quick=True,
+          configure=both(clip_planes(FACING_PLANE), sample_distance(0.25)),
+          note=SAMPLING_NOTE + " The first sample lies a step beyond the plane: at a "
+          "quarter voxel the gradients' neighbours reach across it."),
+    Scene("wavelet-clip-clipped-voxel-intensity-gradient-opacity", "as "
+          "wavelet-clip-clipped-voxel-intensity, unshaded, with gradient opacity 0..10 (VTK "
+          "units) reading the value beyond the plane", "wavelet128",
+          clipped_voxel_intensity(wavelet_gradient_opacity, 40.0),
+          configure=both(clip_planes(FACING_PLANE), sample_distance(0.25)),
           note=SAMPLING_NOTE),
     Scene("wavelet-sphere", "wavelet 128^3 with an opaque sphere intersecting it (depth "
           "in and out)", "wavelet128", wavelet_tf("linear"), quick=True,

@@ -351,6 +351,11 @@ bool vtkFerroVolumeInputHelper::Key::operator==(const Key& o) const
     this->Components == o.Components && this->Budget == o.Budget;
 }
 
+int vtkFerroVolumeInputHelper::GetDataType() const
+{
+  return this->Scalars ? this->Scalars->GetDataType() : VTK_VOID;
+}
+
 bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& error)
 {
   this->Image = nullptr;

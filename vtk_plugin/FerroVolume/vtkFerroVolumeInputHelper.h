@@ -36,6 +36,8 @@ public:
 
   vtkImageData* GetImage() const { return this->Image; }
   int GetComponents() const { return this->Components; }
+  // The selected scalars' VTK type (VTK_VOID before Select).
+  int GetDataType() const;
   // Each component's finite data range.
   const Ranges& GetRanges() const { return this->ComponentRanges; }
   // The mean voxel spacing, VTK's unit of gradient magnitude.

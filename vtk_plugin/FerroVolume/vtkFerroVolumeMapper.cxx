@@ -499,8 +499,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
       vtkFerroVolumeRefinement::FrameBudget(this->PathTracingTimeBudget, win), denoised);
   }
   switch (
-    in->Settings.Apply(this, ren, vol, image, in->Input.GetComponents(), *in->Renderer,
-      traceBudget, in->Warned, error))
+    in->Settings.Apply(this, ren, vol, in->Input, *in->Renderer, traceBudget, in->Warned, error))
   {
     case vtkFerroVolumeSettings::Result::Failed:
       vtkErrorMacro(<< error);

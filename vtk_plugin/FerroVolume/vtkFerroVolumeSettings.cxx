@@ -4,6 +4,7 @@
 #include "vtkContourValues.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
+#include "vtkFerroVolumeInputHelper.h"
 #include "vtkFerroVolumeMapper.h"
 #include "vtkImageData.h"
 #include "vtkLight.h"
@@ -20,6 +21,7 @@
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -160,6 +162,32 @@ FvCamera ToFvCamera(vtkRenderer* ren, int vw, int vh)
   }
   return fcam;
 }
+
+// ClippedVoxelIntensity in the data units of a component with data range `range`.
+// vtkGPUVolumeRayCastMapper puts the value in place of a neighbour's texel, before scaling
+// texels to the range, so its unit is the texel's: the data's own for float, the
+// normalised integer texel for the 8- and 16-bit types (value / 255, / 127, / 32767,
+// / 65535), and the range mapped onto [0, 1] for the types it converts on upload (int,
+// long, double…).
+double ClippedIntensityInDataUnits(int type, double value, const std::array<double, 2>& range)
+{
+  switch (type)
+  {
+    case VTK_FLOAT:
+      return value;
+    case VTK_UNSIGNED_CHAR:
+      return value * 255.0;
+    case VTK_SIGNED_CHAR:
+      return value * 127.0;
+    case VTK_SHORT:
+      return value * 32767.0;
+    case VTK_UNSIGNED_SHORT:
+      return value * 65535.0;
+    default:
+      return range[0] + value * (range[1] - range[0]);
+  }
+}
+
 } // namespace
 
 bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::string& error)
@@ -189,7 +217,7 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
 }
 
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
-  vtkRenderer* ren, vtkVolume* vol, vtkImageData* input, int components,
+  vtkRenderer* ren, vtkVolume* vol, const vtkFerroVolumeInputHelper& input,
   ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
   std::string& error)
 {
@@ -228,8 +256,8 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       // the input's spacing (by magnitude) and extent, whatever SampleDistance says.
       double spacing[3];
       int extent[6];
-      input->GetSpacing(spacing);
-      input->GetExtent(extent);
+      input.GetImage()->GetSpacing(spacing);
+      input.GetImage()->GetExtent(extent);
       for (double& s : spacing)
       {
         s = std::fabs(s);
@@ -259,7 +287,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     // vtkGPUVolumeRayCastMapper's computeDensityGradient: normals from the opacity's
     // gradient. ferrovol takes them in composite ray casting of one or independent
     // components.
-    const bool dependent = components > 1 && !prop->GetIndependentComponents();
+    const bool dependent = input.GetComponents() > 1 && !prop->GetIndependentComponents();
     params.normal_from_opacity = !isosurface && !dependent;
     if (!params.normal_from_opacity && warned.insert("normal-from-opacity").second)
     {
@@ -307,6 +335,25 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       plane->GetNormal(params.clip_planes[i].normal);
     }
     params.clip_plane_count = static_cast<uint32_t>(count);
+    if (prop->GetUseClippedVoxelIntensity() && count > 0)
+    {
+      params.clipped_voxel_enabled = true;
+      for (int c = 0; c < 4; ++c)
+      {
+        params.clipped_voxel_value[c] = ClippedIntensityInDataUnits(
+          input.GetDataType(), prop->GetClippedVoxelIntensity(), input.GetRanges()[c]);
+      }
+      if ((isosurface || params.normal_from_opacity) &&
+        warned.insert("clipped-voxel-intensity").second)
+      {
+        vtkWarningWithObjectMacro(self, << "UseClippedVoxelIntensity: ferrovol uses "
+                                           "ClippedVoxelIntensity in the scalar gradient of "
+                                           "composite ray casting; "
+                                        << (isosurface ? "isosurface normals"
+                                                       : "normals from the opacity")
+                                        << " read the data beyond the clipping planes");
+      }
+    }
   }
   params.average_range_enabled = this->Blend == FV_BLEND_MODE_AVERAGE;
   const double* average = self->GetAverageIPScalarRange();

@@ -11,8 +11,8 @@
 #include <set>
 #include <string>
 
+class vtkFerroVolumeInputHelper;
 class vtkFerroVolumeMapper;
-class vtkImageData;
 class vtkRenderer;
 class vtkVolume;
 
@@ -31,11 +31,11 @@ public:
   };
   // Gives the renderer the frame's parameters (and the isosurfaces, path tracing settings
   // and environment in those modes), and warns about the mapper's settings ferrovol does not
-  // support. `input`: the image rendered (LockSampleDistanceToInputSpacing reads its
-  // spacing and extent), `components` its scalars' components. `traceBudget`: seconds a progressive render's path tracing may
+  // support. `input`: the image and scalars rendered (LockSampleDistanceToInputSpacing reads
+  // the spacing and extent; ClippedVoxelIntensity the type and ranges). `traceBudget`: seconds a progressive render's path tracing may
   // take, 0 when the render is not progressive. `warned`: the warnings said once per mapper.
-  Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol, vtkImageData* input,
-    int components, ferrovol::Renderer& renderer, double traceBudget,
+  Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
+    const vtkFerroVolumeInputHelper& input, ferrovol::Renderer& renderer, double traceBudget,
     std::set<std::string>& warned, std::string& error);
 
   // Gives the renderer the camera VTK draws the opaque geometry with (for a vw × vh

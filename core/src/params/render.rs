@@ -148,6 +148,11 @@ pub struct RenderParams {
     pub shading: Shading,
     pub cropping: Option<Cropping>,
     pub clip_planes: Vec<ClipPlane>,
+    /// What each component reads, in data units, at a gradient's neighbour beyond a clipping
+    /// plane (vtkVolumeProperty::UseClippedVoxelIntensity / ClippedVoxelIntensity): shading
+    /// and gradient opacity of composite ray casting see the cut as a wall of this value.
+    /// None: the data beyond the plane.
+    pub clipped_voxel_value: Option<[f64; 4]>,
     /// AverageIPScalarRange: samples outside are ignored by the average blend mode.
     pub average_range: Option<[f64; 2]>,
     /// Skip blocks classified empty by the transfer function (composite mode), and blocks
@@ -172,6 +177,7 @@ impl Default for RenderParams {
             shading: Shading::default(),
             cropping: None,
             clip_planes: Vec::new(),
+            clipped_voxel_value: None,
             average_range: None,
             empty_space_skipping: true,
             depth_threshold: 0.0,
@@ -211,6 +217,13 @@ impl RenderParams {
             if !p.origin.is_finite() || !p.normal.is_finite() || p.normal.length() < 1e-12 {
                 return Err(Error::InvalidParameter(format!(
                     "clipping plane {p:?} needs a finite origin and a non-zero normal"
+                )));
+            }
+        }
+        if let Some(v) = self.clipped_voxel_value {
+            if v.iter().any(|x| x.is_nan()) {
+                return Err(Error::InvalidParameter(format!(
+                    "clipped voxel value {v:?} must not be NaN"
                 )));
             }
         }

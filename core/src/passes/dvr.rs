@@ -31,6 +31,7 @@ pipeline_variant! {
         lights: u32 => "NUM_LIGHTS",
         volumetric: bool => "VOLUMETRIC",
         opacity_normal: bool => "OPACITY_NORMAL",
+        clipped_voxel: bool => "CLIPPED_VOXEL",
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
@@ -142,6 +143,10 @@ impl DvrPass {
             lights: f.lights(),
             volumetric: f.volumetric,
             opacity_normal,
+            clipped_voxel: params.clipped_voxel_value.is_some()
+                && !params.clip_planes.is_empty()
+                && params.blend == BlendMode::Composite
+                && (params.shading.enabled || f.gradient_opacity),
             precomputed_gradient: vol.gradients,
             forward_diff: params.gradient == GradientMethod::Forward,
             streaming,

@@ -246,6 +246,10 @@ pub(crate) fn frame(
         let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
         u.clip[i] = [ni.x as f32, ni.y as f32, ni.z as f32, w as f32];
     }
+    if let Some(v) = params.clipped_voxel_value {
+        // (an infinite value, VTK's default VTK_DOUBLE_MIN, kept finite in f32)
+        u.clipped_value = v.map(|x| x.clamp(-f32::MAX as f64, f32::MAX as f64) as f32);
+    }
     let mut nl = 0;
     if s.enabled {
         for l in view.lights.iter().take(MAX_LIGHTS) {

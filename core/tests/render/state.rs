@@ -187,6 +187,14 @@ fn errors() {
             "9 clipping planes",
         ),
         (
+            "clipped voxel value NaN",
+            RenderParams {
+                clipped_voxel_value: Some([f64::NAN, 0.0, 0.0, 0.0]),
+                ..Default::default()
+            },
+            "clipped voxel value",
+        ),
+        (
             "termination threshold 0",
             RenderParams {
                 termination_threshold: 0.0,
@@ -412,5 +420,49 @@ fn normals_from_opacity() {
         r.render(&view, &from_opacity(true), None),
         "normals from opacity, gradient opacity, bricked",
         &["gradient opacity", "bricked"],
+    );
+}
+
+/// A clipped voxel value (VTK's UseClippedVoxelIntensity): gradients next to a clipping
+/// plane read it beyond the plane, so a cut through a shaded blob is lit as a wall; without
+/// clipping planes it changes nothing.
+#[test]
+fn clipped_voxel_value_lights_the_cut() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 80, 80);
+    let b = vol.bounds();
+    let centre = DVec3::new(b[0] + b[1], b[2] + b[3], b[4] + b[5]) * 0.5;
+    let eye = view.camera.position;
+    let cut = |value: Option<[f64; 4]>, planes: bool| RenderParams {
+        clip_planes: if planes {
+            vec![ClipPlane {
+                origin: centre,
+                normal: centre - eye,
+            }]
+        } else {
+            vec![]
+        },
+        clipped_voxel_value: value,
+        sample_distance: Some(0.25 * vol.spacing[0]),
+        ..shaded()
+    };
+    let wall = Some([0.0; 4]);
+    let data = r.render_image(&view, &cut(None, true)).unwrap();
+    let walled = r.render_image(&view, &cut(wall, true)).unwrap();
+    save_enlarged(&walled, "clipped_voxel_value");
+    let (mean, max) = image_diff(&data, &walled);
+    println!("clipped voxel value 0 vs the data beyond the cut: mean {mean:.3}/255, max {max}/255");
+    assert!(footprint(&walled) > 1000);
+    assert!(mean > 0.5 && max > 30, "the value beyond the cut lights it");
+    let whole = r.render_image(&view, &cut(None, false)).unwrap();
+    let whole_walled = r.render_image(&view, &cut(wall, false)).unwrap();
+    assert_eq!(
+        image_diff(&whole, &whole_walled).1,
+        0,
+        "no plane, no change"
     );
 }
