@@ -8,6 +8,7 @@
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkPointData.h"
+#include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
 #include <cmath>
@@ -387,7 +388,32 @@ bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& 
   }
   this->Image = image;
   this->Scalars = scalars;
+  this->CountGhosts();
   return true;
+}
+
+void vtkFerroVolumeInputHelper::CountGhosts()
+{
+  vtkDataArray* arrays[2] = { this->Image->GetPointGhostArray(),
+    this->Image->GetCellGhostArray() };
+  vtkIdType* counts[2] = { &this->GhostCounts.Points, &this->GhostCounts.Cells };
+  for (int a = 0; a < 2; ++a)
+  {
+    const std::pair<vtkDataArray*, vtkMTimeType> key(
+      arrays[a], arrays[a] ? arrays[a]->GetMTime() : 0);
+    if (key == this->GhostKey[a])
+    {
+      continue;
+    }
+    this->GhostKey[a] = key;
+    *counts[a] = 0;
+    if (vtkUnsignedCharArray* ghosts = vtkUnsignedCharArray::SafeDownCast(arrays[a]))
+    {
+      const unsigned char* v = ghosts->GetPointer(0);
+      const vtkIdType n = ghosts->GetNumberOfValues();
+      *counts[a] = n - std::count(v, v + n, static_cast<unsigned char>(0));
+    }
+  }
 }
 
 bool vtkFerroVolumeInputHelper::Upload(

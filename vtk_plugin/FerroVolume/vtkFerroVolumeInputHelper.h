@@ -12,6 +12,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 
 class vtkDataArray;
 class vtkDataObject;
@@ -43,6 +44,15 @@ public:
   // The mean voxel spacing, VTK's unit of gradient magnitude.
   double GetMeanSpacing() const { return this->MeanSpacing; }
 
+  // Points and cells the input's ghost arrays mark (any non-zero byte: hidden or duplicate,
+  // what vtkGPUVolumeRayCastMapper's blanking leaves out), counted when an array changes.
+  struct Ghosts
+  {
+    vtkIdType Points = 0;
+    vtkIdType Cells = 0;
+  };
+  const Ghosts& GetGhosts() const { return this->GhostCounts; }
+
 private:
   // What the uploaded volume was made from: anything here changing means a new upload.
   struct Key
@@ -64,7 +74,13 @@ private:
   vtkDataArray* Scalars = nullptr;
   int CellFlag = 0;
 
+  // Counts the marked entries of the image's ghost arrays, when they changed.
+  void CountGhosts();
+
   std::optional<Key> Uploaded;
+  // The ghost arrays counted last: (array, MTime) for points and for cells.
+  std::array<std::pair<vtkDataArray*, vtkMTimeType>, 2> GhostKey{};
+  Ghosts GhostCounts;
   int Components = 0;
   Ranges ComponentRanges{};
   double MeanSpacing = 1.0;

@@ -282,6 +282,15 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   params.shade =
     prop->GetShade(0) != 0 && (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface);
   this->WarnUnsupported(self, warned);
+  const vtkFerroVolumeInputHelper::Ghosts& ghosts = input.GetGhosts();
+  if ((ghosts.Points > 0 || ghosts.Cells > 0) && warned.insert("ghosts").second)
+  {
+    vtkWarningWithObjectMacro(self, << "the input's ghost arrays mark " << ghosts.Points
+                                    << " points and " << ghosts.Cells
+                                    << " cells (hidden or duplicate, as vtkUniformGrid "
+                                       "blanking): vtkGPUVolumeRayCastMapper leaves them out, "
+                                       "ferrovol does not support blanking and draws them");
+  }
   if (self->GetComputeNormalFromOpacity() && params.shade)
   {
     // vtkGPUVolumeRayCastMapper's computeDensityGradient: normals from the opacity's

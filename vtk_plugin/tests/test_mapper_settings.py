@@ -205,6 +205,49 @@ class Settings(unittest.TestCase):
         self.assertEqual(len(warnings["iso-opacity"]), 1)
         self.assertIn("ComputeNormalFromOpacity", warnings["iso-opacity"][0])
 
+    def test_ghost_arrays_warned(self):
+        # vtkGPUVolumeRayCastMapper leaves cells the ghost arrays mark out (vtkUniformGrid
+        # blanking); ferrovol draws them and says so, naming the counts. An all-zero ghost
+        # array marks nothing: no warning.
+        base = self.src.GetOutput()
+        n = base.GetNumberOfCells()
+
+        def with_ghosts(mark):
+            img = vtk.vtkImageData()
+            img.DeepCopy(base)
+            ghosts = vtk.vtkUnsignedCharArray()
+            ghosts.SetName(vtk.vtkDataSetAttributes.GhostArrayName())
+            ghosts.SetNumberOfTuples(n)
+            ghosts.Fill(0)
+            nx = img.GetDimensions()[0] - 1
+            if mark:
+                for c in range(n):
+                    if c % nx < nx // 2:
+                        ghosts.SetValue(c, vtk.vtkDataSetAttributes.HIDDENCELL)
+            img.GetCellData().AddArray(ghosts)
+            return img
+        hidden, clear = with_ghosts(True), with_ghosts(False)
+        marked = sum(1 for c in range(n) if hidden.GetCellData().GetArray(
+            vtk.vtkDataSetAttributes.GhostArrayName()).GetValue(c))
+        warnings = {}
+        for name, data in (("hidden", hidden), ("clear", clear)):
+            scene, errors = fvtest.ferrovol_scene(data, tf_property(), size=(120, 120),
+                                                  camera=view)
+            scene.render()
+            self.assertEqual(errors.messages, [], name)
+            warnings[name] = errors.warnings
+        vtk_images = []
+        for data in (hidden, base):
+            scene = Scene(vtk.vtkGPUVolumeRayCastMapper(), data, tf_property(),
+                          size=(120, 120), camera=view)
+            vtk_images.append(scene.render())
+        fvtest.log("  ghost arrays: %d of %d cells marked; VTK's image changes by %.2f; "
+                   "warnings %s" % (marked, n, mean_diff(*vtk_images), warnings["hidden"]))
+        self.assertGreater(mean_diff(*vtk_images), 1.0)  # VTK does leave them out
+        self.assertEqual(warnings["clear"], [])
+        self.assertEqual(len(warnings["hidden"]), 1)
+        self.assertIn("%d cells" % marked, warnings["hidden"][0])
+
     def test_sample_distance(self):
         def sd(d):
             def f(m):
