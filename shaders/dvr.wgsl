@@ -40,6 +40,32 @@ override STREAMING: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 
+// VTK's blanking (ghost arrays, vtkUniformGrid): per point of the grid, non-zero where the
+// point is hidden (Renderer::set_blanking); BLANKING is on when the volume has a mask.
+@group(0) @binding(8) var blanking_mask: texture_3d<u32>;
+override BLANKING: bool = false;
+
+// Whether the sample at index-space point p is left out: vtkGPUVolumeRayCastMapper skips it
+// when the point nearest to it, or either point around it along an axis (the others
+// rounded), is hidden.
+fn blanked(p: vec3<f32>) -> bool {
+    let hi = vec3<i32>(frame.dims.xyz) - 1;
+    let q = clamp(p, vec3<f32>(0.0), vec3<f32>(hi));
+    let r = vec3<i32>(floor(q + 0.5));
+    let lo = vec3<i32>(floor(q));
+    let up = min(lo + 1, hi);
+    var any = textureLoad(blanking_mask, r, 0).x != 0u;
+    for (var a = 0; a < 3; a = a + 1) {
+        var below = r;
+        var above = r;
+        below[a] = lo[a];
+        above[a] = up[a];
+        any = any || textureLoad(blanking_mask, below, 0).x != 0u
+                  || textureLoad(blanking_mask, above, 0).x != 0u;
+    }
+    return any;
+}
+
 
 // Per min–max block, the first component's (min, max) over every point a sample in the
 // block interpolates from (nearest or trilinear), widened where the storage rounds the data
@@ -323,7 +349,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 let t = seg.x + (k + jit) * dt;
                 let p = ray.index_origin + t * ray.index_dir;
-                if (!CROP || in_crop(p)) {
+                if ((!CROP || in_crop(p)) && !(BLANKING && blanked(p))) {
                     let s = sample_scalars(p);
                     if (blend == BLEND_MAXIMUM) {
                         value = select(max(value, s), s, misc.x == 0.0);
@@ -346,7 +372,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
             continue;
         }
-        if (CROP && !in_crop(p)) {
+        if ((CROP && !in_crop(p)) || (BLANKING && blanked(p))) {
             k = k + 1.0;
             continue;
         }

@@ -92,6 +92,16 @@ impl Renderer {
         self.res.set_volume(&self.ctx, HostVolume::Shared(v), opts)
     }
 
+    /// Blanks points of the current volume's grid (VTK's ghost arrays and vtkUniformGrid
+    /// blanking): `mask` holds one byte per point, x fastest, non-zero where the point is
+    /// hidden. Ray casting skips a sample when the point nearest to it or the points around
+    /// it along an axis are hidden, as vtkGPUVolumeRayCastMapper does; isosurfaces and path
+    /// tracing do not read the mask. `None` clears it; a new volume clears it too. A volume
+    /// of one brick only.
+    pub fn set_blanking(&mut self, mask: Option<&[u8]>) -> Result<()> {
+        self.res.set_blanking(&self.ctx, mask)
+    }
+
     /// Calls `progress` after each pass of a streamed frame (`None`: no calls).
     pub fn set_progress(&mut self, progress: Option<StreamProgress>) {
         self.res.progress = progress;

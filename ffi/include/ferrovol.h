@@ -897,6 +897,16 @@ enum FvStatus fv_renderer_set_memory_budget(struct FvRenderer *renderer, uint64_
 enum FvStatus fv_renderer_set_volume(struct FvRenderer *renderer, const struct FvVolume *volume);
 
 /**
+ * Blanks points of the current volume's grid (VTK's ghost arrays and vtkUniformGrid
+ * blanking): `count` bytes at `mask`, one per point, x fastest, non-zero where the point is
+ * hidden; ray casting leaves out the samples next to a hidden point. NULL clears the mask;
+ * setting a volume clears it too. FV_STATUS_UNSUPPORTED for a bricked volume.
+ */
+enum FvStatus fv_renderer_set_blanking(struct FvRenderer *renderer,
+                                       const uint8_t *mask,
+                                       size_t count);
+
+/**
  * Sets the transfer function; only its tables are re-uploaded.
  */
 enum FvStatus fv_renderer_set_transfer_function(struct FvRenderer *renderer,

@@ -255,6 +255,10 @@ public:
   void set_memory_budget(uint64_t bytes) {
     check(fv_renderer_set_memory_budget(h_.get(), bytes));
   }
+  // One byte per point of the volume's grid, non-zero where hidden; nullptr clears.
+  void set_blanking(const uint8_t *mask, size_t count) {
+    check(fv_renderer_set_blanking(h_.get(), mask, count));
+  }
   void set_max_brick_points(uint32_t points) {
     check(fv_renderer_set_max_brick_points(h_.get(), points));
   }

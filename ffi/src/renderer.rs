@@ -116,6 +116,28 @@ pub unsafe extern "C" fn fv_renderer_set_volume(
     })
 }
 
+/// Blanks points of the current volume's grid (VTK's ghost arrays and vtkUniformGrid
+/// blanking): `count` bytes at `mask`, one per point, x fastest, non-zero where the point is
+/// hidden; ray casting leaves out the samples next to a hidden point. NULL clears the mask;
+/// setting a volume clears it too. FV_STATUS_UNSUPPORTED for a bricked volume.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_blanking(
+    renderer: *mut FvRenderer,
+    mask: *const u8,
+    count: usize,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        let mask = if mask.is_null() {
+            None
+        } else {
+            // SAFETY: the caller guarantees `count` bytes at `mask`.
+            Some(unsafe { std::slice::from_raw_parts(mask, count) })
+        };
+        r.r.set_blanking(mask)?;
+        Ok(())
+    })
+}
+
 /// Sets the transfer function; only its tables are re-uploaded.
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_set_transfer_function(

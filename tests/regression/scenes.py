@@ -124,8 +124,28 @@ def labels():
     return fvtest.image_from_array(lab, spacing=(2 * sx, 2 * sy, sz), name="labels")
 
 
-DATA = {f.__name__: f for f in (wavelet128, wavelet21, marschner_lobb, cranium, colin27,
-                                 heart, labels)}
+@_cached
+def wavelet128_blanked():
+    """wavelet128 with ghost arrays (vtkUniformGrid-style blanking): the cells of an
+    off-centre box marked HIDDENCELL, and the points of a slab marked HIDDENPOINT."""
+    from vtk.util.numpy_support import numpy_to_vtk
+    img = vtk.vtkImageData()
+    img.DeepCopy(wavelet128())
+    for dims, data, flag, region in (
+            ([n - 1 for n in img.GetDimensions()], img.GetCellData(),
+             vtk.vtkDataSetAttributes.HIDDENCELL,
+             lambda x, y, z: (x < 70) & (y > 40) & (z > 30)),
+            (img.GetDimensions(), img.GetPointData(), vtk.vtkDataSetAttributes.HIDDENPOINT,
+             lambda x, y, z: (z < 20) & (x > 80))):
+        z, y, x = np.mgrid[0:dims[2], 0:dims[1], 0:dims[0]]
+        ghosts = numpy_to_vtk((region(x, y, z) * flag).astype(np.uint8).ravel(), deep=True)
+        ghosts.SetName(vtk.vtkDataSetAttributes.GhostArrayName())
+        data.AddArray(ghosts)
+    return img
+
+
+DATA = {f.__name__: f for f in (wavelet128, wavelet128_blanked, wavelet21, marschner_lobb,
+                                 cranium, colin27, heart, labels)}
 
 # ---------------------------------------------------------------------------------------
 # Volume properties
@@ -557,6 +577,11 @@ SCENES = [
           clipped_voxel_intensity(wavelet_gradient_opacity, 40.0),
           configure=both(clip_planes(FACING_PLANE), sample_distance(0.25)),
           note=SAMPLING_NOTE),
+    Scene("wavelet-ghost-blanking", "wavelet 128^3 with ghost arrays: a box of hidden cells "
+          "and a slab of hidden points left out (vtkUniformGrid blanking)",
+          "wavelet128_blanked", wavelet_tf("linear", shade=True), quick=True,
+          note=SAMPLING_NOTE + " Both mappers skip a sample whose nearest point, or a point "
+          "around it along an axis, is hidden."),
     Scene("wavelet-sphere", "wavelet 128^3 with an opaque sphere intersecting it (depth "
           "in and out)", "wavelet128", wavelet_tf("linear"), quick=True,
           actors=sphere_actor((20, -20, 40), 28), views=one(camera=orbit(20, 10)),

@@ -406,6 +406,7 @@ void vtkFerroVolumeInputHelper::CountGhosts()
       continue;
     }
     this->GhostKey[a] = key;
+    this->BlankingStale = true;
     *counts[a] = 0;
     if (vtkUnsignedCharArray* ghosts = vtkUnsignedCharArray::SafeDownCast(arrays[a]))
     {
@@ -465,6 +466,61 @@ bool vtkFerroVolumeInputHelper::Upload(
     this->ComponentRanges[c] = { range[0], range[1] };
   }
   this->MeanSpacing = pv.MeanSpacing;
+  std::copy(pv.Desc.dims, pv.Desc.dims + 3, this->UploadedDims);
+  this->BlankingStale = true;
   this->Uploaded = key;
   return true;
+}
+
+// vtkGPUVolumeRayCastMapper's blanking texture, on ferrovol's grid: a point is hidden where
+// its point ghost byte, or the byte of the cell it starts (the last cell for an axis's last
+// point), is non-zero. Cell data (a grid of cell centres): the cell's own byte, or its first
+// corner's point byte. An axis of one point, uploaded as two, repeats it.
+bool vtkFerroVolumeInputHelper::UpdateBlanking(ferrovol::Renderer& renderer, std::string& error)
+{
+  if (!this->BlankingStale)
+  {
+    return true;
+  }
+  this->BlankingStale = false;
+  if (this->GhostCounts.Points == 0 && this->GhostCounts.Cells == 0)
+  {
+    return vtkFerroVolumeCall(
+      "clear the blanking", error, [&] { renderer.set_blanking(nullptr, 0); });
+  }
+  vtkUnsignedCharArray* pg = vtkUnsignedCharArray::SafeDownCast(this->Image->GetPointGhostArray());
+  vtkUnsignedCharArray* cg = vtkUnsignedCharArray::SafeDownCast(this->Image->GetCellGhostArray());
+  int pd[3];
+  this->Image->GetDimensions(pd);
+  int cd[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    cd[a] = std::max(pd[a] - 1, 1);
+  }
+  const uint32_t* vd = this->UploadedDims;
+  std::vector<uint8_t> mask(static_cast<size_t>(vd[0]) * vd[1] * vd[2], 0);
+  size_t at = 0;
+  for (uint32_t k = 0; k < vd[2]; ++k)
+  {
+    for (uint32_t j = 0; j < vd[1]; ++j)
+    {
+      for (uint32_t i = 0; i < vd[0]; ++i, ++at)
+      {
+        const int q[3] = { static_cast<int>(i), static_cast<int>(j), static_cast<int>(k) };
+        int p[3], c[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          p[a] = std::min(q[a], pd[a] - 1);
+          c[a] = std::min(q[a], cd[a] - 1);
+        }
+        const vtkIdType point = (static_cast<vtkIdType>(p[2]) * pd[1] + p[1]) * pd[0] + p[0];
+        const vtkIdType cell = (static_cast<vtkIdType>(c[2]) * cd[1] + c[1]) * cd[0] + c[0];
+        const bool hidden =
+          (pg && pg->GetValue(point) != 0) || (cg && cg->GetValue(cell) != 0);
+        mask[at] = hidden ? 1 : 0;
+      }
+    }
+  }
+  return vtkFerroVolumeCall(
+    "blank the volume", error, [&] { renderer.set_blanking(mask.data(), mask.size()); });
 }

@@ -53,6 +53,10 @@ public:
   };
   const Ghosts& GetGhosts() const { return this->GhostCounts; }
 
+  // Gives the renderer the blanking mask of the ghost arrays (or clears it) when they or the
+  // uploaded volume changed; false with the reason when the renderer refuses it.
+  bool UpdateBlanking(ferrovol::Renderer& renderer, std::string& error);
+
 private:
   // What the uploaded volume was made from: anything here changing means a new upload.
   struct Key
@@ -81,6 +85,9 @@ private:
   // The ghost arrays counted last: (array, MTime) for points and for cells.
   std::array<std::pair<vtkDataArray*, vtkMTimeType>, 2> GhostKey{};
   Ghosts GhostCounts;
+  // The mask must be (re)sent: the ghost arrays or the volume changed.
+  bool BlankingStale = true;
+  uint32_t UploadedDims[3] = { 0, 0, 0 };
   int Components = 0;
   Ranges ComponentRanges{};
   double MeanSpacing = 1.0;

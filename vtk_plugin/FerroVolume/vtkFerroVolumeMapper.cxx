@@ -115,9 +115,18 @@ public:
     types.Color = self->GetColorRangeType();
     types.ScalarOpacity = self->GetScalarOpacityRangeType();
     types.GradientOpacity = self->GetGradientOpacityRangeType();
-    return this->Input.Select(self, error) && this->MakeRenderer(self, error) &&
-      this->Input.Upload(*this->Renderer, budget, error) &&
-      this->Tables.Update(vol, this->Input, types, *this->Renderer, error);
+    if (!(this->Input.Select(self, error) && this->MakeRenderer(self, error) &&
+          this->Input.Upload(*this->Renderer, budget, error)))
+    {
+      return false;
+    }
+    std::string blanking;
+    if (!this->Input.UpdateBlanking(*this->Renderer, blanking) && this->FirstTime("blanking"))
+    {
+      vtkWarningWithObjectMacro(
+        self, << "the ghost arrays' blanking is not applied (the cells are drawn): " << blanking);
+    }
+    return this->Tables.Update(vol, this->Input, types, *this->Renderer, error);
   }
 
   // A warning said once per mapper for `key`.

@@ -283,13 +283,14 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     prop->GetShade(0) != 0 && (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface);
   this->WarnUnsupported(self, warned);
   const vtkFerroVolumeInputHelper::Ghosts& ghosts = input.GetGhosts();
-  if ((ghosts.Points > 0 || ghosts.Cells > 0) && warned.insert("ghosts").second)
+  if ((ghosts.Points > 0 || ghosts.Cells > 0) &&
+    (isosurface || this->Blend == FV_BLEND_MODE_PATH_TRACE) && warned.insert("ghosts").second)
   {
     vtkWarningWithObjectMacro(self, << "the input's ghost arrays mark " << ghosts.Points
                                     << " points and " << ghosts.Cells
                                     << " cells (hidden or duplicate, as vtkUniformGrid "
-                                       "blanking): vtkGPUVolumeRayCastMapper leaves them out, "
-                                       "ferrovol does not support blanking and draws them");
+                                       "blanking): ferrovol leaves them out in ray casting; "
+                                       "isosurfaces and path tracing draw them");
   }
   if (self->GetComputeNormalFromOpacity() && params.shade)
   {

@@ -4,6 +4,7 @@ import unittest
 
 import numpy as np
 import vtk
+from vtk.util.numpy_support import numpy_to_vtk
 
 import ferrovol
 import fvtest
@@ -205,48 +206,65 @@ class Settings(unittest.TestCase):
         self.assertEqual(len(warnings["iso-opacity"]), 1)
         self.assertIn("ComputeNormalFromOpacity", warnings["iso-opacity"][0])
 
-    def test_ghost_arrays_warned(self):
-        # vtkGPUVolumeRayCastMapper leaves cells the ghost arrays mark out (vtkUniformGrid
-        # blanking); ferrovol draws them and says so, naming the counts. An all-zero ghost
-        # array marks nothing: no warning.
+    def test_ghost_arrays(self):
+        # Cells and points the ghost arrays mark (vtkUniformGrid blanking) are left out as
+        # vtkGPUVolumeRayCastMapper leaves them out; an all-zero ghost array changes nothing;
+        # isosurfaces draw them, with a warning naming the counts.
         base = self.src.GetOutput()
-        n = base.GetNumberOfCells()
+        pd = base.GetDimensions()
+        cd = [d - 1 for d in pd]
 
-        def with_ghosts(mark):
+        def with_ghosts(cells=False, points=False):
             img = vtk.vtkImageData()
             img.DeepCopy(base)
-            ghosts = vtk.vtkUnsignedCharArray()
+            z, y, x = np.mgrid[0:cd[2], 0:cd[1], 0:cd[0]]
+            hide = (x < cd[0] // 2) & (y > cd[1] // 3) if cells else np.zeros_like(x, bool)
+            ghosts = numpy_to_vtk((hide * vtk.vtkDataSetAttributes.HIDDENCELL)
+                                  .astype(np.uint8).ravel(), deep=True)
             ghosts.SetName(vtk.vtkDataSetAttributes.GhostArrayName())
-            ghosts.SetNumberOfTuples(n)
-            ghosts.Fill(0)
-            nx = img.GetDimensions()[0] - 1
-            if mark:
-                for c in range(n):
-                    if c % nx < nx // 2:
-                        ghosts.SetValue(c, vtk.vtkDataSetAttributes.HIDDENCELL)
             img.GetCellData().AddArray(ghosts)
+            if points:
+                z, y, x = np.mgrid[0:pd[2], 0:pd[1], 0:pd[0]]
+                hide = (z > pd[2] // 2) & (x > pd[0] // 3)
+                pg = numpy_to_vtk((hide * vtk.vtkDataSetAttributes.HIDDENPOINT)
+                                  .astype(np.uint8).ravel(), deep=True)
+                pg.SetName(vtk.vtkDataSetAttributes.GhostArrayName())
+                img.GetPointData().AddArray(pg)
             return img
-        hidden, clear = with_ghosts(True), with_ghosts(False)
-        marked = sum(1 for c in range(n) if hidden.GetCellData().GetArray(
-            vtk.vtkDataSetAttributes.GhostArrayName()).GetValue(c))
-        warnings = {}
-        for name, data in (("hidden", hidden), ("clear", clear)):
-            scene, errors = fvtest.ferrovol_scene(data, tf_property(), size=(120, 120),
-                                                  camera=view)
-            scene.render()
-            self.assertEqual(errors.messages, [], name)
-            warnings[name] = errors.warnings
-        vtk_images = []
-        for data in (hidden, base):
-            scene = Scene(vtk.vtkGPUVolumeRayCastMapper(), data, tf_property(),
-                          size=(120, 120), camera=view)
-            vtk_images.append(scene.render())
-        fvtest.log("  ghost arrays: %d of %d cells marked; VTK's image changes by %.2f; "
-                   "warnings %s" % (marked, n, mean_diff(*vtk_images), warnings["hidden"]))
-        self.assertGreater(mean_diff(*vtk_images), 1.0)  # VTK does leave them out
-        self.assertEqual(warnings["clear"], [])
-        self.assertEqual(len(warnings["hidden"]), 1)
-        self.assertIn("%d cells" % marked, warnings["hidden"][0])
+
+        def both(data, configure=None):
+            ours, warnings = None, None
+            images = []
+            for mapper in (ferrovol.vtkFerroVolumeMapper(), vtk.vtkGPUVolumeRayCastMapper()):
+                errors = Errors(mapper)
+                if configure:
+                    configure(mapper)
+                scene = Scene(mapper, data, tf_property(), size=(120, 120), camera=view)
+                images.append(scene.render())
+                if ours is None:
+                    ours, warnings = errors.messages, errors.warnings
+            self.assertEqual(ours, [])
+            return images, warnings
+        (plain, _), _ = both(base)
+        (clear, clear_vtk), w_clear = both(with_ghosts())
+        (cells, cells_vtk), w_cells = both(with_ghosts(cells=True))
+        (mixed, mixed_vtk), w_mixed = both(with_ghosts(cells=True, points=True))
+        save("settings-ghost-arrays", cells, cells_vtk, mixed, mixed_vtk)
+        s_cells, s_mixed = ssim(cells, cells_vtk), ssim(mixed, mixed_vtk)
+        fvtest.log("  ghost arrays against vtkGPUVolumeRayCastMapper: hidden cells SSIM %.4f "
+                   "(%.1f dB), hidden cells and points %.4f (%.1f dB); hiding moves the image "
+                   "%.1f levels" % (s_cells, fvtest.psnr(cells, cells_vtk), s_mixed,
+                                    fvtest.psnr(mixed, mixed_vtk), mean_diff(plain, cells)))
+        self.assertEqual(mean_diff(plain, clear), 0.0)
+        self.assertGreater(mean_diff(plain, cells), 5.0)
+        self.assertGreater(mean_diff(cells, mixed), 2.0)
+        self.assertGreater(s_cells, 0.98)
+        self.assertGreater(s_mixed, 0.98)
+        self.assertEqual(w_clear + w_cells + w_mixed, [])
+        (_, _), w_iso = both(with_ghosts(cells=True), lambda m: m.SetBlendModeToIsoSurface())
+        ghost_warnings = [w for w in w_iso if "ghost arrays" in w]
+        self.assertEqual(len(ghost_warnings), 1)
+        self.assertIn("33511 cells", ghost_warnings[0])
 
     def test_sample_distance(self):
         def sd(d):

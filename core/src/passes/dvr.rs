@@ -9,6 +9,7 @@ use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
+use crate::gpu::texture::block_grid;
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation};
 use crate::resources::targets::{clear_outputs, DepthSource};
@@ -32,6 +33,7 @@ pipeline_variant! {
         volumetric: bool => "VOLUMETRIC",
         opacity_normal: bool => "OPACITY_NORMAL",
         clipped_voxel: bool => "CLIPPED_VOXEL",
+        blanking: bool => "BLANKING",
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
@@ -42,6 +44,8 @@ pipeline_variant! {
 pub(crate) struct DvrPass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<DvrVariant>,
+    /// The blanking mask bound when the volume has none (one point, not blanked).
+    no_blanking: wgpu::TextureView,
 }
 
 impl DvrPass {
@@ -61,10 +65,16 @@ impl DvrPass {
                     storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
                     storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
                     buffer_entry(7, B::Storage { read_only: false }),
+                    sampled_texture_entry(8, wgpu::TextureSampleType::Uint, V::D3),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
-        Ok(DvrPass { bgl, pipelines })
+        let no_blanking = block_grid(ctx, "no blanking", [1; 3], &[0u8]);
+        Ok(DvrPass {
+            bgl,
+            pipelines,
+            no_blanking,
+        })
     }
 
     /// One ray-cast frame.
@@ -143,6 +153,7 @@ impl DvrPass {
             lights: f.lights(),
             volumetric: f.volumetric,
             opacity_normal,
+            blanking: res.blanking.is_some(),
             clipped_voxel: params.clipped_voxel_value.is_some()
                 && !params.clip_planes.is_empty()
                 && params.blend == BlendMode::Composite
@@ -174,6 +185,12 @@ impl DvrPass {
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
                 bind(6, wgpu::BindingResource::TextureView(&depth_view)),
                 bind(7, t.state.as_entire_binding()),
+                bind(
+                    8,
+                    wgpu::BindingResource::TextureView(
+                        res.blanking.as_ref().unwrap_or(&self.no_blanking),
+                    ),
+                ),
             ],
         });
         let rect = u.rect;

@@ -33,6 +33,8 @@ pub(crate) struct Resources {
     /// The frame uniforms (lib/common.wgsl's Frame), written by each pass.
     pub frame_buf: wgpu::Buffer,
     pub volume: Option<GpuVolume>,
+    /// Per point of the volume's grid, non-zero where it is blanked (r8uint), or none.
+    pub blanking: Option<wgpu::TextureView>,
     pub tf: Option<TransferFunction>,
     pub tables: Option<(TableKey, Tables)>,
     /// Occupancy of the min–max blocks under the transfer function.
@@ -94,6 +96,7 @@ impl Resources {
             volume: None,
             tf: None,
             tables: None,
+            blanking: None,
             occupancy: None,
             targets: None,
             output_path: OutputPath::Readback,

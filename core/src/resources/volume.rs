@@ -218,6 +218,7 @@ impl Resources {
             groups: None,
         });
         self.occupancy = None;
+        self.blanking = None;
         self.stats.volume_uploads += 1;
         let uploaded = match whole {
             Some(texels) => self.upload_whole(ctx, &texels),
@@ -228,6 +229,35 @@ impl Resources {
             self.volume = None;
         }
         uploaded
+    }
+
+    /// The blanking mask of the current volume (Renderer::set_blanking).
+    pub fn set_blanking(&mut self, ctx: &Context, mask: Option<&[u8]>) -> Result<()> {
+        let Some(mask) = mask else {
+            self.blanking = None;
+            return Ok(());
+        };
+        let vol = self.volume()?;
+        let d = vol.data_dims;
+        let n = d.iter().map(|&x| x as usize).product::<usize>();
+        if mask.len() != n {
+            return Err(Error::InvalidParameter(format!(
+                "the blanking mask has {} values; the volume's {}x{}x{} grid needs {n}",
+                mask.len(),
+                d[0],
+                d[1],
+                d[2]
+            )));
+        }
+        if !vol.single_brick() {
+            return Err(Error::Unsupported(
+                "blanking needs the volume in one brick, and this one is bricked (larger than \
+                 one texture or than the memory budget)"
+                    .into(),
+            ));
+        }
+        self.blanking = Some(block_grid(ctx, "blanking", d, mask));
+        Ok(())
     }
 
     /// A one-brick volume: its texture (of `texels`) is the pool.

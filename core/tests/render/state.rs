@@ -466,3 +466,63 @@ fn clipped_voxel_value_lights_the_cut() {
         "no plane, no change"
     );
 }
+
+/// Blanking (VTK's ghost arrays): a mask hiding half the points leaves those samples out in
+/// every ray-casting mode; an all-zero mask changes nothing; a new volume clears the mask;
+/// a mask of the wrong length and a bricked volume are refused.
+#[test]
+fn blanking_leaves_hidden_points_out() {
+    let mut r = renderer();
+    let vol = blob_volume(24);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 64, 64);
+    let n = 24usize;
+    let half: Vec<u8> = (0..n * n * n).map(|i| u8::from(i % n < n / 2)).collect();
+    for blend in [
+        BlendMode::Composite,
+        BlendMode::Maximum,
+        BlendMode::Additive,
+    ] {
+        let p = RenderParams {
+            blend,
+            ..RenderParams::default()
+        };
+        r.set_blanking(None).unwrap();
+        let plain = r.render_image(&view, &p).unwrap();
+        r.set_blanking(Some(&vec![0; n * n * n])).unwrap();
+        let clear = r.render_image(&view, &p).unwrap();
+        r.set_blanking(Some(&half)).unwrap();
+        let blanked = r.render_image(&view, &p).unwrap();
+        save_enlarged(&blanked, &format!("blanking_{blend:?}"));
+        let (mean, _) = image_diff(&plain, &blanked);
+        println!("{blend:?}: half the points blanked moves the image {mean:.2}/255");
+        assert_eq!(
+            image_diff(&plain, &clear).1,
+            0,
+            "{blend:?}: an all-zero mask"
+        );
+        assert!(mean > 1.0, "{blend:?}: blanking leaves samples out");
+    }
+    r.set_volume(&vol).unwrap();
+    let p = RenderParams::default();
+    let fresh = r.render_image(&view, &p).unwrap();
+    r.set_blanking(None).unwrap();
+    assert_eq!(
+        image_diff(&fresh, &r.render_image(&view, &p).unwrap()).1,
+        0,
+        "a new volume clears the mask"
+    );
+    assert_error(
+        r.set_blanking(Some(&[0; 7])),
+        "blanking of the wrong length",
+        &["7 values", "24x24x24"],
+    );
+    set_bricked(&mut r, &vol, 12);
+    assert_error(
+        r.set_blanking(Some(&half)),
+        "blanking a bricked volume",
+        &["bricked"],
+    );
+}
