@@ -303,6 +303,20 @@ fn volumetric_shadows_darken_the_far_side() {
     );
 }
 
+/// Uploads `vol` in bricks of at most `bricks` points (None: as few as fit), with or without
+/// precomputed gradients.
+fn upload(r: &mut Renderer, vol: &VolumeData, bricks: Option<u32>, precompute: bool) {
+    r.set_volume_with(
+        vol,
+        UploadOptions {
+            max_brick_points: bricks,
+            precompute_gradients: Some(precompute),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+}
+
 /// Precomputed gradients give the on-the-fly gradients: shaded and gradient-opacity frames
 /// of a blob, one brick and several, with and without them (max difference ≤ 1 level: the
 /// half-float store).
@@ -318,15 +332,7 @@ fn precomputed_gradients_equal_on_the_fly() {
     for bricks in [None, Some(16)] {
         let mut images = vec![];
         for pre in [false, true] {
-            r.set_volume_with(
-                &vol,
-                UploadOptions {
-                    max_brick_points: bricks,
-                    precompute_gradients: Some(pre),
-                    ..Default::default()
-                },
-            )
-            .unwrap();
+            upload(&mut r, &vol, bricks, pre);
             images.push(r.render_image(&view, &shaded()).unwrap());
         }
         let (mean, max) = image_diff(&images[0], &images[1]);
@@ -364,15 +370,7 @@ fn normals_from_opacity() {
         p
     };
     let render = |r: &mut Renderer, tf: &ComponentTransfer, pre: bool, bricks: Option<u32>| {
-        r.set_volume_with(
-            &vol,
-            UploadOptions {
-                max_brick_points: bricks,
-                precompute_gradients: Some(pre),
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        upload(r, &vol, bricks, pre);
         r.set_transfer_function(&TransferFunction::single(tf.clone()))
             .unwrap();
         [false, true].map(|on| r.render_image(&view, &from_opacity(on)).unwrap())
