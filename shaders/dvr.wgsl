@@ -289,9 +289,28 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (seg.x + jit * dt > box.y) {
                 seg = vec2<f32>(1.0, 0.0);
             }
-        } else if (seg.x + jit * dt >= seg.y) {
+        } else if (seg.x + jit * dt >= seg.y && !has_flag(FLAG_PIECE)) {
             // VTK always takes its first sample (clamped to the edge) even past the exit
             first_forced = true;
+        }
+    }
+    // A piece of a whole volume (FLAG_PIECE): samples on the whole's lattice, and a face two
+    // pieces share sampled once, by the nearer piece: the ray's part here is half-open
+    // unless the ray leaves the whole volume here.
+    var half_open = false;
+    if (has_flag(FLAG_PIECE)) {
+        let whole = box_interval(ray, frame.whole_lo.xyz, frame.whole_hi.xyz);
+        let tg = max(whole.x, 0.0);
+        let tge = min(whole.y, ray.far);
+        // (the whole ray's first sample forced past its exit, as above, falls to the piece
+        // where the ray enters the whole)
+        let forced = frame.counts.x == 0u && tg < tge && tg + jit * dt >= tge;
+        piece_samples = select(max(floor((tge - tg) / dt - jit) + 1.0, 0.0), 1.0, forced);
+        piece_last = box.y >= tge - 1.0e-3 * dt;
+        half_open = !piece_last;
+        if (seg.x < seg.y) {
+            first_forced = forced && seg.x <= tg + 1.0e-3 * dt;
+            seg.x = tg + max(ceil((seg.x - tg) / dt - jit), 0.0) * dt;
         }
     }
     // (written so that NaN from a degenerate ray also leaves)
@@ -311,7 +330,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Bounded below 2^24 so that k + 1 is always exact and the loop always ends. Samples
     // up to the segment's end, one exactly on it too (VTK keeps a sample on the exit face).
     let k_last = (seg.y - seg.x) / dt - jit;
-    var k_end = min(floor(k_last) + 1.0, 1.0e7);
+    var k_end = min(select(floor(k_last) + 1.0, ceil(k_last), half_open), 1.0e7);
     if (first_forced) {
         k_end = max(k_end, 1.0);
     }

@@ -461,6 +461,22 @@ typedef struct FvRenderParams {
    * (vtkVolumeMapper::ComputeNormalFromOpacity): composite, one or independent components.
    */
   bool normal_from_opacity;
+  /**
+   * MIP and MinIP: write the extremum's place in the colour table's range as depth,
+   * 0.5·(1 − u) for MIP and 0.5·u for MinIP, so that compositing the frames of several
+   * pieces of one volume by depth keeps the extremum over all of them (ParaView's IceT
+   * under MPI); pixels without samples keep depth 1.
+   */
+  bool extremum_depth;
+  /**
+   * The volume is a piece of a whole (ParaView under MPI): whole_box is the whole
+   * volume's box in this volume's index space (point indices: x, y, z low, then x, y, z
+   * high). Rays sample on the whole's lattice, a shared face once, and additive and
+   * average frames become transparent sums that compositing the pieces back to front
+   * with "over" adds up (see RenderParams::whole_box in ferrovol-core).
+   */
+  bool whole_box_enabled;
+  double whole_box[6];
 } FvRenderParams;
 
 /**

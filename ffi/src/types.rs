@@ -249,6 +249,19 @@ pub struct FvRenderParams {
     /// Shading normals from the gradient of the opacity instead of the scalar's
     /// (vtkVolumeMapper::ComputeNormalFromOpacity): composite, one or independent components.
     pub normal_from_opacity: bool,
+    /// MIP and MinIP: write the extremum's place in the colour table's range as depth,
+    /// 0.5·(1 − u) for MIP and 0.5·u for MinIP, so that compositing the frames of several
+    /// pieces of one volume by depth keeps the extremum over all of them (ParaView's IceT
+    /// under MPI); pixels without samples keep depth 1.
+    pub extremum_depth: bool,
+    /// The volume is a piece of a whole (ParaView under MPI): whole_box is the whole
+    /// volume's box in this volume's index space (point indices: x, y, z low, then x, y, z
+    /// high). Rays sample on the whole's lattice, a shared face once, and additive and
+    /// average frames become nearly transparent sums (alpha 1/255) that compositing the
+    /// pieces back to front with "over" adds up (see RenderParams::whole_box in
+    /// ferrovol-core).
+    pub whole_box_enabled: bool,
+    pub whole_box: [f64; 6],
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -361,6 +374,9 @@ impl FvRenderParams {
             global_illumination_reach: d.shading.global_illumination_reach,
             scattering_anisotropy: d.shading.scattering_anisotropy,
             normal_from_opacity: d.shading.normal_from_opacity,
+            extremum_depth: d.extremum_depth,
+            whole_box_enabled: false,
+            whole_box: [0.0; 6],
         }
     }
 }
@@ -441,6 +457,11 @@ impl ToCore for FvRenderParams {
             empty_space_skipping: self.empty_space_skipping,
             depth_threshold: self.depth_threshold,
             volume_matrix: column_major(&self.volume_matrix),
+            extremum_depth: self.extremum_depth,
+            whole_box: self.whole_box_enabled.then_some([
+                [self.whole_box[0], self.whole_box[1], self.whole_box[2]],
+                [self.whole_box[3], self.whole_box[4], self.whole_box[5]],
+            ]),
         };
         p.validate()?;
         Ok(p)

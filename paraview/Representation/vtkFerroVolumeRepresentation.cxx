@@ -9,8 +9,10 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
 #include "vtkPVView.h"
 #include "vtkPointData.h"
 #include "vtkRenderWindow.h"
@@ -415,6 +417,33 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
   if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
   {
     return 0;
+  }
+  if (request_type == vtkPVRenderView::REQUEST_UPDATE())
+  {
+    // Under MPI each rank draws its own piece, on the whole volume's sample lattice (the
+    // mapper's WholeExtent). vtkImageVolumeRepresentation asks for ordered compositing (IceT
+    // blends the ranks' frames back to front with "over"), which is right for composite
+    // rays and for the nearly transparent sums the mapper draws for additive and average,
+    // but not for the extremum of MIP and MinIP: for those the ranks' frames are composited
+    // by depth instead, and each rank writes its extremum's place in the colour range as
+    // the depth, so the largest maximum (smallest minimum) wins.
+    vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+    const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
+    vtkFerroVolumeMapper* mapper = this->GetFerroVolumeMapper();
+    if (parallel)
+    {
+      mapper->SetWholeExtent(this->WholeExtent);
+    }
+    const int drawn = this->DrawnBlendMode();
+    const bool extremum = parallel &&
+      mapper->GetRenderMode() != vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE &&
+      (drawn == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND ||
+        drawn == vtkVolumeMapper::MINIMUM_INTENSITY_BLEND);
+    mapper->SetExtremumDepth(extremum);
+    if (extremum)
+    {
+      outInfo->Set(vtkPVRenderView::NEED_ORDERED_COMPOSITING(), 0);
+    }
   }
   if (request_type == vtkPVView::REQUEST_RENDER())
   {

@@ -49,6 +49,8 @@ struct Frame {
     scatter: vec4<f32>,           // volumetric shadows: x blending (0 off), y anisotropy, z reach (texture units), w 2 / data range
     clip: array<vec4<f32>, 8>,    // index-space planes: keep dot(xyz, p) + w >= 0
     clipped_value: vec4<f32>,     // per component: what gradients read beyond a clipping plane (CLIPPED_VOXEL)
+    whole_lo: vec4<f32>,          // FLAG_PIECE: the whole volume's box in this piece's index space
+    whole_hi: vec4<f32>,
     lights: array<Light, 8>,
     viewport: vec4<u32>,          // width, height, 0 (camera index base: lib/ray.wgsl), jitter seed
     mode: vec4<u32>,              // blend, flags, crop regions, unused

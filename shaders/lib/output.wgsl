@@ -24,6 +24,18 @@ fn classify_value(v: vec4<f32>) -> vec4<f32> {
     return out;
 }
 
+// FLAG_PIECE (set by the ray caster): the whole volume's ray takes this many samples, and
+// whether it leaves the whole volume in this piece.
+var<private> piece_samples: f32 = 0.0;
+var<private> piece_last: bool = true;
+
+// Whether this piece's pixel closes an additive or average sum (the whole ray has samples
+// and leaves the whole volume here), with samples of its own or not.
+fn closes_sum(blend: u32) -> bool {
+    return has_flag(FLAG_PIECE) && piece_last && piece_samples > 0.0 &&
+        (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE);
+}
+
 fn write_pixel(px: vec2<u32>, st: PixelState) {
     let blend = frame.mode.x;
     var color = vec4<f32>(0.0);
@@ -33,20 +45,39 @@ fn write_pixel(px: vec2<u32>, st: PixelState) {
         if (st.misc.z > 0.0) {
             depth = st.misc.y;
         }
-    } else if (st.misc.x > 0.0) {
+    } else if (st.misc.x > 0.0 || closes_sum(blend)) {
         if (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE) {
-            // VTK: a grey level, opaque, from the opacity-weighted normalised scalars
+            // VTK: a grey level, opaque, from the opacity-weighted normalised scalars. A
+            // piece's is opaque where the ray leaves the whole; in the pieces before, the
+            // average's share of the whole ray, nearly transparent (alpha 1/255, not 0,
+            // which IceT takes for an empty pixel), which compositing "over" adds to the
+            // rest (the shares add up to at most 1), and the additive sum g with alpha g:
+            // "over" then gives 1 − Π(1 − g), the sum where it is small and 1 where any
+            // piece's is, never more than 1 (IceT's 8-bit "over" does not clamp).
             var v = st.value;
-            if (blend == BLEND_AVERAGE) {
+            var alpha = 1.0;
+            var screen = false;
+            if (has_flag(FLAG_PIECE)) {
+                if (blend == BLEND_AVERAGE) {
+                    v = v / max(piece_samples, 1.0);
+                }
+                alpha = select(1.0 / 255.0, 1.0, piece_last);
+                screen = blend == BLEND_ADDITIVE && !piece_last;
+            } else if (blend == BLEND_AVERAGE) {
                 v = v / st.misc.x;
             }
             var g = v.x;
             if (has_flag(FLAG_INDEPENDENT)) {
                 g = dot(v, frame.weights * vec4<f32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(frame.counts.w)));
             }
-            color = vec4<f32>(vec3<f32>(clamp(g, 0.0, 1.0)), 1.0);
+            let grey = clamp(g, 0.0, 1.0);
+            color = vec4<f32>(vec3<f32>(grey), select(alpha, grey, screen));
         } else {
             color = classify_value(st.value);
+            if (has_flag(FLAG_EXTREMUM_DEPTH)) {
+                let u = clamp(scalar_coord(0u, st.value.x), 0.0, 1.0);
+                depth = 0.5 * select(u, 1.0 - u, blend == BLEND_MAXIMUM);
+            }
         }
     }
     textureStore(out_color, vec2<i32>(px), clamp(color, vec4<f32>(0.0), vec4<f32>(1.0)));

@@ -36,6 +36,8 @@ public:
   void Reset() { this->Uploaded.reset(); }
 
   vtkImageData* GetImage() const { return this->Image; }
+  // Whether the selected scalars are cell data (the volume's points are the cell centres).
+  bool UsesCellData() const { return this->CellFlag == 1; }
   int GetComponents() const { return this->Components; }
   // The selected scalars' VTK type (VTK_VOID before Select).
   int GetDataType() const;

@@ -187,6 +187,8 @@ public:
 //------------------------------------------------------------------------------------------
 vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   : EmptySpaceSkipping(1)
+  , ExtremumDepth(0)
+  , WholeExtent{ 0, -1, 0, -1, 0, -1 }
   , OutputPath(OUTPUT_PATH_AUTOMATIC)
   , EnvironmentLighting(0.0)
   , EnvironmentMap(nullptr)
@@ -663,6 +665,10 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Transfer2DYAxisArray: "
      << (this->Transfer2DYAxisArray ? this->Transfer2DYAxisArray : "(none)") << "\n";
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
+  os << indent << "ExtremumDepth: " << this->ExtremumDepth << "\n";
+  os << indent << "WholeExtent: " << this->WholeExtent[0] << " " << this->WholeExtent[1] << " "
+     << this->WholeExtent[2] << " " << this->WholeExtent[3] << " " << this->WholeExtent[4] << " "
+     << this->WholeExtent[5] << "\n";
   os << indent << "EnvironmentLighting: " << this->EnvironmentLighting << "\n";
   os << indent << "EnvironmentMap: "
      << (this->EnvironmentMap && *this->EnvironmentMap ? this->EnvironmentMap : "(sky)") << "\n";

@@ -137,6 +137,34 @@ public:
 
   ///@{
   /**
+   * MIP and MinIP write the extremum's place in the colour function's range as the frame's
+   * depth (0.5 (1 - u) for MIP, 0.5 u for MinIP) instead of the far plane, so that
+   * compositing the frames of several pieces of one volume by depth keeps the largest
+   * maximum or the smallest minimum over all pieces: what the ParaView representation
+   * turns on under MPI, where IceT composites the ranks by depth for these modes. Default
+   * off; other blend modes ignore it.
+   */
+  vtkSetClampMacro(ExtremumDepth, vtkTypeBool, 0, 1);
+  vtkGetMacro(ExtremumDepth, vtkTypeBool);
+  vtkBooleanMacro(ExtremumDepth, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * The whole extent of the dataset the input is a piece of, when each process of a
+   * parallel run draws its own piece and the processes' frames are composited back to front
+   * (ParaView sets it under MPI). Rays then sample on the whole volume's lattice and take a
+   * sample on a face two pieces share once, and the additive and average blend modes draw
+   * nearly transparent sums (alpha 1/255) that the compositing adds up, so the composited
+   * image is the whole volume's. Default: an empty extent (the input is whole). With AverageIPScalarRange the
+   * average divides by all of the whole ray's samples, in range or not.
+   */
+  vtkSetVector6Macro(WholeExtent, int);
+  vtkGetVector6Macro(WholeExtent, int);
+  ///@}
+
+  ///@{
+  /**
    * Isosurface blend mode: how much of the environment's light falls on the surfaces,
    * diffuse (irradiance) and specular (the Phong lobe sampled on the environment map),
    * added to the renderer's lights. 0 (the default) lights the surfaces as
@@ -635,6 +663,8 @@ protected:
   ///@}
 
   vtkTypeBool EmptySpaceSkipping;
+  vtkTypeBool ExtremumDepth;
+  int WholeExtent[6];
   int OutputPath;
   double EnvironmentLighting;
   char* EnvironmentMap;

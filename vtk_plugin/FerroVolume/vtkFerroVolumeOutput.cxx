@@ -171,14 +171,18 @@ void main()
   // ferrovol's rows run top to bottom, OpenGL's bottom to top
   vec2 tc = vec2(texCoord.x, 1.0 - texCoord.y);
   vec4 color = texture(fvColor, tc);
-  if (color.a <= 0.0)
+  float depth = texture(fvDepth, tc).r;
+  // (kept: a transparent pixel with a depth, an extremum that must still win the depth test
+  // (ExtremumDepth), and a transparent colour, a piece's sum that compositing adds up
+  // (WholeExtent))
+  if (color == vec4(0.0) && depth >= 1.0)
   {
     discard;
   }
   // FinalColorWindow / FinalColorLevel, as vtkGPUVolumeRayCastMapper's finalizeRayCast
   color.rgb = color.rgb * fvColorScale + fvColorBias * color.a;
   gl_FragData[0] = color;
-  gl_FragDepth = texture(fvDepth, tc).r;
+  gl_FragDepth = depth;
 }
 )";
 } // namespace

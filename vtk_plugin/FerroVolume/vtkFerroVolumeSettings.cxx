@@ -370,6 +370,21 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   params.average_range[0] = average[0];
   params.average_range[1] = average[1];
   params.empty_space_skipping = self->GetEmptySpaceSkipping() != 0;
+  params.extremum_depth = self->GetExtremumDepth() != 0;
+  // A piece of a whole extent: the whole's box in the piece's index space (points, or the
+  // cell centres with cell data).
+  const int* whole = self->GetWholeExtent();
+  const int* extent = input.GetImage()->GetExtent();
+  params.whole_box_enabled = whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5];
+  if (params.whole_box_enabled)
+  {
+    const int cells = input.UsesCellData() ? 1 : 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      params.whole_box[a] = whole[2 * a] - extent[2 * a];
+      params.whole_box[3 + a] = std::max(whole[2 * a], whole[2 * a + 1] - cells) - extent[2 * a];
+    }
+  }
   ToColumnMajor(vol->GetMatrix(), params.volume_matrix);
   this->Background = false;
   if (isosurface)

@@ -40,6 +40,8 @@ pub struct FrameUniforms {
     pub scatter: [f32; 4],
     pub clip: [[f32; 4]; MAX_CLIP_PLANES],
     pub clipped_value: [f32; 4],
+    pub whole_lo: [f32; 4],
+    pub whole_hi: [f32; 4],
     pub lights: [GpuLight; 8],
     pub viewport: [u32; 4],
     pub mode: [u32; 4],
@@ -166,6 +168,8 @@ pub const FLAG_TWO_SIDED: u32 = 16;
 pub const FLAG_INDEPENDENT: u32 = 64;
 pub const FLAG_DEPTH_INPUT: u32 = 128;
 pub const FLAG_AVERAGE_RANGE: u32 = 1024;
+pub const FLAG_EXTREMUM_DEPTH: u32 = 2048;
+pub const FLAG_PIECE: u32 = 4096;
 
 /// Bits per axis of a page-table entry's slot position (lib/volume.wgsl).
 pub const PAGE_SLOT_BITS: u32 = 10;
@@ -233,6 +237,8 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("FLAG_INDEPENDENT", Wgsl::U32(FLAG_INDEPENDENT)),
     ("FLAG_DEPTH_INPUT", Wgsl::U32(FLAG_DEPTH_INPUT)),
     ("FLAG_AVERAGE_RANGE", Wgsl::U32(FLAG_AVERAGE_RANGE)),
+    ("FLAG_EXTREMUM_DEPTH", Wgsl::U32(FLAG_EXTREMUM_DEPTH)),
+    ("FLAG_PIECE", Wgsl::U32(FLAG_PIECE)),
     ("MAX_LIGHTS", Wgsl::U32(MAX_LIGHTS as u32)),
     ("PAGE_SLOT_BITS", Wgsl::U32(PAGE_SLOT_BITS)),
     ("PAGE_EMPTY", Wgsl::U32(PAGE_EMPTY)),

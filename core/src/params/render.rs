@@ -163,6 +163,22 @@ pub struct RenderParams {
     pub depth_threshold: f32,
     /// The vtkVolume's matrix (data → world).
     pub volume_matrix: DMat4,
+    /// MIP and MinIP write the extremum's place in the colour table's range as the depth
+    /// instead of 1: 0.5·(1 − u) for MIP, 0.5·u for MinIP (u from 0 at the range's low end
+    /// to 1 at its high end), so that a depth test keeps the larger maximum or the smaller
+    /// minimum. A host that composites the frames of several pieces of one volume by depth
+    /// (ParaView's IceT under MPI) then gets the extremum over all pieces; pixels without
+    /// samples keep depth 1. One component (with several, component 0 decides).
+    pub extremum_depth: bool,
+    /// The whole volume this one is a piece of (ParaView under MPI: each rank draws its
+    /// piece and IceT composites the ranks' frames), as a box in this volume's index space
+    /// (point indices, e.g. the whole extent less this piece's first index): rays sample on
+    /// the whole volume's lattice and take a sample on a face two pieces share only once,
+    /// so that compositing the pieces back to front ("over") gives the whole's composite
+    /// image; additive and average frames are nearly transparent sums (alpha 1/255)
+    /// except in the piece where the ray leaves the whole volume (average dividing by the
+    /// whole ray's sample count), so that "over" adds them up. `None`: the volume is whole.
+    pub whole_box: Option<[[f64; 3]; 2]>,
 }
 
 impl Default for RenderParams {
@@ -182,6 +198,8 @@ impl Default for RenderParams {
             empty_space_skipping: true,
             depth_threshold: 0.0,
             volume_matrix: DMat4::IDENTITY,
+            extremum_depth: false,
+            whole_box: None,
         }
     }
 }
@@ -275,6 +293,14 @@ impl RenderParams {
             return Err(Error::InvalidParameter(
                 "the volume matrix is singular or not finite".into(),
             ));
+        }
+        if let Some([lo, hi]) = self.whole_box {
+            if !(0..3).all(|i| lo[i].is_finite() && hi[i].is_finite() && lo[i] <= hi[i]) {
+                return Err(Error::InvalidParameter(format!(
+                    "the whole volume's box {lo:?} - {hi:?} must be finite with each low end \
+                     at most its high end"
+                )));
+            }
         }
         Ok(())
     }

@@ -4,8 +4,8 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::uniforms::{
-    flag_bits, mat, FrameUniforms, FLAG_AVERAGE_RANGE, FLAG_DEPTH_INPUT, FLAG_INDEPENDENT,
-    FLAG_JITTER, FLAG_TWO_SIDED,
+    flag_bits, mat, FrameUniforms, FLAG_AVERAGE_RANGE, FLAG_DEPTH_INPUT, FLAG_EXTREMUM_DEPTH,
+    FLAG_INDEPENDENT, FLAG_JITTER, FLAG_PIECE, FLAG_TWO_SIDED,
 };
 use crate::gpu::Context;
 use crate::params::{BlendMode, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS};
@@ -250,6 +250,10 @@ pub(crate) fn frame(
         // (an infinite value, VTK's default VTK_DOUBLE_MIN, kept finite in f32)
         u.clipped_value = v.map(|x| x.clamp(-f32::MAX as f64, f32::MAX as f64) as f32);
     }
+    if let Some([lo, hi]) = params.whole_box {
+        u.whole_lo = [lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0];
+        u.whole_hi = [hi[0] as f32, hi[1] as f32, hi[2] as f32, 0.0];
+    }
     let mut nl = 0;
     if s.enabled {
         for l in view.lights.iter().take(MAX_LIGHTS) {
@@ -296,6 +300,8 @@ pub(crate) fn frame(
         (params.jitter, FLAG_JITTER),
         (tf.independent, FLAG_INDEPENDENT),
         (depth_input, FLAG_DEPTH_INPUT),
+        (params.extremum_depth, FLAG_EXTREMUM_DEPTH),
+        (params.whole_box.is_some(), FLAG_PIECE),
     ]);
     // VTK's volumetric shadows: composite, shaded, lit; one component.
     let volumetric =

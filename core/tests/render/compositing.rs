@@ -7,7 +7,7 @@ use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, footprint, image_diff, rgba};
 use crate::common::raycast::to_pixel;
 use crate::common::scenes::{
-    blob_volume, component_transfer, shaded, volume, white, with_clip_plane,
+    blob_transfer, blob_volume, component_transfer, shaded, volume, white, with_clip_plane,
 };
 use crate::{box_corners, mask_extents, projected_extents};
 use ferrovol_core::*;
@@ -655,4 +655,133 @@ fn mip_minip_skipping_changes_no_pixel() {
         }
     }
     assert_eq!(compared, 32);
+}
+
+// ---------------------------------------------------------------------------------------
+// A volume drawn in pieces (ParaView under MPI) composites to the whole's image
+// ---------------------------------------------------------------------------------------
+
+/// "over" for premultiplied RGBA8 pixels: `front` over `back`.
+fn over(front: [u8; 4], back: [u8; 4]) -> [u8; 4] {
+    let a = front[3] as f64 / 255.0;
+    std::array::from_fn(|i| {
+        (front[i] as f64 + (1.0 - a) * back[i] as f64)
+            .round()
+            .min(255.0) as u8
+    })
+}
+
+/// The blob volume cut at z = 17 into two pieces sharing that plane of points, as
+/// ParaView's extent translator cuts an image for two ranks, each drawn alone with the
+/// whole volume's box (`RenderParams::whole_box`): composited back to front with "over"
+/// (composite, additive, average) or by depth with `extremum_depth` (MIP, MinIP), as IceT
+/// composites the ranks, they give the whole volume's image, sample for sample (within a
+/// level of rounding), but for additive: there "over" of 8-bit colours that cannot exceed
+/// 1 gives 1 − (1 − a)(1 − b) for the pieces' sums a and b where the whole has
+/// min(1, a + b).
+#[test]
+fn pieces_composite_to_the_whole() {
+    let mut r = renderer();
+    let n = 33u32;
+    let cut = 17u32;
+    let blob = blob_volume(n);
+    let at = |v: &VolumeData, x: f64, y: f64, z: f64| match &v.scalars {
+        Scalars::F32(d) => {
+            d[x as usize + n as usize * (y as usize + n as usize * z as usize)] as f64
+        }
+        _ => unreachable!(),
+    };
+    // MinIP sees the blob as a hole: its minima lie inside the volume, not on its faces
+    let hole = volume([n; 3], |x, y, z| 1.0 - at(&blob, x, y, z));
+    // the points z0..=z1 of `whole`, in place, with the whole's box in their index space
+    let piece = |whole: &VolumeData, z0: u32, z1: u32| {
+        let mut v = volume([n, n, z1 - z0 + 1], |x, y, z| {
+            at(whole, x, y, z + z0 as f64)
+        });
+        v.origin = [0.0, 0.0, z0 as f64];
+        let m = (n - 1) as f64;
+        (v, [[0.0, 0.0, -(z0 as f64)], [m, m, m - z0 as f64]])
+    };
+    let mut view = View::fit(blob.bounds(), 48, 48);
+    // from +z (the near piece holds z >= cut), tilted so that rays cross the cut obliquely
+    view.camera.position = view.camera.focal_point + DVec3::new(0.35, 0.25, 1.0) * 90.0;
+    view.camera.reset_clipping_range(blob.bounds());
+    let tf = TransferFunction::single(blob_transfer());
+    r.set_transfer_function(&tf).unwrap();
+    for blend in [
+        BlendMode::Composite,
+        BlendMode::Additive,
+        BlendMode::Average,
+        BlendMode::Maximum,
+        BlendMode::Minimum,
+    ] {
+        let extremum = matches!(blend, BlendMode::Maximum | BlendMode::Minimum);
+        let whole = if blend == BlendMode::Minimum {
+            &hole
+        } else {
+            &blob
+        };
+        let (near, near_box) = piece(whole, cut, n - 1);
+        let (far, far_box) = piece(whole, 0, cut);
+        let params = RenderParams {
+            blend,
+            extremum_depth: extremum,
+            ..RenderParams::default()
+        };
+        r.set_volume(whole).unwrap();
+        let reference = r.render_image(&view, &params).unwrap();
+        // the whole as a piece of itself: the same image
+        let itself = RenderParams {
+            whole_box: Some([[0.0; 3], [(n - 1) as f64; 3]]),
+            ..params.clone()
+        };
+        let (_, most) = image_diff(&r.render_image(&view, &itself).unwrap(), &reference);
+        assert_eq!(most, 0, "{blend:?}: the whole volume as its own piece");
+        let mut frames = Vec::new();
+        for (v, b) in [(&near, near_box), (&far, far_box)] {
+            r.set_volume(v).unwrap();
+            let p = RenderParams {
+                whole_box: Some(b),
+                ..params.clone()
+            };
+            frames.push(r.render_image(&view, &p).unwrap());
+        }
+        let mut worst = 0u8;
+        let mut total = 0u64;
+        let mut drawn = 0;
+        for i in 0..(48 * 48) as usize {
+            let px = |img: &Image| -> [u8; 4] { img.rgba[4 * i..4 * i + 4].try_into().unwrap() };
+            let got = if extremum {
+                // by depth, the smaller wins (IceT's z-buffer compositing)
+                if frames[0].depth[i] <= frames[1].depth[i] {
+                    px(&frames[0])
+                } else {
+                    px(&frames[1])
+                }
+            } else {
+                over(px(&frames[0]), px(&frames[1]))
+            };
+            let want = px(&reference);
+            drawn += usize::from(want[3] > 0);
+            let d = (0..4).map(|c| got[c].abs_diff(want[c])).max().unwrap();
+            worst = worst.max(d);
+            total += d as u64;
+            if blend == BlendMode::Additive {
+                // 1 − (1 − a)(1 − b) in place of min(1, a + b): never more, opaque alike
+                assert!(
+                    got[0] <= want[0].saturating_add(1) && got[3] == want[3],
+                    "{got:?} {want:?}"
+                );
+            }
+        }
+        println!(
+            "{blend:?}: {drawn} pixels drawn, pieces composited differ by at most {worst} \
+             levels, {:.3} on average",
+            total as f64 / drawn as f64
+        );
+        assert!(drawn > 400, "{blend:?}: the whole volume is drawn");
+        // additive: the sum's error a·b is at most a quarter (64 levels)
+        let bound = if blend == BlendMode::Additive { 64 } else { 2 };
+        assert!(worst <= bound, "{blend:?}: {worst} levels");
+    }
 }
