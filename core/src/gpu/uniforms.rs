@@ -347,6 +347,8 @@ mod layout_tests {
                     scatter,
                     clip,
                     clipped_value,
+                    whole_lo,
+                    whole_hi,
                     lights,
                     viewport,
                     mode,
