@@ -472,8 +472,9 @@ typedef struct FvRenderParams {
    * The volume is a piece of a whole (ParaView under MPI): whole_box is the whole
    * volume's box in this volume's index space (point indices: x, y, z low, then x, y, z
    * high). Rays sample on the whole's lattice, a shared face once, and additive and
-   * average frames become transparent sums that compositing the pieces back to front
-   * with "over" adds up (see RenderParams::whole_box in ferrovol-core).
+   * average frames become nearly transparent sums (alpha 1/255) that compositing the
+   * pieces back to front with "over" adds up (see RenderParams::whole_box in
+   * ferrovol-core).
    */
   bool whole_box_enabled;
   double whole_box[6];
