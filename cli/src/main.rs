@@ -169,6 +169,11 @@ struct RenderArgs {
     /// accumulation over, as a moving camera does, and traces --spp paths per pixel.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     repeat: u32,
+    /// With --repeat: turn the camera by this many degrees about the view up vector
+    /// (azimuth) before each frame after the first, an interactive camera path; the summary
+    /// adds the bricks uploaded per frame.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    orbit: f64,
     #[command(flatten)]
     iso: IsoArgs,
     #[command(flatten)]
@@ -755,9 +760,12 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         );
     }
     let mut timing = None;
+    let mut uploads = None;
     if a.repeat > 1 {
+        let before = r.stats().brick_uploads;
         let t0 = std::time::Instant::now();
         for _ in 1..a.repeat {
+            view.camera.azimuth(a.orbit);
             if path_tracing.is_some() {
                 r.reset_accumulation();
                 while r.accumulated_samples() < a.pt.paths() {
@@ -769,6 +777,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             r.finish()?;
         }
         timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);
+        uploads = Some((r.stats().brick_uploads - before) as f64 / (a.repeat - 1) as f64);
         img = r.read_image()?;
     }
     ferrovol_io::image::write_png(&img, &a.out, a.background)?;
@@ -801,9 +810,10 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             r.stats().frames
         );
     }
-    if let Some(ms) = timing {
+    if let (Some(ms), Some(uploads)) = (timing, uploads) {
         println!(
-            "ferrovol: {:.1} ms/frame (mean of {} frames after the first)",
+            "ferrovol: {:.1} ms/frame, {uploads:.1} bricks uploaded per frame (mean of {} \
+             frames after the first)",
             ms,
             a.repeat - 1
         );
