@@ -3,7 +3,9 @@
 //! through the bricks it crosses. Composite skips blocks the transfer function makes empty
 //! (occupancy), MIP and MinIP blocks whose scalar range cannot change the ray's extremum.
 
-use super::frame::{self, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY};
+use super::frame::{
+    self, bricks_in_view, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY,
+};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
@@ -92,8 +94,17 @@ impl DvrPass {
         } else {
             Needed::All
         };
-        let order = visibility_order(res, view, params)?;
-        let plan = res.plan_streaming(ctx, needed, &order)?;
+        // Volumetric shadows' rays leave the pixels' lines: every needed brick, in view or
+        // not.
+        let s = &params.shading;
+        let shadows = s.enabled && s.volumetric_blending > 0.0 && !view.lights.is_empty();
+        let in_view = if shadows {
+            None
+        } else {
+            Some(bricks_in_view(res, view, params)?)
+        };
+        let front = visibility_order(res, view, params)?;
+        let plan = res.plan_streaming(ctx, needed, &front, in_view.as_deref())?;
         let occupied = res.occupancy.as_ref().map_or(1.0, |o| o.fraction);
         let skip = params.empty_space_skipping
             && params.blend == BlendMode::Composite

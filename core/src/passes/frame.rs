@@ -9,7 +9,7 @@ use crate::gpu::uniforms::{
 };
 use crate::gpu::Context;
 use crate::params::{BlendMode, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS};
-use crate::resources::bricks::BLOCK_SIZE;
+use crate::resources::bricks::{FrontToBack, BLOCK_SIZE};
 use crate::resources::targets::DepthSource;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -94,13 +94,14 @@ impl Frame {
     }
 }
 
-/// The pixels the volume's box can cover: the bounding rectangle of its projected corners
-/// widened by a pixel, as [x0, y0, x1, y1) — or the whole image when a corner lies behind
-/// the camera (the camera is inside or beside the volume).
+/// The pixels the index-space box `lo`…`hi` can cover: the bounding rectangle of its
+/// projected corners widened by a pixel, as [x0, y0, x1, y1) — or the whole image when a
+/// corner lies behind the camera (the camera is inside or beside the box).
 fn screen_rect(
     vp: DMat4,
     index_to_world: DMat4,
-    dims: [u32; 3],
+    lo: [f64; 3],
+    hi: [f64; 3],
     width: u32,
     height: u32,
 ) -> [u32; 4] {
@@ -112,23 +113,8 @@ fn screen_rect(
         f64::NEG_INFINITY,
     );
     for c in 0..8u32 {
-        let ijk = DVec3::new(
-            if c & 1 != 0 {
-                (dims[0] - 1) as f64
-            } else {
-                0.0
-            },
-            if c & 2 != 0 {
-                (dims[1] - 1) as f64
-            } else {
-                0.0
-            },
-            if c & 4 != 0 {
-                (dims[2] - 1) as f64
-            } else {
-                0.0
-            },
-        );
+        let corner = |a: usize| if c & (1 << a) != 0 { hi[a] } else { lo[a] };
+        let ijk = DVec3::new(corner(0), corner(1), corner(2));
         let clip = vp * index_to_world.transform_point3(ijk).extend(1.0);
         if clip.w <= 1e-9 || !clip.is_finite() {
             return full;
@@ -343,7 +329,8 @@ pub(crate) fn frame(
         ];
     }
     u.viewport = [view.width, view.height, 0, 0x9e37_79b9];
-    u.rect = screen_rect(vp, index_to_world, vol.data_dims, view.width, view.height);
+    let last = vol.data_dims.map(|d| d as f64 - 1.0);
+    u.rect = screen_rect(vp, index_to_world, [0.0; 3], last, view.width, view.height);
     u.mode[0] = params.blend.code();
     u.mode[1] = flags;
     u.counts = [
@@ -371,12 +358,40 @@ pub(crate) fn visibility_order(
     res: &Resources,
     view: &View,
     params: &RenderParams,
-) -> Result<Vec<usize>> {
+) -> Result<FrontToBack> {
     let vol = res.volume()?;
     let world_to_index = (params.volume_matrix * vol.index_to_data).inverse();
-    Ok(vol.grid.visibility_order(
+    Ok(vol.grid.front_to_back(
         world_to_index.transform_point3(view.camera.position),
         world_to_index.transform_vector3(view.camera.direction()),
         view.camera.parallel,
     ))
+}
+
+/// Per brick: whether any pixel's ray can reach it, by its box (one cell wider on every
+/// side, within the volume) projected on the screen; a brick with a corner behind the
+/// camera counts as reached. Rays that stay on their pixel's line (ray casting, the first
+/// hit) read no other brick.
+pub(crate) fn bricks_in_view(
+    res: &Resources,
+    view: &View,
+    params: &RenderParams,
+) -> Result<Vec<bool>> {
+    let vol = res.volume()?;
+    let vp = view.camera.view_projection(view.aspect());
+    let index_to_world = params.volume_matrix * vol.index_to_data;
+    let g = &vol.grid;
+    let last = vol.data_dims.map(|d| d.max(1) as f64 - 1.0);
+    Ok((0..g.len())
+        .map(|i| {
+            let cell = g.cell(i);
+            let b = g.brick_cells as f64;
+            let lo: [f64; 3] =
+                std::array::from_fn(|a| (cell[a] as f64 * b - 1.0).clamp(0.0, last[a]));
+            let hi: [f64; 3] =
+                std::array::from_fn(|a| ((cell[a] + 1) as f64 * b + 1.0).clamp(0.0, last[a]));
+            let r = screen_rect(vp, index_to_world, lo, hi, view.width, view.height);
+            r[0] < r[2] && r[1] < r[3]
+        })
+        .collect())
 }

@@ -22,7 +22,9 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
-use super::frame::{self, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY};
+use super::frame::{
+    self, bricks_in_view, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY,
+};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
@@ -362,8 +364,15 @@ impl IsoPass {
             res.ensure_resident(ctx, Needed::Blocks(&both))?;
             None
         } else {
-            let order = visibility_order(res, view, params)?;
-            res.plan_streaming(ctx, Needed::Blocks(surfaces), &order)?
+            // Ambient-occlusion rays leave the pixels' lines: every brick a surface lies in,
+            // in view or not.
+            let in_view = if iso.ambient_occlusion.is_some_and(|a| a.samples > 0) {
+                None
+            } else {
+                Some(bricks_in_view(res, view, params)?)
+            };
+            let front = visibility_order(res, view, params)?;
+            res.plan_streaming(ctx, Needed::Blocks(surfaces), &front, in_view.as_deref())?
         };
         if plan.is_some() {
             check_streamable(res, params, iso, step)?;

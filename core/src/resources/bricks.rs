@@ -156,37 +156,43 @@ impl BrickGrid {
     }
 
     /// All bricks front to back for a camera at `eye` looking along `dir` (index space):
-    /// along each axis, bricks on the camera's side of a brick boundary come first. Along
-    /// any ray a later brick has a strictly larger key (perspective: the sum over the axes of
-    /// the brick steps from the camera's brick; parallel: the sum of the cells signed by the
-    /// view direction), so the order holds for every ray.
-    pub fn visibility_order(
-        &self,
-        eye: glam::DVec3,
-        dir: glam::DVec3,
-        parallel: bool,
-    ) -> Vec<usize> {
+    /// along each axis, bricks on the camera's side of a brick boundary come first. A ray's
+    /// brick coordinates change monotonically along each axis, away from the camera's brick
+    /// (perspective) or along the view direction (parallel), so every brick a ray crosses
+    /// before brick `i` is reached from `i` by steps of one brick toward the camera
+    /// ([`FrontToBack::before`]); each such step lowers the key (perspective: the sum over
+    /// the axes of the brick steps from the camera's brick; parallel: the sum of the cells
+    /// signed by the view direction) by one, so along any ray a later brick has a strictly
+    /// larger key and the order holds for every ray.
+    pub fn front_to_back(&self, eye: glam::DVec3, dir: glam::DVec3, parallel: bool) -> FrontToBack {
         let b = self.brick_cells as f64;
+        let toward: [Toward; 3] = std::array::from_fn(|a| {
+            if parallel {
+                Toward::Lower(dir[a] >= 0.0)
+            } else {
+                Toward::Cell((eye[a] / b).floor() as i64)
+            }
+        });
         let key = |i: usize| -> i64 {
             let cell = self.cell(i);
             (0..3)
                 .map(|a| {
                     let c = cell[a] as i64;
-                    if parallel {
-                        if dir[a] >= 0.0 {
-                            c
-                        } else {
-                            -c
-                        }
-                    } else {
-                        (c - (eye[a] / b).floor() as i64).abs()
+                    match toward[a] {
+                        Toward::Lower(true) => c,
+                        Toward::Lower(false) => -c,
+                        Toward::Cell(e) => (c - e).abs(),
                     }
                 })
                 .sum()
         };
         let mut order: Vec<usize> = (0..self.len()).collect();
         order.sort_by_key(|&i| key(i));
-        order
+        FrontToBack {
+            order,
+            grid: *self,
+            toward,
+        }
     }
 
     /// The min–max blocks (of `block_dims`, [`BLOCK_SIZE`] cells each, x fastest) the core
@@ -217,6 +223,52 @@ impl BrickGrid {
     /// `cell` holds.
     pub fn slot_origin_point(&self, cell: [u32; 3]) -> [i64; 3] {
         cell.map(|c| c as i64 * self.brick_cells as i64 - self.apron as i64)
+    }
+}
+
+/// Where rays come from along one axis of the brick grid.
+#[derive(Clone, Copy, Debug)]
+enum Toward {
+    /// A parallel projection: rays go toward higher coordinates (true) or lower.
+    Lower(bool),
+    /// A perspective one: rays leave the camera's brick coordinate.
+    Cell(i64),
+}
+
+/// The bricks front to back for one view ([`BrickGrid::front_to_back`]).
+#[derive(Clone, Debug)]
+pub struct FrontToBack {
+    /// Every brick, front to back.
+    pub order: Vec<usize>,
+    grid: BrickGrid,
+    toward: [Toward; 3],
+}
+
+impl super::residency::Before for FrontToBack {
+    /// The bricks one step from `i` toward the camera along each axis, inside the grid.
+    fn before(&self, i: usize) -> [Option<usize>; 3] {
+        let cell = self.grid.cell(i);
+        let counts = self.grid.counts;
+        std::array::from_fn(|a| {
+            let c = cell[a] as i64;
+            let step = match self.toward[a] {
+                Toward::Lower(up) => {
+                    if up {
+                        -1
+                    } else {
+                        1
+                    }
+                }
+                Toward::Cell(e) => (e - c).signum(),
+            };
+            let to = c + step;
+            if step == 0 || to < 0 || to >= counts[a] as i64 {
+                return None;
+            }
+            let mut n = cell;
+            n[a] = to as u32;
+            Some(((n[2] * counts[1] + n[1]) * counts[0] + n[0]) as usize)
+        })
     }
 }
 

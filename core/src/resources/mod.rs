@@ -5,6 +5,7 @@
 pub(crate) mod bricks;
 pub(crate) mod environment;
 pub(crate) mod gradients;
+pub(crate) mod residency;
 pub(crate) mod tables;
 pub(crate) mod targets;
 pub(crate) mod volume;

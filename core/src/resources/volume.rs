@@ -5,8 +5,9 @@
 //! the host's data when they are first needed. The min–max grid is on the CPU, and the
 //! first component's ranges on the device.
 
-use super::bricks::{self, BrickGrid, Layout, MinMaxGrid};
+use super::bricks::{self, BrickGrid, FrontToBack, Layout, MinMaxGrid};
 use super::gradients::GradientPass;
+use super::residency::{self, Slots, NOT_LATER};
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::bind;
@@ -81,10 +82,9 @@ pub(crate) struct GpuVolume {
     host: Option<Arc<VolumeData>>,
     /// The memory budget: most bytes of the pool (with precomputed gradients).
     max_bytes: u64,
-    /// Per brick: its slot in the pool once resident.
-    slot_of: Vec<Option<u32>>,
-    /// Slots in use (filled in order) and layers of slots allocated.
-    resident: u32,
+    /// Which brick is in which slot, and when each was last used.
+    slots: Slots,
+    /// Layers of slots the pool texture has.
     layers: u32,
     pool: Option<wgpu::Texture>,
     gradient: Option<wgpu::Texture>,
@@ -119,7 +119,7 @@ impl GpuVolume {
         let bytes = |n: [u32; 3]| n.iter().map(|&d| d as u64).product::<u64>() * point;
         Residency {
             bricks: self.grid.len() as u32,
-            resident: self.resident,
+            resident: self.slots.resident(),
             pool_bytes: self.pool.as_ref().map_or(0, |t| {
                 let s = t.size();
                 bytes([s.width, s.height, s.depth_or_array_layers])
@@ -206,8 +206,7 @@ impl Resources {
             gradients,
             host,
             max_bytes,
-            slot_of: vec![None; grid.len()],
-            resident: 0,
+            slots: Slots::new(grid.len()),
             layers: 0,
             pool: None,
             gradient: None,
@@ -266,52 +265,63 @@ impl Resources {
         let pool = new_pool(ctx, vol, 1)?;
         upload_texture(&ctx.queue, &pool, texels, vol.layout.texel_bytes);
         vol.pool = Some(pool);
-        vol.slot_of[0] = Some(0);
+        vol.slots.place(&[0], |_| NOT_LATER, 1, 1);
         vol.page[0] = 0;
-        vol.resident = 1;
         vol.layers = 1;
         self.finish_residency(ctx)
     }
 
     /// Makes the bricks `needed` names resident: each is read from the host's data into a
-    /// free slot, the pool growing by layers of slots as it fills. Bricks stay resident
-    /// while the memory budget holds them, so a transfer-function change uploads only the
-    /// bricks it adds; past the budget the pool is refilled with what this frame needs. An
-    /// error names the sizes when even that exceeds the budget (only ray casting streams).
+    /// free slot, the pool growing by layers of slots as it fills, or into the slot of the
+    /// least recently used brick this frame does not need. Bricks stay resident across
+    /// frames while the memory budget holds them, so a transfer-function change uploads only
+    /// the bricks it adds and a frame needing what the last one held uploads none. A pool at
+    /// least twice the layers this frame needs shrinks to one and a half times them. An
+    /// error names the sizes when the bricks exceed the budget (only ray casting streams).
     pub fn ensure_resident(&mut self, ctx: &Context, needed: Needed<'_>) -> Result<()> {
         self.with_flags(needed, |res, flags| {
             res.plan_residency(ctx, flags, None).map(|_| ())
         })
     }
 
-    /// [`Resources::ensure_resident`] for a pass that can stream: when the bricks `needed`
-    /// names exceed the memory budget, none is uploaded and the plan to stream them comes
-    /// back instead, in groups the pool holds, front to back in `order` (a visibility order
-    /// of all bricks).
+    /// [`Resources::ensure_resident`] for a pass that can stream, its rays confined to the
+    /// bricks `in_view` marks (all without): when the bricks `needed` names exceed the memory
+    /// budget, none is uploaded and the plan to stream them comes back instead, in passes
+    /// the pool holds, front to back for the view `front` is of (`residency::passes`).
     pub fn plan_streaming(
         &mut self,
         ctx: &Context,
         needed: Needed<'_>,
-        order: &[usize],
+        front: &FrontToBack,
+        in_view: Option<&[bool]>,
     ) -> Result<Option<StreamPlan>> {
         self.with_flags(needed, |res, flags| {
-            res.plan_residency(ctx, flags, Some(order))
+            res.plan_residency(ctx, flags, Some((front, in_view)))
         })
     }
 
-    /// Loads group `g` of a streaming plan: its bricks resident, the plan's other bricks
-    /// PAGE_MISSING (rays stop there and resume in a later pass), the rest empty.
+    /// Loads pass `g` of a streaming plan: its bricks resident (evicting first bricks this
+    /// frame no longer needs, least recently used first), the plan's other bricks resident
+    /// where they stayed, otherwise PAGE_MISSING (rays stop there and resume in a later
+    /// pass), the rest empty.
     pub fn load_stream_group(&mut self, ctx: &Context, plan: &StreamPlan, g: usize) -> Result<()> {
         let vol = self.volume.as_mut().expect("a plan is for a volume");
         let host = vol.host.clone().expect("a plan is for a bricked volume");
-        evict_all(vol);
-        for (page, &needed) in vol.page.iter_mut().zip(&plan.needed) {
-            if needed {
-                *page = PAGE_MISSING;
-            }
-        }
-        upload_bricks(ctx, vol, &host, &plan.groups[g])?;
-        self.stats.brick_uploads += plan.groups[g].len() as u32;
+        vol.slots.tick();
+        let layer = vol.grid.layer_slots();
+        let g32 = g as u32;
+        let moves = vol.slots.place(
+            &plan.groups[g],
+            |b| match plan.pass_of[b] {
+                p if p != NOT_LATER && p > g32 => plan.rank[b],
+                _ => NOT_LATER,
+            },
+            layer,
+            capacity(vol),
+        );
+        apply_moves(ctx, vol, &host, &moves, |b| plan.pass_of[b] != NOT_LATER)
+            .inspect_err(|_| forget(vol))?;
+        self.stats.brick_uploads += moves.len() as u32;
         self.finish_residency(ctx)
     }
 
@@ -342,13 +352,14 @@ impl Resources {
         }
     }
 
-    /// The bricks overlapping a block flagged in `flags` (all of them without) resident,
-    /// or, past the budget with a streaming `order`, the plan to stream them.
+    /// The bricks overlapping a block flagged in `flags` (all of them without), within the
+    /// view where `stream` marks one, resident; or, past the budget with a streaming view
+    /// (its front-to-back order), the plan to stream them.
     fn plan_residency(
         &mut self,
         ctx: &Context,
         flags: Option<&[u32]>,
-        order: Option<&[usize]>,
+        stream: Option<(&FrontToBack, Option<&[bool]>)>,
     ) -> Result<Option<StreamPlan>> {
         let vol = self
             .volume
@@ -357,40 +368,59 @@ impl Resources {
         let Some(host) = vol.host.clone() else {
             return Ok(None);
         };
-        let needed = needed_bricks(vol, flags);
+        let mut needed = needed_bricks(vol, flags);
+        if let Some((_, Some(in_view))) = stream {
+            for (n, &v) in needed.iter_mut().zip(in_view) {
+                *n &= v;
+            }
+        }
         let count = needed.iter().filter(|&&n| n).count() as u32;
         let capacity = capacity(vol);
         if capacity == 0 {
             return Err(over_budget(vol, count));
         }
+        let layer = vol.grid.layer_slots();
         if count > capacity {
-            let Some(order) = order else {
+            let Some((front, _)) = stream else {
                 return Err(over_budget(vol, count));
             };
-            let ahead: Vec<usize> = order.iter().copied().filter(|&i| needed[i]).collect();
-            let groups = ahead
-                .chunks(capacity as usize)
-                .map(|c| c.to_vec())
-                .collect();
-            return Ok(Some(StreamPlan { groups, needed }));
+            let groups = residency::passes(
+                &front.order,
+                front,
+                &needed,
+                capacity,
+                vol.slots.clone(),
+                layer,
+            );
+            let mut pass_of = vec![NOT_LATER; needed.len()];
+            for (p, group) in groups.iter().enumerate() {
+                for &b in group {
+                    pass_of[b] = p as u32;
+                }
+            }
+            let mut rank = vec![0; needed.len()];
+            for (r, &b) in front.order.iter().enumerate() {
+                rank[b] = r as u32;
+            }
+            return Ok(Some(StreamPlan {
+                groups,
+                pass_of,
+                rank,
+            }));
         }
-        let mut wanted: Vec<usize> = (0..needed.len())
-            .filter(|&i| needed[i] && vol.slot_of[i].is_none())
-            .collect();
-        if vol.resident + wanted.len() as u32 > capacity || vol.page.contains(&PAGE_MISSING) {
-            // (past the budget, or left by a streamed frame: start again from this frame)
-            evict_all(vol);
-            wanted = (0..needed.len()).filter(|&i| needed[i]).collect();
-        } else if wanted.is_empty() && vol.groups.is_some() {
+        vol.slots.tick();
+        let need_layers = count.div_ceil(layer).max(1);
+        if vol.layers >= 2 * need_layers {
+            shrink(ctx, vol, (3 * need_layers).div_ceil(2), &needed);
+        }
+        let wanted: Vec<usize> = (0..needed.len()).filter(|&i| needed[i]).collect();
+        let moves = vol.slots.place(&wanted, |_| NOT_LATER, layer, capacity);
+        let pages_before = vol.page.clone();
+        apply_moves(ctx, vol, &host, &moves, |_| false).inspect_err(|_| forget(vol))?;
+        self.stats.brick_uploads += moves.len() as u32;
+        if moves.is_empty() && vol.page == pages_before && vol.groups.is_some() {
             return Ok(None);
         }
-        if let Err(e) = upload_bricks(ctx, vol, &host, &wanted) {
-            // (nothing half-resident: the next frame starts again)
-            evict_all(vol);
-            vol.groups = None;
-            return Err(e);
-        }
-        self.stats.brick_uploads += wanted.len() as u32;
         self.finish_residency(ctx)?;
         Ok(None)
     }
@@ -483,11 +513,14 @@ fn new_pool(ctx: &Context, vol: &GpuVolume, layers: u32) -> Result<wgpu::Texture
     })
 }
 
-/// Streaming a frame: the bricks it needs (per brick) and, front to back, the groups of
-/// them the pool holds, one pass each.
+/// Streaming a frame: front to back, the passes of bricks the pool holds, one dispatch
+/// each (`residency::passes`).
 pub(crate) struct StreamPlan {
     pub groups: Vec<Vec<usize>>,
-    needed: Vec<bool>,
+    /// Per brick: the pass it is needed in ([`NOT_LATER`]: none).
+    pass_of: Vec<u32>,
+    /// Per brick: its place in the front-to-back order.
+    rank: Vec<u32>,
 }
 
 /// Per brick: whether it overlaps a block flagged in `flags` (all bricks without).
@@ -537,24 +570,79 @@ fn size_text(bytes: u64) -> String {
     }
 }
 
-/// No brick resident.
-fn evict_all(vol: &mut GpuVolume) {
-    vol.slot_of.fill(None);
-    vol.resident = 0;
+/// No brick resident and no pool (after a failed upload: the next frame starts again).
+fn forget(vol: &mut GpuVolume) {
+    vol.slots = Slots::new(vol.grid.len());
     vol.page.fill(PAGE_EMPTY);
+    vol.pool = None;
+    vol.layers = 0;
+    vol.groups = None;
 }
 
-/// Reads `bricks` from `host` into the next free slots, growing the pool by layers.
-fn upload_bricks(
+/// Where slot `s` lies in the pool, in slots per axis.
+fn slot_position(grid: &BrickGrid, s: u32) -> [u32; 3] {
+    [
+        s % grid.slots[0],
+        s / grid.slots[0] % grid.slots[1],
+        s / grid.layer_slots(),
+    ]
+}
+
+/// Shrinks the pool to `layers` layers of slots, keeping the bricks `needed` names first,
+/// then the most recently used (copied on the device, not read again).
+fn shrink(ctx: &Context, vol: &mut GpuVolume, layers: u32, needed: &[bool]) {
+    let grid = vol.grid;
+    let moves = vol.slots.shrink(layers * grid.layer_slots(), needed);
+    let (Some(old), Ok(pool)) = (vol.pool.as_ref(), new_pool(ctx, vol, layers)) else {
+        // (no pool yet, or none allocated: the next upload starts from an empty one)
+        forget(vol);
+        return;
+    };
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    let corner = |s: u32| {
+        let p = slot_position(&grid, s);
+        wgpu::Origin3d {
+            x: p[0] * grid.slot[0],
+            y: p[1] * grid.slot[1],
+            z: p[2] * grid.slot[2],
+        }
+    };
+    for &(from, to) in &moves {
+        enc.copy_texture_to_texture(
+            wgpu::TexelCopyTextureInfo {
+                origin: corner(from),
+                ..old.as_image_copy()
+            },
+            wgpu::TexelCopyTextureInfo {
+                origin: corner(to),
+                ..pool.as_image_copy()
+            },
+            wgpu::Extent3d {
+                width: grid.slot[0],
+                height: grid.slot[1],
+                depth_or_array_layers: grid.slot[2],
+            },
+        );
+    }
+    ctx.queue.submit([enc.finish()]);
+    vol.pool = Some(pool);
+    vol.layers = layers;
+    // (the page table follows in apply_moves)
+    vol.groups = None;
+}
+
+/// Applies a placement: the pool grown to the slots allocated (the old pool copied), the
+/// bricks `moves` names read from `host` into their slots, and the page table: resident
+/// bricks at their slots, bricks `missing` marks PAGE_MISSING, the rest empty.
+fn apply_moves(
     ctx: &Context,
     vol: &mut GpuVolume,
     host: &VolumeData,
-    bricks: &[usize],
+    moves: &[(usize, u32)],
+    missing: impl Fn(usize) -> bool,
 ) -> Result<()> {
     let grid = vol.grid;
-    let layers = (vol.resident + bricks.len() as u32)
-        .div_ceil(grid.layer_slots())
-        .max(1);
+    let layers = vol.slots.allocated().div_ceil(grid.layer_slots()).max(1);
     if layers > vol.layers {
         let pool = new_pool(ctx, vol, layers)?;
         if let Some(old) = vol.pool.as_ref() {
@@ -564,23 +652,22 @@ fn upload_bricks(
         }
         vol.pool = Some(pool);
         vol.layers = layers;
+        vol.groups = None;
     }
     let pool = vol.pool.as_ref().expect("allocated above");
-    for &i in bricks {
-        let slot = vol.resident;
-        vol.resident += 1;
-        let [sx, sy, sz] = [
-            slot % grid.slots[0],
-            slot / grid.slots[0] % grid.slots[1],
-            slot / grid.layer_slots(),
-        ];
+    for &(i, slot) in moves {
         let texels = bricks::brick_texels(
             host,
             &vol.layout,
             grid.slot_origin_point(grid.cell(i)),
             grid.slot,
         )?;
-        let origin = [sx * grid.slot[0], sy * grid.slot[1], sz * grid.slot[2]];
+        let p = slot_position(&grid, slot);
+        let origin = [
+            p[0] * grid.slot[0],
+            p[1] * grid.slot[1],
+            p[2] * grid.slot[2],
+        ];
         upload_region(
             &ctx.queue,
             pool,
@@ -589,8 +676,16 @@ fn upload_bricks(
             &texels,
             vol.layout.texel_bytes,
         );
-        vol.slot_of[i] = Some(slot);
-        vol.page[i] = sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS);
+    }
+    for (i, page) in vol.page.iter_mut().enumerate() {
+        *page = match vol.slots.slot_of(i) {
+            Some(s) => {
+                let [sx, sy, sz] = slot_position(&grid, s);
+                sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS)
+            }
+            None if missing(i) => PAGE_MISSING,
+            None => PAGE_EMPTY,
+        };
     }
     Ok(())
 }

@@ -742,3 +742,132 @@ fn streamed_frames_equal_in_core_ones() {
         "{err}"
     );
 }
+
+/// Residency across frames: a zoomed-in camera path whose frames each see less than the
+/// memory budget holds, of a volume that exceeds it. Only the bricks in view are resident
+/// (rays never leave the view), so no frame streams; the bricks stay resident between
+/// frames, and a frame a small camera move away uploads only the bricks that came into
+/// view, evicting the least recently used. Every frame equals the in-core one.
+#[test]
+fn resident_bricks_carry_over_between_frames() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let params = shaded();
+    let mut view = View::fit(vol.bounds(), 64, 64);
+    view.camera.zoom(3.0);
+    const AZIMUTH_STEP: f64 = 20.0;
+    let views: Vec<View> = (0..4)
+        .map(|_| {
+            let v = view.clone();
+            view.camera.azimuth(AZIMUTH_STEP);
+            v
+        })
+        .collect();
+    r.set_volume(&vol).unwrap();
+    let in_core: Vec<Image> = views
+        .iter()
+        .map(|v| r.render_image(v, &params).unwrap())
+        .collect();
+    // slots of 12³ float32 points: a budget of 150 holds the bricks in view, not all 216
+    let slot = 12u64.pow(3) * 4;
+    let budget = UploadOptions {
+        max_brick_points: Some(12),
+        memory_budget: Some(150 * slot),
+        ..Default::default()
+    };
+    r.set_volume_with(&vol, budget).unwrap();
+    let mut uploads = Vec::new();
+    for (step, (v, in_core)) in views.iter().zip(&in_core).enumerate() {
+        let before = r.stats();
+        let frame = r.render_image(v, &params).unwrap();
+        let after = r.stats();
+        let (mean, max) = image_diff(in_core, &frame);
+        let res = r.residency();
+        let n = after.brick_uploads - before.brick_uploads;
+        println!(
+            "frame {step}: {n} bricks uploaded, {} streamed passes, {} of {} bricks resident; \
+             against in core: mean {mean:.4}/255, max {max}/255",
+            after.streamed_passes - before.streamed_passes,
+            res.resident,
+            res.bricks
+        );
+        assert_content(&frame, "zoomed frame");
+        assert_eq!(
+            after.streamed_passes, before.streamed_passes,
+            "not streamed"
+        );
+        assert!(max <= 1, "frame {step}: {max}/255 off");
+        assert!(res.pool_bytes <= 150 * slot);
+        uploads.push(n);
+    }
+    assert!(uploads[0] < 216, "{uploads:?}: only the bricks in view");
+    for &n in &uploads[1..] {
+        assert!(
+            n > 0 && 4 * n < uploads[0],
+            "{uploads:?}: a small camera move uploads the bricks that came into view"
+        );
+    }
+}
+
+/// The pool shrinks when a frame needs much less of it (a transfer function that hides most
+/// of the volume) and not for small changes: it shrinks only when it holds twice the layers
+/// of slots the frame needs, to one and a half times them, keeping the needed bricks
+/// (copied on the device, not uploaded again).
+#[test]
+fn the_pool_shrinks_with_hysteresis() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    let view = View::fit(vol.bounds(), 64, 64);
+    let tf = |from: f64| {
+        TransferFunction::single(component_transfer(
+            &[(0.0, [0.9, 0.6, 0.2]), (1.0, [1.0, 1.0, 0.9])],
+            &[(0.0, 0.0), (from, 0.0), (1.0, 0.8)],
+            3.0,
+        ))
+    };
+    let params = RenderParams::default();
+    let steps = [0.1, 0.7, 0.65, 0.1];
+    r.set_volume(&vol).unwrap();
+    let one: Vec<Image> = steps
+        .iter()
+        .map(|&from| {
+            r.set_transfer_function(&tf(from)).unwrap();
+            r.render_image(&view, &params).unwrap()
+        })
+        .collect();
+    set_bricked(&mut r, &vol, 12);
+    let mut seen = Vec::new();
+    for (&from, one) in steps.iter().zip(&one) {
+        r.set_transfer_function(&tf(from)).unwrap();
+        let uploads = r.stats().brick_uploads;
+        let split = r.render_image(&view, &params).unwrap();
+        let (_, max) = image_diff(one, &split);
+        let res = r.residency();
+        println!(
+            "opacity from {from}: {} of {} bricks resident, pool {} bytes, {} uploaded; \
+             against one brick max {max}/255",
+            res.resident,
+            res.bricks,
+            res.pool_bytes,
+            r.stats().brick_uploads - uploads
+        );
+        assert!(max <= 2, "{max}/255 off");
+        assert!(footprint(&split) > 50, "drawn");
+        seen.push((res, r.stats().brick_uploads - uploads));
+    }
+    let [(wide, _), (narrow, narrow_uploads), (wider, _), (again, _)] = seen[..] else {
+        unreachable!()
+    };
+    assert!(
+        2 * narrow.pool_bytes <= wide.pool_bytes,
+        "a transfer function showing little shrinks the pool: {narrow:?} after {wide:?}"
+    );
+    assert_eq!(narrow_uploads, 0, "the needed bricks were resident: copied");
+    assert_eq!(
+        wider.pool_bytes, narrow.pool_bytes,
+        "a little more shown: the pool neither grows nor shrinks"
+    );
+    assert_eq!(again.pool_bytes, wide.pool_bytes, "and grows back");
+}
