@@ -123,7 +123,8 @@ pub fn read_volume(path: &Path) -> Result<VolumeData, ReadError> {
 
 /// Opens a volume file as [`read_volume`] reads it, but leaves uncompressed binary data
 /// where it is: a NRRD (`encoding: raw`, no `line skip`) or MetaImage (`BinaryData`, not
-/// `CompressedData`) volume, its data detached or attached, comes back with
+/// `CompressedData`) volume, its data detached or attached, or a `.vti` whose array is raw
+/// appended data without a compressor (its XML part within the first MiB), comes back with
 /// [`ferrovol_core::Scalars::Source`] scalars ([`RawFileSource`]) that read runs of values
 /// with positioned reads as the renderer needs them, so it never holds the whole volume.
 /// Other files (other formats, encodings and compressions) are read into memory by
@@ -135,6 +136,7 @@ pub fn open_volume(path: &Path) -> Result<VolumeData, ReadError> {
     let raw = match Format::from_path(path) {
         Some(Format::Nrrd) => header_prefix(path).map(|h| nrrd::raw_data(&h)),
         Some(Format::MetaImage) => header_prefix(path).map(|h| metaimage::raw_data(&h)),
+        Some(Format::Vti) => header_prefix(path).map(|h| vti::raw_data(&h)),
         _ => None,
     };
     // A header the in-place reader cannot use (or an error in it) goes to read_volume,

@@ -19,7 +19,7 @@
 //! XML: only the part of the file before it goes to the XML parser, and the data is
 //! located by byte offset after the `_` marker.
 
-use ferrovol_core::VolumeData;
+use ferrovol_core::{ScalarType, VolumeData};
 use quick_xml::events::{BytesStart, Event};
 
 use crate::base64::{Base64, TakeError};
@@ -123,6 +123,130 @@ fn rfind(hay: &[u8], needle: &[u8]) -> Option<usize> {
 
 /// Parses a `.vti` file from its bytes.
 pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
+    let h = describe(bytes)?;
+    let Described {
+        layout,
+        geometry,
+        array,
+        what,
+        ty,
+        binary,
+        appended_encoding,
+        xml_end,
+    } = h;
+    let big_endian = binary.big_endian;
+    let scalars = match array.format.as_str() {
+        "ascii" => parse_ascii(&format!("ascii {what}"), &array.text, ty, layout.count)?,
+        "binary" => {
+            let mut src = Source::Base64(Base64::new(array.text.as_bytes()));
+            let what = format!("binary (base64) {what}");
+            let raw = read_binary(&what, &mut src, binary, layout.nbytes)?;
+            decode_binary(&raw, ty, big_endian)
+        }
+        "appended" => {
+            let (encoding, offset) = appended_array(&what, &array, appended_encoding)?;
+            let data = appended_section(bytes, xml_end)?;
+            let what = format!("appended data of {what}");
+            let rest = data
+                .get(offset..)
+                .ok_or_else(|| ReadError::truncated(&what, offset.saturating_add(1), data.len()))?;
+            let mut src = match encoding {
+                Encoding::Raw => Source::Raw { data: rest, pos: 0 },
+                Encoding::Base64 => Source::Base64(Base64::new(rest)),
+            };
+            let raw = read_binary(&what, &mut src, binary, layout.nbytes)?;
+            decode_binary(&raw, ty, big_endian)
+        }
+        other => {
+            return Err(bad(format!(
+                "{what} has format=\"{other}\"; expected ascii, binary or appended"
+            )))
+        }
+    };
+    layout.volume(geometry, scalars)
+}
+
+/// Where the data of a `.vti` file whose XML part lies in `prefix` (its first bytes) is, when
+/// it can be read in place: an uncompressed array in raw appended data whose byte-count
+/// header (in `prefix`) matches the extent. `None` otherwise (the in-memory reader then
+/// reads the file, and names any problem).
+pub(crate) fn raw_data(prefix: &[u8]) -> Result<Option<crate::raw::RawData>, ReadError> {
+    use crate::raw::{RawData, RawStart};
+    let h = describe(prefix)?;
+    if h.array.format != "appended" || h.binary.compressed {
+        return Ok(None);
+    }
+    let (encoding, offset) = appended_array(&h.what, &h.array, h.appended_encoding)?;
+    if !matches!(encoding, Encoding::Raw) {
+        return Ok(None);
+    }
+    let data = appended_section(prefix, h.xml_end)?;
+    // the section's first byte, as an offset in the file
+    let section = data.as_ptr() as usize - prefix.as_ptr() as usize;
+    let width = if h.binary.header_u64 { 8 } else { 4 };
+    let Some(count) = data.get(offset..).and_then(|d| d.get(..width)) else {
+        return Ok(None);
+    };
+    let count = if h.binary.big_endian {
+        count.iter().fold(0u64, |v, &x| (v << 8) | x as u64)
+    } else {
+        count.iter().rev().fold(0u64, |v, &x| (v << 8) | x as u64)
+    };
+    if count != h.layout.nbytes as u64 {
+        return Ok(None);
+    }
+    Ok(Some(RawData {
+        format: FORMAT,
+        layout: h.layout,
+        geometry: h.geometry,
+        big_endian: h.binary.big_endian,
+        file: None,
+        start: RawStart::At((section + offset + width) as u64),
+    }))
+}
+
+/// What the XML part of a `.vti` file says: the chosen array, its layout and geometry, and
+/// how its binary data is stored.
+struct Described {
+    layout: Layout,
+    geometry: Geometry,
+    array: ArrayDesc,
+    /// "DataArray 'name'", for messages.
+    what: String,
+    ty: ScalarType,
+    binary: Binary,
+    appended_encoding: Option<Encoding>,
+    /// The end of the XML part (after the `<AppendedData>` start tag, if there is one).
+    xml_end: usize,
+}
+
+/// The encoding and offset of an array with `format="appended"`.
+fn appended_array(
+    what: &str,
+    array: &ArrayDesc,
+    appended_encoding: Option<Encoding>,
+) -> Result<(Encoding, usize), ReadError> {
+    let encoding = appended_encoding.ok_or_else(|| {
+        bad(format!(
+            "{what} is format=\"appended\" but the file has no <AppendedData> section"
+        ))
+    })?;
+    let offset = array.offset.as_deref().ok_or_else(|| {
+        bad(format!(
+            "{what} is format=\"appended\" but has no offset attribute"
+        ))
+    })?;
+    let offset: usize = offset.trim().parse().map_err(|_| {
+        bad(format!(
+            "{what}: offset=\"{offset}\" is not a non-negative integer"
+        ))
+    })?;
+    Ok((encoding, offset))
+}
+
+/// Reads the XML part of a `.vti` file (all of `bytes` up to any `<AppendedData>` start
+/// tag) and checks what it describes.
+fn describe(bytes: &[u8]) -> Result<Described, ReadError> {
     // The XML part ends with the <AppendedData ...> start tag, if there is one; what
     // follows it may be raw binary.
     let appended_tag = find(bytes, b"<AppendedData");
@@ -295,50 +419,16 @@ pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
         *o += d[r][0] * first[0] + d[r][1] * first[1] + d[r][2] * first[2];
     }
 
-    let scalars = match array.format.as_str() {
-        "ascii" => parse_ascii(&format!("ascii {what}"), &array.text, ty, layout.count)?,
-        "binary" => {
-            let mut src = Source::Base64(Base64::new(array.text.as_bytes()));
-            let what = format!("binary (base64) {what}");
-            let raw = read_binary(&what, &mut src, binary, layout.nbytes)?;
-            decode_binary(&raw, ty, big_endian)
-        }
-        "appended" => {
-            let encoding = appended_encoding.ok_or_else(|| {
-                bad(format!(
-                    "{what} is format=\"appended\" but the file has no <AppendedData> section"
-                ))
-            })?;
-            let offset = array.offset.as_deref().ok_or_else(|| {
-                bad(format!(
-                    "{what} is format=\"appended\" but has no offset attribute"
-                ))
-            })?;
-            let offset: usize = offset.trim().parse().map_err(|_| {
-                bad(format!(
-                    "{what}: offset=\"{offset}\" is not a non-negative integer"
-                ))
-            })?;
-            let data = appended_section(bytes, xml_end)?;
-            let what = format!("appended data of {what}");
-            let rest = data
-                .get(offset..)
-                .ok_or_else(|| ReadError::truncated(&what, offset.saturating_add(1), data.len()))?;
-            let mut src = match encoding {
-                Encoding::Raw => Source::Raw { data: rest, pos: 0 },
-                Encoding::Base64 => Source::Base64(Base64::new(rest)),
-            };
-            let raw = read_binary(&what, &mut src, binary, layout.nbytes)?;
-            decode_binary(&raw, ty, big_endian)
-        }
-        other => {
-            return Err(bad(format!(
-                "{what} has format=\"{other}\"; expected ascii, binary or appended"
-            )))
-        }
-    };
-
-    layout.volume(geometry, scalars)
+    Ok(Described {
+        layout,
+        geometry,
+        array,
+        what,
+        ty,
+        binary,
+        appended_encoding,
+        xml_end,
+    })
 }
 
 /// An attribute with two values: false for `off` (also where the attribute is missing),

@@ -1,6 +1,7 @@
-//! `open_volume`: raw data read in place (NRRD and MetaImage, detached and attached, both
-//! byte orders) gives the values `read_volume` reads into memory; a data file shorter
-//! than its header says is an error that names it, never a panic.
+//! `open_volume`: raw data read in place (NRRD and MetaImage, detached and attached, and
+//! `.vti` raw appended data; both byte orders) gives the values `read_volume` reads into
+//! memory; a data file shorter than its header says is an error that names it, never a
+//! panic.
 
 use std::path::Path;
 
@@ -178,4 +179,102 @@ fn a_truncated_raw_file_is_a_clear_error() {
     );
     let m = open_volume(&p).unwrap_err().to_string();
     assert!(m.contains("gone.raw"), "{m}");
+}
+
+/// A `.vti` with raw appended data: a first array `skip` (3 bytes of data, so the chosen
+/// array's offset is not 0), then `values` as `ty` in point data (its `Scalars`), with
+/// `header` (UInt32 or UInt64) byte-count headers in `order`; `count` overrides the chosen
+/// array's header.
+fn vti_appended(ty: &str, values: &[u8], header: &str, big: bool, count: Option<u64>) -> Vec<u8> {
+    let order = if big { "BigEndian" } else { "LittleEndian" };
+    let width = if header == "UInt64" { 8 } else { 4 };
+    let uint = |n: u64| -> Vec<u8> {
+        let b = if big {
+            n.to_be_bytes()
+        } else {
+            n.to_le_bytes()
+        };
+        if big {
+            b[8 - width..].to_vec()
+        } else {
+            b[..width].to_vec()
+        }
+    };
+    let offset = width + 3;
+    let mut f = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"{order}\" header_type=\"{header}\">\n\
+         <ImageData WholeExtent=\"2 6 0 3 0 2\" Origin=\"1 2 3\" Spacing=\"0.5 1 2\">\n<Piece Extent=\"2 6 0 3 0 2\">\n\
+         <PointData Scalars=\"density\">\n\
+         <DataArray type=\"UInt8\" Name=\"skip\" format=\"appended\" offset=\"0\"/>\n\
+         <DataArray type=\"{ty}\" Name=\"density\" format=\"appended\" offset=\"{offset}\"/>\n\
+         </PointData>\n</Piece>\n</ImageData>\n<AppendedData encoding=\"raw\">\n   _"
+    )
+    .into_bytes();
+    f.extend(uint(3));
+    f.extend([9, 9, 9]);
+    f.extend(uint(count.unwrap_or(values.len() as u64)));
+    f.extend(values);
+    f.extend(b"\n</AppendedData>\n</VTKFile>\n");
+    f
+}
+
+#[test]
+fn raw_appended_vti_reads_in_place() {
+    let dir = TempDir::new("vti");
+    for big in [false, true] {
+        for header in ["UInt32", "UInt64"] {
+            let name = format!("f-{big}-{header}.vti");
+            let f = vti_appended("Float32", &f32_bytes(big), header, big, None);
+            check_same(&dir.write(&name, &f));
+            let name = format!("u-{big}-{header}.vti");
+            let f = vti_appended("UInt16", &u16_bytes(big, 1), header, big, None);
+            check_same(&dir.write(&name, &f));
+        }
+    }
+    // a byte-count header that disagrees with the extent: the in-memory reader's error
+    let f = vti_appended("Float32", &f32_bytes(false), "UInt32", false, Some(236));
+    let p = dir.write("wrong.vti", &f);
+    let m = open_volume(&p).unwrap_err().to_string();
+    assert_eq!(m, read_volume(&p).unwrap_err().to_string());
+    assert!(m.contains("header says 236 bytes"), "{m}");
+    // cut short: named, as for NRRD and MetaImage
+    let f = vti_appended("Float32", &f32_bytes(false), "UInt32", false, None);
+    let p = dir.write("cut.vti", &f[..f.len() - 60]);
+    let m = open_volume(&p).unwrap_err().to_string();
+    println!("{m}");
+    assert!(m.starts_with(&format!("{}: truncated", p.display())), "{m}");
+}
+
+/// Rendering reads a source brick by brick, one run per row of a brick: every brick's runs
+/// of the in-place `.vti` equal the in-memory reader's values.
+#[test]
+fn raw_appended_vti_bricks_equal_the_in_memory_ones() {
+    let dir = TempDir::new("vti-bricks");
+    let p = dir.write(
+        "b.vti",
+        &vti_appended("UInt16", &u16_bytes(false, 1), "UInt64", false, None),
+    );
+    let a = open_volume(&p).unwrap();
+    let b = read_volume(&p).unwrap();
+    assert!(a.scalars.source().is_some());
+    let [nx, ny, nz] = a.dims.map(|d| d as usize);
+    // bricks of 2³ cells: 3 × 3 × 2 points each (overlapping by one), clamped to the volume
+    for (z0, y0, x0) in (0..nz - 1).step_by(2).flat_map(|z| {
+        (0..ny - 1)
+            .step_by(2)
+            .flat_map(move |y| (0..nx - 1).step_by(2).map(move |x| (z, y, x)))
+    }) {
+        for z in z0..(z0 + 3).min(nz) {
+            for y in y0..(y0 + 3).min(ny) {
+                let x1 = (x0 + 3).min(nx);
+                let start = (z * ny + y) * nx + x0;
+                let mut run = vec![0.0; x1 - x0];
+                a.scalars.read_run(start, &mut run).unwrap();
+                let want: Vec<f64> = (start..start + run.len())
+                    .map(|i| b.scalars.get(i))
+                    .collect();
+                assert_eq!(run, want, "brick at ({x0}, {y0}, {z0}), row ({y}, {z})");
+            }
+        }
+    }
 }
