@@ -124,28 +124,19 @@ fn rfind(hay: &[u8], needle: &[u8]) -> Option<usize> {
 /// Parses a `.vti` file from its bytes.
 pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
     let h = describe(bytes)?;
-    let Described {
-        layout,
-        geometry,
-        array,
-        what,
-        ty,
-        binary,
-        appended_encoding,
-        xml_end,
-    } = h;
+    let (what, array, ty, binary) = (&h.what, &h.array, h.ty, h.binary);
     let big_endian = binary.big_endian;
     let scalars = match array.format.as_str() {
-        "ascii" => parse_ascii(&format!("ascii {what}"), &array.text, ty, layout.count)?,
+        "ascii" => parse_ascii(&format!("ascii {what}"), &array.text, ty, h.layout.count)?,
         "binary" => {
             let mut src = Source::Base64(Base64::new(array.text.as_bytes()));
             let what = format!("binary (base64) {what}");
-            let raw = read_binary(&what, &mut src, binary, layout.nbytes)?;
+            let raw = read_binary(&what, &mut src, binary, h.layout.nbytes)?;
             decode_binary(&raw, ty, big_endian)
         }
         "appended" => {
-            let (encoding, offset) = appended_array(&what, &array, appended_encoding)?;
-            let data = appended_section(bytes, xml_end)?;
+            let (encoding, offset) = appended_array(what, array, h.appended_encoding)?;
+            let data = appended_section(bytes, h.xml_end)?;
             let what = format!("appended data of {what}");
             let rest = data
                 .get(offset..)
@@ -154,7 +145,7 @@ pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
                 Encoding::Raw => Source::Raw { data: rest, pos: 0 },
                 Encoding::Base64 => Source::Base64(Base64::new(rest)),
             };
-            let raw = read_binary(&what, &mut src, binary, layout.nbytes)?;
+            let raw = read_binary(&what, &mut src, binary, h.layout.nbytes)?;
             decode_binary(&raw, ty, big_endian)
         }
         other => {
@@ -163,7 +154,7 @@ pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
             )))
         }
     };
-    layout.volume(geometry, scalars)
+    h.layout.volume(h.geometry, scalars)
 }
 
 /// Where the data of a `.vti` file whose XML part lies in `prefix` (its first bytes) is, when

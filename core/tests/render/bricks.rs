@@ -536,6 +536,15 @@ fn bricked_path_tracing_equals_unbricked() {
     assert!(flip_split <= 1.1 * flip_seed);
 }
 
+/// The blob's colours, transparent below `from` and rising to 0.8 at 1.
+fn opacity_from(from: f64) -> TransferFunction {
+    TransferFunction::single(component_transfer(
+        &[(0.0, [0.9, 0.6, 0.2]), (1.0, [1.0, 1.0, 0.9])],
+        &[(0.0, 0.0), (from, 0.0), (1.0, 0.8)],
+        3.0,
+    ))
+}
+
 /// Sparse residency: a bricked volume keeps only the bricks something visible lies in, so a
 /// transfer function that shows a small part of the volume takes a matching part of the
 /// memory; widening it uploads only the bricks it adds; the projection modes make every
@@ -545,17 +554,10 @@ fn only_visible_bricks_are_resident() {
     let mut r = renderer();
     let vol = blob_volume(40);
     let view = View::fit(vol.bounds(), 64, 64);
-    let tf = |from: f64| {
-        TransferFunction::single(component_transfer(
-            &[(0.0, [0.9, 0.6, 0.2]), (1.0, [1.0, 1.0, 0.9])],
-            &[(0.0, 0.0), (from, 0.0), (1.0, 0.8)],
-            3.0,
-        ))
-    };
     let params = RenderParams::default();
     let mut frames = Vec::new();
     for from in [0.55, 0.1] {
-        r.set_transfer_function(&tf(from)).unwrap();
+        r.set_transfer_function(&opacity_from(from)).unwrap();
         r.set_volume(&vol).unwrap();
         let one = r.render_image(&view, &params).unwrap();
         set_bricked(&mut r, &vol, 12);
@@ -585,11 +587,11 @@ fn only_visible_bricks_are_resident() {
     assert!(narrow.resident * 3 < narrow.bricks, "{narrow:?}");
     assert!(wide.resident > narrow.resident);
     // Widening the transfer function on the same upload: only the added bricks come in.
-    r.set_transfer_function(&tf(0.55)).unwrap();
+    r.set_transfer_function(&opacity_from(0.55)).unwrap();
     r.render_image(&view, &params).unwrap();
     let before = r.stats().brick_uploads;
     let narrow_resident = r.residency().resident;
-    r.set_transfer_function(&tf(0.1)).unwrap();
+    r.set_transfer_function(&opacity_from(0.1)).unwrap();
     r.render_image(&view, &params).unwrap();
     assert_eq!(
         r.stats().brick_uploads - before,
@@ -820,27 +822,20 @@ fn the_pool_shrinks_with_hysteresis() {
     let mut r = renderer();
     let vol = blob_volume(40);
     let view = View::fit(vol.bounds(), 64, 64);
-    let tf = |from: f64| {
-        TransferFunction::single(component_transfer(
-            &[(0.0, [0.9, 0.6, 0.2]), (1.0, [1.0, 1.0, 0.9])],
-            &[(0.0, 0.0), (from, 0.0), (1.0, 0.8)],
-            3.0,
-        ))
-    };
     let params = RenderParams::default();
     let steps = [0.1, 0.7, 0.65, 0.1];
     r.set_volume(&vol).unwrap();
     let one: Vec<Image> = steps
         .iter()
         .map(|&from| {
-            r.set_transfer_function(&tf(from)).unwrap();
+            r.set_transfer_function(&opacity_from(from)).unwrap();
             r.render_image(&view, &params).unwrap()
         })
         .collect();
     set_bricked(&mut r, &vol, 12);
     let mut seen = Vec::new();
     for (&from, one) in steps.iter().zip(&one) {
-        r.set_transfer_function(&tf(from)).unwrap();
+        r.set_transfer_function(&opacity_from(from)).unwrap();
         let uploads = r.stats().brick_uploads;
         let split = r.render_image(&view, &params).unwrap();
         let (_, max) = image_diff(one, &split);
