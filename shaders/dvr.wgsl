@@ -388,7 +388,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let t = seg.x + (k + jit) * dt;
         let p = ray.index_origin + t * ray.index_dir;
         if (SKIP && !block_occupied(p)) {
-            k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+            let next = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+            if (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE) {
+                // their terms there are 0, but the samples count
+                misc.x = misc.x + min(next, k_end) - k;
+            }
+            k = next;
             continue;
         }
         if ((CROP && !in_crop(p)) || (BLANKING && blanked(p))) {

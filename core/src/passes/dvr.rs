@@ -1,7 +1,8 @@
 //! Ray casting (shaders/dvr.wgsl) in the blend modes of VTK's mappers (composite with early
 //! ray termination, maximum, minimum, average, additive): one dispatch, each ray marching
-//! through the bricks it crosses. Composite skips blocks the transfer function makes empty
-//! (occupancy), MIP and MinIP blocks whose scalar range cannot change the ray's extremum.
+//! through the bricks it crosses. Composite, additive and average skip blocks the transfer
+//! function makes empty (occupancy), MIP and MinIP blocks whose scalar range cannot change the
+//! ray's extremum.
 
 use super::frame::{
     self, bricks_in_view, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY,
@@ -106,9 +107,6 @@ impl DvrPass {
         let front = visibility_order(res, view, params)?;
         let plan = res.plan_streaming(ctx, needed, &front, in_view.as_deref())?;
         let occupied = res.occupancy.as_ref().map_or(1.0, |o| o.fraction);
-        let skip = params.empty_space_skipping
-            && params.blend == BlendMode::Composite
-            && occupied < SKIP_MAX_OCCUPANCY;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
@@ -123,6 +121,17 @@ impl DvrPass {
         }
         let streaming = plan.is_some();
         let vol = res.volume()?;
+        // Additive and average skip empty blocks too, counting the skipped samples (their
+        // terms are 0), as long as every sample counts (no cropping, blanking or average
+        // range) and the occupancy is of the components they sum (one or independent).
+        let counts_all = params.cropping.is_none()
+            && res.blanking.is_none()
+            && (vol.components == 1 || f.independent)
+            && (params.blend == BlendMode::Additive
+                || (params.blend == BlendMode::Average && params.average_range.is_none()));
+        let skip = params.empty_space_skipping
+            && (params.blend == BlendMode::Composite || counts_all)
+            && occupied < SKIP_MAX_OCCUPANCY;
         // MIP and MinIP skip blocks whose range cannot move the ray's extremum, on
         // one-component volumes (the range grid holds the first component).
         let range_skip = params.empty_space_skipping

@@ -2,7 +2,7 @@
 //! termination), MIP and MinIP, a camera inside the volume, and the other blend modes with
 //! cropping and clipping.
 
-use crate::common::gpu::renderer;
+use crate::common::gpu::{renderer, set_bricked};
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, footprint, image_diff, rgba};
 use crate::common::raycast::to_pixel;
@@ -547,6 +547,49 @@ fn blend_modes_cropping_clipping() {
         right_changed, 0,
         "the kept half changed ({right_changed} px)"
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// Additive and average skip empty blocks and count their samples: the same image
+// ---------------------------------------------------------------------------------------
+
+/// The blob under a transfer function transparent below 0.3 (most blocks empty): additive
+/// and average, with and without skipping, give the same pixels (the skipped samples are
+/// counted, so the average divides by as many and a ray through empty space alone still
+/// draws its opaque zero), also across bricks of 16 points.
+#[test]
+fn additive_average_skipping_changes_no_pixel() {
+    let mut r = renderer();
+    let blob = blob_volume(40);
+    let mut view = View::fit(blob.bounds(), 64, 64);
+    view.camera.azimuth(27.0);
+    view.camera.elevation(18.0);
+    view.camera.orthogonalize_view_up();
+    view.camera.reset_clipping_range(blob.bounds());
+    r.set_transfer_function(&white(&[(0.0, 0.0), (0.3, 0.0), (1.0, 0.8)], 1.0))
+        .unwrap();
+    for bricked in [false, true] {
+        if bricked {
+            set_bricked(&mut r, &blob, 16);
+        } else {
+            r.set_volume(&blob).unwrap();
+        }
+        for blend in [BlendMode::Additive, BlendMode::Average] {
+            let [skipped, marched] = [true, false].map(|empty_space_skipping| {
+                let p = RenderParams {
+                    blend,
+                    empty_space_skipping,
+                    ..RenderParams::default()
+                };
+                r.render_image(&view, &p).unwrap()
+            });
+            let (_, most) = image_diff(&skipped, &marched);
+            let opaque = footprint(&marched);
+            println!("{blend:?} (bricked {bricked}): {opaque} opaque pixels, skipping changes at most {most} levels");
+            assert!(opaque > 1000, "{blend:?}: the volume's box is drawn");
+            assert_eq!(most, 0, "{blend:?} (bricked {bricked})");
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------
