@@ -55,23 +55,19 @@ fn write_pixel(px: vec2<u32>, st: PixelState) {
             // "over" then gives 1 − Π(1 − g), the sum where it is small and 1 where any
             // piece's is, never more than 1 (IceT's 8-bit "over" does not clamp).
             var v = st.value;
-            var alpha = 1.0;
-            var screen = false;
-            if (has_flag(FLAG_PIECE)) {
-                if (blend == BLEND_AVERAGE) {
-                    v = v / max(piece_samples, 1.0);
-                }
-                alpha = select(1.0 / 255.0, 1.0, piece_last);
-                screen = blend == BLEND_ADDITIVE && !piece_last;
-            } else if (blend == BLEND_AVERAGE) {
-                v = v / st.misc.x;
+            if (blend == BLEND_AVERAGE) {
+                v = v / select(st.misc.x, max(piece_samples, 1.0), has_flag(FLAG_PIECE));
             }
             var g = v.x;
             if (has_flag(FLAG_INDEPENDENT)) {
                 g = dot(v, frame.weights * vec4<f32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(frame.counts.w)));
             }
             let grey = clamp(g, 0.0, 1.0);
-            color = vec4<f32>(vec3<f32>(grey), select(alpha, grey, screen));
+            var alpha = 1.0;
+            if (has_flag(FLAG_PIECE) && !piece_last) {
+                alpha = select(1.0 / 255.0, grey, blend == BLEND_ADDITIVE);
+            }
+            color = vec4<f32>(vec3<f32>(grey), alpha);
         } else {
             color = classify_value(st.value);
             if (has_flag(FLAG_EXTREMUM_DEPTH)) {
