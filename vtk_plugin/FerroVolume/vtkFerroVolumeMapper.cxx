@@ -141,6 +141,15 @@ public:
     this->Convergence.reset();
   }
 
+  // The renderer with the output's images in `window` and RenderToImage's, all made from
+  // the renderer's device.
+  void ReleaseDeviceResources(vtkWindow* window)
+  {
+    this->Output.ReleaseGraphicsResources(window);
+    this->Image.ReleaseGraphicsResources();
+    this->FreeRenderer();
+  }
+
   // The renderer's counters; false before the first frame.
   bool Stats(FvStats& s) const
   {
@@ -331,9 +340,7 @@ vtkTypeInt64 vtkFerroVolumeMapper::GetDeviceObjectsInUse()
 void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 {
   this->Internals->Refinement.Stop();
-  this->Internals->Output.ReleaseGraphicsResources(window);
-  this->Internals->Image.ReleaseGraphicsResources();
-  this->Internals->FreeRenderer();
+  this->Internals->ReleaseDeviceResources(window);
   this->Superclass::ReleaseGraphicsResources(window);
 }
 
@@ -460,9 +467,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   // renderer; both are made again below.
   if (in->RendererLost())
   {
-    in->Output.ReleaseGraphicsResources(win);
-    in->Image.ReleaseGraphicsResources();
-    in->FreeRenderer();
+    in->ReleaseDeviceResources(win);
   }
 
   // Blend mode, input, volume (on change), tables (on change), frame parameters.
