@@ -849,6 +849,15 @@ enum FvStatus fv_context_device_memory(const struct FvContext *ctx, struct FvDev
 void fv_context_lose_device(const struct FvContext *ctx);
 
 /**
+ * Caps the device memory the context and its renderers may hold together, as a device with
+ * that much memory would: an allocation past it fails with FV_STATUS_OUT_OF_MEMORY and what
+ * was there before stays usable. For testing a host's handling of out-of-memory on any
+ * device; 0 removes the cap. The renderers' memory budget (bricks streamed through a pool)
+ * is set apart from this, on the render parameters.
+ */
+enum FvStatus fv_context_limit_device_memory(const struct FvContext *ctx, uint64_t bytes);
+
+/**
  * Waits for the last frame and copies it to the CPU. `*out` receives the frame.
  */
 enum FvStatus fv_renderer_read_frame(const struct FvRenderer *renderer, struct FvFrame **out);

@@ -92,6 +92,11 @@ public:
   }
   /// Loses the device on purpose, to test recovery (see fv_context_lose_device).
   void lose_device() const noexcept { fv_context_lose_device(h_.get()); }
+  /// Caps the device memory the context may hold, as a smaller device would (0: no cap), to
+  /// test out-of-memory handling (see fv_context_limit_device_memory).
+  void limit_device_memory(uint64_t bytes) const {
+    check(fv_context_limit_device_memory(h_.get(), bytes));
+  }
   FvContext *get() const noexcept { return h_.get(); }
 
 private:

@@ -140,3 +140,20 @@ pub unsafe extern "C" fn fv_context_lose_device(ctx: *const FvContext) {
         }
     })
 }
+
+/// Caps the device memory the context and its renderers may hold together, as a device with
+/// that much memory would: an allocation past it fails with FV_STATUS_OUT_OF_MEMORY and what
+/// was there before stays usable. For testing a host's handling of out-of-memory on any
+/// device; 0 removes the cap. The renderers' memory budget (bricks streamed through a pool)
+/// is set apart from this, on the render parameters.
+#[no_mangle]
+pub unsafe extern "C" fn fv_context_limit_device_memory(
+    ctx: *const FvContext,
+    bytes: u64,
+) -> FvStatus {
+    guard(|| {
+        let c = const_ref(ctx, "ctx")?;
+        c.ctx.limit_device_memory((bytes != 0).then_some(bytes));
+        Ok(())
+    })
+}

@@ -818,6 +818,50 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
     );
 }
 
+/// Out of device memory (a cap set with fv_context_limit_device_memory, as a smaller device
+/// would have): a frame that needs more memory returns FV_STATUS_OUT_OF_MEMORY naming the
+/// sizes, the renderer stays usable, and without the cap it draws the same frame as before.
+#[test]
+fn out_of_memory_is_reported_and_the_renderer_recovers() {
+    let lib = Lib::open();
+    let n = 16usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    let mut s = Session::new(&lib);
+    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
+        &[0.0, 0.0, 15.0, 1.0],
+    );
+    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    let before = s.frame(24, 24).to_vec();
+    assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    type Limit = unsafe extern "C" fn(H, u64) -> FvStatus;
+    let limit = lib.f::<Limit>("fv_context_limit_device_memory");
+    let render = lib.f::<Render>("fv_renderer_render");
+    let mut memory = ferrovol::FvDeviceMemory::default();
+    // SAFETY: valid handles and a live FvDeviceMemory.
+    unsafe {
+        lib.expect(limit(null_mut(), 1), Null, "ctx");
+        lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvDeviceMemory) -> FvStatus>(
+            "fv_context_device_memory",
+        )(s.ctx, &mut memory);
+        let held = memory.buffer_bytes + memory.texture_bytes;
+        assert!(held > 0, "the frame holds device memory");
+        assert_eq!(limit(s.ctx, held + 1024), FvStatus::Ok);
+        lib.expect(
+            render(s.r, 512, 512, null(), 0),
+            FvStatus::OutOfMemory,
+            "limited to",
+        );
+        assert_eq!(limit(s.ctx, 0), FvStatus::Ok);
+    }
+    assert_eq!(
+        s.frame(24, 24),
+        &before[..],
+        "without the cap the renderer draws the same frame"
+    );
+}
+
 /// A lost device (fv_context_lose_device, as a driver reset would): the renderer's next
 /// frame returns FV_STATUS_DEVICE_LOST with a message saying what to do, and a new context
 /// and renderer draw the same frame as before.

@@ -19,6 +19,7 @@ const ferrovol::Context* vtkFerroVolumeContext::Acquire(std::string& error)
     {
       // Deleted only when lost: see Acquire's comment.
       self.Context = new ferrovol::Context();
+      self.Context->limit_device_memory(self.MemoryCap);
     }
     catch (const ferrovol::Error& e)
     {
@@ -73,6 +74,17 @@ void vtkFerroVolumeContext::LoseDevice()
   }
 }
 
+void vtkFerroVolumeContext::LimitDeviceMemory(vtkTypeUInt64 bytes)
+{
+  vtkFerroVolumeContext& self = Get();
+  std::lock_guard<std::mutex> lock(self.Mutex);
+  self.MemoryCap = bytes;
+  if (self.Context)
+  {
+    self.Context->limit_device_memory(bytes);
+  }
+}
+
 const char* vtkFerroVolumeContext::Description()
 {
   std::string error;
@@ -100,6 +112,11 @@ std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e)
   {
     vtkFerroVolumeContext::Lost();
     s << " (ferrovol opens a new device at the next render)";
+  }
+  else if (e.status() == FV_STATUS_OUT_OF_MEMORY)
+  {
+    s << " (make the window or the volume smaller, lower MaxMemoryInBytes or "
+         "MaxMemoryFraction, or free GPU memory other programs hold)";
   }
   return s.str();
 }

@@ -4,6 +4,7 @@
 #define vtkFerroVolumeContext_h
 
 #include "ferrovol.hpp"
+#include "vtkType.h"
 
 #include <mutex>
 #include <string>
@@ -28,6 +29,10 @@ public:
   // Loses the device on purpose, to test recovery (fv_context_lose_device).
   static void LoseDevice();
 
+  // Caps the device memory ferrovol may hold, as a smaller device would (0: no cap), to test
+  // out-of-memory handling (fv_context_limit_device_memory); kept for devices opened later.
+  static void LimitDeviceMemory(vtkTypeUInt64 bytes);
+
   // "name (backend, driver)" of the device, "" when none could be opened.
   static const char* Description();
 
@@ -41,6 +46,7 @@ private:
   std::mutex Mutex;
   const ferrovol::Context* Context = nullptr;
   unsigned Losses = 0;
+  vtkTypeUInt64 MemoryCap = 0;
   bool Tried = false;
   std::string Error;
   std::string Desc;

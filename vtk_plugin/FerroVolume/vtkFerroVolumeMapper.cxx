@@ -324,6 +324,11 @@ void vtkFerroVolumeMapper::LoseDevice()
   vtkFerroVolumeContext::LoseDevice();
 }
 
+void vtkFerroVolumeMapper::LimitDeviceMemory(vtkTypeUInt64 bytes)
+{
+  vtkFerroVolumeContext::LimitDeviceMemory(bytes);
+}
+
 vtkTypeInt64 vtkFerroVolumeMapper::GetDeviceMemoryInUse()
 {
   const FvDeviceMemory m = vtkFerroVolumeContext::DeviceMemory();

@@ -552,6 +552,14 @@ public:
    */
   static void LoseDevice();
 
+  /**
+   * Caps the GPU memory ferrovol may hold (every mapper of the process together), as a
+   * device with that much memory would, to test a host's handling of out-of-memory: a render
+   * that needs more fails with a vtkErrorMacro saying what to do and draws nothing; the
+   * renders after the cap is lifted (0) draw again.
+   */
+  static void LimitDeviceMemory(vtkTypeUInt64 bytes);
+
   ///@{
   /**
    * What ferrovol holds on its GPU device now, every mapper of the process together (wgpu's

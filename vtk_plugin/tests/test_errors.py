@@ -211,6 +211,23 @@ class ErrorCases(unittest.TestCase):
                    % np.abs(after.astype(int) - before.astype(int)).max())
         np.testing.assert_array_equal(after, before)
 
+    def test_out_of_memory(self):
+        before = self.scene.render()
+        held = ferrovol.vtkFerroVolumeMapper.GetDeviceMemoryInUse()
+        self.assertGreater(held, 0)
+        ferrovol.vtkFerroVolumeMapper.LimitDeviceMemory(held + 1024)
+        try:
+            self.scene.window.SetSize(400, 400)
+            self.expect_error(["out of GPU memory", "limited to", "make the window"])
+        finally:
+            ferrovol.vtkFerroVolumeMapper.LimitDeviceMemory(0)
+            self.scene.window.SetSize(80, 80)
+        self.recover()
+        after = self.scene.render()
+        fvtest.log("  out of memory -> drawn again without the cap, max difference %d levels"
+                   % np.abs(after.astype(int) - before.astype(int)).max())
+        np.testing.assert_array_equal(after, before)
+
     # -- degenerate volumes that do render ------------------------------------------------------
     def test_single_voxel(self):
         self.mapper.SetInputData(image_from_array(np.full((1, 1, 1), 200.0, np.float32),

@@ -38,6 +38,13 @@ pub struct DeviceMemory {
     pub texture_bytes: u64,
 }
 
+impl DeviceMemory {
+    /// Device memory bound to buffers and textures, in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.buffer_bytes + self.texture_bytes
+    }
+}
+
 /// An adapter, a device and its queue. `Send + Sync`; clones share the same device.
 #[derive(Clone)]
 pub struct Context {
@@ -47,6 +54,9 @@ pub struct Context {
     pub info: DeviceInfo,
     /// Set (with the driver's message) when the device is lost.
     lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// The device memory (bytes) allocations may reach before they fail as out of memory;
+    /// `u64::MAX` for no cap ([`Context::limit_device_memory`]).
+    memory_cap: std::sync::Arc<std::sync::atomic::AtomicU64>,
 }
 
 /// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and
@@ -180,11 +190,17 @@ impl Context {
             queue,
             info,
             lost,
+            memory_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
         })
     }
 
-    /// Runs `f` and turns any wgpu validation or out-of-memory error it caused into an [`Error`].
+    /// Runs `f` and turns any wgpu validation or out-of-memory error it caused into an
+    /// [`Error`]; so does an allocation by `f` that takes the context's device memory past the
+    /// cap of [`Context::limit_device_memory`] (what `f` made is dropped, as the driver's
+    /// failed allocation would be).
     pub fn checked<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+        let cap = self.memory_cap.load(std::sync::atomic::Ordering::Relaxed);
+        let before = (cap != u64::MAX).then(|| self.device_memory().bytes());
         let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let val = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let out = f();
@@ -193,6 +209,16 @@ impl Context {
         self.check_lost(what)?;
         if let Some(e) = o {
             return Err(Error::OutOfMemory(format!("{what}: {e}")));
+        }
+        if let Some(before) = before {
+            let after = self.device_memory().bytes();
+            if after > before && after > cap {
+                return Err(Error::OutOfMemory(format!(
+                    "{what}: {} bytes more would hold {after} bytes on a device limited to \
+                     {cap} bytes",
+                    after - before
+                )));
+            }
         }
         if let Some(e) = v {
             return Err(Error::Gpu(format!("{what}: {e}")));
@@ -231,6 +257,18 @@ impl Context {
             l.get_or_insert_with(|| "the device was lost on request (lose_device)".into());
         }
         self.device.destroy();
+    }
+
+    /// Caps the device memory this context (its clones and their renderers together) may
+    /// hold, as a device with that much memory would: an allocation that goes past it fails
+    /// with [`Error::OutOfMemory`] and leaves what was there before usable. For testing how a
+    /// host handles out-of-memory on any device; `None` removes the cap. The renderers' memory
+    /// budget for streaming bricks is set apart from this (`RenderParams`).
+    pub fn limit_device_memory(&self, bytes: Option<u64>) {
+        self.memory_cap.store(
+            bytes.unwrap_or(u64::MAX),
+            std::sync::atomic::Ordering::Relaxed,
+        );
     }
 
     /// [`Error::DeviceLost`] once the driver has reported the device lost.
