@@ -447,6 +447,8 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->GPURender(ren, vol);
   timer->StopTimer();
   this->TimeToDraw = timer->GetElapsedTime();
+  (vol->GetAllocatedRenderTime() < 1.0 ? this->SmallTimeToDraw : this->BigTimeToDraw) =
+    this->TimeToDraw;
   this->InvokeEvent(vtkCommand::VolumeMapperRenderEndEvent, nullptr);
 }
 

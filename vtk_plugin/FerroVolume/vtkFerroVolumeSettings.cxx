@@ -216,6 +216,42 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
   return true;
 }
 
+double vtkFerroVolumeSettings::UpdateReductionFactor(
+  vtkFerroVolumeMapper* self, double allocatedTime)
+{
+  if (self->TimeToDraw > 0.0)
+  {
+    // The time the last render of this kind (still: allocated time >= 1 s, interactive:
+    // less) took, scaled to a full-resolution step; the new factor averages the old one with
+    // what would fit the allocated time, and is held to 1, 1/2, 1/5 or 1/10 (steps that do
+    // not flicker between frames) within Minimum/MaximumImageSampleDistance.
+    double last = allocatedTime < 1.0 ? self->SmallTimeToDraw : self->BigTimeToDraw;
+    if (last == 0.0 && allocatedTime < 1.0)
+    {
+      last = self->BigTimeToDraw / 3.0;
+    }
+    if (last == 0.0)
+    {
+      last = 10.0;
+    }
+    const double fits = allocatedTime / (last / this->ReductionFactor);
+    double factor = std::min(1.0, 0.5 * (fits + this->ReductionFactor));
+    factor = factor < 0.2 ? 0.1 : factor < 0.5 ? 0.2 : factor < 1.0 ? 0.5 : 1.0;
+    const double finest = self->GetMinimumImageSampleDistance();
+    const double coarsest = self->GetMaximumImageSampleDistance();
+    if (coarsest > 0.0 && 1.0 / factor > coarsest)
+    {
+      factor = 1.0 / coarsest;
+    }
+    if (finest > 0.0 && 1.0 / factor < finest)
+    {
+      factor = 1.0 / finest;
+    }
+    this->ReductionFactor = factor;
+  }
+  return this->ReductionFactor;
+}
+
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
   vtkRenderer* ren, vtkVolume* vol, const vtkFerroVolumeInputHelper& input,
   ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
@@ -275,6 +311,30 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
         return Result::Failed;
       }
       params.sample_distance = distance;
+    }
+  }
+  else
+  {
+    // vtkOpenGLGPUVolumeRayCastMapper: the smallest world spacing of the input, lengthened
+    // by the reduction factor the render time asks for.
+    const double factor = this->UpdateReductionFactor(self, vol->GetAllocatedRenderTime());
+    if (factor < 1.0)
+    {
+      double spacing[3];
+      input.GetImage()->GetSpacing(spacing);
+      vtkMatrix4x4* m = vol->GetMatrix();
+      double smallest = VTK_DOUBLE_MAX;
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        const double column = std::sqrt(m->GetElement(0, axis) * m->GetElement(0, axis) +
+          m->GetElement(1, axis) * m->GetElement(1, axis) +
+          m->GetElement(2, axis) * m->GetElement(2, axis));
+        smallest = std::min(smallest, std::fabs(spacing[axis]) * column);
+      }
+      if (smallest > 0.0 && std::isfinite(smallest))
+      {
+        params.sample_distance = smallest / factor;
+      }
     }
   }
   params.jitter = self->GetUseJittering() != 0;
@@ -456,16 +516,6 @@ void vtkFerroVolumeSettings::WarnUnsupported(
   {
     vtkWarningWithObjectMacro(self, << "Transfer2DYAxisArray '" << self->GetTransfer2DYAxisArray()
                                     << "' is not used: ferrovol has no 2D transfer functions");
-  }
-  if (self->GetAutoAdjustSampleDistances() &&
-    (self->GetMinimumImageSampleDistance() != 1.0f ||
-      self->GetMaximumImageSampleDistance() != 10.0f) &&
-    warned.insert("image-sample-distance-range").second)
-  {
-    vtkWarningWithObjectMacro(self, << "MinimumImageSampleDistance and "
-                                       "MaximumImageSampleDistance are not used: ferrovol's "
-                                       "AutoAdjustSampleDistances is not driven by the render "
-                                       "time (ImageSampleDistance is not adjusted)");
   }
   for (int port = 1; port < self->GetNumberOfInputPorts(); ++port)
   {

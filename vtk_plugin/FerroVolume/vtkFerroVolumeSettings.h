@@ -59,6 +59,11 @@ private:
   // effect that ferrovol does not honour.
   void WarnUnsupported(vtkFerroVolumeMapper* self, std::set<std::string>& warned) const;
   bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
+  // AutoAdjustSampleDistances: the factor (1, 1/2, 1/5 or 1/10) the smallest world spacing
+  // is divided by to make the step, from the time the last render took against the time
+  // allocated to this one (vtkVolume::GetAllocatedRenderTime, from the window's
+  // DesiredUpdateRate), as vtkOpenGLGPUVolumeRayCastMapper::ComputeReductionFactor sets it.
+  double UpdateReductionFactor(vtkFerroVolumeMapper* self, double allocatedTime);
   bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
     ferrovol::Renderer& renderer, double traceBudget, std::string& error);
   Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol,
@@ -67,6 +72,7 @@ private:
   uint32_t Blend = FV_BLEND_MODE_COMPOSITE;
   FvRenderParams Params{};
   bool Background = false;
+  double ReductionFactor = 1.0;
 
   // The environment last given to the renderer (isosurfaces, path tracing).
   bool HaveEnvironment = false;

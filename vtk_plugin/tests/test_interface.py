@@ -14,6 +14,7 @@ mapper: RenderToImage (colour and depth images, against the window and against V
 the transfer function range types, FinalColorWindow/Level, LockSampleDistanceToInputSpacing;
 and the render start/end events, CreateCanonicalView, PreLoadData, IsRenderSupported.
 """
+import hashlib
 import math
 import unittest
 
@@ -159,6 +160,21 @@ def reads(name, value):
         got = getattr(m, "Get" + name)()
         return math.isclose(got, value) if isinstance(value, float) else got == value
     return state(lambda m, rig: getattr(m, "Set" + name)(value), check)
+
+
+def interactive_image(m, rig):
+    """The image (its digest) after renders with almost no time allocated (DesiredUpdateRate
+    10⁶): with AutoAdjustSampleDistances the step lengthens render by render to the coarsest
+    that MaximumImageSampleDistance allows. (MinimumImageSampleDistance bounds the finest:
+    a still render after the first.)"""
+    rate = rig.window.GetDesiredUpdateRate()
+    rig.window.SetDesiredUpdateRate(1e6)
+    try:
+        for _ in range(5):
+            img = rig.render()
+    finally:
+        rig.window.SetDesiredUpdateRate(rate)
+    return hashlib.sha1(img.tobytes()).hexdigest()
 
 
 def calls(*steps):
@@ -361,10 +377,9 @@ SETTINGS = {
         calls(("LockSampleDistanceToInputSpacingOff",)),
         prepare=calls(AUTO_OFF, SD4, ("LockSampleDistanceToInputSpacingOn",))),
     "SetImageSampleDistance": image(calls(("SetImageSampleDistance", 3.0))),
-    "SetMinimumImageSampleDistance": warned(calls(("SetMinimumImageSampleDistance", 2.0)),
-                                            "MinimumImageSampleDistance"),
-    "SetMaximumImageSampleDistance": warned(calls(("SetMaximumImageSampleDistance", 4.0)),
-                                            "MaximumImageSampleDistance"),
+    "SetMinimumImageSampleDistance": image(calls(("SetMinimumImageSampleDistance", 2.0))),
+    "SetMaximumImageSampleDistance": effect(calls(("SetMaximumImageSampleDistance", 4.0)),
+                                            interactive_image),
     "SetUseJittering": image(calls(("SetUseJittering", 1))),
     "UseJitteringOn": image(calls(("UseJitteringOn",))),
     "UseJitteringOff": image(calls(("UseJitteringOff",)), prepare=calls(("UseJitteringOn",))),
