@@ -182,8 +182,8 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         }
         return e;
     }
-    // Independent components, mixed as VTK does: colour weighted by opacity × weight,
-    // opacity the opacity-weighted mean of the components' opacities.
+    // Independent components, mixed as VTK does: the premultiplied colours weighted and
+    // added (Σ a·w·rgb, which may pass the brightest component's), opacity Σ a² / Σ a·w.
     var entry: array<vec4<f32>, 4>;
     var any = false;
     for (var c = 0u; c < ncomp; c = c + 1u) {
@@ -220,13 +220,34 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
             }
         }
         rgb_sum = rgb_sum + a * w * rgb;
-        a_sq = a_sq + a * a * w;
+        a_sq = a_sq + a * a;
         total = total + a * w;
     }
     if (total <= 0.0) {
         return vec4<f32>(0.0);
     }
-    return vec4<f32>(rgb_sum / total, min(a_sq / total, 1.0));
+    // (colour not premultiplied: the compositing multiplies it by the opacity again)
+    let alpha = min(a_sq / total, 1.0);
+    return vec4<f32>(rgb_sum / alpha, alpha);
+}
+
+// The ray's extremum after sample s (MIP: maximum, MinIP: minimum): per component for one
+// or independent components; for dependent components the whole sample whose opacity
+// component (the last) is the extremum, as vtkGPUVolumeRayCastMapper keeps it, so colour and
+// opacity come from one sample. The first sample (`first`) is taken as it is.
+fn extremum(value: vec4<f32>, s: vec4<f32>, first: bool) -> vec4<f32> {
+    if (first) {
+        return s;
+    }
+    if (!INDEPENDENT) {
+        let oc = NCOMP - 1u;
+        let better = select(s[oc] < value[oc], s[oc] > value[oc], BLEND == BLEND_MAXIMUM);
+        return select(value, s, better);
+    }
+    if (BLEND == BLEND_MAXIMUM) {
+        return max(value, s);
+    }
+    return min(value, s);
 }
 
 // Opacity × normalised scalar per component (average and additive blend modes), the
@@ -369,12 +390,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 let t = seg.x + (k + jit) * dt;
                 let p = ray.index_origin + t * ray.index_dir;
                 if ((!CROP || in_crop(p)) && !(BLANKING && blanked(p))) {
-                    let s = sample_scalars(p);
-                    if (blend == BLEND_MAXIMUM) {
-                        value = select(max(value, s), s, misc.x == 0.0);
-                    } else {
-                        value = select(min(value, s), s, misc.x == 0.0);
-                    }
+                    value = extremum(value, sample_scalars(p), misc.x == 0.0);
                     misc.x = misc.x + 1.0;
                 }
                 k = k + 1.0;
@@ -418,11 +434,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     break;
                 }
             }
-        } else if (blend == BLEND_MAXIMUM) {
-            value = select(max(value, s), s, misc.x == 0.0);
-            misc.x = misc.x + 1.0;
-        } else if (blend == BLEND_MINIMUM) {
-            value = select(min(value, s), s, misc.x == 0.0);
+        } else if (blend == BLEND_MAXIMUM || blend == BLEND_MINIMUM) {
+            value = extremum(value, s, misc.x == 0.0);
             misc.x = misc.x + 1.0;
         } else if (blend == BLEND_AVERAGE) {
             // VTK: opacity-weighted normalised scalars of the samples inside the range

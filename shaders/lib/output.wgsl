@@ -6,14 +6,21 @@
 @group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
 
 // Premultiplied colour of a projected value (maximum, minimum): the transfer function
-// applied to the value found, un-corrected opacity; independent components mixed as VTK
-// does (colour and opacity summed, weighted).
+// applied to the value found, un-corrected opacity; dependent components as in composite
+// (2: colour table on the first, opacity on the second; 4: the data's RGB, opacity on the
+// fourth); independent components mixed as VTK does (colour and opacity summed, weighted).
 fn classify_value(v: vec4<f32>) -> vec4<f32> {
     let ncomp = frame.counts.w;
     if (!has_flag(FLAG_INDEPENDENT)) {
         let oc = ncomp - 1u;
         let a = raw_alpha(0u, v[oc]);
-        return vec4<f32>(classify(0u, v.x).rgb * a, a);
+        var rgb = classify(0u, v.x).rgb;
+        if (ncomp == 4u) {
+            // the data's RGB as the texture holds it (sample_scalars' scale undone)
+            let texel = (v - frame.scalar_shift) / frame.scalar_scale;
+            rgb = clamp(texel.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+        }
+        return vec4<f32>(rgb * a, a);
     }
     var out = vec4<f32>(0.0);
     for (var c = 0u; c < ncomp; c = c + 1u) {
@@ -71,7 +78,9 @@ fn write_pixel(px: vec2<u32>, st: PixelState) {
         } else {
             color = classify_value(st.value);
             if (has_flag(FLAG_EXTREMUM_DEPTH)) {
-                let u = clamp(scalar_coord(0u, st.value.x), 0.0, 1.0);
+                // (dependent components: their extremum is the opacity component's)
+                let key = select(0u, frame.counts.w - 1u, !has_flag(FLAG_INDEPENDENT));
+                let u = clamp(scalar_coord(0u, st.value[key]), 0.0, 1.0);
                 depth = 0.5 * select(u, 1.0 - u, blend == BLEND_MAXIMUM);
             }
         }
