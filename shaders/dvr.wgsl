@@ -216,7 +216,8 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
                 a = a * gradient_opacity(c, length(world_gradient(g, c)));
             }
             if (SHADE) {
-                rgb = shade(rgb, world_gradient(gn, c), pos, view_dir);
+                rgb = shade_material(rgb, world_gradient(gn, c), pos, view_dir,
+                                     frame.component_materials[c]);
             }
         }
         rgb_sum = rgb_sum + a * w * rgb;

@@ -1156,6 +1156,15 @@ enum FvStatus fv_transfer_function_set_unit_distance(struct FvTransferFunction *
                                                      double weight);
 
 /**
+ * One component's own material when components are independent (vtkVolumeProperty's
+ * per-component shading): `material` = ambient, diffuse and specular coefficients and
+ * specular power, each finite and ≥ 0; NULL: the render parameters' (the default).
+ */
+enum FvStatus fv_transfer_function_set_material(struct FvTransferFunction *tf,
+                                                uint32_t component,
+                                                const float (*material)[4]);
+
+/**
  * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
  * `desc->scalar_type`, components interleaved, x fastest; `data_bytes` is its size in
  * bytes (checked). Scalars are validated (NaN/Inf refused, spacing > 0, direction

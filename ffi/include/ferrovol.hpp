@@ -148,6 +148,11 @@ public:
   void set_unit_distance(uint32_t component, double unit_distance, double weight = 1.0) {
     check(fv_transfer_function_set_unit_distance(h_.get(), component, unit_distance, weight));
   }
+  /// One component's own ambient, diffuse, specular and specular power (independent
+  /// components; see fv_transfer_function_set_material).
+  void set_material(uint32_t component, const float (&material)[4]) {
+    check(fv_transfer_function_set_material(h_.get(), component, &material));
+  }
   const FvTransferFunction *get() const noexcept { return h_.get(); }
 
 private:

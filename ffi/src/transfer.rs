@@ -9,6 +9,7 @@ struct PartialComponent {
     gradient_opacity: Option<Piecewise<1>>,
     unit_distance: Option<f64>,
     weight: Option<f32>,
+    material: Option<[f32; 4]>,
 }
 
 /// Colour, scalar opacity and gradient opacity per component (vtkVolumeProperty's
@@ -44,6 +45,7 @@ impl ToCore for FvTransferFunction {
             t.gradient_opacity = c.gradient_opacity.clone();
             t.unit_distance = c.unit_distance.unwrap_or(t.unit_distance);
             t.weight = c.weight.unwrap_or(t.weight);
+            t.material = c.material;
             components.push(t);
         }
         Ok(TransferFunction {
@@ -208,6 +210,32 @@ pub unsafe extern "C" fn fv_transfer_function_set_unit_distance(
         let c = t.component(component)?;
         c.unit_distance = Some(unit_distance);
         c.weight = Some(weight as f32);
+        Ok(())
+    })
+}
+
+/// One component's own material when components are independent (vtkVolumeProperty's
+/// per-component shading): `material` = ambient, diffuse and specular coefficients and
+/// specular power, each finite and ≥ 0; NULL: the render parameters' (the default).
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_material(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    material: *const [f32; 4],
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        // SAFETY: NULL or four floats, as the caller guarantees.
+        let m = unsafe { material.as_ref() }.copied();
+        if let Some(m) = m {
+            if !m.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(FfiError::invalid(format!(
+                    "material {m:?} (ambient, diffuse, specular, specular power) must be \
+                     finite and non-negative"
+                )));
+            }
+        }
+        t.component(component)?.material = m;
         Ok(())
     })
 }

@@ -57,6 +57,7 @@ struct Frame {
     counts: vec4<u32>,            // clip planes, lights, occupancy block size, components
     occupancy_dims: vec4<u32>,    // blocks per axis
     rect: vec4<u32>,              // pixels the passes cover: x0, y0, x1, y1 (exclusive)
+    component_materials: array<vec4<f32>, 4>, // each independent component's material
 }
 
 @group(0) @binding(0) var<uniform> frame_ubo: Frame;

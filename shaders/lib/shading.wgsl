@@ -36,6 +36,12 @@ fn light_incidence(light: Light, pos: vec3<f32>, v: vec3<f32>) -> vec4<f32> {
 }
 
 fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec3<f32> {
+    return shade_material(color, grad, pos, view_dir, frame.material);
+}
+
+// shade() with the material m (ambient, diffuse, specular, specular power).
+fn shade_material(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>,
+                  m: vec4<f32>) -> vec3<f32> {
     let glen = length(grad);
     var ambient = vec3<f32>(0.0);
     var diffuse = vec3<f32>(0.0);
@@ -66,10 +72,10 @@ fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>)
             let r = 2.0 * ndl * nl - l;
             let rdv = dot(r, v);
             if (rdv > 0.0) {
-                specular = specular + atten * pow(rdv, frame.material.w) * light.specular.rgb;
+                specular = specular + atten * pow(rdv, m.w) * light.specular.rgb;
             }
         }
     }
-    let lit = color * (frame.material.x * ambient + frame.material.y * diffuse) + frame.material.z * specular;
+    let lit = color * (m.x * ambient + m.y * diffuse) + m.z * specular;
     return clamp(lit, vec3<f32>(0.0), vec3<f32>(1.0));
 }

@@ -298,6 +298,18 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
     {
       return false;
     }
+    if (independent && n > 1)
+    {
+      // vtkGPUVolumeRayCastMapper shades each independent component with its own material.
+      const float material[4] = { static_cast<float>(prop->GetAmbient(c)),
+        static_cast<float>(prop->GetDiffuse(c)), static_cast<float>(prop->GetSpecular(c)),
+        static_cast<float>(prop->GetSpecularPower(c)) };
+      if (!vtkFerroVolumeCall("set the component's shading material", error,
+            [&] { tf->set_material(component, material); }))
+      {
+        return false;
+      }
+    }
     const int goIndex = independent ? c : 0;
     if (prop->HasGradientOpacity(goIndex) && !prop->GetDisableGradientOpacity(goIndex))
     {

@@ -339,6 +339,31 @@ class VtkReference(unittest.TestCase):
         # 23.0 dB when ferrovol took their opacity-weighted mean
         self.check("ref-two-components", 0.99, 42.0, data=img, prop=prop)
 
+    def test_component_materials(self):
+        """Shaded independent components, each with its own ambient, diffuse, specular and
+        specular power."""
+        n = 40
+        z, y, x = np.mgrid[0:n, 0:n, 0:n].astype(np.float32)
+        r1 = np.sqrt((x - 14) ** 2 + (y - 20) ** 2 + (z - 20) ** 2)
+        r2 = np.sqrt((x - 26) ** 2 + (y - 20) ** 2 + (z - 20) ** 2)
+        a = np.stack([np.clip(12 - r1, 0, 12) * 16, np.clip(12 - r2, 0, 12) * 16], axis=-1)
+        img = fvtest.image_from_array(a.astype(np.float32))
+
+        def prop():
+            p = fvtest.component_property([(1.0, 0.5, 0.1), (0.1, 0.5, 1.0)], 0.5,
+                                          interpolation="linear")
+            p.ShadeOn()
+            for c, (ka, kd, ks, power) in enumerate(((0.4, 0.5, 0.0, 1.0),
+                                                     (0.05, 0.9, 0.8, 40.0))):
+                p.SetAmbient(c, ka)
+                p.SetDiffuse(c, kd)
+                p.SetSpecular(c, ks)
+                p.SetSpecularPower(c, power)
+            return p
+        # measured SSIM 1.0000, PSNR 67.1 dB (0.9836 / 31.7 dB with component 0's material
+        # for both, as ferrovol shaded them before)
+        self.check("ref-component-materials", 0.99, 50.0, data=img, prop=prop)
+
     def test_rgba_mip_minip(self):
         """Dependent RGBA: MIP/MinIP keep the whole sample whose fourth component is largest /
         smallest and draw its RGB with the opacity of that component."""

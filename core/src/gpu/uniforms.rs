@@ -48,6 +48,8 @@ pub struct FrameUniforms {
     pub counts: [u32; 4],
     pub occupancy_dims: [u32; 4],
     pub rect: [u32; 4],
+    /// Each independent component's material (ambient, diffuse, specular, power).
+    pub component_materials: [[f32; 4]; 4],
 }
 
 #[repr(C)]
@@ -354,7 +356,8 @@ mod layout_tests {
                     mode,
                     counts,
                     occupancy_dims,
-                    rect
+                    rect,
+                    component_materials
                 ]
             );
             let (_, ps) = wgsl_struct(&m, "PixelState");

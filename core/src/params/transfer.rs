@@ -88,6 +88,10 @@ pub struct ComponentTransfer {
     pub unit_distance: f64,
     /// Weight of this component when components are independent (VTK's component weight).
     pub weight: f32,
+    /// This component's own ambient, diffuse and specular coefficients and specular power
+    /// (vtkVolumeProperty's per-component shading) when components are independent; `None`:
+    /// the render parameters' shading.
+    pub material: Option<[f32; 4]>,
 }
 
 impl ComponentTransfer {
@@ -98,6 +102,7 @@ impl ComponentTransfer {
             gradient_opacity: None,
             unit_distance: 1.0,
             weight: 1.0,
+            material: None,
         }
     }
 
@@ -177,6 +182,14 @@ impl TransferFunction {
                     "component {i}: weight {} must be finite and non-negative",
                     c.weight
                 )));
+            }
+            if let Some(m) = c.material {
+                if !m.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                    return Err(Error::InvalidTransferFunction(format!(
+                        "component {i}: material {m:?} (ambient, diffuse, specular, specular \
+                         power) must be finite and non-negative"
+                    )));
+                }
             }
         }
         if !(self.independent || volume_components == 2 || volume_components == 4) {

@@ -199,6 +199,9 @@ pub(crate) fn frame(
     }
     let s = &params.shading;
     u.material = [s.ambient, s.diffuse, s.specular, s.specular_power];
+    for (c, m) in u.component_materials.iter_mut().enumerate() {
+        *m = tf.component(c).material.unwrap_or(u.material);
+    }
     let mut flags = 0;
     if let Some(c) = &params.cropping {
         u.crop_lo = [
