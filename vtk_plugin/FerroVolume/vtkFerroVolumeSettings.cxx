@@ -313,10 +313,12 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       params.sample_distance = distance;
     }
   }
-  else
+  else if (this->Blend != FV_BLEND_MODE_PATH_TRACE)
   {
     // vtkOpenGLGPUVolumeRayCastMapper: the smallest world spacing of the input, lengthened
-    // by the reduction factor the render time asks for.
+    // by the reduction factor the render time asks for. (Path tracing keeps the step: its
+    // accumulation would start over at each change, and its renders fill their time
+    // budget instead.)
     const double factor = this->UpdateReductionFactor(self, vol->GetAllocatedRenderTime());
     if (factor < 1.0)
     {
