@@ -337,9 +337,21 @@ fn transfer_function_errors() {
         let material = lib.f::<unsafe extern "C" fn(H, u32, *const [f32; 4]) -> FvStatus>(
             "fv_transfer_function_set_material",
         );
-        lib.expect(material(tf, 0, &[0.1, 0.7, -0.2, 10.0]), Invalid, "material");
-        lib.expect(material(tf, 0, &[0.1, f32::NAN, 0.2, 10.0]), Invalid, "non-negative");
-        lib.expect(material(tf, 1, &[0.1, 0.7, 0.2, 10.0]), Invalid, "component 1");
+        lib.expect(
+            material(tf, 0, &[0.1, 0.7, -0.2, 10.0]),
+            Invalid,
+            "material",
+        );
+        lib.expect(
+            material(tf, 0, &[0.1, f32::NAN, 0.2, 10.0]),
+            Invalid,
+            "non-negative",
+        );
+        lib.expect(
+            material(tf, 1, &[0.1, 0.7, 0.2, 10.0]),
+            Invalid,
+            "component 1",
+        );
         lib.ok(material(tf, 0, &[0.1, 0.7, 0.2, 10.0]));
         lib.ok(material(tf, 0, null()));
         lib.f::<Free>("fv_transfer_function_free")(tf);
