@@ -37,6 +37,11 @@ override OPACITY_NORMAL: bool = false;
 // a later pass (PAGE_MISSING), keeps its state in `state` and resumes there; misc.w holds
 // the next sample's index, or −1 once the pixel is written.
 override STREAMING: bool = false;
+// Pre-integrated classification (RenderParams::preintegration; composite, one or independent
+// components): each sample classifies the ray segment from the previous lattice point, the
+// scalar taken to run linearly between them, from the pre-integration tables; shading and
+// gradient opacity stay the sample's own (the back of the segment).
+override PREINT: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 
@@ -66,6 +71,56 @@ fn blanked(p: vec3<f32>) -> bool {
     return any;
 }
 
+
+// Per component c, rows c·TABLE_N + f: for a segment whose front scalar is at table entry f
+// and whose back scalar is at entry b (column), the premultiplied colour and opacity it adds
+// at this step (core/src/params/transfer.rs, build_preintegration).
+@group(0) @binding(9) var preint_tables: texture_2d<f32>;
+
+// The pre-integration table of component c at front scalar sf and back scalar sb, read
+// bilinearly (nearest with NEAREST), clamped to the table's range as `classify` is.
+fn preintegrated(c: u32, sf: f32, sb: f32) -> vec4<f32> {
+    let last = f32(TABLE_N - 1u);
+    let x = clamp(scalar_coord(c, sb), 0.0, 1.0) * last;
+    let y = clamp(scalar_coord(c, sf), 0.0, 1.0) * last;
+    let row = i32(c * TABLE_N);
+    if (NEAREST) {
+        return textureLoad(preint_tables, vec2<i32>(i32(x + 0.5), row + i32(y + 0.5)), 0);
+    }
+    let x0 = u32(x);
+    let y0 = u32(y);
+    let x1 = i32(min(x0 + 1u, TABLE_N - 1u));
+    let y1 = row + i32(min(y0 + 1u, TABLE_N - 1u));
+    let a = vec2<i32>(i32(x0), row + i32(y0));
+    let top = mix(textureLoad(preint_tables, a, 0), textureLoad(preint_tables, vec2<i32>(x1, a.y), 0), x - f32(x0));
+    let bottom = mix(textureLoad(preint_tables, vec2<i32>(a.x, y1), 0), textureLoad(preint_tables, vec2<i32>(x1, y1), 0), x - f32(x0));
+    return mix(top, bottom, y - f32(y0));
+}
+
+// Colour (not premultiplied) and step-corrected opacity of component c for the segment
+// from the previous sample (scalar sf) to this one (scalar s): pre-integrated with PREINT,
+// else the sample's own classification.
+fn classify_segment(c: u32, sf: f32, s: f32) -> vec4<f32> {
+    if (!PREINT) {
+        return classify(c, s);
+    }
+    let e = preintegrated(c, sf, s);
+    if (e.a <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(e.rgb / e.a, e.a);
+}
+
+// PREINT: the scalars at the previous lattice point q, for a sample whose previous one was
+// not taken (the ray's first, or one after skipped, cropped or blanked samples); the
+// sample's own scalars s where q's brick is not resident (its constant is not the data).
+fn front_scalars(q: vec3<f32>, s: vec4<f32>) -> vec4<f32> {
+    let v = sample_scalars(q);
+    if (!SINGLE_BRICK && (brick.empty || brick.missing)) {
+        return s;
+    }
+    return v;
+}
 
 // Per min–max block, the first component's (min, max) over every point a sample in the
 // block interpolates from (nearest or trilinear), widened where the storage rounds the data
@@ -132,8 +187,9 @@ fn shading_gradient(p: vec3<f32>, g: Gradient) -> Gradient {
     return g;
 }
 
-// Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample.
-fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
+// Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample
+// (scalars s; sf: the previous sample's, which PREINT classifies the segment from).
+fn classify_sample(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
     let ncomp = NCOMP;
     let need_grad = SHADE || GRAD_OPACITY;
     if (!INDEPENDENT) {
@@ -159,7 +215,7 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
         return vec4<f32>(rgb, a);
     }
     if (NCOMP == 1u) {
-        var e = classify(0u, s.x);
+        var e = classify_segment(0u, sf.x, s.x);
         if (e.a <= 0.0 || frame.weights.x <= 0.0) {
             return vec4<f32>(0.0);
         }
@@ -187,7 +243,7 @@ fn classify_sample(s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f3
     var entry: array<vec4<f32>, 4>;
     var any = false;
     for (var c = 0u; c < ncomp; c = c + 1u) {
-        entry[c] = classify(c, s[c]);
+        entry[c] = classify_segment(c, sf[c], s[c]);
         any = any || entry[c].a * frame.weights[c] > 0.0;
     }
     if (!any) {
@@ -364,6 +420,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the conversion reads the camera at a dynamic index (lib/ray.wgsl) with a gather per
     // matrix element.
     var depth_t = -1.0;
+    // PREINT: the scalars of sample front_k, the last taken (composite keeps them in the
+    // ray state's `value`, and front_k + 2 in misc.x: 0 there means none), and whether its
+    // block was occupied.
+    var front = st.value;
+    var front_k = st.misc.x - 2.0;
+    var front_occupied = true;
     if (RANGE_SKIP) {
         // MIP / MinIP block by block: an outer loop decides per block, as the ray enters it,
         // whether to skip the block whole or to march all its samples in the inner loop.
@@ -404,7 +466,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         let t = seg.x + (k + jit) * dt;
         let p = ray.index_origin + t * ray.index_dir;
-        if (SKIP && !block_occupied(p)) {
+        var occupied = true;
+        if (SKIP) {
+            occupied = block_occupied(p);
+        }
+        // PREINT takes the sample after one taken in an occupied block even in an empty
+        // block: its segment begins in the occupied one.
+        if (SKIP && !occupied && !(PREINT && front_occupied && front_k == k - 1.0)) {
             let next = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
             if (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE) {
                 // their terms there are 0, but the samples count
@@ -423,7 +491,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         let s = sample_scalars(p);
         if (blend == BLEND_COMPOSITE) {
-            let c = classify_sample(s, p, ray.origin + t * ray.dir, ray.dir);
+            var sf = s;
+            if (PREINT) {
+                sf = front;
+                if (front_k != k - 1.0) {
+                    sf = front_scalars(p - dt * ray.index_dir, s);
+                }
+                front = s;
+                front_k = k;
+                front_occupied = occupied;
+            }
+            let c = classify_sample(sf, s, p, ray.origin + t * ray.dir, ray.dir);
             if (c.a > 0.0) {
                 let w = (1.0 - color.a) * c.a;
                 color = vec4<f32>(color.rgb + w * c.rgb, color.a + w);
@@ -454,6 +532,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     if (depth_t >= 0.0) {
         misc.y = distance_to_depth(ray, depth_t);
+    }
+    if (PREINT) {
+        value = front;
+        misc.x = front_k + 2.0;
     }
     st.color = color;
     st.value = value;

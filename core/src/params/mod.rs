@@ -25,7 +25,7 @@ pub use render::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
     MAX_CLIP_PLANES, MAX_LIGHTS,
 };
-pub(crate) use transfer::build_tables;
+pub(crate) use transfer::{build_preintegration, build_tables};
 pub use transfer::{
     ComponentTransfer, Piecewise, TransferFunction, MAX_TRANSFER_POSITION, TABLE_SIZE,
 };

@@ -179,6 +179,14 @@ pub struct RenderParams {
     /// except in the piece where the ray leaves the whole volume (average dividing by the
     /// whole ray's sample count), so that "over" adds them up. `None`: the volume is whole.
     pub whole_box: Option<[[f64; 3]; 2]>,
+    /// Pre-integrated classification (Engel, Kraus, Ertl 2001): composite ray casting
+    /// classifies the segment between consecutive samples, the scalar taken to run linearly
+    /// from one to the next, from a table of its integrated colour and opacity (built from
+    /// the transfer function for the step, rebuilt when either changes), instead of the
+    /// sample alone; shading and gradient opacity are the back sample's. Thin opacity peaks
+    /// then show at the default step without slicing. One component or independent
+    /// components, without volumetric shadows; other modes sample as without.
+    pub preintegration: bool,
 }
 
 impl Default for RenderParams {
@@ -200,6 +208,7 @@ impl Default for RenderParams {
             volume_matrix: DMat4::IDENTITY,
             extremum_depth: false,
             whole_box: None,
+            preintegration: false,
         }
     }
 }

@@ -67,6 +67,9 @@ pub struct Stats {
     /// Times the path tracer's accumulation started over (anything it converges to
     /// changed, or the first frame).
     pub accumulation_restarts: u32,
+    /// Builds of the pre-integration tables (when the transfer function or the step
+    /// changed under pre-integration).
+    pub preintegration_builds: u32,
 }
 
 /// Called after each pass of a streamed frame is submitted: (passes so far, passes in the

@@ -15,6 +15,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation};
+use crate::resources::tables::Tables;
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 
@@ -40,6 +41,7 @@ pipeline_variant! {
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
+        preintegration: bool => "PREINT",
     }
 }
 
@@ -49,6 +51,8 @@ pub(crate) struct DvrPass {
     pipelines: PipelineCache<DvrVariant>,
     /// The blanking mask bound when the volume has none (one point, not blanked).
     no_blanking: wgpu::TextureView,
+    /// Bound in place of the pre-integration tables when a frame does not use them.
+    no_preintegration: Tables,
 }
 
 impl DvrPass {
@@ -69,6 +73,7 @@ impl DvrPass {
                     storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
                     buffer_entry(7, B::Storage { read_only: false }),
                     sampled_texture_entry(8, wgpu::TextureSampleType::Uint, V::D3),
+                    texture_entry(9, false, V::D2),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -77,6 +82,7 @@ impl DvrPass {
             bgl,
             pipelines,
             no_blanking,
+            no_preintegration: Tables::new(&ctx.device, [1, 1]),
         })
     }
 
@@ -158,6 +164,11 @@ impl DvrPass {
                     .into(),
             ));
         }
+        // Pre-integration: composite, one or independent components, no volumetric shadows.
+        let preintegration = params.preintegration
+            && params.blend == BlendMode::Composite
+            && (vol.components == 1 || f.independent)
+            && !f.volumetric;
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
@@ -181,11 +192,20 @@ impl DvrPass {
             precomputed_gradient: vol.gradients,
             forward_diff: params.gradient == GradientMethod::Forward,
             streaming,
+            preintegration,
         };
+        if preintegration {
+            res.ensure_preintegration(ctx, step)?;
+        }
+        let vol = res.volume()?;
         let dvr = self.pipelines.get(ctx, variant)?;
         let t = res.targets.as_ref().expect("targets allocated above");
         let (_, tables) = res.tables.as_ref().expect("tables built above");
         let occupancy = &res.occupancy.as_ref().expect("occupancy built above").grid;
+        let preintegrated = match &res.preintegration {
+            Some((_, t)) if preintegration => t,
+            _ => &self.no_preintegration,
+        };
         let q = &ctx.queue;
         let d = &ctx.device;
         let u = f.uniforms;
@@ -211,6 +231,7 @@ impl DvrPass {
                         res.blanking.as_ref().unwrap_or(&self.no_blanking),
                     ),
                 ),
+                bind(9, wgpu::BindingResource::TextureView(&preintegrated.view)),
             ],
         });
         let rect = u.rect;

@@ -38,6 +38,8 @@ pub(crate) struct Resources {
     pub blanking: Option<wgpu::TextureView>,
     pub tf: Option<TransferFunction>,
     pub tables: Option<(TableKey, Tables)>,
+    /// The pre-integration tables, built when a frame asks for pre-integration.
+    pub preintegration: Option<(TableKey, Tables)>,
     /// Occupancy of the min–max blocks under the transfer function.
     pub occupancy: Option<Occupancy<TableKey>>,
     pub targets: Option<Targets>,
@@ -97,6 +99,7 @@ impl Resources {
             volume: None,
             tf: None,
             tables: None,
+            preintegration: None,
             blanking: None,
             occupancy: None,
             targets: None,

@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
-use crate::params::{build_tables, TransferFunction};
+use crate::params::{build_preintegration, build_tables, TransferFunction};
 
 /// Everything that decides the tables' contents; tables are rebuilt only when it changes.
 #[derive(PartialEq)]
@@ -97,6 +97,32 @@ impl Resources {
         upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 16);
         self.tables = Some((key, tables));
         self.stats.table_uploads += 1;
+        Ok(())
+    }
+
+    /// Builds the pre-integration tables (one `TABLE_SIZE`² block of rows per component,
+    /// front sample's entry by row, back sample's by column; params::transfer's
+    /// build_preintegration) for the transfer function at sample distance `step`, unless
+    /// they are current.
+    pub fn ensure_preintegration(&mut self, ctx: &Context, step: f64) -> Result<()> {
+        let tf = self.transfer_function()?;
+        let key = TableKey::new(tf, step);
+        if self.preintegration.as_ref().is_some_and(|(k, _)| *k == key) {
+            return Ok(());
+        }
+        let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
+        let mut data: Vec<[f32; 4]> = Vec::with_capacity(comps * TABLE_SIZE * TABLE_SIZE);
+        for c in 0..comps {
+            data.extend(build_preintegration(tf.component(c), step));
+        }
+        let size = [TABLE_SIZE as u32, (comps * TABLE_SIZE) as u32];
+        let tables = match self.preintegration.take() {
+            Some((_, t)) if [t.texture.width(), t.texture.height()] == size => t,
+            _ => Tables::new(&ctx.device, size),
+        };
+        upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 16);
+        self.preintegration = Some((key, tables));
+        self.stats.preintegration_builds += 1;
         Ok(())
     }
 
