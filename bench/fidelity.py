@@ -11,7 +11,12 @@ each frame waited for with WaitForCompletion). The configurations:
 
   ferrovol default   vtkFerroVolumeMapper as a script gets it
   ferrovol fast      SampleDistance twice the smallest spacing (AutoAdjust off)
+  ferrovol half      SampleDistance half the smallest spacing (AutoAdjust off)
+  pre-int default    the default with PreIntegration on
+  pre-int fast       ferrovol fast with PreIntegration on
   vtk default        vtkGPUVolumeRayCastMapper as a script gets it
+
+(ferrovol's reference is drawn without pre-integration: both converge to the same image)
 
 and one more row says how far the two references are from each other (the two
 renderers' conventions). Scenes: the wavelet benchmark (VTK's TestGPURayCastMapperBenchmark
@@ -90,9 +95,11 @@ class Bench:
         self.start.DeepCopy(self.renderer.GetActiveCamera())
         self.spacing = min(data.GetSpacing())
 
-    def configure(self, sample_distance=None):
+    def configure(self, sample_distance=None, preintegration=False):
         """Sample distance as a multiple of the smallest spacing; None: the defaults."""
         m = self.mapper
+        if hasattr(m, "SetPreIntegration"):
+            m.SetPreIntegration(preintegration)
         if sample_distance is None:
             m.AutoAdjustSampleDistancesOn()
             m.SetSampleDistance(1.0)
@@ -163,11 +170,14 @@ def main(argv):
             b.configure(1.0 / REFERENCE_DIVISOR)
             refs[kind] = b.image()
         rows = []
-        for label, kind, distance in (("ferrovol default", "ferrovol", None),
-                                      ("ferrovol fast", "ferrovol", 2.0),
-                                      ("vtk default", "vtk", None)):
+        for label, kind, distance, pre in (("ferrovol default", "ferrovol", None, False),
+                                           ("ferrovol fast", "ferrovol", 2.0, False),
+                                           ("ferrovol half", "ferrovol", 0.5, False),
+                                           ("pre-int default", "ferrovol", None, True),
+                                           ("pre-int fast", "ferrovol", 2.0, True),
+                                           ("vtk default", "vtk", None, False)):
             b = benches[kind]
-            b.configure(distance)
+            b.configure(distance, pre)
             img = b.image()
             rows.append((label, b.ms_per_frame(args.frames)) + errors(refs[kind], img))
         vtk_ms = rows[-1][1]

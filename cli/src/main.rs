@@ -152,6 +152,10 @@ struct RenderArgs {
     /// Disable empty-space skipping.
     #[arg(long)]
     no_skip: bool,
+    /// Pre-integrated classification: composite mode classifies the segment between
+    /// consecutive samples (thin opacity peaks without slicing at the default step).
+    #[arg(long)]
+    preintegration: bool,
     /// Background colour r,g,b in [0, 1].
     #[arg(long, default_value = "0,0,0", value_parser = parse_rgb)]
     background: [f32; 3],
@@ -731,6 +735,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         sample_distance: a.sample_distance,
         jitter: a.jitter,
         empty_space_skipping: !a.no_skip,
+        preintegration: a.preintegration,
         ..Default::default()
     };
     params.shading.enabled = a.shade;

@@ -478,6 +478,14 @@ typedef struct FvRenderParams {
    */
   bool whole_box_enabled;
   double whole_box[6];
+  /**
+   * Pre-integrated classification (Engel, Kraus, Ertl 2001): composite ray casting
+   * classifies the segment between consecutive samples from a table of its integrated
+   * colour and opacity, so thin opacity peaks show at the default step; one or
+   * independent components, without volumetric shadows (see RenderParams::preintegration
+   * in ferrovol-core). Off by default.
+   */
+  bool preintegration;
 } FvRenderParams;
 
 /**

@@ -262,6 +262,12 @@ pub struct FvRenderParams {
     /// ferrovol-core).
     pub whole_box_enabled: bool,
     pub whole_box: [f64; 6],
+    /// Pre-integrated classification (Engel, Kraus, Ertl 2001): composite ray casting
+    /// classifies the segment between consecutive samples from a table of its integrated
+    /// colour and opacity, so thin opacity peaks show at the default step; one or
+    /// independent components, without volumetric shadows (see RenderParams::preintegration
+    /// in ferrovol-core). Off by default.
+    pub preintegration: bool,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -377,6 +383,7 @@ impl FvRenderParams {
             extremum_depth: d.extremum_depth,
             whole_box_enabled: false,
             whole_box: [0.0; 6],
+            preintegration: d.preintegration,
         }
     }
 }
@@ -462,6 +469,7 @@ impl ToCore for FvRenderParams {
                 [self.whole_box[0], self.whole_box[1], self.whole_box[2]],
                 [self.whole_box[3], self.whole_box[4], self.whole_box[5]],
             ]),
+            preintegration: self.preintegration,
         };
         p.validate()?;
         Ok(p)

@@ -156,6 +156,12 @@ void vtkFerroVolumeRepresentation::SetEmptySpaceSkipping(int value)
 }
 
 //------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::SetPreIntegration(int value)
+{
+  this->GetFerroVolumeMapper()->SetPreIntegration(value != 0);
+}
+
+//------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::SetMaxMemoryInBytes(vtkIdType value)
 {
   this->GetFerroVolumeMapper()->SetMaxMemoryInBytes(value);

@@ -26,7 +26,8 @@
  *   background, specular sampling, ambient occlusion, shininess from the gradient, Fresnel;
  * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
  *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering,
- *   EmptySpaceSkipping, MaxMemoryInBytes and MaxMemoryFraction.
+ *   EmptySpaceSkipping, MaxMemoryInBytes and MaxMemoryFraction; and vtkFerroVolumeMapper's
+ *   PreIntegration.
  *
  * Inputs: vtkImageData only (what vtkFerroVolumeMapper renders). Rectilinear grids and
  * composite datasets, which "Volume" accepts, are not drawn; a warning says so.
@@ -103,6 +104,7 @@ public:
   void SetImageSampleDistance(double value);
   void SetUseJittering(int value);
   void SetEmptySpaceSkipping(int value);
+  void SetPreIntegration(int value);
   void SetMaxMemoryInBytes(vtkIdType value);
   void SetMaxMemoryFraction(double value);
   ///@}

@@ -433,6 +433,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   params.average_range[1] = average[1];
   params.empty_space_skipping = self->GetEmptySpaceSkipping() != 0;
   params.extremum_depth = self->GetExtremumDepth() != 0;
+  params.preintegration = self->GetPreIntegration() != 0;
   // A piece of a whole extent: the whole's box in the piece's index space (points, or the
   // cell centres with cell data).
   const int* whole = self->GetWholeExtent();

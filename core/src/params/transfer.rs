@@ -409,7 +409,12 @@ mod tests {
         .unwrap();
         let c = ComponentTransfer::new(grey, peak);
         let step = 0.5;
+        let t0 = std::time::Instant::now();
         let pre = build_preintegration(&c, step);
+        println!(
+            "pre-integration table {n}²: built in {:.1} ms",
+            t0.elapsed().as_secs_f64() * 1e3
+        );
         let one = build_tables(&c, step);
         assert_eq!(pre.len(), n * n);
         for i in [0, 499, 500, 501] {
