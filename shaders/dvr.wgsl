@@ -77,24 +77,14 @@ fn blanked(p: vec3<f32>) -> bool {
 // at this step (core/src/params/transfer.rs, build_preintegration).
 @group(0) @binding(9) var preint_tables: texture_2d<f32>;
 
-// The pre-integration table of component c at front scalar sf and back scalar sb, read
-// bilinearly (nearest with NEAREST), clamped to the table's range as `classify` is.
+// The pre-integration table of component c at front scalar sf and back scalar sb, clamped to
+// the table's range as `classify` is, read with the volume's sampler: bilinear, or nearest
+// with NEAREST (whose pipelines bind the nearest sampler).
 fn preintegrated(c: u32, sf: f32, sb: f32) -> vec4<f32> {
-    let last = f32(TABLE_N - 1u);
-    let x = clamp(scalar_coord(c, sb), 0.0, 1.0) * last;
-    let y = clamp(scalar_coord(c, sf), 0.0, 1.0) * last;
-    let row = i32(c * TABLE_N);
-    if (NEAREST) {
-        return textureLoad(preint_tables, vec2<i32>(i32(x + 0.5), row + i32(y + 0.5)), 0);
-    }
-    let x0 = u32(x);
-    let y0 = u32(y);
-    let x1 = i32(min(x0 + 1u, TABLE_N - 1u));
-    let y1 = row + i32(min(y0 + 1u, TABLE_N - 1u));
-    let a = vec2<i32>(i32(x0), row + i32(y0));
-    let top = mix(textureLoad(preint_tables, a, 0), textureLoad(preint_tables, vec2<i32>(x1, a.y), 0), x - f32(x0));
-    let bottom = mix(textureLoad(preint_tables, vec2<i32>(a.x, y1), 0), textureLoad(preint_tables, vec2<i32>(x1, y1), 0), x - f32(x0));
-    return mix(top, bottom, y - f32(y0));
+    let n = f32(TABLE_N);
+    let x = clamp(scalar_coord(c, sb), 0.0, 1.0) * (n - 1.0) + 0.5;
+    let y = clamp(scalar_coord(c, sf), 0.0, 1.0) * (n - 1.0) + 0.5 + f32(c) * n;
+    return textureSampleLevel(preint_tables, volume_sampler, vec2<f32>(x / n, y / (n * f32(NCOMP))), 0.0);
 }
 
 // Colour (not premultiplied) and step-corrected opacity of component c for the segment

@@ -15,7 +15,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation};
-use crate::resources::tables::Tables;
+use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 
@@ -73,7 +73,7 @@ impl DvrPass {
                     storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
                     buffer_entry(7, B::Storage { read_only: false }),
                     sampled_texture_entry(8, wgpu::TextureSampleType::Uint, V::D3),
-                    texture_entry(9, false, V::D2),
+                    texture_entry(9, true, V::D2),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -82,7 +82,7 @@ impl DvrPass {
             bgl,
             pipelines,
             no_blanking,
-            no_preintegration: Tables::new(&ctx.device, [1, 1]),
+            no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
         })
     }
 
