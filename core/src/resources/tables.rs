@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
-use crate::params::{build_preintegration, build_tables, TransferFunction};
+use crate::params::{build_preintegration, build_tables, ComponentTransfer, TransferFunction};
 
 /// The pre-integration tables' texel format.
 pub(crate) const PREINTEGRATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -83,28 +83,53 @@ impl<K: PartialEq> Occupancy<K> {
     }
 }
 
+/// Keeps in `slot` the tables `build` makes of each of `comps` components' transfer
+/// (`rows` rows of `TABLE_SIZE` texels each, of `format`) for `key`: rebuilt only when the
+/// key changed, in the same texture when its size is the same. Whether it rebuilt them.
+fn ensure_rows<T: bytemuck::Pod>(
+    ctx: &Context,
+    slot: &mut Option<(TableKey, Tables)>,
+    key: TableKey,
+    comps: usize,
+    rows: usize,
+    format: wgpu::TextureFormat,
+    build: impl Fn(&ComponentTransfer) -> Vec<T>,
+) -> bool {
+    if slot.as_ref().is_some_and(|(k, _)| *k == key) {
+        return false;
+    }
+    let mut data: Vec<T> = Vec::with_capacity(comps * rows * TABLE_SIZE);
+    for c in 0..comps {
+        data.extend(build(key.tf.component(c)));
+    }
+    let size = [TABLE_SIZE as u32, (comps * rows) as u32];
+    let tables = match slot.take() {
+        Some((_, t)) if [t.texture.width(), t.texture.height()] == size => t,
+        _ => Tables::with_format(&ctx.device, size, format),
+    };
+    let texel = std::mem::size_of::<T>() as u32;
+    upload_texture(
+        &ctx.queue,
+        &tables.texture,
+        bytemuck::cast_slice(&data),
+        texel,
+    );
+    *slot = Some((key, tables));
+    true
+}
+
 impl Resources {
     /// Builds the tables for the transfer function at sample distance `step`, unless they are
     /// current.
     pub fn ensure_tables(&mut self, ctx: &Context, step: f64) -> Result<()> {
-        let tf = self.transfer_function()?;
-        let key = TableKey::new(tf, step);
-        if self.tables.as_ref().is_some_and(|(k, _)| *k == key) {
-            return Ok(());
-        }
+        let key = TableKey::new(self.transfer_function()?, step);
         let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
-        let mut data: Vec<[f32; 4]> = Vec::with_capacity(comps * 2 * TABLE_SIZE);
-        for c in 0..comps {
-            data.extend(build_tables(tf.component(c), step));
+        let format = wgpu::TextureFormat::Rgba32Float;
+        if ensure_rows(ctx, &mut self.tables, key, comps, 2, format, |c| {
+            build_tables(c, step)
+        }) {
+            self.stats.table_uploads += 1;
         }
-        let size = [TABLE_SIZE as u32, 2 * comps as u32];
-        let tables = match self.tables.take() {
-            Some((_, t)) if [t.texture.width(), t.texture.height()] == size => t,
-            _ => Tables::new(&ctx.device, size),
-        };
-        upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 16);
-        self.tables = Some((key, tables));
-        self.stats.table_uploads += 1;
         Ok(())
     }
 
@@ -115,28 +140,27 @@ impl Resources {
     /// fetch (the volume's sampler) where four loads of 32-bit floats would take longer on
     /// lavapipe; their 11-bit precision is below the 8-bit output's.
     pub fn ensure_preintegration(&mut self, ctx: &Context, step: f64) -> Result<()> {
-        let tf = self.transfer_function()?;
-        let key = TableKey::new(tf, step);
-        if self.preintegration.as_ref().is_some_and(|(k, _)| *k == key) {
-            return Ok(());
-        }
+        let key = TableKey::new(self.transfer_function()?, step);
         let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
-        let mut data: Vec<[half::f16; 4]> = Vec::with_capacity(comps * TABLE_SIZE * TABLE_SIZE);
-        for c in 0..comps {
-            data.extend(
-                build_preintegration(tf.component(c), step)
-                    .into_iter()
-                    .map(|e| e.map(half::f16::from_f32)),
-            );
-        }
-        let size = [TABLE_SIZE as u32, (comps * TABLE_SIZE) as u32];
-        let tables = match self.preintegration.take() {
-            Some((_, t)) if [t.texture.width(), t.texture.height()] == size => t,
-            _ => Tables::with_format(&ctx.device, size, PREINTEGRATION_FORMAT),
+        let half = |c: &ComponentTransfer| -> Vec<[half::f16; 4]> {
+            let table = build_preintegration(c, step);
+            table
+                .into_iter()
+                .map(|e| e.map(half::f16::from_f32))
+                .collect()
         };
-        upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 8);
-        self.preintegration = Some((key, tables));
-        self.stats.preintegration_builds += 1;
+        let format = PREINTEGRATION_FORMAT;
+        if ensure_rows(
+            ctx,
+            &mut self.preintegration,
+            key,
+            comps,
+            TABLE_SIZE,
+            format,
+            half,
+        ) {
+            self.stats.preintegration_builds += 1;
+        }
         Ok(())
     }
 
