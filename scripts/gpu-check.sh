@@ -13,7 +13,8 @@
 # `run --quick OUT` uses small sizes, for a CPU device. Figures: ms per frame (the first
 # frame, which builds pipelines and tables, is not counted) of VTK's benchmark scene (wavelet
 # 256³, 900²) unshaded and shaded; a 1024³ uint16 wavelet (2 GiB) streamed through memory
-# budgets, with the bricks uploaded per frame along a camera orbit; isosurfaces; path tracing.
+# budgets, with the bricks uploaded per frame along a camera orbit; composite with and without
+# pre-integrated classification; isosurfaces; path tracing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -38,7 +39,9 @@ run() {
     local out=${1:?usage: scripts/gpu-check.sh run [--quick] OUT}
     mkdir -p "$out"
     local fv=.gpu/ferrovol
-    [ -x "$fv" ] || fv=target/release/ferrovol
+    if [ ! -x "$fv" ] || [ target/release/ferrovol -nt "$fv" ]; then
+        fv=target/release/ferrovol
+    fi
     if ! ldconfig -p | grep -q libvulkan.so.1 && [ -d .gpu/deb ]; then
         for f in .gpu/deb/*.deb; do dpkg -x "$f" /; done
         ldconfig
@@ -72,6 +75,10 @@ run() {
     done
     step "in core $big³ uint16" render --demo-size "$big" --demo-type uint16 --size "$render" \
         --zoom 1.5 --repeat "$repeat" --orbit 2 -o "$out/in-core.png"
+    for pre in "" --preintegration; do
+        step "wavelet 256³ composite ${pre:-sampled}" render --demo-size 256 $pre \
+            --size "$render" --repeat "$repeat" -o "$out/composite${pre:+-preintegrated}.png"
+    done
     step isosurfaces render --demo-size 256 --mode iso --iso 180 --size "$render" \
         --repeat "$repeat" -o "$out/iso.png"
     step "path tracing, $spp paths per pixel" render --demo-size 256 --mode pathtrace \
