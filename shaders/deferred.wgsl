@@ -29,6 +29,8 @@
 
 // 0: no scattering; 1: the preview; 2: traced (pipeline constant).
 override SCATTER: u32 = 0u;
+// The component whose isosurfaces are drawn (core/src/passes/iso.rs, iso_component).
+override ISO_COMP: u32 = 0u;
 
 @group(0) @binding(2) var<storage, read> state: array<PixelState>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
@@ -125,7 +127,7 @@ fn shade_surface(color: vec3<f32>, pos: vec3<f32>, n: vec3<f32>, gmag: f32, ao: 
 // −ln(1 − α) per unit distance, scaled).
 fn absorption_at(x: vec3<f32>) -> f32 {
     let p = (frame.world_to_index * vec4<f32>(x, 1.0)).xyz;
-    let a = min(raw_alpha(0u, sample_scalars(p).x), 0.9999);
+    let a = min(raw_alpha(ISO_COMP, sample_scalars(p)[ISO_COMP]), 0.9999);
     return -log(1.0 - a) * iso.scatter.x;
 }
 

@@ -23,6 +23,8 @@ override CROP: bool = false;
 // serving them (the host streams only with a sample distance of at most one voxel and no
 // ambient occlusion), so its apron holds every point a crossing's refinement reads.
 override STREAMING: bool = false;
+// The component whose isosurfaces are drawn (core/src/passes/iso.rs, iso_component).
+override ISO_COMP: u32 = 0u;
 
 // Per pixel: color.x = layers written, color.y = their accumulated opacity; deferred.wgsl
 // reads the layer count from it. Streaming also keeps: color.z the next sample, color.w 1
@@ -46,7 +48,7 @@ fn point_at(ray: Ray, t: f32) -> vec3<f32> {
 
 fn texel_scalar(c: vec3<i32>) -> f32 {
     let tc = (vec3<f32>(c) + 0.5) * pool.inv_size.xyz;
-    return textureSampleLevel(volume_tex, texel_sampler, tc, 0.0).x;
+    return textureSampleLevel(volume_tex, texel_sampler, tc, 0.0)[ISO_COMP];
 }
 
 // Where p falls in its brick's slot of the pool: the cell's first texel (clamped so the
@@ -75,7 +77,7 @@ fn cell_texel(c: Cell, o: vec3<i32>) -> f32 {
     return texel_scalar(clamp(c.i0 + o, c.lo, c.hi));
 }
 
-// Component 0 at index-space point p, interpolated trilinearly in f32 from the texels
+// Component ISO_COMP at index-space point p, interpolated trilinearly in f32 from the texels
 // themselves: a sampler's filter weights carry only a few bits of sub-texel precision
 // (8 on lavapipe, 1/256 of a voxel), far coarser than the hits are placed.
 fn exact_scalar(p: vec3<f32>) -> f32 {
@@ -87,9 +89,9 @@ fn exact_scalar(p: vec3<f32>) -> f32 {
     let x11 = mix(cell_texel(c, vec3<i32>(0, 1, 1)), cell_texel(c, vec3<i32>(1, 1, 1)), f.x);
     var v = mix(mix(x00, x10, f.y), mix(x01, x11, f.y), f.z);
     if (!SINGLE_BRICK && brick.empty) {
-        v = brick.constant.x;
+        v = brick.constant[ISO_COMP];
     }
-    return v * frame.scalar_scale.x + frame.scalar_shift.x;
+    return v * frame.scalar_scale[ISO_COMP] + frame.scalar_shift[ISO_COMP];
 }
 
 // Index-space gradient at p: central differences, one voxel each way along each axis, of
@@ -122,7 +124,7 @@ fn exact_gradient(p: vec3<f32>) -> vec3<f32> {
     if (!SINGLE_BRICK && brick.empty) {
         g = vec3<f32>(0.0);
     }
-    return 0.5 * frame.scalar_scale.x * g;
+    return 0.5 * frame.scalar_scale[ISO_COMP] * g;
 }
 
 // The distance in [t0, t1] where the field crosses v, `below` telling whether it is below v
@@ -136,7 +138,7 @@ fn refine(ray: Ray, t0: f32, t1: f32, v: f32, below: bool) -> f32 {
     var b = t1;
     for (var i = 0u; i < iso.counts.y; i = i + 1u) {
         let m = 0.5 * (a + b);
-        if ((sample_scalars(point_at(ray, m)).x < v) == below) {
+        if ((sample_scalars(point_at(ray, m))[ISO_COMP] < v) == below) {
             a = m;
         } else {
             b = m;
@@ -174,7 +176,7 @@ fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 
             if (any(q < lo) || any(q > hi)) {
                 break;
             }
-            if ((sample_scalars(q).x < v) != front_below) {
+            if ((sample_scalars(q)[ISO_COMP] < v) != front_below) {
                 hit = true;
                 break;
             }
@@ -337,7 +339,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 tail = tail || at_tail;
                 break;
             }
-            let s_q = sample_scalars(point_at(ray, t_q)).x;
+            let s_q = sample_scalars(point_at(ray, t_q))[ISO_COMP];
             if (take_prev) {
                 t_prev = t_q;
                 s_prev = s_q;

@@ -452,7 +452,8 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   this->Background = false;
   if (isosurface)
   {
-    const Result iso = this->SetUpIsosurfaces(self, vol, renderer, warned, error);
+    const Result iso =
+      this->SetUpIsosurfaces(self, vol, input.GetComponents(), renderer, warned, error);
     if (iso != Result::Ready)
     {
       return iso;
@@ -638,15 +639,27 @@ bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRen
 
 // Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
 // environment when it changed. The surfaces' colours and opacities are the property's
-// colour and scalar opacity functions at the iso-values (first component), as
-// vtkGPUVolumeRayCastMapper's; Shade off draws flat colours (ambient 1, no diffuse or
+// colour and scalar opacity functions at the iso-values, as vtkGPUVolumeRayCastMapper's:
+// those of the component the surfaces are of (independent components: the one of the
+// largest weight, the first of equal ones, as ferrovol's core picks it; else the first); Shade off draws flat colours (ambient 1, no diffuse or
 // specular light, no environment light). Without iso-values nothing is drawn, silently, as
 // vtkGPUVolumeRayCastMapper does.
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
-  vtkFerroVolumeMapper* self, vtkVolume* vol, ferrovol::Renderer& renderer,
+  vtkFerroVolumeMapper* self, vtkVolume* vol, int components, ferrovol::Renderer& renderer,
   std::set<std::string>& warned, std::string& error)
 {
   vtkVolumeProperty* prop = vol->GetProperty();
+  int comp = 0;
+  if (prop->GetIndependentComponents())
+  {
+    for (int c = 1; c < components; ++c)
+    {
+      if (prop->GetComponentWeight(c) > prop->GetComponentWeight(comp))
+      {
+        comp = c;
+      }
+    }
+  }
   FvRenderParams& params = this->Params;
   vtkContourValues* contours = prop->GetIsoSurfaceValues();
   const int n = contours ? contours->GetNumberOfContours() : 0;
@@ -667,10 +680,10 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
   }
   // (Get{Gray,RGB}TransferFunction create a default function, and switch the property to
   // it, when it has none: ask for the one the property uses.)
-  const bool grayColor = prop->GetColorChannels(0) == 1;
-  vtkColorTransferFunction* rgb = grayColor ? nullptr : prop->GetRGBTransferFunction(0);
-  vtkPiecewiseFunction* gray = grayColor ? prop->GetGrayTransferFunction(0) : nullptr;
-  vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(0);
+  const bool grayColor = prop->GetColorChannels(comp) == 1;
+  vtkColorTransferFunction* rgb = grayColor ? nullptr : prop->GetRGBTransferFunction(comp);
+  vtkPiecewiseFunction* gray = grayColor ? prop->GetGrayTransferFunction(comp) : nullptr;
+  vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(comp);
   uint32_t count = 0;
   for (int i = 0; i < std::min(n, static_cast<int>(FV_MAX_ISO_VALUES)); ++i)
   {

@@ -66,7 +66,7 @@ private:
   double UpdateReductionFactor(vtkFerroVolumeMapper* self, double allocatedTime);
   bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
     ferrovol::Renderer& renderer, double traceBudget, std::string& error);
-  Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol,
+  Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol, int components,
     ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
 
   uint32_t Blend = FV_BLEND_MODE_COMPOSITE;

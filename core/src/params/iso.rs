@@ -19,7 +19,8 @@ pub const MAX_AO_SAMPLES: u32 = 1024;
 /// Most steps per ambient-occlusion ray.
 pub const MAX_AO_STEPS: u32 = 256;
 
-/// One isosurface: where the field equals `value` (first component), drawn in `color`
+/// One isosurface: where the field equals `value` (of the component the isosurfaces are of,
+/// see [`IsoParams`]), drawn in `color`
 /// with `opacity` (1: opaque; less: the surfaces behind show through).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IsoValue {
@@ -113,7 +114,9 @@ impl Default for AmbientOcclusion {
 /// whatever `shading.enabled` says); its termination threshold ends marching behind
 /// translucent surfaces; its depth threshold picks the layer whose depth is written. The
 /// field is always interpolated trilinearly (`interpolation` is for the DVR modes), and
-/// the isosurfaces are those of the first component.
+/// the isosurfaces are those of one component, as vtkGPUVolumeRayCastMapper chooses it: with
+/// independent components the one of the largest weight (the first of equal ones), else the
+/// first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IsoParams {
     /// 1 to [`MAX_ISO_VALUES`] isosurfaces.

@@ -37,6 +37,7 @@ use crate::gpu::Context;
 use crate::params::iso::MAX_SPECULAR_SAMPLES;
 use crate::params::{
     BlendMode, GBuffer, IsoParams, IsoScatterMode, RenderParams, Shading, Shininess,
+    TransferFunction,
 };
 use crate::resources::environment::texel_solid_angle;
 use crate::resources::tables::{Occupancy, Tables};
@@ -53,6 +54,8 @@ pipeline_variant! {
         crop: bool => "CROP",
         single_brick: bool => "SINGLE_BRICK",
         streaming: bool => "STREAMING",
+        /// The component the isosurfaces are of (iso_component).
+        component: u32 => "ISO_COMP",
     }
 }
 
@@ -64,6 +67,25 @@ pipeline_variant! {
         /// 0 none, 1 preview, 2 traced (IsoScattering).
         scatter: u32 => "SCATTER",
         single_brick: bool => "SINGLE_BRICK",
+        component: u32 => "ISO_COMP",
+    }
+}
+
+/// The component whose isosurfaces are drawn, as vtkGPUVolumeRayCastMapper chooses it:
+/// with independent components the one of the largest weight (the first of equal ones),
+/// else (one or dependent components) the first.
+fn iso_component(tf: Option<&TransferFunction>, components: u32) -> u32 {
+    match tf {
+        Some(tf) if tf.independent && components > 1 => {
+            let mut best = 0;
+            for c in 1..components as usize {
+                if tf.component(c).weight > tf.component(best).weight {
+                    best = c;
+                }
+            }
+            best as u32
+        }
+        _ => 0,
     }
 }
 
@@ -81,6 +103,7 @@ struct GBufferTargets {
 #[derive(PartialEq)]
 struct OccupancyKey {
     values: Vec<u64>,
+    component: u32,
     volume_upload: u32,
 }
 
@@ -294,10 +317,17 @@ impl IsoPass {
     }
 
     /// The occupancy grid (a texture) for these iso-values: blocks whose min–max range holds one.
-    fn ensure_occupancy(&mut self, ctx: &Context, res: &Resources, values: &[f32]) -> Result<()> {
+    fn ensure_occupancy(
+        &mut self,
+        ctx: &Context,
+        res: &Resources,
+        values: &[f32],
+        component: u32,
+    ) -> Result<()> {
         let vol = res.volume()?;
         let key = OccupancyKey {
             values: values.iter().map(|v| v.to_bits() as u64).collect(),
+            component,
             volume_upload: res.stats.volume_uploads,
         };
         if Occupancy::current(&self.occupancy, &key) {
@@ -309,7 +339,7 @@ impl IsoPass {
             .ranges
             .chunks(nc)
             .map(|r| {
-                let [lo, hi] = r[0];
+                let [lo, hi] = r[component as usize];
                 values.iter().any(|&v| v >= lo && v <= hi) as u32
             })
             .collect();
@@ -354,7 +384,8 @@ impl IsoPass {
             ..params.clone()
         })?;
         let values: Vec<f32> = iso.values.iter().map(|v| v.value as f32).collect();
-        self.ensure_occupancy(ctx, res, &values)?;
+        let component = iso_component(res.tf.as_ref(), res.volume()?.components);
+        self.ensure_occupancy(ctx, res, &values, component)?;
         let surfaces = &self.occupancy.as_ref().expect("built above").flags;
         let plan = if iso.scattering.is_some() {
             // the scattering also reads the transfer function's opacity between the surfaces
@@ -391,18 +422,18 @@ impl IsoPass {
         };
         let f = frame::frame(res, view, &lit, step, depth_input)?;
         let vol = res.volume()?;
-        let data_range = vol
-            .minmax
-            .ranges
-            .chunks(vol.components as usize)
-            .fold([f32::INFINITY, f32::NEG_INFINITY], |a, r| {
-                [a[0].min(r[0][0]), a[1].max(r[0][1])]
-            });
+        let data_range = vol.minmax.ranges.chunks(vol.components as usize).fold(
+            [f32::INFINITY, f32::NEG_INFINITY],
+            |a, r| {
+                let [lo, hi] = r[component as usize];
+                [a[0].min(lo), a[1].max(hi)]
+            },
+        );
         let single_brick = vol.single_brick();
         let unit = res
             .tf
             .as_ref()
-            .map_or(1.0, |tf| tf.component(0).unit_distance);
+            .map_or(1.0, |tf| tf.component(component as usize).unit_distance);
         let full = [0, 0, view.width, view.height];
         let occupied = self.occupancy.as_ref().map_or(1.0, |o| o.fraction);
         let fh = FirstHitVariant {
@@ -410,6 +441,7 @@ impl IsoPass {
             crop: params.cropping.is_some(),
             single_brick,
             streaming: plan.is_some(),
+            component,
         };
         let df = DeferredVariant {
             lights: f.lights(),
@@ -420,6 +452,7 @@ impl IsoPass {
                 Some(IsoScatterMode::Traced) => 2,
             },
             single_brick,
+            component,
         };
         let firsthit = self.firsthit.get(ctx, fh)?;
         let deferred = self.deferred.get(ctx, df)?;
