@@ -334,6 +334,19 @@ fn errors_say_what_is_wrong() {
             ..d
         })
         .is_err());
+    // Several components are refused, not rendered as the first one.
+    let two: Vec<f32> = (0..8 * 8 * 8 * 2).map(|i| (i % 7) as f32 / 7.0).collect();
+    let vol2 = VolumeData::new([8, 8, 8], 2, Scalars::F32(two)).unwrap();
+    r.set_volume(&vol2).unwrap();
+    let mut tf = medium([0.8; 3], 0.0, 0.5, 1.0);
+    tf.components.push(tf.components[0].clone());
+    r.set_transfer_function(&tf).unwrap();
+    let view = View::fit(vol2.bounds(), 16, 16);
+    assert_error(
+        r.render(&view, &pt_params(), None),
+        "two components",
+        &["one-component", "2 components"],
+    );
 }
 
 /// Positional lights and cropping: a positional light far away (no attenuation, no cone)

@@ -25,7 +25,7 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment) built (the procedural sky
 //! by default).
 //!
-//! The first component is the medium (other components are not read).
+//! The volume is the medium: one-component volumes (others are refused, naming the count).
 
 use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::depth_check::DepthCheck;
@@ -394,7 +394,15 @@ impl PathTracePass {
         params.validate()?;
         let pp = *pp;
         pp.validate()?;
-        let single_brick = res.volume()?.single_brick();
+        let vol = res.volume()?;
+        if vol.components != 1 {
+            return Err(Error::Unsupported(format!(
+                "path tracing renders one-component volumes (this one has {} components): \
+                 extract one (vtkImageExtractComponents) or use ray casting",
+                vol.components
+            )));
+        }
+        let single_brick = vol.single_brick();
         frame::check_light_count(view)?;
         let unit = res
             .tf
