@@ -308,6 +308,61 @@ fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     return out;
 }
 
+// The slice blend mode (VTK 9.2's SLICE_BLEND with a vtkPlane): the pixel's state from the
+// point at distance t where its ray meets the plane frame.slice, box being the ray's
+// interval in the volume's box and term where the opaque depth ends it. Nothing where the
+// ray runs parallel to the plane, or the point lies outside the box, behind the camera,
+// at or past the opaque depth, on the cut side of a clipping plane, in a cropped region or
+// blanked. The colour is the transfer function's as given, premultiplied by the scalar
+// opacity; the alpha is that opacity times gradient opacity (VTK's computeColor, then
+// rgb × opacity); shading as composite's. Independent components mix as the maximum
+// intensity projection does (classify_value), unshaded. The depth is the point's once
+// the alpha exceeds the depth threshold.
+fn slice_state(ray: Ray, box: vec2<f32>, term: f32) -> PixelState {
+    var st: PixelState;
+    let pl = frame.slice;
+    let rate = dot(pl.xyz, ray.index_dir);
+    let t = -(dot(pl.xyz, ray.index_origin) + pl.w) / rate;
+    // (written so that a NaN t, from a ray parallel to the plane, also leaves)
+    if (!(t >= max(box.x, 0.0) && t <= box.y && t < term)) {
+        return st;
+    }
+    let cl = clip_interval(ray, vec2<f32>(t, t));
+    let p = ray.index_origin + t * ray.index_dir;
+    if (cl.x > cl.y || (CROP && !in_crop(p)) || (BLANKING && blanked(p))) {
+        return st;
+    }
+    let s = sample_scalars(p);
+    var color: vec4<f32>;
+    if (INDEPENDENT && NCOMP > 1u) {
+        color = classify_value(s);
+    } else {
+        let oc = select(NCOMP - 1u, 0u, INDEPENDENT);
+        let a = raw_alpha(0u, s[oc]);
+        var rgb = classify(0u, s.x).rgb;
+        if (!INDEPENDENT && NCOMP == 4u) {
+            rgb = clamp(sample_texel(p).rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+        }
+        var alpha = a;
+        if (SHADE || GRAD_OPACITY) {
+            let g = world_gradient(gradient_at(p, s), oc);
+            if (GRAD_OPACITY) {
+                alpha = a * gradient_opacity(0u, length(g));
+            }
+            if (SHADE) {
+                rgb = shade(rgb, g, ray.origin + t * ray.dir, ray.dir);
+            }
+        }
+        color = vec4<f32>(rgb * a, alpha);
+    }
+    st.color = color;
+    if (color.a > frame.misc.z) {
+        st.misc.y = distance_to_depth(ray, t);
+        st.misc.z = 1.0;
+    }
+    return st;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
@@ -339,6 +394,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (has_flag(FLAG_DEPTH_INPUT)) {
         let d = textureLoad(depth_in, vec2<i32>(px), 0).x;
         term = min(term, depth_to_distance(ray, px, d));
+    }
+    if (BLEND == BLEND_SLICE) {
+        write_pixel(px, slice_state(ray, box, term));
+        return;
     }
     let cl = clip_interval(ray, vec2<f32>(seg.x, term));
     var first_forced = false;

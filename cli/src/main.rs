@@ -5,10 +5,10 @@ mod presets;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
-    synth, AmbientOcclusion, BlendMode, BsdfParams, Context, Environment, GradientMethod,
-    Interpolation, IsoParams, IsoScatterMode, IsoScattering, IsoValue, PathTraceParams,
-    RenderParams, Renderer, ScalarType, ScatterRegions, Shininess, SpecularMode, UploadOptions,
-    View, VolumeData,
+    synth, AmbientOcclusion, BlendMode, BsdfParams, ClipPlane, Context, Environment,
+    GradientMethod, Interpolation, IsoParams, IsoScatterMode, IsoScattering, IsoValue,
+    PathTraceParams, RenderParams, Renderer, ScalarType, ScatterRegions, Shininess, SpecularMode,
+    UploadOptions, View, VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,6 +58,8 @@ enum Mode {
     /// Monte Carlo path tracing of the volume as a scattering medium (--spp, --g,
     /// --bounces; the environment flags light it).
     Pathtrace,
+    /// VTK's slice blend mode: the transfer function on the plane --slice-plane.
+    Slice,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -118,6 +120,10 @@ struct RenderArgs {
     /// name that is neither lists the presets.
     #[arg(long)]
     tf: Option<String>,
+    /// The plane --mode slice draws, world coordinates: ox,oy,oz,nx,ny,nz (a point on it,
+    /// then its normal). Default: through the volume's centre, normal along z.
+    #[arg(long, value_parser = parse_plane, allow_hyphen_values = true)]
+    slice_plane: Option<[f64; 6]>,
     /// Camera rotation about the view up vector, degrees (vtkCamera::Azimuth).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     azimuth: f64,
@@ -589,6 +595,20 @@ fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
     }
 }
 
+fn parse_plane(s: &str) -> Result<[f64; 6], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("plane '{s}' must be ox,oy,oz,nx,ny,nz"))?;
+    match <[f64; 6]>::try_from(v.as_slice()) {
+        Ok(p) if p.iter().all(|x| x.is_finite()) && p[3..].iter().any(|x| *x != 0.0) => Ok(p),
+        _ => Err(format!(
+            "plane '{s}' must be six finite numbers ox,oy,oz,nx,ny,nz with a non-zero normal"
+        )),
+    }
+}
+
 /// Everything that can go wrong in the CLI, each with a message for the user.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
@@ -721,6 +741,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             Mode::Additive => BlendMode::Additive,
             Mode::Iso => BlendMode::Isosurface,
             Mode::Pathtrace => BlendMode::PathTrace,
+            Mode::Slice => BlendMode::Slice,
         },
         interpolation: if a.interpolation == InterpArg::Nearest {
             Interpolation::Nearest
@@ -736,6 +757,21 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         jitter: a.jitter,
         empty_space_skipping: !a.no_skip,
         preintegration: a.preintegration,
+        slice_plane: (a.mode == Mode::Slice).then(|| {
+            let b = vol.bounds();
+            let p = a.slice_plane.unwrap_or([
+                0.5 * (b[0] + b[1]),
+                0.5 * (b[2] + b[3]),
+                0.5 * (b[4] + b[5]),
+                0.0,
+                0.0,
+                1.0,
+            ]);
+            ClipPlane {
+                origin: glam::DVec3::new(p[0], p[1], p[2]),
+                normal: glam::DVec3::new(p[3], p[4], p[5]),
+            }
+        }),
         ..Default::default()
     };
     params.shading.enabled = a.shade;

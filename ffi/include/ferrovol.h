@@ -107,6 +107,12 @@ typedef enum FvBlendMode {
    * (fv_renderer_set_path_tracing; each frame adds paths to the ones before).
    */
   FV_BLEND_MODE_PATH_TRACE = 6,
+  /**
+   * VTK's slice blend mode: each pixel shows where its ray meets
+   * FvRenderParams::slice_plane (world coordinates), the transfer function's colour and
+   * opacity there without step correction, and that point's depth.
+   */
+  FV_BLEND_MODE_SLICE = 7,
 } FvBlendMode;
 
 /**
@@ -486,6 +492,11 @@ typedef struct FvRenderParams {
    * in ferrovol-core). Off by default.
    */
   bool preintegration;
+  /**
+   * The plane FV_BLEND_MODE_SLICE draws, world coordinates (a non-zero normal; its sign
+   * does not matter); ignored by the other blend modes.
+   */
+  struct FvPlane slice_plane;
 } FvRenderParams;
 
 /**

@@ -87,6 +87,10 @@ pub enum FvBlendMode {
     /// Progressive Monte Carlo path tracing of the volume as a scattering medium
     /// (fv_renderer_set_path_tracing; each frame adds paths to the ones before).
     PathTrace = 6,
+    /// VTK's slice blend mode: each pixel shows where its ray meets
+    /// FvRenderParams::slice_plane (world coordinates), the transfer function's colour and
+    /// opacity there without step correction, and that point's depth.
+    Slice = 7,
 }
 
 /// Volume interpolation (vtkVolumeProperty::InterpolationType).
@@ -268,6 +272,9 @@ pub struct FvRenderParams {
     /// independent components, without volumetric shadows (see RenderParams::preintegration
     /// in ferrovol-core). Off by default.
     pub preintegration: bool,
+    /// The plane FV_BLEND_MODE_SLICE draws, world coordinates (a non-zero normal; its sign
+    /// does not matter); ignored by the other blend modes.
+    pub slice_plane: FvPlane,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -384,6 +391,10 @@ impl FvRenderParams {
             whole_box_enabled: false,
             whole_box: [0.0; 6],
             preintegration: d.preintegration,
+            slice_plane: FvPlane {
+                origin: [0.0; 3],
+                normal: [0.0, 0.0, 1.0],
+            },
         }
     }
 }
@@ -403,6 +414,7 @@ impl ToCore for FvRenderParams {
                 B::Additive,
                 B::Isosurface,
                 B::PathTrace,
+                B::Slice,
             ],
         )?;
         let interpolation = enum_value(
@@ -470,6 +482,10 @@ impl ToCore for FvRenderParams {
                 [self.whole_box[3], self.whole_box[4], self.whole_box[5]],
             ]),
             preintegration: self.preintegration,
+            slice_plane: (blend == B::Slice).then_some(ClipPlane {
+                origin: DVec3::from_array(self.slice_plane.origin),
+                normal: DVec3::from_array(self.slice_plane.normal),
+            }),
         };
         p.validate()?;
         Ok(p)

@@ -399,8 +399,22 @@ fn renderer_errors() {
         lib.expect(render(s.r, 8, 8, depth.as_ptr(), 10), Invalid, "10 values");
 
         type Edit = fn(&mut FvRenderParams);
-        let cases: [(Edit, &str); 10] = [
+        let cases: [(Edit, &str); 12] = [
             (|p| p.blend_mode = 42, "blend_mode 42"),
+            (
+                |p| {
+                    p.blend_mode = FvBlendMode::Slice as u32;
+                    p.slice_plane.normal = [0.0; 3];
+                },
+                "slice plane",
+            ),
+            (
+                |p| {
+                    p.blend_mode = FvBlendMode::Slice as u32;
+                    p.slice_plane.origin[1] = f64::INFINITY;
+                },
+                "finite origin",
+            ),
             (|p| p.interpolation = 2, "interpolation 2"),
             (|p| p.gradient_method = 9, "gradient_method 9"),
             (|p| p.sample_distance = -1.0, "sample_distance -1"),

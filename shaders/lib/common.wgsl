@@ -58,6 +58,7 @@ struct Frame {
     occupancy_dims: vec4<u32>,    // blocks per axis
     rect: vec4<u32>,              // pixels the passes cover: x0, y0, x1, y1 (exclusive)
     component_materials: array<vec4<f32>, 4>, // each independent component's material
+    slice: vec4<f32>,             // BLEND_SLICE: the index-space plane dot(xyz, p) + w = 0
 }
 
 @group(0) @binding(0) var<uniform> frame_ubo: Frame;

@@ -47,7 +47,7 @@ fn write_pixel(px: vec2<u32>, st: PixelState) {
     let blend = frame.mode.x;
     var color = vec4<f32>(0.0);
     var depth = 1.0;
-    if (blend == BLEND_COMPOSITE) {
+    if (blend == BLEND_COMPOSITE || blend == BLEND_SLICE) {
         color = st.color;
         if (st.misc.z > 0.0) {
             depth = st.misc.y;

@@ -37,7 +37,7 @@ ACCEPT_BLENDS = {"composite", "maximum", "minimum"}
 FIXED_BLENDS = {"composite", "maximum", "minimum", "additive"}
 BLEND = {"composite": "Composite", "maximum": "MaximumIntensity",
          "minimum": "MinimumIntensity", "average": "AverageIntensity",
-         "additive": "Additive", "isosurface": "IsoSurface"}
+         "additive": "Additive", "isosurface": "IsoSurface", "slice": "Slice"}
 MAPPERS = ("vtk-gpu", "ferrovol", "vtk-fixed")
 
 

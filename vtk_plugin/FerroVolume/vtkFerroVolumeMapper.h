@@ -23,8 +23,10 @@
  *   IndependentComponents, Shade/Ambient/Diffuse/Specular/SpecularPower, interpolation;
  *   the tables span each component's data range as vtkGPUVolumeRayCastMapper's do;
  * - vtkVolumeMapper: composite, maximum, minimum, average (AverageIPScalarRange),
- *   additive and isosurface blend modes (slice is refused with an error), cropping with
- *   region flags, clipping planes (world coordinates);
+ *   additive, isosurface and slice blend modes (slice: the property's SliceFunction, a
+ *   vtkPlane, drawn as vtkGPUVolumeRayCastMapper draws it: the transfer function where
+ *   each ray meets the plane, without step correction; any other function is an error),
+ *   cropping with region flags, clipping planes (world coordinates);
  * - isosurfaces (ISOSURFACE_BLEND): the property's iso-values (GetIsoSurfaceValues), each
  *   coloured by the colour function and made translucent by the scalar opacity function at
  *   its value, as vtkGPUVolumeRayCastMapper; each crossing is refined by interval

@@ -7,7 +7,9 @@
 #include "vtkFerroVolumeInputHelper.h"
 #include "vtkFerroVolumeMapper.h"
 #include "vtkImageData.h"
+#include "vtkImplicitFunction.h"
 #include "vtkLight.h"
+#include "vtkMath.h"
 #include "vtkLightCollection.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
@@ -199,15 +201,15 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
     { vtkVolumeMapper::AVERAGE_INTENSITY_BLEND, FV_BLEND_MODE_AVERAGE },
     { vtkVolumeMapper::ADDITIVE_BLEND, FV_BLEND_MODE_ADDITIVE },
     { vtkVolumeMapper::ISOSURFACE_BLEND, FV_BLEND_MODE_ISOSURFACE },
+    { vtkVolumeMapper::SLICE_BLEND, FV_BLEND_MODE_SLICE },
   };
   const auto mode = std::find_if(std::begin(modes), std::end(modes),
     [&](const std::pair<int, FvBlendMode>& m) { return m.first == self->GetBlendMode(); });
   if (mode == std::end(modes))
   {
     error = "blend mode " + std::to_string(self->GetBlendMode()) +
-      (self->GetBlendMode() == vtkVolumeMapper::SLICE_BLEND ? " (SLICE_BLEND)" : "") +
       " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
-      "additive and isosurface are): nothing is drawn";
+      "additive, isosurface and slice are): nothing is drawn";
     return false;
   }
   this->Blend = self->GetRenderMode() == vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE
@@ -265,6 +267,44 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     return Result::Failed;
   }
   params.blend_mode = this->Blend;
+  if (this->Blend == FV_BLEND_MODE_SLICE)
+  {
+    // As vtkOpenGLGPUVolumeRayCastMapper: the plane's origin and normal in world
+    // coordinates (the implicit function's own transform is not applied).
+    vtkPlane* plane = vtkPlane::SafeDownCast(prop->GetSliceFunction());
+    if (!plane)
+    {
+      error = std::string("SLICE_BLEND needs a vtkPlane as the volume property's "
+                          "SliceFunction (it has ") +
+        (prop->GetSliceFunction() ? prop->GetSliceFunction()->GetClassName() : "none") +
+        "): nothing is drawn";
+      return Result::Failed;
+    }
+    // vtkOpenGLGPUVolumeRayCastMapper takes the plane into the volume's data coordinates
+    // with the vtkVolume's inverse matrix, its normal as a direction (w = 0) rather than
+    // as a normal: with a rotation and a uniform scale that is the same plane, under a
+    // non-uniform scale or a shear another one. The world plane it draws has the same
+    // origin and the normal (A·Aᵀ)⁻¹·n (A: the matrix's linear part), given here.
+    plane->GetOrigin(params.slice_plane.origin);
+    double n[3];
+    plane->GetNormal(n);
+    vtkMatrix4x4* m = vol->GetMatrix();
+    double aat[3][3];
+    for (int i = 0; i < 3; ++i)
+    {
+      for (int j = 0; j < 3; ++j)
+      {
+        aat[i][j] = 0.0;
+        for (int k = 0; k < 3; ++k)
+        {
+          aat[i][j] += m->GetElement(i, k) * m->GetElement(j, k);
+        }
+      }
+    }
+    double inv[3][3];
+    vtkMath::Invert3x3(aat, inv);
+    vtkMath::Multiply3x3(inv, n, params.slice_plane.normal);
+  }
   switch (prop->GetInterpolationType())
   {
     case VTK_NEAREST_INTERPOLATION:
@@ -341,8 +381,8 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   }
   params.jitter = self->GetUseJittering() != 0;
   const bool isosurface = this->Blend == FV_BLEND_MODE_ISOSURFACE;
-  params.shade =
-    prop->GetShade(0) != 0 && (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface);
+  params.shade = prop->GetShade(0) != 0 &&
+    (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface || this->Blend == FV_BLEND_MODE_SLICE);
   this->WarnUnsupported(self, warned);
   const vtkFerroVolumeInputHelper::Ghosts& ghosts = input.GetGhosts();
   if ((ghosts.Points > 0 || ghosts.Cells > 0) &&

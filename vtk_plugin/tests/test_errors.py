@@ -167,8 +167,15 @@ class ErrorCases(unittest.TestCase):
         self.recover()
 
     # -- unsupported settings ------------------------------------------------------------------
-    def test_slice_blend_mode(self):
-        self.expect_error(["blend mode"], configure=lambda m: m.SetBlendModeToSlice())
+    def test_slice_blend_mode_without_a_plane(self):
+        def sphere(m):
+            m.SetBlendModeToSlice()
+            self.scene.volume.GetProperty().SetSliceFunction(vtk.vtkSphere())
+        self.expect_error(["SliceFunction", "vtkPlane", "vtkSphere"], configure=sphere)
+        self.scene.volume.GetProperty().SetSliceFunction(None)
+        self.errors.messages.clear()
+        self.expect_error(["SliceFunction", "vtkPlane", "none"],
+                          configure=lambda m: m.SetBlendModeToSlice())
         self.recover(lambda m: m.SetBlendModeToComposite())
 
     def test_non_positive_sample_distance(self):

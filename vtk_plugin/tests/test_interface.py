@@ -206,6 +206,14 @@ def observed(m, rig):
     return m.HasObserver("UserEvent") == 0
 
 
+def slice_plane(m, rig):
+    """The property's SliceFunction: a plane through the data's centre."""
+    p = vtk.vtkPlane()
+    p.SetOrigin(rig.data.GetCenter())
+    p.SetNormal(0.2, 0.3, 1.0)
+    rig.prop.SetSliceFunction(p)
+
+
 def plane(rig):
     p = vtk.vtkPlane()
     p.SetOrigin(0.0, 0.0, 0.0)
@@ -332,7 +340,7 @@ SETTINGS = {
     "SetBlendModeToAverageIntensity": image(calls(("SetBlendModeToAverageIntensity",))),
     "SetBlendModeToAdditive": image(calls(("SetBlendModeToAdditive",))),
     "SetBlendModeToIsoSurface": image(calls(("SetBlendModeToIsoSurface",))),
-    "SetBlendModeToSlice": warned(calls(("SetBlendModeToSlice",)), "SLICE_BLEND"),
+    "SetBlendModeToSlice": image(calls(("SetBlendModeToSlice",)), prepare=slice_plane),
     "SetAverageIPScalarRange": image(calls(("SetAverageIPScalarRange", 150.0, 220.0)),
                                      prepare=calls(("SetBlendModeToAverageIntensity",))),
     "SetCropping": image(calls(("SetCropping", 1)), prepare=calls(CROP_MID)),

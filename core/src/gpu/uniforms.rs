@@ -50,6 +50,7 @@ pub struct FrameUniforms {
     pub rect: [u32; 4],
     /// Each independent component's material (ambient, diffuse, specular, power).
     pub component_materials: [[f32; 4]; 4],
+    pub slice: [f32; 4],
 }
 
 #[repr(C)]
@@ -163,6 +164,7 @@ pub const BLEND_AVERAGE: u32 = 3;
 pub const BLEND_ADDITIVE: u32 = 4;
 pub const BLEND_ISOSURFACE: u32 = 5;
 pub const BLEND_PATHTRACE: u32 = 6;
+pub const BLEND_SLICE: u32 = 7;
 
 /// Frame flag bits (`frame.mode.y`).
 pub const FLAG_JITTER: u32 = 2;
@@ -234,6 +236,7 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("BLEND_ADDITIVE", Wgsl::U32(BLEND_ADDITIVE)),
     ("BLEND_ISOSURFACE", Wgsl::U32(BLEND_ISOSURFACE)),
     ("BLEND_PATHTRACE", Wgsl::U32(BLEND_PATHTRACE)),
+    ("BLEND_SLICE", Wgsl::U32(BLEND_SLICE)),
     ("FLAG_JITTER", Wgsl::U32(FLAG_JITTER)),
     ("FLAG_TWO_SIDED", Wgsl::U32(FLAG_TWO_SIDED)),
     ("FLAG_INDEPENDENT", Wgsl::U32(FLAG_INDEPENDENT)),
@@ -357,7 +360,8 @@ mod layout_tests {
                     counts,
                     occupancy_dims,
                     rect,
-                    component_materials
+                    component_materials,
+                    slice
                 ]
             );
             let (_, ps) = wgsl_struct(&m, "PixelState");

@@ -5,7 +5,7 @@ use super::check::{non_negative, within};
 use crate::error::{Error, Result};
 use crate::gpu::uniforms::{
     BLEND_ADDITIVE, BLEND_AVERAGE, BLEND_COMPOSITE, BLEND_ISOSURFACE, BLEND_MAXIMUM, BLEND_MINIMUM,
-    BLEND_PATHTRACE,
+    BLEND_PATHTRACE, BLEND_SLICE,
 };
 pub use crate::gpu::uniforms::{MAX_CLIP_PLANES, MAX_LIGHTS};
 use glam::{DMat4, DVec3};
@@ -30,6 +30,14 @@ pub enum BlendMode {
     /// Progressive Monte Carlo path tracing of the volume as a scattering medium
     /// (crate::passes::pathtrace; settings from [`crate::Renderer::set_path_tracing`]).
     PathTrace,
+    /// VTK's slice blend mode (SLICE_BLEND with a vtkPlane as the property's slice
+    /// function): each pixel shows the point where its ray meets
+    /// [`RenderParams::slice_plane`], with the transfer function's colour and opacity as
+    /// given (no step correction), shaded and with gradient opacity as composite applies
+    /// them, and that point's depth; nothing where the point lies outside the volume's
+    /// box, behind the opaque depth, on the cut side of a clipping plane or in a cropped
+    /// region.
+    Slice,
 }
 
 impl BlendMode {
@@ -42,6 +50,7 @@ impl BlendMode {
             BlendMode::Additive => BLEND_ADDITIVE,
             BlendMode::Isosurface => BLEND_ISOSURFACE,
             BlendMode::PathTrace => BLEND_PATHTRACE,
+            BlendMode::Slice => BLEND_SLICE,
         }
     }
 }
@@ -125,8 +134,9 @@ impl Cropping {
     pub const INVERTED_CROSS: u32 = 0x7be8bef;
 }
 
-/// A clipping plane: points with dot(normal, p − origin) ≥ 0 are kept (VTK's convention:
-/// the normal points into the kept half-space).
+/// A plane through `origin` with `normal`. As a clipping plane it keeps the points with
+/// dot(normal, p − origin) ≥ 0 (VTK's convention: the normal points into the kept
+/// half-space); as the slice blend mode's plane its normal's sign does not matter.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClipPlane {
     pub origin: DVec3,
@@ -187,6 +197,9 @@ pub struct RenderParams {
     /// then show at the default step without slicing. One component or independent
     /// components, without volumetric shadows; other modes sample as without.
     pub preintegration: bool,
+    /// The plane [`BlendMode::Slice`] draws, in world coordinates (the normal's sign does
+    /// not matter); required by that blend mode, ignored by the others.
+    pub slice_plane: Option<ClipPlane>,
 }
 
 impl Default for RenderParams {
@@ -209,6 +222,7 @@ impl Default for RenderParams {
             extremum_depth: false,
             whole_box: None,
             preintegration: false,
+            slice_plane: None,
         }
     }
 }
@@ -246,6 +260,21 @@ impl RenderParams {
                     "clipping plane {p:?} needs a finite origin and a non-zero normal"
                 )));
             }
+        }
+        match self.slice_plane {
+            Some(p)
+                if !p.origin.is_finite() || !p.normal.is_finite() || p.normal.length() < 1e-12 =>
+            {
+                return Err(Error::InvalidParameter(format!(
+                    "slice plane {p:?} needs a finite origin and a non-zero normal"
+                )));
+            }
+            None if self.blend == BlendMode::Slice => {
+                return Err(Error::InvalidParameter(
+                    "the slice blend mode needs a slice plane (RenderParams::slice_plane)".into(),
+                ));
+            }
+            _ => {}
         }
         if let Some(v) = self.clipped_voxel_value {
             if v.iter().any(|x| x.is_nan()) {

@@ -126,6 +126,13 @@ impl DvrPass {
             ));
         }
         let streaming = plan.is_some();
+        if streaming && params.blend == BlendMode::Slice {
+            return Err(Error::Unsupported(
+                "the slice blend mode needs every brick in view resident, and they exceed \
+                 the volume's memory budget: raise the budget"
+                    .into(),
+            ));
+        }
         let vol = res.volume()?;
         // Additive and average skip empty blocks too, counting the skipped samples (their
         // terms are 0), as long as every sample counts (no cropping, blanking or average

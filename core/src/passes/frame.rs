@@ -235,6 +235,14 @@ pub(crate) fn frame(
         let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
         u.clip[i] = [ni.x as f32, ni.y as f32, ni.z as f32, w as f32];
     }
+    // the slice plane, world → index space: dot(n_i, p) + w = 0 (the same plane whatever
+    // the volume matrix, shears and non-uniform scales included)
+    if let (BlendMode::Slice, Some(p)) = (params.blend, params.slice_plane) {
+        let n = p.normal.normalize();
+        let ni = index_to_world.transpose().transform_vector3(n);
+        let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
+        u.slice = [ni.x as f32, ni.y as f32, ni.z as f32, w as f32];
+    }
     if let Some(v) = params.clipped_voxel_value {
         // (an infinite value, VTK's default VTK_DOUBLE_MIN, kept finite in f32)
         u.clipped_value = v.map(|x| x.clamp(-f32::MAX as f64, f32::MAX as f64) as f32);

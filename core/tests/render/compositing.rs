@@ -828,3 +828,86 @@ fn pieces_composite_to_the_whole() {
         assert!(worst <= bound, "{blend:?}: {worst} levels");
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// The slice blend mode: the transfer function where each ray meets the plane
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn slice_shows_the_plane_and_nothing_else() {
+    let mut r = renderer();
+    let n = 24u32;
+    // a ramp along x, 0 at x = 0 to 1 at x = n − 1; white, opacity = value
+    let vol = volume([n; 3], |x, _, _| x / (n - 1) as f64);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&white(&[(0.0, 0.0), (1.0, 1.0)], 1.0))
+        .unwrap();
+    let mut view = View::fit(vol.bounds(), 64, 64);
+    view.camera.azimuth(35.0);
+    view.camera.elevation(20.0);
+    view.camera.orthogonalize_view_up();
+    view.camera.reset_clipping_range(vol.bounds());
+    let c = 15.0;
+    let params = RenderParams {
+        blend: BlendMode::Slice,
+        slice_plane: Some(ClipPlane {
+            origin: DVec3::new(c, 0.0, 0.0),
+            normal: DVec3::new(-2.0, 0.0, 0.0),
+        }),
+        ..RenderParams::default()
+    };
+    let img = r.render_image(&view, &params).unwrap();
+    save_enlarged(&img, "slice");
+    let want = (c / (n - 1) as f64 * 255.0) as i32;
+    let hi = DVec3::splat((n - 1) as f64);
+    let (mut covered, mut mismatched, mut worst) = (0, 0, 0);
+    for y in 0..view.height {
+        for x in 0..view.width {
+            let ray = crate::common::raycast::pixel_ray(&view, x, y);
+            let t = (c - ray.origin.x) / ray.dir.x;
+            let p = ray.origin + t * ray.dir;
+            let inside = t >= 0.0 && p.cmpge(DVec3::ZERO).all() && p.cmple(hi).all();
+            let px = rgba(&img, x, y);
+            if inside != (px[3] > 0) {
+                mismatched += 1;
+                continue;
+            }
+            if inside {
+                covered += 1;
+                // premultiplied white: grey = alpha = the opacity at x = c, not corrected
+                worst = worst
+                    .max((px[3] as i32 - want).abs())
+                    .max((px[0] as i32 - want).abs());
+                let d = img.depth[(y * view.width + x) as usize] as f64;
+                let clip = view.camera.view_projection(view.aspect()) * p.extend(1.0);
+                let expected = 0.5 * clip.z / clip.w + 0.5;
+                assert!(
+                    (d - expected).abs() < 1e-4,
+                    "pixel ({x}, {y}): depth {d} where the plane's is {expected}"
+                );
+            }
+        }
+    }
+    println!(
+        "slice x = {c}: {covered} pixels on the plane, {mismatched} differ in coverage, \
+         colour within {worst}/255 of {want}"
+    );
+    assert!(covered > 400, "the slice covers only {covered} pixels");
+    assert!(
+        mismatched <= covered / 50,
+        "{mismatched} pixels disagree about whether the ray meets the plane in the box"
+    );
+    assert!(worst <= 1, "slice colour off by {worst}/255");
+    // without a plane the mode is refused
+    let err = r
+        .render_image(
+            &view,
+            &RenderParams {
+                blend: BlendMode::Slice,
+                ..RenderParams::default()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("slice plane"), "{err}");
+}
