@@ -566,15 +566,7 @@ bool vtkFerroVolumeRepresentation::WarnAboutSettings(int drawn)
   const int renderMode = this->GetFerroVolumeMapper()->GetRenderMode();
   if (renderMode != vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE)
   {
-    if (drawn == vtkVolumeMapper::SLICE_BLEND)
-    {
-      warnings.emplace_back("Blend Mode \"Slice\" (the volume cut by its Slice Type) is not "
-                            "supported by ferrovol yet: the volume is hidden. Choose Composite "
-                            "or Isosurface, or draw slices with the \"Volume\" or \"Slice\" "
-                            "representation.");
-      draw = false;
-    }
-    else if (!BlendModeName(drawn))
+    if (!BlendModeName(drawn))
     {
       warnings.emplace_back("Blend Mode " + std::to_string(drawn) +
         " is not one of vtkVolumeMapper's blend modes (0-6): the volume is hidden.");
@@ -621,9 +613,10 @@ void vtkFerroVolumeRepresentation::UpdateMapperParameters()
 
   const int drawn = this->DrawnBlendMode();
   const bool drawable =
-    drawn >= vtkVolumeMapper::COMPOSITE_BLEND && drawn <= vtkVolumeMapper::ISOSURFACE_BLEND;
-  // Slice or a value that is no blend mode: the mapper gets composite, which path tracing
-  // ignores; ray casting hides the volume (WarnAboutSettings).
+    drawn >= vtkVolumeMapper::COMPOSITE_BLEND && drawn <= vtkVolumeMapper::SLICE_BLEND;
+  // A value that is no blend mode: the mapper gets composite, which path tracing ignores;
+  // ray casting hides the volume (WarnAboutSettings). Slice draws the property's
+  // SliceFunction (Slice Type), which the superclass sets.
   this->VolumeMapper->SetBlendMode(drawable ? drawn : vtkVolumeMapper::COMPOSITE_BLEND);
 
   if (!this->WarnAboutSettings(drawn) || !this->InputIsImageData)

@@ -9,8 +9,8 @@
  * ghost-cell cropping, the outline on ranks without data and, under MPI, ordered compositing
  * of the ranks' translucent images from the bounds of each rank's piece
  * (vtkPVRenderView::USE_BOUNDS_FOR_REDISTRIBUTION; see paraview/README.md). The shared
- * settings ferrovol does not draw (Blend Mode Slice, 2D transfer functions, Volume Rendering
- * Mode) give a warning; paraview/README.md lists what ferrovol does with every property of
+ * settings ferrovol does not draw (2D transfer functions, Volume Rendering Mode) give a
+ * warning; paraview/README.md lists what ferrovol does with every property of
  * "Volume".
  *
  * The server-manager XML (FerrovolRepresentation.xml) adds it to UniformGridRepresentation
@@ -20,8 +20,8 @@
  * - FerrovolBlendMode extends ParaView's own "BlendMode" (Composite / Isosurface / Slice,
  *   shared with "Volume", as are the "IsosurfaceValues"): its default, FOLLOW_BLEND_MODE, draws
  *   what BlendMode says; maximum, minimum, average and additive (and, for scripts written
- *   before, composite and isosurface) override it. Slice is not drawn by ferrovol: a warning
- *   says so and the volume is hidden (see UpdateMapperParameters());
+ *   before, composite and isosurface) override it. Slice draws the plane of Slice Type
+ *   (SliceFunction, "Volume"'s plane itself) as vtkFerroVolumeMapper's slice blend mode;
  * - the isosurface shading of vtkFerroVolumeMapper: environment lighting and map,
  *   background, specular sampling, ambient occlusion, shininess from the gradient, Fresnel;
  * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
@@ -235,9 +235,8 @@ protected:
    * The superclass's work (array selection, scalar mode, cropping planes, independent
    * components, the transfer-function mode), then the blend mode ferrovol draws (see
    * DrawnBlendMode()). Hides the volume when the input is not image data, when ray casting
-   * in blend mode Slice or in a value that is no vtkVolumeMapper mode, or with "Use 2D
-   * Transfer Function" on (Slice and 2D transfer functions: not supported by ferrovol yet);
-   * WarnAboutSettings() says so.
+   * in a value that is no vtkVolumeMapper mode, or with "Use 2D Transfer Function" on (2D
+   * transfer functions: not supported by ferrovol yet); WarnAboutSettings() says so.
    */
   void UpdateMapperParameters() override;
 

@@ -221,7 +221,7 @@ CASES = {
     "UseTransfer2D": ({"TransferFunction2D": tf2d}, {"UseTransfer2D": 1}, WARNED_HIDDEN, None,
                       "\"Use 2D Transfer Function\""),
     "SliceFunction": ({"BlendMode": "Slice"}, {"SliceFunction.Normal": [0, 0.6, 0.8]},
-                      WARNED_HIDDEN, None, "Blend Mode \"Slice\""),
+                      DRAWN, 0.95, 32.0),
     "VolumeRenderingMode": ({}, {"VolumeRenderingMode": "GPU Based"}, WARNED_UNCHANGED, None,
                             "Volume Rendering Mode \"GPU Based\""),
 }
