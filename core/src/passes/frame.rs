@@ -8,7 +8,9 @@ use crate::gpu::uniforms::{
     FLAG_INDEPENDENT, FLAG_JITTER, FLAG_PIECE, FLAG_TWO_SIDED,
 };
 use crate::gpu::Context;
-use crate::params::{BlendMode, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS};
+use crate::params::{
+    BlendMode, ClipPlane, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS,
+};
 use crate::resources::bricks::{FrontToBack, BLOCK_SIZE};
 use crate::resources::targets::DepthSource;
 use crate::resources::Resources;
@@ -139,6 +141,15 @@ fn screen_rect(
     r
 }
 
+/// A world plane in index space as (n_i, w): dot(n_i, p) + w is the world distance to the
+/// plane of the point p (index coordinates), for any invertible index → world matrix.
+fn index_plane(index_to_world: DMat4, p: &ClipPlane) -> [f32; 4] {
+    let n = p.normal.normalize();
+    let ni = index_to_world.transpose().transform_vector3(n);
+    let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
+    [ni.x as f32, ni.y as f32, ni.z as f32, w as f32]
+}
+
 /// The frame uniforms of a frame of `view` with `params` at sample distance `step`, with
 /// what the passes specialise on.
 pub(crate) fn frame(
@@ -228,20 +239,13 @@ pub(crate) fn frame(
         flags |= FLAG_AVERAGE_RANGE;
         u.average_range = [r[0] as f32, r[1] as f32, 0.0, 0.0];
     }
-    // clipping planes, world → index space: keep dot(n_i, p) + w >= 0
+    // clipping planes in index space: keep dot(n_i, p) + w >= 0
     for (i, p) in params.clip_planes.iter().enumerate() {
-        let n = p.normal.normalize();
-        let ni = index_to_world.transpose().transform_vector3(n);
-        let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
-        u.clip[i] = [ni.x as f32, ni.y as f32, ni.z as f32, w as f32];
+        u.clip[i] = index_plane(index_to_world, p);
     }
-    // the slice plane, world → index space: dot(n_i, p) + w = 0 (the same plane whatever
-    // the volume matrix, shears and non-uniform scales included)
+    // the slice plane in index space: dot(n_i, p) + w = 0
     if let (BlendMode::Slice, Some(p)) = (params.blend, params.slice_plane) {
-        let n = p.normal.normalize();
-        let ni = index_to_world.transpose().transform_vector3(n);
-        let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);
-        u.slice = [ni.x as f32, ni.y as f32, ni.z as f32, w as f32];
+        u.slice = index_plane(index_to_world, &p);
     }
     if let Some(v) = params.clipped_voxel_value {
         // (an infinite value, VTK's default VTK_DOUBLE_MIN, kept finite in f32)
