@@ -1,7 +1,8 @@
 # ferrovol — GPU volume ray casting on wgpu.
 #   make demo   render the built-in demo volume to build/demo.png
 #   make test   format, lint and run every test (installs what is missing first)
-#   make bench  VTK's GPU ray cast benchmark scene, ferrovol vs vtkGPUVolumeRayCastMapper
+#   make bench  VTK's GPU ray cast benchmark scene, ferrovol vs vtkGPUVolumeRayCastMapper,
+#               then the equal-fidelity table (time and error against converged references)
 #   make bench-vtk  the same scene in a VTK window: vtkFerroVolumeMapper vs vtkGPUVolumeRayCastMapper,
 #               and the equal-fidelity table (time and error against converged references)
 #   make build  release build of the `ferrovol` command and the VTK module (make vtk)
@@ -151,6 +152,7 @@ regression-quick: vtk
 bench: build
 	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 2 >/dev/null
 	scripts/with-xvfb.sh $(FERROVOL) bench --vtk --frames 20 --png-dir build/bench
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/fidelity.py
 
 # vtkFerroVolumeMapper (zero-copy shared path and readback path) against
 # vtkGPUVolumeRayCastMapper in a VTK window, the same benchmark scene, alternating rounds:
