@@ -740,6 +740,56 @@ fn bricked_volume_residency_outlives_the_volume() {
     assert_eq!(before, after, "the renderer still has the data");
 }
 
+/// The brick pool follows what a frame needs: a transfer function that shows a corner of
+/// the volume after one that shows all of it shrinks the pool the residency reports, the
+/// needed bricks copied on the device (no upload); showing all again grows it back.
+#[test]
+fn brick_pool_shrinks_to_what_is_shown() {
+    let lib = Lib::open();
+    let n = 24usize;
+    let data: Vec<u8> = (0..n * n * n)
+        .map(|i| {
+            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
+            ((x + y + z) * 255 / (3 * (n - 1))) as u8
+        })
+        .collect();
+    let mut s = Session::new(&lib);
+    let set_bricks =
+        lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_max_brick_points");
+    let residency = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus>(
+        "fv_renderer_residency",
+    );
+    // SAFETY: a valid handle.
+    unsafe { lib.ok(set_bricks(s.r, 8)) };
+    s.set_volume([24, 24, 24], FvScalarType::U8, &data);
+    s.set_camera(&camera([11.5, 11.5, 80.0], [11.5; 3], [1.0, 200.0]));
+    let white = [0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0];
+    let mut seen = Vec::new();
+    for from in [1.0, 235.0, 1.0] {
+        s.set_transfer_function(&white, &[0.0, 0.0, from, 0.0, 255.0, 0.8]);
+        assert!(s.frame(32, 32).chunks(4).any(|p| p[3] > 20), "drawn");
+        let mut res = ferrovol::FvResidency::default();
+        // SAFETY: valid handles.
+        unsafe { lib.ok(residency(s.r, &mut res)) };
+        println!(
+            "opacity from {from}: {} of {} bricks resident, pool {} bytes, {} uploaded",
+            res.resident, res.bricks, res.pool_bytes, res.brick_uploads
+        );
+        seen.push(res);
+    }
+    let (all, corner, again) = (seen[0], seen[1], seen[2]);
+    assert!(
+        2 * corner.pool_bytes <= all.pool_bytes,
+        "showing a corner shrinks the pool: {corner:?} after {all:?}"
+    );
+    assert!(corner.resident < all.resident);
+    assert_eq!(
+        corner.brick_uploads, all.brick_uploads,
+        "the corner's bricks were resident: copied, not uploaded"
+    );
+    assert_eq!(again.pool_bytes, all.pool_bytes, "and grows back");
+}
+
 /// Progress of a streamed frame: a memory budget under what a frame needs makes ray casting
 /// stream the bricks in several passes, and the callback hears of each one in order.
 #[test]
