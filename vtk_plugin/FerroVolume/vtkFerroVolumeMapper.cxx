@@ -28,10 +28,14 @@
 #include "vtkFerroVolumeRenderToImage.h"
 #include "vtkFerroVolumeSettings.h"
 #include "vtkCommand.h"
+#include "vtkDualDepthPeelingPass.h"
+#include "vtkInformation.h"
+#include "vtkInformationObjectBaseVectorKey.h"
 #include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkOpenGLRenderPass.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
@@ -453,6 +457,30 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->InvokeEvent(vtkCommand::VolumeMapperRenderEndEvent, nullptr);
 }
 
+namespace
+{
+// Whether vtkDualDepthPeelingPass is drawing the volume inside its peeling loop (its
+// volumetric peels mark the prop with vtkOpenGLRenderPass::RenderPasses), where it expects
+// vtkOpenGLGPUVolumeRayCastMapper's shader to read its depth textures and write its targets.
+bool InsideDualDepthPeeling(vtkVolume* vol)
+{
+  vtkInformation* keys = vol->GetPropertyKeys();
+  if (!keys || !keys->Has(vtkOpenGLRenderPass::RenderPasses()))
+  {
+    return false;
+  }
+  const int n = keys->Length(vtkOpenGLRenderPass::RenderPasses());
+  for (int i = 0; i < n; ++i)
+  {
+    if (vtkDualDepthPeelingPass::SafeDownCast(keys->Get(vtkOpenGLRenderPass::RenderPasses(), i)))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+}
+
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
 {
@@ -460,9 +488,29 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   this->LastRenderProgressive = 0;
   vtkInternals* in = this->Internals;
   in->Refinement.Begin();
-  if (!ren || !vol || ren->GetSelector())
+  if (!ren || !vol)
   {
-    return; // (hardware selection passes are not supported: nothing is drawn into them)
+    return;
+  }
+  if (ren->GetSelector())
+  {
+    if (in->FirstTime("selection"))
+    {
+      vtkWarningMacro(<< "hardware selection (picking) of volumes is not supported by "
+                         "ferrovol: the volume is not drawn into selection passes");
+    }
+    return;
+  }
+  if (InsideDualDepthPeeling(vol))
+  {
+    if (in->FirstTime("depth-peeling"))
+    {
+      vtkWarningMacro(<< "depth peeling for volumes (vtkRenderer UseDepthPeelingForVolumes "
+                         "with translucent geometry) is not supported by ferrovol: the "
+                         "volume is not drawn; turn UseDepthPeelingForVolumes off to have it "
+                         "composited over the translucent geometry");
+    }
+    return;
   }
   vtkOpenGLRenderWindow* win = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   if (!win)

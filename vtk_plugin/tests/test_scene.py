@@ -55,6 +55,54 @@ class SceneTests(unittest.TestCase):
         self.assertEqual(((results["behind"][..., 1] > 200) &
                           (results["behind"][..., 0] < 60)).sum(), 0)
 
+    def test_depth_peeling_for_volumes_is_warned(self):
+        """A translucent sphere with UseDepthPeelingForVolumes: vtkDualDepthPeelingPass draws
+        the volume inside its peels, which ferrovol does not support. One warning saying so
+        and what to do, the volume left out (ferrovol's frame drawn into the peeling's targets
+        gave changing, garbage-looking colours); with UseDepthPeelingForVolumes off it is
+        composited over the translucent geometry as usual."""
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        errors = Errors(mapper)
+        sphere = fvtest.sphere_actor((0, 0, 8), 8, (1.0, 0.3, 0.3))
+        sphere.GetProperty().SetOpacity(0.4)
+        scene = Scene(mapper, self.src, tf_property(), size=(100, 100), camera=view,
+                      actors=[sphere])
+        scene.renderer.SetUseDepthPeeling(1)
+        scene.renderer.SetUseDepthPeelingForVolumes(1)
+        first, second = scene.render(), scene.render()
+        scene.renderer.RemoveVolume(scene.volume)
+        alone = scene.render()
+        scene.renderer.AddVolume(scene.volume)
+        scene.renderer.SetUseDepthPeelingForVolumes(0)
+        over = scene.render()
+        fvtest.log("  depth peeling for volumes: %d warning(s), max |frame - sphere alone| %d; "
+                   "peeling for volumes off: coverage change %.3f"
+                   % (len(errors.warnings), np.abs(first - alone).max(),
+                      coverage(over) - coverage(alone)))
+        self.assertEqual(errors.messages, [])
+        self.assertEqual(len(errors.warnings), 1)
+        self.assertIn("UseDepthPeelingForVolumes off", errors.warnings[0])
+        np.testing.assert_array_equal(first, second)
+        self.assertEqual(np.abs(first - alone).max(), 0)
+        self.assertGreater(np.abs(over - alone).max(), 50, "the volume is drawn without it")
+
+    def test_hardware_selection_is_warned(self):
+        """vtkHardwareSelector: ferrovol draws nothing into selection passes, and says so
+        once."""
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        errors = Errors(mapper)
+        scene = Scene(mapper, self.src, tf_property(), size=(80, 80), camera=view)
+        scene.render()
+        selector = vtk.vtkHardwareSelector()
+        selector.SetRenderer(scene.renderer)
+        selector.SetArea(0, 0, 79, 79)
+        selector.Select()
+        selector.Select()
+        fvtest.log("  hardware selection: %s" % errors.warnings)
+        self.assertEqual(errors.messages, [])
+        self.assertEqual(len(errors.warnings), 1)
+        self.assertIn("selection", errors.warnings[0])
+
     def test_sphere_cutting_the_volume(self):
         # a sphere half inside a translucent volume: where it is, rays stop at it (the volume
         # in front of it still tints it); elsewhere the image is unchanged
