@@ -508,7 +508,8 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
       vtkWarningMacro(<< "depth peeling for volumes (vtkRenderer UseDepthPeelingForVolumes "
                          "with translucent geometry) is not supported by ferrovol: the "
                          "volume is not drawn; turn UseDepthPeelingForVolumes off to have it "
-                         "composited over the translucent geometry");
+                         "composited over the translucent geometry (in ParaView: the render "
+                         "view's DepthPeelingForVolumes, on by default)");
     }
     return;
   }
