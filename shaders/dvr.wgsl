@@ -50,7 +50,25 @@ override PREINT: bool = false;
 @group(0) @binding(8) var blanking_mask: texture_3d<u32>;
 override BLANKING: bool = false;
 
-// Whether the sample at index-space point p is left out: vtkGPUVolumeRayCastMapper skips it
+// A mask (Renderer::set_mask), one value per point of the grid: MASK_BINARY leaves out the
+// samples whose nearest point holds 0, MASK_LABELS classifies samples by their nearest
+// point's label (classify_labelled); the blanking mask's placeholder otherwise.
+@group(0) @binding(10) var mask_tex: texture_3d<u32>;
+override MASK: u32 = MASK_NONE;
+
+// The mask's value at the point nearest to index-space point p (VTK reads its mask texture
+// with nearest filtering).
+fn mask_at(p: vec3<f32>) -> u32 {
+    let q = clamp(p, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    return textureLoad(mask_tex, vec3<i32>(floor(q + 0.5)), 0).x;
+}
+
+// Whether the sample at index-space point p is left out by blanking or a binary mask.
+fn left_out(p: vec3<f32>) -> bool {
+    return (BLANKING && blanked(p)) || (MASK == MASK_BINARY && mask_at(p) == 0u);
+}
+
+// Whether the sample at index-space point p is blanked: vtkGPUVolumeRayCastMapper skips it
 // when the point nearest to it, or either point around it along an axis (the others
 // rounded), is hidden.
 fn blanked(p: vec3<f32>) -> bool {
@@ -177,6 +195,56 @@ fn shading_gradient(p: vec3<f32>, g: Gradient) -> Gradient {
     return g;
 }
 
+// classify_sample of a one-component volume by its transfer function.
+fn classify_one(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
+    var e = classify_segment(0u, sf.x, s.x);
+    if (e.a <= 0.0 || frame.weights.x <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    if (SHADE || GRAD_OPACITY) {
+        let gs = gradient_at(p, s);
+        let g = world_gradient(gs, 0u);
+        let a = e.a;
+        if (GRAD_OPACITY) {
+            e.a = e.a * gradient_opacity(0u, length(g));
+        }
+        if (SHADE) {
+            let n = world_gradient(shading_gradient(p, gs), 0u);
+            var rgb = shade(e.rgb, n, pos, view_dir);
+            if (VOLUMETRIC) {
+                let gm = vtk_gradient_magnitude(n, OPACITY_NORMAL);
+                rgb = volumetric_shade(e.rgb, a, gm, rgb, p, pos, view_dir, GRAD_OPACITY);
+            }
+            e = vec4<f32>(rgb, e.a);
+        }
+    }
+    return e;
+}
+
+// MASK_LABELS: a one-component sample labelled l (1 to frame.mask.y) classified as VTK's
+// label maps do: its label's colour and step-corrected opacity at the scalar, lit and
+// times its label's gradient opacity where that opacity is above 0, mixed with the
+// transfer function's classification (classify_one) by the blend factor frame.mask.x,
+// colour and opacity alike.
+fn classify_labelled(l: u32, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
+    let row = NCOMP + l - 1u;
+    var e = table_lookup(row, 0u, (s.x - frame.labels.x) * frame.labels.y);
+    if (e.a > 0.0 && (SHADE || GRAD_OPACITY)) {
+        let g = world_gradient(gradient_at(p, s), 0u);
+        if (GRAD_OPACITY) {
+            e.a = e.a * table_lookup(row, 1u, (length(g) - frame.labels.z) * frame.labels.w).y;
+        }
+        if (SHADE) {
+            e = vec4<f32>(shade(e.rgb, g, pos, view_dir), e.a);
+        }
+    }
+    let b = frame.mask.x;
+    if (b >= 1.0) {
+        return e;
+    }
+    return mix(classify_one(s, s, p, pos, view_dir), e, b);
+}
+
 // Colour (rgb, not premultiplied) and opacity corrected for the step of one composite sample
 // (scalars s; sf: the previous sample's, which PREINT classifies the segment from).
 fn classify_sample(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
@@ -205,28 +273,13 @@ fn classify_sample(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, vi
         return vec4<f32>(rgb, a);
     }
     if (NCOMP == 1u) {
-        var e = classify_segment(0u, sf.x, s.x);
-        if (e.a <= 0.0 || frame.weights.x <= 0.0) {
-            return vec4<f32>(0.0);
-        }
-        if (need_grad) {
-            let gs = gradient_at(p, s);
-            let g = world_gradient(gs, 0u);
-            let a = e.a;
-            if (GRAD_OPACITY) {
-                e.a = e.a * gradient_opacity(0u, length(g));
-            }
-            if (SHADE) {
-                let n = world_gradient(shading_gradient(p, gs), 0u);
-                var rgb = shade(e.rgb, n, pos, view_dir);
-                if (VOLUMETRIC) {
-                    let gm = vtk_gradient_magnitude(n, OPACITY_NORMAL);
-                    rgb = volumetric_shade(e.rgb, a, gm, rgb, p, pos, view_dir, GRAD_OPACITY);
-                }
-                e = vec4<f32>(rgb, e.a);
+        if (MASK == MASK_LABELS) {
+            let l = mask_at(p);
+            if (l > 0u && f32(l) <= frame.mask.y) {
+                return classify_labelled(l, s, p, pos, view_dir);
             }
         }
-        return e;
+        return classify_one(sf, s, p, pos, view_dir);
     }
     // Independent components, mixed as VTK does: the premultiplied colours weighted and
     // added (Σ a·w·rgb, which may pass the brightest component's), opacity Σ a² / Σ a·w.
@@ -329,7 +382,7 @@ fn slice_state(ray: Ray, box: vec2<f32>, term: f32) -> PixelState {
     }
     let cl = clip_interval(ray, vec2<f32>(t, t));
     let p = ray.index_origin + t * ray.index_dir;
-    if (cl.x > cl.y || (CROP && !in_crop(p)) || (BLANKING && blanked(p))) {
+    if (cl.x > cl.y || (CROP && !in_crop(p)) || left_out(p)) {
         return st;
     }
     let s = sample_scalars(p);
@@ -501,7 +554,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 let t = seg.x + (k + jit) * dt;
                 let p = ray.index_origin + t * ray.index_dir;
-                if ((!CROP || in_crop(p)) && !(BLANKING && blanked(p))) {
+                if ((!CROP || in_crop(p)) && !left_out(p)) {
                     value = extremum(value, sample_scalars(p), misc.x == 0.0);
                     misc.x = misc.x + 1.0;
                 }
@@ -530,7 +583,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             k = next;
             continue;
         }
-        if ((CROP && !in_crop(p)) || (BLANKING && blanked(p))) {
+        if ((CROP && !in_crop(p)) || left_out(p)) {
             k = k + 1.0;
             continue;
         }

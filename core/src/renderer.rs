@@ -7,7 +7,7 @@ use crate::gpu::interop::{OutputPath, SharedOutput};
 use crate::gpu::Context;
 use crate::params::{
     BlendMode, BsdfParams, Convergence, CubeImage, Environment, GBuffer, Image, IsoParams,
-    PathTraceParams, RenderParams, Residency, Stats, StreamProgress, TransferFunction,
+    MaskKind, PathTraceParams, RenderParams, Residency, Stats, StreamProgress, TransferFunction,
     UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
@@ -100,6 +100,14 @@ impl Renderer {
     /// of one brick only.
     pub fn set_blanking(&mut self, mask: Option<&[u8]>) -> Result<()> {
         self.res.set_blanking(&self.ctx, mask)
+    }
+
+    /// Masks the current volume (VTK's MaskInput with MaskType): `values` holds one byte per
+    /// point of the volume's grid, x fastest, read at the point nearest to each sample, as
+    /// `kind` says ([`MaskKind`]). Ray casting reads it; isosurfaces and path tracing refuse
+    /// a masked volume. `None` clears it; a new volume clears it too.
+    pub fn set_mask(&mut self, mask: Option<(&[u8], MaskKind)>) -> Result<()> {
+        self.res.set_mask(&self.ctx, mask)
     }
 
     /// Calls `progress` after each pass of a streamed frame (`None`: no calls).
@@ -307,6 +315,15 @@ impl Renderer {
         depth: DepthSource<'_>,
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
+        if self.res.mask.is_some()
+            && matches!(params.blend, BlendMode::Isosurface | BlendMode::PathTrace)
+        {
+            return Err(Error::Unsupported(format!(
+                "masks are read by ray casting, not by the {:?} blend mode: clear the mask \
+                 (Renderer::set_mask(None)) or choose another blend mode",
+                params.blend
+            )));
+        }
         let (ctx, res) = (&self.ctx, &mut self.res);
         let input = |res| FrameInput {
             ctx,

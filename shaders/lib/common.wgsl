@@ -59,6 +59,8 @@ struct Frame {
     rect: vec4<u32>,              // pixels the passes cover: x0, y0, x1, y1 (exclusive)
     component_materials: array<vec4<f32>, 4>, // each independent component's material
     slice: vec4<f32>,             // BLEND_SLICE: the index-space plane dot(xyz, p) + w = 0
+    mask: vec4<f32>,              // x: label-map blend factor, y: highest label with own tables
+    labels: vec4<f32>,            // labels' tables: scalar lo, 1 / width, gradient lo, 1 / width
 }
 
 @group(0) @binding(0) var<uniform> frame_ubo: Frame;

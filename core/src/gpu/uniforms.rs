@@ -51,6 +51,11 @@ pub struct FrameUniforms {
     /// Each independent component's material (ambient, diffuse, specular, power).
     pub component_materials: [[f32; 4]; 4],
     pub slice: [f32; 4],
+    /// A mask: x the label-map blend factor, y the highest label with functions of its own.
+    pub mask: [f32; 4],
+    /// The labels' tables: scalar at the first entry, 1 / scalar width, the same for
+    /// gradient magnitude.
+    pub labels: [f32; 4],
 }
 
 #[repr(C)]
@@ -184,6 +189,12 @@ pub const PAGE_EMPTY: u32 = 1 << 31;
 /// a streamed frame (the ray stops there and resumes then; shaders/dvr.wgsl).
 pub const PAGE_MISSING: u32 = 1 << 30;
 
+/// What the DVR pass's mask does (its MASK pipeline constant): nothing, leave out the
+/// samples at points holding 0, classify labelled samples with their labels' tables.
+pub const MASK_NONE: u32 = 0;
+pub const MASK_BINARY: u32 = 1;
+pub const MASK_LABELS: u32 = 2;
+
 /// Most lights and clipping planes a frame takes (the sizes of Frame's arrays).
 pub const MAX_LIGHTS: usize = 8;
 pub const MAX_CLIP_PLANES: usize = 8;
@@ -244,6 +255,9 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("FLAG_AVERAGE_RANGE", Wgsl::U32(FLAG_AVERAGE_RANGE)),
     ("FLAG_EXTREMUM_DEPTH", Wgsl::U32(FLAG_EXTREMUM_DEPTH)),
     ("FLAG_PIECE", Wgsl::U32(FLAG_PIECE)),
+    ("MASK_NONE", Wgsl::U32(MASK_NONE)),
+    ("MASK_BINARY", Wgsl::U32(MASK_BINARY)),
+    ("MASK_LABELS", Wgsl::U32(MASK_LABELS)),
     ("MAX_LIGHTS", Wgsl::U32(MAX_LIGHTS as u32)),
     ("PAGE_SLOT_BITS", Wgsl::U32(PAGE_SLOT_BITS)),
     ("PAGE_EMPTY", Wgsl::U32(PAGE_EMPTY)),
@@ -361,7 +375,9 @@ mod layout_tests {
                     occupancy_dims,
                     rect,
                     component_materials,
-                    slice
+                    slice,
+                    mask,
+                    labels
                 ]
             );
             let (_, ps) = wgsl_struct(&m, "PixelState");

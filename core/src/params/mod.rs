@@ -25,9 +25,12 @@ pub use render::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
     MAX_CLIP_PLANES, MAX_LIGHTS,
 };
-pub(crate) use transfer::{build_preintegration, build_tables};
+pub(crate) use transfer::{build_preintegration, build_tables, build_tables_over};
 pub use transfer::{
-    ComponentTransfer, Piecewise, TransferFunction, MAX_TRANSFER_POSITION, TABLE_SIZE,
+    ComponentTransfer, LabelTransfer, Piecewise, TransferFunction, MAX_TRANSFER_POSITION,
+    TABLE_SIZE,
 };
 pub use view::{Image, Residency, Stats, StreamProgress, UploadOptions, View};
-pub use volume::{Direction, ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};
+pub use volume::{
+    Direction, MaskKind, ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION,
+};

@@ -200,6 +200,10 @@ pub struct RenderParams {
     /// The plane [`BlendMode::Slice`] draws, in world coordinates (the normal's sign does
     /// not matter); required by that blend mode, ignored by the others.
     pub slice_plane: Option<ClipPlane>,
+    /// VTK's MaskBlendFactor, in [0, 1]: with a label-map mask ([`crate::MaskKind`]), how
+    /// much of a labelled sample's colour and opacity come from its label's functions
+    /// rather than the transfer function's components (0: the mask is not read).
+    pub mask_blend: f32,
 }
 
 impl Default for RenderParams {
@@ -223,6 +227,7 @@ impl Default for RenderParams {
             whole_box: None,
             preintegration: false,
             slice_plane: None,
+            mask_blend: 1.0,
         }
     }
 }
@@ -301,6 +306,7 @@ impl RenderParams {
                 )));
             }
         }
+        within("mask blend factor", self.mask_blend, 0.0, 1.0)?;
         let s = &self.shading;
         for (n, v) in [
             ("ambient", s.ambient),

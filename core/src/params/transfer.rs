@@ -132,6 +132,18 @@ fn widen([lo, hi]: [f64; 2]) -> [f64; 2] {
     }
 }
 
+/// A label's own functions (vtkVolumeProperty's SetLabelColor / SetLabelScalarOpacity /
+/// SetLabelGradientOpacity): where a label-map mask gives a sample this label, these
+/// classify it; a function left `None` is the first component's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelTransfer {
+    /// 1 to 255 (label 0 is the unlabelled background: the components' functions).
+    pub label: u8,
+    pub color: Option<Piecewise<3>>,
+    pub opacity: Option<Piecewise<1>>,
+    pub gradient_opacity: Option<Piecewise<1>>,
+}
+
 /// The transfer function of a volume: one [`ComponentTransfer`] per component when
 /// components are independent, one in all when they are dependent.
 #[derive(Clone, Debug, PartialEq)]
@@ -140,6 +152,8 @@ pub struct TransferFunction {
     /// VTK's IndependentComponents (default true). When false: 2 components = (colour
     /// scalar, opacity scalar), 4 components = RGB direct + opacity scalar through the table.
     pub independent: bool,
+    /// The labels' own functions, read where a label-map mask is set (one entry per label).
+    pub labels: Vec<LabelTransfer>,
 }
 
 impl TransferFunction {
@@ -148,6 +162,7 @@ impl TransferFunction {
         TransferFunction {
             components: vec![c],
             independent: true,
+            labels: Vec::new(),
         }
     }
 
@@ -192,6 +207,22 @@ impl TransferFunction {
                 }
             }
         }
+        let mut seen = [false; 256];
+        for l in &self.labels {
+            if l.label == 0 {
+                return Err(Error::InvalidTransferFunction(
+                    "label 0 is the unlabelled background, classified by the components' \
+                     functions: give labels 1 to 255 their own"
+                        .into(),
+                ));
+            }
+            if std::mem::replace(&mut seen[l.label as usize], true) {
+                return Err(Error::InvalidTransferFunction(format!(
+                    "label {} has two entries; give each label one",
+                    l.label
+                )));
+            }
+        }
         if !(self.independent || volume_components == 2 || volume_components == 4) {
             return Err(Error::InvalidTransferFunction(format!(
                 "dependent components need 2 or 4 components per point, the volume has {volume_components}"
@@ -203,6 +234,50 @@ impl TransferFunction {
     /// The transfer for component `c` (the last one given is reused for the rest).
     pub fn component(&self, c: usize) -> &ComponentTransfer {
         &self.components[c.min(self.components.len() - 1)]
+    }
+
+    /// The highest label with functions of its own (0: none). Labels above it classify as
+    /// the background does.
+    pub fn max_label(&self) -> u8 {
+        self.labels.iter().map(|l| l.label).max().unwrap_or(0)
+    }
+
+    /// Label `label`'s functions, those it lacks taken from the first component.
+    pub fn label_transfer(&self, label: u8) -> ComponentTransfer {
+        let mut t = self.component(0).clone();
+        if let Some(l) = self.labels.iter().find(|l| l.label == label) {
+            if let Some(c) = &l.color {
+                t.color = c.clone();
+            }
+            if let Some(o) = &l.opacity {
+                t.opacity = o.clone();
+            }
+            if let Some(g) = &l.gradient_opacity {
+                t.gradient_opacity = Some(g.clone());
+            }
+        }
+        t
+    }
+
+    /// The scalar and gradient-magnitude ranges every label's table spans: the union of the
+    /// ranges of labels 1 to [`Self::max_label`] (theirs and the first component's).
+    pub fn label_ranges(&self) -> ([f64; 2], [f64; 2]) {
+        let mut r = (
+            [f64::INFINITY, f64::NEG_INFINITY],
+            [f64::INFINITY, f64::NEG_INFINITY],
+        );
+        for label in 1..=self.max_label() {
+            let t = self.label_transfer(label);
+            let (a, g) = (t.table_range(), t.gradient_range());
+            r.0 = [r.0[0].min(a[0]), r.0[1].max(a[1])];
+            r.1 = [r.1[0].min(g[0]), r.1[1].max(g[1])];
+        }
+        r
+    }
+
+    /// Whether some label from 1 to [`Self::max_label`] has a gradient opacity function.
+    pub fn labels_gradient_opacity(&self) -> bool {
+        (1..=self.max_label()).any(|l| self.label_transfer(l).gradient_opacity.is_some())
     }
 }
 
@@ -217,8 +292,16 @@ pub fn correct_opacity(alpha: f32, step: f64, unit_distance: f64) -> f32 {
 /// entries of (r, g, b, α corrected for the step) then `TABLE_SIZE` entries of
 /// (α, gradient opacity, 0, 0).
 pub fn build_tables(c: &ComponentTransfer, step: f64) -> Vec<[f32; 4]> {
-    let [lo, hi] = c.table_range();
-    let [glo, ghi] = c.gradient_range();
+    build_tables_over(c, step, c.table_range(), c.gradient_range())
+}
+
+/// [`build_tables`] over the scalar range `[lo, hi]` and gradient range `[glo, ghi]`.
+pub fn build_tables_over(
+    c: &ComponentTransfer,
+    step: f64,
+    [lo, hi]: [f64; 2],
+    [glo, ghi]: [f64; 2],
+) -> Vec<[f32; 4]> {
     let n = TABLE_SIZE;
     let mut out = Vec::with_capacity(2 * n);
     for i in 0..n {

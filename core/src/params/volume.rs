@@ -519,3 +519,16 @@ mod tests {
         assert_eq!(v.bounds()[..4], [-1e38, 1e38, 0.0, 1e30]);
     }
 }
+
+/// How a mask's values act on the volume (VTK's MaskType): one byte per point of the
+/// volume's grid ([`crate::Renderer::set_mask`]), read at the point nearest to a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaskKind {
+    /// A sample whose point holds 0 is left out, in every blend mode ray casting has.
+    Binary,
+    /// Each point's value is its label: composite ray casting of a one-component volume
+    /// classifies a sample labelled 1 to [`crate::TransferFunction::max_label`] with its
+    /// label's functions ([`crate::LabelTransfer`]), blended with the components' by
+    /// [`crate::RenderParams::mask_blend`]; label 0 and higher labels as without a mask.
+    LabelMap,
+}

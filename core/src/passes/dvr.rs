@@ -13,8 +13,9 @@ use crate::gpu::binding::{
 };
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
+use crate::gpu::uniforms::{MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation};
+use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
@@ -38,6 +39,7 @@ pipeline_variant! {
         opacity_normal: bool => "OPACITY_NORMAL",
         clipped_voxel: bool => "CLIPPED_VOXEL",
         blanking: bool => "BLANKING",
+        mask: u32 => "MASK",
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
@@ -49,7 +51,8 @@ pipeline_variant! {
 pub(crate) struct DvrPass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<DvrVariant>,
-    /// The blanking mask bound when the volume has none (one point, not blanked).
+    /// The blanking mask bound when the volume has none (one point, not blanked); the
+    /// mask's place takes it too.
     no_blanking: wgpu::TextureView,
     /// Bound in place of the pre-integration tables when a frame does not use them.
     no_preintegration: Tables,
@@ -74,6 +77,7 @@ impl DvrPass {
                     buffer_entry(7, B::Storage { read_only: false }),
                     sampled_texture_entry(8, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(9, true, V::D2),
+                    sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -137,8 +141,22 @@ impl DvrPass {
         // Additive and average skip empty blocks too, counting the skipped samples (their
         // terms are 0), as long as every sample counts (no cropping, blanking or average
         // range) and the occupancy is of the components they sum (one or independent).
+        let mask = match res.mask_kind() {
+            Some(MaskKind::Binary) => MASK_BINARY,
+            // label maps: composite ray casting of one component, as VTK's
+            Some(MaskKind::LabelMap)
+                if params.blend == BlendMode::Composite
+                    && vol.components == 1
+                    && params.mask_blend > 0.0
+                    && res.transfer_function()?.max_label() > 0 =>
+            {
+                MASK_LABELS
+            }
+            _ => MASK_NONE,
+        };
         let counts_all = params.cropping.is_none()
             && res.blanking.is_none()
+            && mask != MASK_BINARY
             && (vol.components == 1 || f.independent)
             && (params.blend == BlendMode::Additive
                 || (params.blend == BlendMode::Average && params.average_range.is_none()));
@@ -171,11 +189,13 @@ impl DvrPass {
                     .into(),
             ));
         }
-        // Pre-integration: composite, one or independent components, no volumetric shadows.
+        // Pre-integration: composite, one or independent components, no volumetric shadows
+        // and no label map (a labelled sample is classified alone).
         let preintegration = params.preintegration
             && params.blend == BlendMode::Composite
             && (vol.components == 1 || f.independent)
-            && !f.volumetric;
+            && !f.volumetric
+            && mask != MASK_LABELS;
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
@@ -192,6 +212,7 @@ impl DvrPass {
             volumetric: f.volumetric,
             opacity_normal,
             blanking: res.blanking.is_some(),
+            mask,
             clipped_voxel: params.clipped_voxel_value.is_some()
                 && !params.clip_planes.is_empty()
                 && params.blend == BlendMode::Composite
@@ -239,6 +260,12 @@ impl DvrPass {
                     ),
                 ),
                 bind(9, wgpu::BindingResource::TextureView(&preintegrated.view)),
+                bind(
+                    10,
+                    wgpu::BindingResource::TextureView(
+                        res.mask.as_ref().map_or(&self.no_blanking, |(m, _)| m),
+                    ),
+                ),
             ],
         });
         let rect = u.rect;

@@ -9,7 +9,7 @@ use crate::gpu::uniforms::{
 };
 use crate::gpu::Context;
 use crate::params::{
-    BlendMode, ClipPlane, LightSpace, RenderParams, TransferFunction, View, MAX_LIGHTS,
+    BlendMode, ClipPlane, LightSpace, MaskKind, RenderParams, TransferFunction, View, MAX_LIGHTS,
 };
 use crate::resources::bricks::{FrontToBack, BLOCK_SIZE};
 use crate::resources::targets::DepthSource;
@@ -207,6 +207,20 @@ pub(crate) fn frame(
         u.weights[c] = ct.weight;
         u.additive_scale[c] = (step / ct.unit_distance) as f32;
         any_go |= ct.gradient_opacity.is_some() && (c as u32) < vol.components;
+    }
+    if res.mask_kind() == Some(MaskKind::LabelMap) && vol.components == 1 {
+        let ([lo, hi], [glo, ghi]) = tf.label_ranges();
+        let max_label = tf.max_label();
+        if max_label > 0 {
+            u.labels = [
+                lo as f32,
+                (1.0 / (hi - lo)) as f32,
+                glo as f32,
+                (1.0 / (ghi - glo)) as f32,
+            ];
+        }
+        u.mask = [params.mask_blend, f32::from(max_label), 0.0, 0.0];
+        any_go |= params.mask_blend > 0.0 && tf.labels_gradient_opacity();
     }
     let s = &params.shading;
     u.material = [s.ambient, s.diffuse, s.specular, s.specular_power];

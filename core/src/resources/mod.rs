@@ -16,7 +16,7 @@ use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::interop::OutputPath;
 use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Context;
-use crate::params::{RenderParams, Stats, StreamProgress, TransferFunction};
+use crate::params::{MaskKind, RenderParams, Stats, StreamProgress, TransferFunction};
 use environment::EnvironmentState;
 use gradients::GradientPass;
 use tables::{Occupancy, TableKey, Tables};
@@ -36,6 +36,8 @@ pub(crate) struct Resources {
     pub volume: Option<GpuVolume>,
     /// Per point of the volume's grid, non-zero where it is blanked (r8uint), or none.
     pub blanking: Option<wgpu::TextureView>,
+    /// The mask of the current volume (r8uint, one value per point) and what it means.
+    pub mask: Option<(wgpu::TextureView, MaskKind)>,
     pub tf: Option<TransferFunction>,
     pub tables: Option<(TableKey, Tables)>,
     /// The pre-integration tables, built when a frame asks for pre-integration.
@@ -101,6 +103,7 @@ impl Resources {
             tables: None,
             preintegration: None,
             blanking: None,
+            mask: None,
             occupancy: None,
             targets: None,
             output_path: OutputPath::Readback,
@@ -124,6 +127,11 @@ impl Resources {
         self.tf
             .as_ref()
             .ok_or_else(|| Error::InvalidParameter("no transfer function has been set".into()))
+    }
+
+    /// The mask's kind, where one is set.
+    pub fn mask_kind(&self) -> Option<MaskKind> {
+        self.mask.as_ref().map(|(_, k)| *k)
     }
 
     /// The world distance between samples these parameters give for the current volume.

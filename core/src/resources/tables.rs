@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
-use crate::params::{build_preintegration, build_tables, ComponentTransfer, TransferFunction};
+use crate::params::{build_preintegration, build_tables, build_tables_over, TransferFunction};
 
 /// The pre-integration tables' texel format.
 pub(crate) const PREINTEGRATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -83,26 +83,21 @@ impl<K: PartialEq> Occupancy<K> {
     }
 }
 
-/// Keeps in `slot` the tables `build` makes of each of `comps` components' transfer
-/// (`rows` rows of `TABLE_SIZE` texels each, of `format`) for `key`: rebuilt only when the
-/// key changed, in the same texture when its size is the same. Whether it rebuilt them.
+/// Keeps in `slot` the tables `build` makes of the transfer function of `key` (rows of
+/// `TABLE_SIZE` texels of `format`): rebuilt only when the key changed, in the same texture
+/// when its size is the same. Whether it rebuilt them.
 fn ensure_rows<T: bytemuck::Pod>(
     ctx: &Context,
     slot: &mut Option<(TableKey, Tables)>,
     key: TableKey,
-    comps: usize,
-    rows: usize,
     format: wgpu::TextureFormat,
-    build: impl Fn(&ComponentTransfer) -> Vec<T>,
+    build: impl Fn(&TransferFunction) -> Vec<T>,
 ) -> bool {
     if slot.as_ref().is_some_and(|(k, _)| *k == key) {
         return false;
     }
-    let mut data: Vec<T> = Vec::with_capacity(comps * rows * TABLE_SIZE);
-    for c in 0..comps {
-        data.extend(build(key.tf.component(c)));
-    }
-    let size = [TABLE_SIZE as u32, (comps * rows) as u32];
+    let data = build(&key.tf);
+    let size = [TABLE_SIZE as u32, (data.len() / TABLE_SIZE) as u32];
     let tables = match slot.take() {
         Some((_, t)) if [t.texture.width(), t.texture.height()] == size => t,
         _ => Tables::with_format(&ctx.device, size, format),
@@ -118,6 +113,22 @@ fn ensure_rows<T: bytemuck::Pod>(
     true
 }
 
+/// The lookup tables of every component (two rows each, `build_tables`), then those of
+/// labels 1 to the highest with functions of its own, over the labels' shared ranges (the
+/// frame's `labels` uniform).
+fn table_rows(tf: &TransferFunction, comps: usize, step: f64) -> Vec<[f32; 4]> {
+    let mut data = Vec::with_capacity((comps + tf.max_label() as usize) * 2 * TABLE_SIZE);
+    for c in 0..comps {
+        data.extend(build_tables(tf.component(c), step));
+    }
+    let (range, gradient_range) = tf.label_ranges();
+    for label in 1..=tf.max_label() {
+        let t = tf.label_transfer(label);
+        data.extend(build_tables_over(&t, step, range, gradient_range));
+    }
+    data
+}
+
 impl Resources {
     /// Builds the tables for the transfer function at sample distance `step`, unless they are
     /// current.
@@ -125,8 +136,8 @@ impl Resources {
         let key = TableKey::new(self.transfer_function()?, step);
         let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
         let format = wgpu::TextureFormat::Rgba32Float;
-        if ensure_rows(ctx, &mut self.tables, key, comps, 2, format, |c| {
-            build_tables(c, step)
+        if ensure_rows(ctx, &mut self.tables, key, format, |tf| {
+            table_rows(tf, comps, step)
         }) {
             self.stats.table_uploads += 1;
         }
@@ -142,23 +153,14 @@ impl Resources {
     pub fn ensure_preintegration(&mut self, ctx: &Context, step: f64) -> Result<()> {
         let key = TableKey::new(self.transfer_function()?, step);
         let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
-        let half = |c: &ComponentTransfer| -> Vec<[half::f16; 4]> {
-            let table = build_preintegration(c, step);
-            table
-                .into_iter()
+        let half = |tf: &TransferFunction| -> Vec<[half::f16; 4]> {
+            (0..comps)
+                .flat_map(|c| build_preintegration(tf.component(c), step))
                 .map(|e| e.map(half::f16::from_f32))
                 .collect()
         };
         let format = PREINTEGRATION_FORMAT;
-        if ensure_rows(
-            ctx,
-            &mut self.preintegration,
-            key,
-            comps,
-            TABLE_SIZE,
-            format,
-            half,
-        ) {
+        if ensure_rows(ctx, &mut self.preintegration, key, format, half) {
             self.stats.preintegration_builds += 1;
         }
         Ok(())
@@ -183,19 +185,31 @@ impl Resources {
         } else {
             vec![nc - 1]
         };
-        let prefix: Vec<(usize, [f64; 2], Vec<u32>)> = opacity_comps
+        let counts = |tables: Vec<[f32; 4]>, visible: bool| {
+            let mut p = vec![0u32; TABLE_SIZE + 1];
+            for i in 0..TABLE_SIZE {
+                p[i + 1] = p[i] + (tables[i][3] > 0.0 && visible) as u32;
+            }
+            p
+        };
+        let mut prefix: Vec<(usize, [f64; 2], Vec<u32>)> = opacity_comps
             .iter()
             .map(|&c| {
                 let ct = tf.component(if tf.independent { c } else { 0 });
-                let tables = build_tables(ct, step);
-                let mut p = vec![0u32; TABLE_SIZE + 1];
-                for i in 0..TABLE_SIZE {
-                    let nz = tables[i][3] > 0.0 && (!tf.independent || ct.weight > 0.0);
-                    p[i + 1] = p[i] + nz as u32;
-                }
-                (c, ct.table_range(), p)
+                let visible = !tf.independent || ct.weight > 0.0;
+                (c, ct.table_range(), counts(build_tables(ct, step), visible))
             })
             .collect();
+        // A label map classifies a one-component volume's labelled samples with their
+        // labels' functions: a block may hold what one of those shows.
+        if nc == 1 {
+            let (range, gradient_range) = tf.label_ranges();
+            for label in 1..=tf.max_label() {
+                let t = tf.label_transfer(label);
+                let tables = build_tables_over(&t, step, range, gradient_range);
+                prefix.push((0, range, counts(tables, true)));
+            }
+        }
         let nblocks = vol.minmax.ranges.len() / nc;
         let mut occ = vec![0u32; nblocks];
         let last = (TABLE_SIZE - 1) as f64;

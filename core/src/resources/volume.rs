@@ -15,7 +15,7 @@ use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
 use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS};
 use crate::gpu::Context;
-use crate::params::{Residency, UploadOptions, VolumeData};
+use crate::params::{MaskKind, Residency, UploadOptions, VolumeData};
 use glam::DMat4;
 use std::sync::Arc;
 
@@ -218,6 +218,7 @@ impl Resources {
         });
         self.occupancy = None;
         self.blanking = None;
+        self.mask = None;
         self.stats.volume_uploads += 1;
         let uploaded = match whole {
             Some(texels) => self.upload_whole(ctx, &texels),
@@ -256,6 +257,37 @@ impl Resources {
             ));
         }
         self.blanking = Some(block_grid(ctx, "blanking", d, mask));
+        Ok(())
+    }
+
+    /// The mask of the current volume (Renderer::set_mask): one value per point of its
+    /// grid, in one texture whatever the volume's bricking.
+    pub fn set_mask(&mut self, ctx: &Context, mask: Option<(&[u8], MaskKind)>) -> Result<()> {
+        let Some((values, kind)) = mask else {
+            self.mask = None;
+            return Ok(());
+        };
+        let d = self.volume()?.data_dims;
+        let n = d.iter().map(|&x| x as usize).product::<usize>();
+        if values.len() != n {
+            return Err(Error::InvalidParameter(format!(
+                "the mask has {} values; the volume's {}x{}x{} grid needs {n}, one per point",
+                values.len(),
+                d[0],
+                d[1],
+                d[2]
+            )));
+        }
+        let max = ctx.info.limits.max_texture_dimension_3d;
+        if d.iter().any(|&x| x > max) {
+            return Err(Error::Unsupported(format!(
+                "a mask is one 3D texture, and this device's are at most {max} points along \
+                 an axis: the volume's grid is {}x{}x{}",
+                d[0], d[1], d[2]
+            )));
+        }
+        let texture = ctx.checked("the mask", || block_grid(ctx, "mask", d, values))?;
+        self.mask = Some((texture, kind));
         Ok(())
     }
 

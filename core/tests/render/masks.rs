@@ -1,0 +1,278 @@
+//! Masks (VTK's MaskInput): binary masks leave samples out in every ray-casting blend mode,
+//! label maps classify labelled samples with their labels' functions.
+
+use crate::common::gpu::{assert_error, renderer, set_bricked};
+use crate::common::images::save_enlarged;
+use crate::common::metrics::{image_diff, rgba};
+use crate::common::raycast::to_pixel;
+use crate::common::scenes::{blob_transfer, blob_volume, piecewise1, piecewise3, shaded};
+use ferrovol_core::*;
+use glam::DVec3;
+
+const N: usize = 24;
+
+/// One byte per point of the N³ grid, `f` of the point's x index.
+fn by_x(f: impl Fn(usize) -> u8) -> Vec<u8> {
+    (0..N * N * N).map(|i| f(i % N)).collect()
+}
+
+/// The blob volume, its transfer function (shaded with gradient opacity where `shade`) and
+/// a view along z of 64² pixels.
+fn scene(r: &mut Renderer, labels: Vec<LabelTransfer>) -> View {
+    let vol = blob_volume(N as u32);
+    r.set_volume(&vol).unwrap();
+    let mut tf = TransferFunction::single(blob_transfer());
+    tf.labels = labels;
+    r.set_transfer_function(&tf).unwrap();
+    View::fit(vol.bounds(), 64, 64)
+}
+
+/// Pixel column where the world plane x = `x` projects on the volume's centre line.
+fn column(view: &View, x: f64) -> f64 {
+    let c = view.camera.focal_point;
+    to_pixel(view, DVec3::new(x, c.y, c.z)).0
+}
+
+fn params(blend: BlendMode) -> RenderParams {
+    RenderParams {
+        blend,
+        ..RenderParams::default()
+    }
+}
+
+/// A binary mask of zeros on the points x < 12 leaves out every sample nearer to them: the
+/// pixels whose rays see only that side are background, in every blend mode, bricked or not;
+/// a mask of ones changes nothing.
+#[test]
+fn binary_mask_leaves_out_samples() {
+    let mut r = renderer();
+    let view = scene(&mut r, Vec::new());
+    let ones = by_x(|_| 1);
+    let half = by_x(|x| u8::from(x >= 12));
+    // samples with x < 11.5 (index = world here) are left out
+    let edge = column(&view, 11.5);
+    for blend in [
+        BlendMode::Composite,
+        BlendMode::Maximum,
+        BlendMode::Minimum,
+        BlendMode::Average,
+        BlendMode::Additive,
+    ] {
+        let p = params(blend);
+        r.set_mask(None).unwrap();
+        let plain = r.render_image(&view, &p).unwrap();
+        r.set_mask(Some((&ones, MaskKind::Binary))).unwrap();
+        let all = r.render_image(&view, &p).unwrap();
+        assert_eq!(image_diff(&plain, &all).1, 0, "{blend:?}: a mask of ones");
+        r.set_mask(Some((&half, MaskKind::Binary))).unwrap();
+        let masked = r.render_image(&view, &p).unwrap();
+        save_enlarged(&masked, &format!("mask_binary_{blend:?}"));
+        let (mut left, mut right) = (0, 0);
+        for y in 0..64 {
+            for x in 0..64 {
+                let a = rgba(&masked, x, y)[3];
+                if (x as f64) < edge - 1.0 {
+                    left += u32::from(a > 0);
+                } else if (x as f64) > edge + 1.0 && rgba(&plain, x, y)[3] > 0 {
+                    right += u32::from(a > 0);
+                }
+            }
+        }
+        println!("{blend:?}: edge at column {edge:.1}; {left} pixels left of it, {right} right");
+        assert_eq!(
+            left, 0,
+            "{blend:?}: nothing drawn where every sample is masked"
+        );
+        // (the blob's minimum along every ray is transparent: MinIP draws nothing here)
+        if blend != BlendMode::Minimum {
+            assert!(right > 200, "{blend:?}: the unmasked side is drawn");
+        }
+        let vol = blob_volume(N as u32);
+        set_bricked(&mut r, &vol, 10);
+        r.set_mask(Some((&half, MaskKind::Binary))).unwrap();
+        let bricked = r.render_image(&view, &p).unwrap();
+        let (mean, max) = image_diff(&masked, &bricked);
+        println!("{blend:?}: bricked vs one brick, mean {mean:.3}, max {max}");
+        assert!(max <= 1, "{blend:?}: bricking changes the masked image");
+        r.set_volume(&vol).unwrap();
+    }
+}
+
+/// A label map: labels classify with their own functions (one left out is the first
+/// component's), blended by the blend factor; label 0 and labels above the highest with
+/// functions are the background's; a label of zero opacity equals a binary mask of it.
+#[test]
+fn label_map_classifies_by_label() {
+    let mut r = renderer();
+    let red = LabelTransfer {
+        label: 2,
+        color: Some(piecewise3(&[
+            (0.0, [1.0, 0.0, 0.0]),
+            (1.0, [1.0, 0.0, 0.0]),
+        ])),
+        opacity: None,
+        gradient_opacity: None,
+    };
+    let hidden = LabelTransfer {
+        label: 3,
+        color: None,
+        opacity: Some(piecewise1(&[(0.0, 0.0), (1.0, 0.0)])),
+        gradient_opacity: None,
+    };
+    let view = scene(&mut r, vec![red, hidden]);
+    let p = RenderParams {
+        mask_blend: 1.0,
+        ..RenderParams::default()
+    };
+    let plain = r.render_image(&view, &p).unwrap();
+    // label 1 (no functions: the first component's), 0 and 9 (above the highest) draw as
+    // without a mask
+    for label in [0u8, 1, 9] {
+        r.set_mask(Some((&by_x(|_| label), MaskKind::LabelMap)))
+            .unwrap();
+        let same = r.render_image(&view, &p).unwrap();
+        assert_eq!(image_diff(&plain, &same).1, 0, "label {label}");
+    }
+    // label 2 on the right half: red there, unchanged on the left
+    let right_red = by_x(|x| if x >= 12 { 2 } else { 0 });
+    r.set_mask(Some((&right_red, MaskKind::LabelMap))).unwrap();
+    let labelled = r.render_image(&view, &p).unwrap();
+    save_enlarged(&labelled, "mask_label_red");
+    let edge = column(&view, 11.5);
+    let (mut red_px, mut other) = (0, 0);
+    for y in 0..64 {
+        for x in 0..64 {
+            let [cr, cg, cb, a] = rgba(&labelled, x, y);
+            if (x as f64) > edge + 1.0 && a > 64 {
+                red_px += 1;
+                assert!(
+                    cr > 2 * cg.max(cb),
+                    "({x}, {y}) = {cr} {cg} {cb}: labelled red"
+                );
+            } else if (x as f64) < edge - 1.0 {
+                other = other.max(rgba(&plain, x, y)[0].abs_diff(cr));
+            }
+        }
+    }
+    println!("{red_px} red pixels; the unlabelled side within {other} levels");
+    assert!(red_px > 100);
+    assert!(other <= 1, "the unlabelled side changed by {other} levels");
+    // blend 0 reads no mask; 0.5 lies between
+    let none = r
+        .render_image(
+            &view,
+            &RenderParams {
+                mask_blend: 0.0,
+                ..p.clone()
+            },
+        )
+        .unwrap();
+    assert_eq!(image_diff(&plain, &none).1, 0, "blend factor 0");
+    let half = r
+        .render_image(
+            &view,
+            &RenderParams {
+                mask_blend: 0.5,
+                ..p.clone()
+            },
+        )
+        .unwrap();
+    let (d_plain, _) = image_diff(&plain, &half);
+    let (d_label, _) = image_diff(&labelled, &half);
+    println!("blend 0.5: {d_plain:.2} from the unmasked image, {d_label:.2} from the labelled");
+    assert!(d_plain > 0.5 && d_label > 0.5);
+    // a label of zero opacity leaves its samples out as a binary mask does
+    r.set_mask(Some((
+        &by_x(|x| if x < 12 { 3 } else { 0 }),
+        MaskKind::LabelMap,
+    )))
+    .unwrap();
+    let hidden_left = r.render_image(&view, &p).unwrap();
+    r.set_mask(Some((&by_x(|x| u8::from(x >= 12)), MaskKind::Binary)))
+        .unwrap();
+    let binary = r.render_image(&view, &p).unwrap();
+    assert_eq!(
+        image_diff(&binary, &hidden_left).1,
+        0,
+        "label 3 = binary mask"
+    );
+}
+
+/// A label's gradient opacity applies to its samples; the components' does not.
+#[test]
+fn label_gradient_opacity() {
+    let mut r = renderer();
+    let flat = LabelTransfer {
+        label: 1,
+        color: None,
+        opacity: None,
+        gradient_opacity: Some(piecewise1(&[(0.0, 0.0), (1e-3, 0.0)])),
+    };
+    let view = scene(&mut r, vec![flat]);
+    let p = shaded();
+    let plain = r.render_image(&view, &p).unwrap();
+    r.set_mask(Some((&by_x(|_| 1), MaskKind::LabelMap)))
+        .unwrap();
+    let gone = r.render_image(&view, &p).unwrap();
+    let lit = (0..64 * 64)
+        .filter(|i| rgba(&gone, i % 64, i / 64)[3] > 0)
+        .count();
+    println!("label gradient opacity 0: {lit} pixels drawn");
+    assert_eq!(lit, 0);
+    assert!(image_diff(&plain, &gone).0 > 1.0);
+}
+
+/// Bad masks and the modes that do not read one are refused, naming why; a new volume
+/// clears the mask.
+#[test]
+fn mask_errors() {
+    let mut r = renderer();
+    let view = scene(&mut r, Vec::new());
+    assert_error(
+        r.set_mask(Some((&[1; 7], MaskKind::Binary))),
+        "mask of the wrong length",
+        &["7 values", "24x24x24"],
+    );
+    let dup = |label| LabelTransfer {
+        label,
+        color: None,
+        opacity: None,
+        gradient_opacity: None,
+    };
+    let mut tf = TransferFunction::single(blob_transfer());
+    tf.labels = vec![dup(0)];
+    assert_error(r.set_transfer_function(&tf), "label 0", &["label 0"]);
+    tf.labels = vec![dup(4), dup(4)];
+    assert_error(r.set_transfer_function(&tf), "two label 4", &["label 4"]);
+    assert_error(
+        r.render_image(
+            &view,
+            &RenderParams {
+                mask_blend: 1.5,
+                ..RenderParams::default()
+            },
+        ),
+        "blend factor",
+        &["mask blend factor 1.5"],
+    );
+    r.set_mask(Some((&by_x(|_| 1), MaskKind::Binary))).unwrap();
+    for blend in [BlendMode::Isosurface, BlendMode::PathTrace] {
+        assert_error(
+            r.render_image(&view, &params(blend)),
+            &format!("{blend:?} with a mask"),
+            &["masks", &format!("{blend:?}")],
+        );
+    }
+    let p = params(BlendMode::Composite);
+    r.set_mask(None).unwrap();
+    let plain = r.render_image(&view, &p).unwrap();
+    r.set_mask(Some((&by_x(|x| u8::from(x >= 12)), MaskKind::Binary)))
+        .unwrap();
+    r.set_volume(&blob_volume(N as u32)).unwrap();
+    let fresh = r.render_image(&view, &p).unwrap();
+    assert_eq!(
+        image_diff(&plain, &fresh).1,
+        0,
+        "a new volume clears the mask"
+    );
+}
