@@ -88,9 +88,6 @@ typedef enum FvStatus {
   FV_STATUS_PANIC = 9,
 } FvStatus;
 
-/**
- * How samples along a ray combine (vtkVolumeMapper's blend modes).
- */
 typedef enum FvBlendMode {
   FV_BLEND_MODE_COMPOSITE = 0,
   FV_BLEND_MODE_MAXIMUM = 1,
@@ -263,7 +260,7 @@ typedef struct FvRenderer FvRenderer;
 
 /**
  * Colour, scalar opacity and gradient opacity per component (vtkVolumeProperty's
- * functions). Thread use: one thread at a time.
+ * functions), and per label of a label-map mask. Thread use: one thread at a time.
  */
 typedef struct FvTransferFunction FvTransferFunction;
 
@@ -497,6 +494,13 @@ typedef struct FvRenderParams {
    * does not matter); ignored by the other blend modes.
    */
   struct FvPlane slice_plane;
+  /**
+   * vtkGPUVolumeRayCastMapper's MaskBlendFactor, in [0, 1] (default 1): with a label-map
+   * mask (fv_renderer_set_mask), how much of a labelled sample's colour and opacity come
+   * from its label's functions (fv_transfer_function_set_label_*) rather than the
+   * components'; 0 reads no label.
+   */
+  float mask_blend_factor;
 } FvRenderParams;
 
 /**
@@ -952,6 +956,21 @@ enum FvStatus fv_renderer_set_blanking(struct FvRenderer *renderer,
                                        size_t count);
 
 /**
+ * Masks the current volume (vtkGPUVolumeRayCastMapper's MaskInput and MaskType): `count`
+ * bytes at `values`, one per point of the volume's grid, x fastest, read at the point
+ * nearest to each sample; `mask_type` an FvMaskType. FV_MASK_TYPE_BINARY leaves out the
+ * samples at points holding 0; FV_MASK_TYPE_LABEL_MAP classifies labelled samples with
+ * their labels' functions (fv_transfer_function_set_label_*), mixed by
+ * FvRenderParams::mask_blend_factor. Ray casting reads it; isosurfaces and path tracing
+ * answer FV_STATUS_UNSUPPORTED while a mask is set. NULL clears it; setting a volume
+ * clears it too.
+ */
+enum FvStatus fv_renderer_set_mask(struct FvRenderer *renderer,
+                                   const uint8_t *values,
+                                   size_t count,
+                                   uint32_t mask_type);
+
+/**
  * Sets the transfer function; only its tables are re-uploaded.
  */
 enum FvStatus fv_renderer_set_transfer_function(struct FvRenderer *renderer,
@@ -1182,6 +1201,35 @@ enum FvStatus fv_transfer_function_set_unit_distance(struct FvTransferFunction *
 enum FvStatus fv_transfer_function_set_material(struct FvTransferFunction *tf,
                                                 uint32_t component,
                                                 const float (*material)[4]);
+
+/**
+ * Colour points of label `label` (1 to 255; vtkVolumeProperty::SetLabelColor): `count`
+ * quadruples (x, r, g, b); count = 0: the first component's colour function again. Read
+ * where a label-map mask gives a sample this label (fv_renderer_set_mask).
+ */
+enum FvStatus fv_transfer_function_set_label_color(struct FvTransferFunction *tf,
+                                                   uint32_t label,
+                                                   const double *xrgb,
+                                                   size_t count);
+
+/**
+ * Scalar opacity points of label `label` (vtkVolumeProperty::SetLabelScalarOpacity):
+ * `count` pairs (x, opacity); count = 0: the first component's opacity function again.
+ */
+enum FvStatus fv_transfer_function_set_label_opacity(struct FvTransferFunction *tf,
+                                                     uint32_t label,
+                                                     const double *xa,
+                                                     size_t count);
+
+/**
+ * Gradient-magnitude opacity points of label `label`
+ * (vtkVolumeProperty::SetLabelGradientOpacity): `count` pairs (|∇s|, opacity multiplier);
+ * count = 0: the first component's gradient opacity again.
+ */
+enum FvStatus fv_transfer_function_set_label_gradient_opacity(struct FvTransferFunction *tf,
+                                                              uint32_t label,
+                                                              const double *xa,
+                                                              size_t count);
 
 /**
  * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of

@@ -33,8 +33,8 @@ pub use types::*;
 pub use volume::*;
 
 use ferrovol_core::{
-    ComponentTransfer, Context, Environment, Image, OutputPath, Piecewise, Renderer, Scalars,
-    TransferFunction, UploadOptions, View, VolumeData,
+    ComponentTransfer, Context, Environment, Image, LabelTransfer, OutputPath, Piecewise, Renderer,
+    Scalars, TransferFunction, UploadOptions, View, VolumeData,
 };
 use std::ffi::{c_char, c_void, CStr};
 

@@ -138,6 +138,34 @@ pub unsafe extern "C" fn fv_renderer_set_blanking(
     })
 }
 
+/// Masks the current volume (vtkGPUVolumeRayCastMapper's MaskInput and MaskType): `count`
+/// bytes at `values`, one per point of the volume's grid, x fastest, read at the point
+/// nearest to each sample; `mask_type` an FvMaskType. FV_MASK_TYPE_BINARY leaves out the
+/// samples at points holding 0; FV_MASK_TYPE_LABEL_MAP classifies labelled samples with
+/// their labels' functions (fv_transfer_function_set_label_*), mixed by
+/// FvRenderParams::mask_blend_factor. Ray casting reads it; isosurfaces and path tracing
+/// answer FV_STATUS_UNSUPPORTED while a mask is set. NULL clears it; setting a volume
+/// clears it too.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_set_mask(
+    renderer: *mut FvRenderer,
+    values: *const u8,
+    count: usize,
+    mask_type: u32,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        let kind = types::mask_kind(mask_type)?;
+        let values = if values.is_null() {
+            None
+        } else {
+            // SAFETY: the caller guarantees `count` bytes at `values`.
+            Some(unsafe { std::slice::from_raw_parts(values, count) })
+        };
+        r.r.set_mask(values.map(|v| (v, kind)))?;
+        Ok(())
+    })
+}
+
 /// Sets the transfer function; only its tables are re-uploaded.
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_set_transfer_function(

@@ -13,10 +13,12 @@ struct PartialComponent {
 }
 
 /// Colour, scalar opacity and gradient opacity per component (vtkVolumeProperty's
-/// functions). Thread use: one thread at a time.
+/// functions), and per label of a label-map mask. Thread use: one thread at a time.
 pub struct FvTransferFunction {
     components: Vec<PartialComponent>,
     independent: bool,
+    /// Index: label − 1.
+    labels: Vec<LabelTransfer>,
 }
 
 impl FvTransferFunction {
@@ -28,6 +30,31 @@ impl FvTransferFunction {
                 n - 1
             ))
         })
+    }
+}
+
+impl FvTransferFunction {
+    /// Label `label`'s functions, created empty when it has none.
+    fn label(&mut self, label: u32) -> FfiResult<&mut LabelTransfer> {
+        let Ok(l @ 1..=255) = u8::try_from(label) else {
+            return Err(FfiError::invalid(format!(
+                "label {label}: labels with functions of their own are 1 to 255 (label 0 is \
+                 the background, drawn with the components' functions)"
+            )));
+        };
+        let i = match self.labels.iter().position(|t| t.label == l) {
+            Some(i) => i,
+            None => {
+                self.labels.push(LabelTransfer {
+                    label: l,
+                    color: None,
+                    opacity: None,
+                    gradient_opacity: None,
+                });
+                self.labels.len() - 1
+            }
+        };
+        Ok(&mut self.labels[i])
     }
 }
 
@@ -48,9 +75,16 @@ impl ToCore for FvTransferFunction {
             t.material = c.material;
             components.push(t);
         }
+        let labels = self
+            .labels
+            .iter()
+            .filter(|l| l.color.is_some() || l.opacity.is_some() || l.gradient_opacity.is_some())
+            .cloned()
+            .collect();
         Ok(TransferFunction {
             components,
             independent: self.independent,
+            labels,
         })
     }
 }
@@ -96,6 +130,7 @@ pub unsafe extern "C" fn fv_transfer_function_new(
         *slot = Box::into_raw(Box::new(FvTransferFunction {
             components: vec![PartialComponent::default(); components as usize],
             independent,
+            labels: Vec::new(),
         }));
         Ok(())
     })
@@ -237,5 +272,67 @@ pub unsafe extern "C" fn fv_transfer_function_set_material(
         }
         t.component(component)?.material = m;
         Ok(())
+    })
+}
+
+/// Replaces one of label `label`'s functions (`field`) with `count` points of 1 + N doubles
+/// at `p`; no points: the first component's function again.
+fn set_label_points<const N: usize>(
+    tf: *mut FvTransferFunction,
+    label: u32,
+    what: &str,
+    p: *const f64,
+    count: usize,
+    field: fn(&mut LabelTransfer) -> &mut Option<Piecewise<N>>,
+) -> FvStatus {
+    guard(|| {
+        let t = mut_ref(tf, "tf")?;
+        let pts = points::<N>(what, p, count)?;
+        *field(t.label(label)?) = pts;
+        Ok(())
+    })
+}
+
+/// Colour points of label `label` (1 to 255; vtkVolumeProperty::SetLabelColor): `count`
+/// quadruples (x, r, g, b); count = 0: the first component's colour function again. Read
+/// where a label-map mask gives a sample this label (fv_renderer_set_mask).
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_label_color(
+    tf: *mut FvTransferFunction,
+    label: u32,
+    xrgb: *const f64,
+    count: usize,
+) -> FvStatus {
+    set_label_points(tf, label, "label colour points", xrgb, count, |l| {
+        &mut l.color
+    })
+}
+
+/// Scalar opacity points of label `label` (vtkVolumeProperty::SetLabelScalarOpacity):
+/// `count` pairs (x, opacity); count = 0: the first component's opacity function again.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_label_opacity(
+    tf: *mut FvTransferFunction,
+    label: u32,
+    xa: *const f64,
+    count: usize,
+) -> FvStatus {
+    set_label_points(tf, label, "label opacity points", xa, count, |l| {
+        &mut l.opacity
+    })
+}
+
+/// Gradient-magnitude opacity points of label `label`
+/// (vtkVolumeProperty::SetLabelGradientOpacity): `count` pairs (|∇s|, opacity multiplier);
+/// count = 0: the first component's gradient opacity again.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_label_gradient_opacity(
+    tf: *mut FvTransferFunction,
+    label: u32,
+    xa: *const f64,
+    count: usize,
+) -> FvStatus {
+    set_label_points(tf, label, "label gradient opacity points", xa, count, |l| {
+        &mut l.gradient_opacity
     })
 }

@@ -5,7 +5,7 @@
 use crate::status::{FfiError, FfiResult};
 use ferrovol_core::{
     BlendMode, Camera, ClipPlane, Cropping, GradientMethod, Interpolation, Light, LightSpace,
-    RenderParams, Shading,
+    MaskKind, RenderParams, Shading,
 };
 use glam::{DMat4, DVec3};
 
@@ -73,6 +73,22 @@ pub enum FvScalarType {
 }
 
 /// How samples along a ray combine (vtkVolumeMapper's blend modes).
+/// What a mask's values mean (vtkGPUVolumeRayCastMapper's MaskType).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvMaskType {
+    /// Ray casting leaves out the samples whose nearest point holds 0 (every blend mode).
+    Binary = 0,
+    /// Each point's value is its label: composite ray casting of a one-component volume
+    /// classifies a sample labelled 1 to 255 with that label's functions, as VTK does.
+    LabelMap = 1,
+}
+
+/// The mask kind an FvMaskType value (as a C caller passes it) names.
+pub fn mask_kind(v: u32) -> FfiResult<MaskKind> {
+    enum_value("mask type", v, &[MaskKind::Binary, MaskKind::LabelMap])
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FvBlendMode {
@@ -275,6 +291,11 @@ pub struct FvRenderParams {
     /// The plane FV_BLEND_MODE_SLICE draws, world coordinates (a non-zero normal; its sign
     /// does not matter); ignored by the other blend modes.
     pub slice_plane: FvPlane,
+    /// vtkGPUVolumeRayCastMapper's MaskBlendFactor, in [0, 1] (default 1): with a label-map
+    /// mask (fv_renderer_set_mask), how much of a labelled sample's colour and opacity come
+    /// from its label's functions (fv_transfer_function_set_label_*) rather than the
+    /// components'; 0 reads no label.
+    pub mask_blend_factor: f32,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -395,6 +416,7 @@ impl FvRenderParams {
                 origin: [0.0; 3],
                 normal: [0.0, 0.0, 1.0],
             },
+            mask_blend_factor: d.mask_blend,
         }
     }
 }
@@ -486,6 +508,7 @@ impl ToCore for FvRenderParams {
                 origin: DVec3::from_array(self.slice_plane.origin),
                 normal: DVec3::from_array(self.slice_plane.normal),
             }),
+            mask_blend: self.mask_blend_factor,
         };
         p.validate()?;
         Ok(p)

@@ -493,6 +493,90 @@ fn renderer_errors() {
 }
 
 #[test]
+fn masks_through_the_c_abi() {
+    let lib = Lib::open();
+    type SetMask = unsafe extern "C" fn(H, *const u8, usize, u32) -> FvStatus;
+    let n = 8usize;
+    let mut s = Session::new(&lib);
+    s.set_volume([8, 8, 8], FvScalarType::U8, &vec![200u8; n * n * n]);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0],
+        &[0.0, 0.0, 255.0, 0.5],
+    );
+    s.set_camera(&camera([3.5, 3.5, 18.0], [3.5, 3.5, 3.5], [0.1, 100.0]));
+    let pixel = |rgba: &[u8], x: usize, y: usize| -> [u8; 4] {
+        let i = 4 * (y * 16 + x);
+        [rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]]
+    };
+    let plain = s.frame(16, 16).to_vec();
+    // points with x < 4 hold 0 (binary) / label 2 (label map)
+    let left: Vec<u8> = (0..n * n * n).map(|i| u8::from(i % n >= 4)).collect();
+    let labels: Vec<u8> = left.iter().map(|&v| if v == 0 { 2 } else { 0 }).collect();
+    let set_mask = lib.f::<SetMask>("fv_renderer_set_mask");
+    let label_color = lib.f::<SetPoints>("fv_transfer_function_set_label_color");
+    // SAFETY: arguments follow the header; invalid ones are the test.
+    unsafe {
+        lib.expect(set_mask(s.r, left.as_ptr(), 7, 0), Invalid, "7 values");
+        lib.expect(
+            set_mask(s.r, left.as_ptr(), left.len(), 2),
+            Invalid,
+            "mask type 2",
+        );
+        lib.expect(set_mask(null_mut(), null(), 0, 0), Null, "renderer");
+        let red = [0.0, 1.0, 0.0, 0.0, 255.0, 1.0, 0.0, 0.0];
+        lib.expect(label_color(s.tf, 0, red.as_ptr(), 2), Invalid, "label 0");
+        lib.expect(
+            label_color(s.tf, 256, red.as_ptr(), 2),
+            Invalid,
+            "label 256",
+        );
+        lib.ok(label_color(s.tf, 2, red.as_ptr(), 2));
+        lib.ok(lib.f::<SetH>("fv_renderer_set_transfer_function")(
+            s.r, s.tf,
+        ));
+
+        lib.ok(set_mask(s.r, left.as_ptr(), left.len(), 0));
+        let binary = s.frame(16, 16).to_vec();
+        lib.ok(set_mask(s.r, labels.as_ptr(), labels.len(), 1));
+        let labelled = s.frame(16, 16).to_vec();
+        let mut p = FvRenderParams::defaults();
+        p.mask_blend_factor = 2.0;
+        lib.expect(
+            lib.f::<SetParams>("fv_renderer_set_params")(s.r, &p),
+            Invalid,
+            "mask blend factor 2",
+        );
+        p.mask_blend_factor = 0.0;
+        s.set_params(&p);
+        let unlabelled = s.frame(16, 16).to_vec();
+        p.mask_blend_factor = 1.0;
+        p.blend_mode = FvBlendMode::Isosurface as u32;
+        s.set_params(&p);
+        let render = lib.f::<Render>("fv_renderer_render");
+        lib.expect(
+            render(s.r, 16, 16, null(), 0),
+            FvStatus::Unsupported,
+            "masks",
+        );
+        lib.ok(set_mask(s.r, null(), 0, 0));
+        println!(
+            "centre: plain {:?}, binary {:?} / {:?}, labelled {:?} / {:?}",
+            pixel(&plain, 8, 8),
+            pixel(&binary, 4, 8),
+            pixel(&binary, 12, 8),
+            pixel(&labelled, 4, 8),
+            pixel(&labelled, 12, 8)
+        );
+        assert_eq!(pixel(&binary, 4, 8)[3], 0, "masked side empty");
+        assert_eq!(pixel(&binary, 12, 8), pixel(&plain, 12, 8));
+        let [r, g, _, a] = pixel(&labelled, 4, 8);
+        assert!(a > 100 && r > 100 && g == 0, "label 2 red");
+        assert_eq!(pixel(&labelled, 12, 8), pixel(&plain, 12, 8));
+        assert_eq!(unlabelled, plain, "blend factor 0 reads no label");
+    }
+}
+
+#[test]
 fn last_error_is_per_thread_and_status_names_are_static() {
     let lib = Lib::open();
     let name = lib.f::<extern "C" fn(i32) -> *const c_char>("fv_status_name");
