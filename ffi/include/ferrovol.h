@@ -239,6 +239,22 @@ typedef enum FvScatterRegions {
 } FvScatterRegions;
 
 /**
+ * How samples along a ray combine (vtkVolumeMapper's blend modes).
+ * What a mask's values mean (vtkGPUVolumeRayCastMapper's MaskType).
+ */
+typedef enum FvMaskType {
+  /**
+   * Ray casting leaves out the samples whose nearest point holds 0 (every blend mode).
+   */
+  FV_MASK_TYPE_BINARY = 0,
+  /**
+   * Each point's value is its label: composite ray casting of a one-component volume
+   * classifies a sample labelled 1 to 255 with that label's functions, as VTK does.
+   */
+  FV_MASK_TYPE_LABEL_MAP = 1,
+} FvMaskType;
+
+/**
  * A GPU adapter and device. Create one per process (or per host graphics context) and
  * share it between renderers. Thread use: may be used from any thread; calls on one
  * context may run concurrently (the device is internally synchronised).

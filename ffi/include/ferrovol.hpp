@@ -153,6 +153,20 @@ public:
   void set_material(uint32_t component, const float (&material)[4]) {
     check(fv_transfer_function_set_material(h_.get(), component, &material));
   }
+  /// Label `label`'s (1-255) own functions, read where a label-map mask gives a sample this
+  /// label (see fv_transfer_function_set_label_color); empty: the first component's again.
+  void set_label_color(uint32_t label, const std::vector<double> &xrgb) {
+    check(fv_transfer_function_set_label_color(h_.get(), label, detail::data_or_null(xrgb),
+                                               xrgb.size() / 4));
+  }
+  void set_label_opacity(uint32_t label, const std::vector<double> &xa) {
+    check(fv_transfer_function_set_label_opacity(h_.get(), label, detail::data_or_null(xa),
+                                                 xa.size() / 2));
+  }
+  void set_label_gradient_opacity(uint32_t label, const std::vector<double> &xa) {
+    check(fv_transfer_function_set_label_gradient_opacity(
+        h_.get(), label, detail::data_or_null(xa), xa.size() / 2));
+  }
   const FvTransferFunction *get() const noexcept { return h_.get(); }
 
 private:
@@ -268,6 +282,11 @@ public:
   // One byte per point of the volume's grid, non-zero where hidden; nullptr clears.
   void set_blanking(const uint8_t *mask, size_t count) {
     check(fv_renderer_set_blanking(h_.get(), mask, count));
+  }
+  /// `values`: one byte per point of the volume's grid, or nullptr to clear the mask (see
+  /// fv_renderer_set_mask).
+  void set_mask(const uint8_t *values, size_t count, FvMaskType type) {
+    check(fv_renderer_set_mask(h_.get(), values, count, static_cast<uint32_t>(type)));
   }
   void set_max_brick_points(uint32_t points) {
     check(fv_renderer_set_max_brick_points(h_.get(), points));

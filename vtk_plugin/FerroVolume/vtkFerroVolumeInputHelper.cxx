@@ -5,6 +5,7 @@
 #include "vtkDataArray.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeMapper.h"
+#include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkPointData.h"
@@ -468,6 +469,7 @@ bool vtkFerroVolumeInputHelper::Upload(
   this->MeanSpacing = pv.MeanSpacing;
   std::copy(pv.Desc.dims, pv.Desc.dims + 3, this->UploadedDims);
   this->BlankingStale = true;
+  this->MaskKey.reset();
   this->Uploaded = key;
   return true;
 }
@@ -523,4 +525,104 @@ bool vtkFerroVolumeInputHelper::UpdateBlanking(ferrovol::Renderer& renderer, std
   }
   return vtkFerroVolumeCall(
     "blank the volume", error, [&] { renderer.set_blanking(mask.data(), mask.size()); });
+}
+
+// vtkGPUVolumeRayCastMapper's mask texture, on ferrovol's grid: the mask image must have the
+// input's extent; its point scalars mask point data, its cell scalars cell data (first
+// component). Binary: a point is kept where its value is above 0 (VTK tests the texture
+// value > 0). Label map: the value is the point's label, an integer 0 to 255.
+bool vtkFerroVolumeInputHelper::UpdateMask(
+  vtkImageData* mask, int maskType, ferrovol::Renderer& renderer, std::string& error)
+{
+  vtkDataArray* scalars = nullptr;
+  if (mask)
+  {
+    scalars = this->CellFlag == 1 ? mask->GetCellData()->GetScalars()
+                                  : mask->GetPointData()->GetScalars();
+  }
+  const auto key = std::make_tuple(mask, mask ? mask->GetMTime() : 0, scalars,
+    scalars ? scalars->GetMTime() : 0, maskType);
+  if (this->MaskKey && *this->MaskKey == key)
+  {
+    return true;
+  }
+  this->MaskKey = key;
+  auto clear = [&] { renderer.set_mask(nullptr, 0, FV_MASK_TYPE_BINARY); };
+  if (!mask)
+  {
+    return vtkFerroVolumeCall("clear the mask", error, clear);
+  }
+  std::string problem;
+  int md[3], pd[3];
+  mask->GetDimensions(md);
+  this->Image->GetDimensions(pd);
+  const char* where = this->CellFlag == 1 ? "cell" : "point";
+  if (!std::equal(md, md + 3, pd))
+  {
+    std::ostringstream os;
+    os << "the mask input is " << md[0] << "x" << md[1] << "x" << md[2]
+       << " points and the volume " << pd[0] << "x" << pd[1] << "x" << pd[2]
+       << ": a mask needs the volume's extent";
+    problem = os.str();
+  }
+  else if (!scalars)
+  {
+    problem = std::string("the mask input has no ") + where + " scalars (the volume's are " +
+      where + " data)";
+  }
+  const bool labels = maskType == vtkGPUVolumeRayCastMapper::LabelMapMaskType;
+  std::vector<uint8_t> values;
+  if (problem.empty())
+  {
+    int sd[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      sd[a] = this->CellFlag == 1 ? std::max(pd[a] - 1, 1) : pd[a];
+    }
+    const uint32_t* vd = this->UploadedDims;
+    values.resize(static_cast<size_t>(vd[0]) * vd[1] * vd[2]);
+    size_t at = 0;
+    for (uint32_t k = 0; k < vd[2] && problem.empty(); ++k)
+    {
+      for (uint32_t j = 0; j < vd[1] && problem.empty(); ++j)
+      {
+        for (uint32_t i = 0; i < vd[0]; ++i, ++at)
+        {
+          const int q[3] = { static_cast<int>(i), static_cast<int>(j), static_cast<int>(k) };
+          vtkIdType id = 0;
+          for (int a = 2; a >= 0; --a)
+          {
+            id = id * sd[a] + std::min(q[a], sd[a] - 1);
+          }
+          const double v = scalars->GetComponent(id, 0);
+          if (!labels)
+          {
+            values[at] = v > 0.0 ? 1 : 0;
+          }
+          else if (v >= 0.0 && v <= 255.0 && v == std::floor(v))
+          {
+            values[at] = static_cast<uint8_t>(v);
+          }
+          else
+          {
+            std::ostringstream os;
+            os << "the label map holds " << v << " at " << where << " " << id
+               << ": labels are integers from 0 to 255";
+            problem = os.str();
+            break;
+          }
+        }
+      }
+    }
+  }
+  if (!problem.empty())
+  {
+    vtkFerroVolumeCall("clear the mask", error, clear);
+    error = problem;
+    return false;
+  }
+  return vtkFerroVolumeCall("set the mask", error, [&] {
+    renderer.set_mask(
+      values.data(), values.size(), labels ? FV_MASK_TYPE_LABEL_MAP : FV_MASK_TYPE_BINARY);
+  });
 }

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <optional>
+#include <tuple>
 #include <string>
 #include <utility>
 
@@ -59,6 +60,13 @@ public:
   // uploaded volume changed; false with the reason when the renderer refuses it.
   bool UpdateBlanking(ferrovol::Renderer& renderer, std::string& error);
 
+  // Gives the renderer `mask` (vtkGPUVolumeRayCastMapper's MaskInput, nullptr for none)
+  // with `maskType` (BinaryMaskType or LabelMapMaskType), or clears it, when the mask, its
+  // scalars, the type or the uploaded volume changed; false with the reason (the mask is
+  // then cleared).
+  bool UpdateMask(
+    vtkImageData* mask, int maskType, ferrovol::Renderer& renderer, std::string& error);
+
 private:
   // What the uploaded volume was made from: anything here changing means a new upload.
   struct Key
@@ -89,6 +97,10 @@ private:
   Ghosts GhostCounts;
   // The mask must be (re)sent: the ghost arrays or the volume changed.
   bool BlankingStale = true;
+  // What the mask sent last was made from: (image, its MTime, scalars, their MTime, type);
+  // reset by a new volume upload.
+  std::optional<std::tuple<vtkImageData*, vtkMTimeType, vtkDataArray*, vtkMTimeType, int>>
+    MaskKey;
   uint32_t UploadedDims[3] = { 0, 0, 0 };
   int Components = 0;
   Ranges ComponentRanges{};

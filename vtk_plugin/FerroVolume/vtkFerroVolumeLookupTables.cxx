@@ -324,13 +324,99 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
   }
   return true;
 }
+
+// The labels' own functions (vtkVolumeProperty::SetLabel*) of a one-component volume,
+// sampled as VTK 9.2's label-map tables are: colour and scalar opacity with GetTable over
+// the component's data range, gradient opacity as the component's. Labels above 255 are left
+// out: a label map holds labels 0 to 255.
+bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
+  double gradientScale, ferrovol::TransferFunction& tf, std::string& error)
+{
+  std::vector<double> xs, pts, values;
+  TablePositions(range[0], range[1], xs);
+  const int m = static_cast<int>(xs.size());
+  for (const int label : prop->GetLabelMapLabels())
+  {
+    if (label < 1 || label > 255)
+    {
+      continue;
+    }
+    const uint32_t l = static_cast<uint32_t>(label);
+    if (vtkColorTransferFunction* ctf = prop->GetLabelColor(label))
+    {
+      values.assign(static_cast<size_t>(3) * m, 0.0);
+      SampleColor(ctf, range[0], range[1], m, values.data());
+      pts.resize(static_cast<size_t>(4) * m);
+      for (int i = 0; i < m; ++i)
+      {
+        pts[4 * i] = xs[i];
+        for (int k = 0; k < 3; ++k)
+        {
+          pts[4 * i + 1 + k] = Clamp01(values[3 * i + k]);
+        }
+      }
+      if (!vtkFerroVolumeCall(
+            "set a label's colour function", error, [&] { tf.set_label_color(l, pts); }))
+      {
+        return false;
+      }
+    }
+    if (vtkPiecewiseFunction* sof = prop->GetLabelScalarOpacity(label))
+    {
+      values.assign(m, 0.0);
+      SampleScalar(sof, range[0], range[1], m, values.data());
+      pts.resize(static_cast<size_t>(2) * m);
+      for (int i = 0; i < m; ++i)
+      {
+        pts[2 * i] = xs[i];
+        pts[2 * i + 1] = Clamp01(values[i]);
+      }
+      if (!vtkFerroVolumeCall(
+            "set a label's opacity function", error, [&] { tf.set_label_opacity(l, pts); }))
+      {
+        return false;
+      }
+    }
+    if (vtkPiecewiseFunction* gof = prop->GetLabelGradientOpacity(label))
+    {
+      GradientOpacityNodes(gof, range, false, gradientScale, pts);
+      if (pts.empty())
+      {
+        // (a constant 1: no attenuation, which the first component's function may have)
+        pts = { 0.0, 1.0 };
+      }
+      if (!vtkFerroVolumeCall("set a label's gradient opacity function", error,
+            [&] { tf.set_label_gradient_opacity(l, pts); }))
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The latest modification of the property's label functions.
+vtkMTimeType LabelsMTime(vtkVolumeProperty* prop)
+{
+  vtkMTimeType t = 0;
+  for (const int label : prop->GetLabelMapLabels())
+  {
+    vtkObject* functions[3] = { prop->GetLabelColor(label), prop->GetLabelScalarOpacity(label),
+      prop->GetLabelGradientOpacity(label) };
+    for (vtkObject* f : functions)
+    {
+      t = f ? std::max(t, f->GetMTime()) : t;
+    }
+  }
+  return t;
+}
 } // namespace
 
 bool vtkFerroVolumeLookupTables::Key::operator==(const Key& o) const
 {
   return this->Property == o.Property && this->PropertyMTime == o.PropertyMTime &&
     this->Components == o.Components && this->Ranges == o.Ranges && this->Types == o.Types &&
-    this->GradientScale == o.GradientScale;
+    this->GradientScale == o.GradientScale && this->LabelsMTime == o.LabelsMTime;
 }
 
 double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
@@ -362,6 +448,7 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   key.Ranges = input.GetRanges();
   key.Types = rangeTypes;
   key.GradientScale = 1.0 / (input.GetMeanSpacing() * matrixScale);
+  key.LabelsMTime = LabelsMTime(prop);
   if (this->Uploaded && *this->Uploaded == key)
   {
     return true;
@@ -370,6 +457,8 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   std::unique_ptr<ferrovol::TransferFunction> tf;
   if (!BuildTransferFunction(
         prop, key.Components, key.Ranges, key.Types, key.GradientScale, tf, error) ||
+    (key.Components == 1 &&
+      !BuildLabels(prop, key.Ranges[0], key.GradientScale, *tf, error)) ||
     !vtkFerroVolumeCall(
       "set the transfer function", error, [&] { renderer.set_transfer_function(*tf); }))
   {

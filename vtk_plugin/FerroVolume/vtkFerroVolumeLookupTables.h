@@ -58,6 +58,7 @@ private:
     vtkFerroVolumeInputHelper::Ranges Ranges{};
     RangeTypes Types;
     double GradientScale = 0.0;
+    vtkMTimeType LabelsMTime = 0;
 
     bool operator==(const Key& o) const;
   };

@@ -130,6 +130,25 @@ public:
       vtkWarningWithObjectMacro(
         self, << "the ghost arrays' blanking is not applied (the cells are drawn): " << blanking);
     }
+    // Masks are read by ray casting; isosurfaces and path tracing draw the volume unmasked.
+    vtkImageData* mask = self->GetMaskInput();
+    const uint32_t blend = this->Settings.GetBlend();
+    if (mask && (blend == FV_BLEND_MODE_ISOSURFACE || blend == FV_BLEND_MODE_PATH_TRACE))
+    {
+      if (this->FirstTime("mask-mode"))
+      {
+        vtkWarningWithObjectMacro(self, << "MaskInput is applied by ray casting only: the "
+                                        << (blend == FV_BLEND_MODE_ISOSURFACE ? "isosurface"
+                                                                              : "path-traced")
+                                        << " image is drawn unmasked");
+      }
+      mask = nullptr;
+    }
+    if (!this->Input.UpdateMask(mask, self->GetMaskType(), *this->Renderer, error))
+    {
+      error = "MaskInput: " + error;
+      return false;
+    }
     return this->Tables.Update(vol, this->Input, types, *this->Renderer, error);
   }
 

@@ -267,6 +267,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     return Result::Failed;
   }
   params.blend_mode = this->Blend;
+  params.mask_blend_factor = self->GetMaskBlendFactor();
   if (this->Blend == FV_BLEND_MODE_SLICE)
   {
     // As vtkOpenGLGPUVolumeRayCastMapper: the plane's origin and normal in world
@@ -393,6 +394,17 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
                                     << " cells (hidden or duplicate, as vtkUniformGrid "
                                        "blanking): ferrovol leaves them out in ray casting; "
                                        "isosurfaces and path tracing draw them");
+  }
+  if (self->GetMaskInput() &&
+    self->GetMaskType() == vtkGPUVolumeRayCastMapper::LabelMapMaskType &&
+    this->Blend == FV_BLEND_MODE_COMPOSITE && input.GetComponents() > 1 &&
+    warned.insert("label-components").second)
+  {
+    vtkWarningWithObjectMacro(self, << "a label map (MaskType LabelMapMaskType) colours "
+                                       "one-component volumes, as vtkGPUVolumeRayCastMapper's: "
+                                       "this one has "
+                                    << input.GetComponents()
+                                    << " components and is drawn without its labels");
   }
   if (self->GetComputeNormalFromOpacity() && params.shade)
   {
@@ -543,12 +555,6 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
 void vtkFerroVolumeSettings::WarnUnsupported(
   vtkFerroVolumeMapper* self, std::set<std::string>& warned) const
 {
-  if (self->GetMaskInput() && warned.insert("mask").second)
-  {
-    vtkWarningWithObjectMacro(self, << "MaskInput is not supported by ferrovol yet (binary "
-                                       "masks and label maps, with MaskType and "
-                                       "MaskBlendFactor): the volume is drawn unmasked");
-  }
   if (self->GetUseDepthPass() && this->Blend == FV_BLEND_MODE_COMPOSITE &&
     warned.insert("depth-pass").second)
   {

@@ -22,6 +22,8 @@ public:
   // The mapper's blend mode (or path tracing) in ferrovol's terms; false with the reason
   // when ferrovol has no such mode.
   bool SelectBlendMode(vtkFerroVolumeMapper* self, std::string& error);
+  // The blend mode SelectBlendMode chose (an FvBlendMode).
+  uint32_t GetBlend() const { return this->Blend; }
 
   enum class Result
   {

@@ -207,6 +207,21 @@ class ErrorCases(unittest.TestCase):
         self.expect_error(["empty"], data=img)
         self.recover()
 
+    def test_mask_of_the_wrong_size(self):
+        small = image_from_array(np.ones((6, 12, 12), np.uint8))
+        self.expect_error(["mask", "12x12x6", "12x12x12", "extent"],
+                          configure=lambda m: m.SetMaskInput(small))
+        self.recover(lambda m: m.SetMaskInput(None))
+
+    def test_label_out_of_range(self):
+        labels = image_from_array(np.full((12, 12, 12), 300, np.int16))
+
+        def label_map(m):
+            m.SetMaskInput(labels)
+            m.SetMaskTypeToLabelMap()
+        self.expect_error(["label map holds 300", "0 to 255"], configure=label_map)
+        self.recover(lambda m: m.SetMaskInput(None))
+
     # -- device faults ---------------------------------------------------------------------------
     def test_device_loss(self):
         before = self.scene.render()
