@@ -25,4 +25,16 @@ if [ ! -f build/data/heart.vti ]; then
   cp "$tmp"/usr/share/doc/mayavi2/examples/mayavi/data/heart.vti build/data/heart.vti
   rm -rf "$tmp"
 fi
+# pyvista's frog tissue label map (500x470x136 uint8, labels 0-29): taken out of the wheel,
+# not installed.
+if [ ! -f build/data/frog_tissues.vti ]; then
+  tmp=$(mktemp -d)
+  if python3 -m pip download --quiet --no-deps --dest "$tmp" pyvista==0.49.2 >/dev/null 2>&1; then
+    (cd "$tmp" && python3 -m zipfile -e pyvista-*.whl extracted >/dev/null)
+    cp "$tmp"/extracted/pyvista/examples/frog_tissues.vti build/data/frog_tissues.vti
+  else
+    echo "fetch-data: pip could not download pyvista: no build/data/frog_tissues.vti" >&2
+  fi
+  rm -rf "$tmp"
+fi
 ls -la build/data

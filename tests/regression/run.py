@@ -242,7 +242,7 @@ def run_scene(scene, table):
     except S.MissingData as e:
         res.update(status="SKIP", why=[str(e)])
         return res
-    fixed_ok = set(scene.blends) <= FIXED_BLENDS and not ARGS.no_fixed
+    fixed_ok = set(scene.blends) <= FIXED_BLENDS and scene.fixed and not ARGS.no_fixed
     imgs = {}
     for kind in MAPPERS:
         if kind == "vtk-fixed" and not fixed_ok:

@@ -144,8 +144,38 @@ def wavelet128_blanked():
     return img
 
 
+@_cached
+def frog():
+    """pyvista's frog tissue label map: 500x470x136 uint8 labels 0-29, spacing 1 x 1 x 1.5."""
+    return _read("frog_tissues.vti")
+
+
+def _mask_of(image, values):
+    """A mask image on `image`'s grid holding `values` ([z, y, x] uint8)."""
+    m = fvtest.image_from_array(values.astype(np.uint8), spacing=image.GetSpacing(),
+                                origin=image.GetOrigin(), name="mask")
+    m.SetExtent(image.GetExtent())
+    return m
+
+
+@_cached
+def cranium_cutaway_mask():
+    """A binary mask of the skull CT: 0 in the quarter x < half, y < half (a cutaway)."""
+    nx, ny, nz = cranium().GetDimensions()
+    z, y, x = np.mgrid[0:nz, 0:ny, 0:nx]
+    return _mask_of(cranium(), ~((x < nx // 2) & (y < ny // 2)))
+
+
+@_cached
+def frog_mask():
+    """The frog's labels as a label-map mask of itself."""
+    m = vtk.vtkImageData()
+    m.DeepCopy(frog())
+    return m
+
+
 DATA = {f.__name__: f for f in (wavelet128, wavelet128_blanked, wavelet21, marschner_lobb,
-                                 cranium, colin27, heart, labels)}
+                                 cranium, colin27, heart, labels, frog)}
 
 # ---------------------------------------------------------------------------------------
 # Volume properties
@@ -277,6 +307,44 @@ def label_tf():
     return p
 
 
+# The frog's tissues drawn through a label map of themselves: every tissue a faint grey
+# (the property's own functions), five of them their own colour and opacity
+# (vtkVolumeProperty::SetLabelColor / SetLabelScalarOpacity). Label 29, the mask's highest,
+# has functions too (the property's grey): VTK 9.2 reads label L's row at floor(L·N/M), N the
+# highest label with functions and M the mask's highest value, right only where N = M.
+FROG_LABELS = {3: ((0.9, 0.2, 0.2), 0.35), 9: ((0.2, 0.8, 0.3), 0.35),
+               10: ((0.95, 0.85, 0.4), 0.08), 13: ((0.3, 0.5, 1.0), 0.04),
+               15: ((0.9, 0.5, 0.9), 0.25), 29: ((0.7, 0.7, 0.7), 0.02)}
+
+
+def frog_tf(shade=False):
+    def make():
+        ctf = vtk.vtkColorTransferFunction()
+        ctf.AddRGBPoint(0.0, 0.0, 0.0, 0.0)
+        ctf.AddRGBPoint(29.0, 0.7, 0.7, 0.7)
+        otf = vtk.vtkPiecewiseFunction()
+        otf.AddPoint(0.49, 0.0)
+        otf.AddPoint(0.51, 0.02)
+        otf.AddPoint(29.0, 0.02)
+        p = vtk.vtkVolumeProperty()
+        p.SetColor(ctf)
+        p.SetScalarOpacity(otf)
+        p.SetInterpolationTypeToNearest()
+        for label, (rgb, alpha) in FROG_LABELS.items():
+            c = vtk.vtkColorTransferFunction()
+            c.AddRGBPoint(0.0, *rgb)
+            c.AddRGBPoint(29.0, *rgb)
+            p.SetLabelColor(label, c)
+            o = vtk.vtkPiecewiseFunction()
+            o.AddPoint(0.0, alpha)
+            o.AddPoint(29.0, alpha)
+            p.SetLabelScalarOpacity(label, o)
+        if shade:
+            p.ShadeOn()
+        return p
+    return make
+
+
 # ---------------------------------------------------------------------------------------
 # Cameras, actors, mapper settings
 
@@ -394,6 +462,15 @@ def clipped_voxel_intensity(make_prop, value):
     return make
 
 
+def mask(make_mask, label_map=False, blend_factor=1.0):
+    """The mapper's MaskInput (vtkGPUVolumeRayCastMapper's binary mask or label map)."""
+    def f(m):
+        m.SetMaskInput(make_mask())
+        m.SetMaskType(m.LabelMapMaskType if label_map else m.BinaryMaskType)
+        m.SetMaskBlendFactor(blend_factor)
+    return f
+
+
 def both(*configures):
     def f(m):
         for c in configures:
@@ -473,6 +550,7 @@ class Scene:
     lights: Optional[Callable] = None      # (vtkRenderer) -> None: scene lights
     iso_values: tuple = ()
     multisamples: Optional[int] = None     # window MSAA; None: VTK's default (8)
+    fixed: bool = True                     # False: the fixed-point mapper lacks a setting used
     quick: bool = False
     note: str = ""                   # known, understood differences shown next to the images
 
@@ -697,6 +775,20 @@ SCENES = [
     Scene("heart-mip", "heart.vti, maximum intensity", "heart", heart_tf(),
           views=one("maximum", orbit(-30, 40)), note=OUTLINE_NOTE),
     # --- label map
+    # --- masks (vtkGPUVolumeRayCastMapper's MaskInput)
+    Scene("ct-binary-mask", "skull CT, bone and skin, shaded, a binary mask cutting a quarter "
+          "away", "cranium", ct_tf(), views=one(camera=ct_front(35, 15, 1.1)),
+          configure=mask(cranium_cutaway_mask), fixed=False, quick=True),
+    Scene("ct-binary-mask-mip", "skull CT, maximum intensity, the binary cutaway mask",
+          "cranium", ct_mip_tf, views=one("maximum", ct_front(35, 15, 1.1)),
+          configure=mask(cranium_cutaway_mask), fixed=False),
+    Scene("frog-label-map", "frog tissues 500x470x136 uint8 as a label map of themselves: "
+          "five labels their own colour and opacity, nearest", "frog", frog_tf(),
+          views=one(camera=orbit(30, 20, 1.3)), configure=mask(frog_mask, label_map=True),
+          fixed=False, quick=True),
+    Scene("frog-label-map-blend", "frog label map, MaskBlendFactor 0.5, shaded", "frog",
+          frog_tf(shade=True), views=one(camera=orbit(30, 20, 1.3)),
+          configure=mask(frog_mask, label_map=True, blend_factor=0.5), fixed=False),
     Scene("labels-composite", "label map 128x128x108 uint8 (skull CT in 4 tissues), "
           "categorical TF, nearest", "labels", label_tf, quick=True,
           views=one(camera=ct_front(30, 10))),
