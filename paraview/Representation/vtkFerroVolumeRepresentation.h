@@ -46,6 +46,7 @@
 
 #include "vtkSmartPointer.h" // for ivar
 
+#include <array>  // for ivar
 #include <string> // for ivar
 #include <vector> // for ivar
 
@@ -175,6 +176,24 @@ public:
    */
   void SetProgressiveMode(int mode);
 
+  ///@{
+  /**
+   * A mask from an array of the dataset (vtkGPUVolumeRayCastMapper's MaskInput):
+   * SetMaskArrayName names a point or cell array of the input ("" or "None": no mask; the
+   * mapper reads it as the volume's own association), SetMaskType is the mapper's
+   * (BinaryMaskType 0, LabelMapMaskType 1), SetMaskBlendFactor its MaskBlendFactor. Each
+   * AddLabelColor(label, r, g, b, opacity) gives label 1-255 a flat colour and scalar opacity
+   * of its own (vtkVolumeProperty::SetLabelColor / SetLabelScalarOpacity);
+   * RemoveAllLabelColors clears them. Under MPI each rank masks its piece with the array of
+   * that piece.
+   */
+  void SetMaskArrayName(const char* name);
+  void SetMaskType(int type);
+  void SetMaskBlendFactor(double factor);
+  void AddLabelColor(double label, double r, double g, double b, double opacity);
+  void RemoveAllLabelColors();
+  ///@}
+
   /**
    * The mapper this representation renders with.
    */
@@ -267,6 +286,20 @@ protected:
   int LastRenderSize[2] = { 0, 0 };
   // the progressive mode set through the property (screenshots render with it off)
   int ProgressiveMode = 0;
+
+  /**
+   * Gives the mapper the mask image of MaskArrayName (rebuilt when the input or the array
+   * changed) and the property the labels' colours; warns once when the array is missing.
+   */
+  void UpdateMask();
+
+  std::string MaskArrayName;
+  // the mask image (the input's structure with the array as its scalars) and its source
+  vtkSmartPointer<vtkImageData> MaskImage;
+  std::string MaskKey;
+  // label → (r, g, b, opacity) as the property gives them, and the labels the property holds
+  std::vector<std::array<double, 5>> LabelColors;
+  std::vector<int> AppliedLabels;
 
   // ApplyVectorMode()'s single-component image, its producer and what it was made from.
   vtkSmartPointer<vtkImageData> VectorModeImage;

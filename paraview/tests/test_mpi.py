@@ -37,7 +37,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fvtest as T  # noqa: E402
-from paraview.simple import Wavelet, ExtractSubset, Show, Hide, Render  # noqa: E402
+from paraview.simple import (  # noqa: E402
+    ExtractSubset, Hide, PythonCalculator, Render, Show, Wavelet)
 
 MODE = sys.argv[1] if len(sys.argv) > 1 else "distributed"
 SIZE = (300, 300)
@@ -76,6 +77,14 @@ BLENDS = {
 GI = {"Shade": 1, "VolumetricScatteringBlending": 2.0, "GlobalIlluminationReach": 0.5}
 GI_CAMERA = "oblique"
 
+# A label map from an array of the dataset (Mask Array, Label Colors): label 1 (green) where
+# RTData > 200, label 2 (yellow) where RTData < 110, the rest unlabelled. Under MPI each rank
+# masks its piece with its piece of the array.
+LABELS = ("numpy.where(inputs[0].PointData['RTData'] > 200.0, 1, "
+          "numpy.where(inputs[0].PointData['RTData'] < 110.0, 2, 0))")
+LABEL_COLORS = [1, 0.1, 0.9, 0.2, 0.6, 2, 1.0, 0.9, 0.1, 0.3]
+LABEL_CAMERA = "oblique"
+
 T.load_plugin(globals())
 
 
@@ -91,6 +100,18 @@ def setup(view, source, rep="Ferrovol Volume"):
     disp.ScalarOpacityUnitDistance = 2.0
     disp.Representation = rep
     return disp
+
+
+def show_labels(view, source):
+    """The source with a label array, shown with a label map of it."""
+    calc = PythonCalculator(Input=source)
+    calc.Expression = LABELS
+    calc.ArrayName = "labels"
+    disp = setup(view, calc)
+    disp.FerrovolMaskArray = "labels"
+    disp.FerrovolMaskType = "Label Map"
+    disp.FerrovolLabelColors = LABEL_COLORS
+    return calc, disp
 
 
 def ref_path(cam, blend=None):
@@ -120,10 +141,40 @@ def serial():
     set_gi(disp, False)
     Hide(src, view)
 
+    # The label map: the labels' colours where they are; Mask Blend Factor 0 is the
+    # unlabelled image; a binary mask of the same array draws less.
+    failures = []
+    calc, ldisp = show_labels(view, src)
+    T.set_camera(view, bounds, direction=CAMERAS[LABEL_CAMERA])
+    Render(view)
+    img, path, _ = T.screenshot(view, "mpi-serial-labels-%s" % LABEL_CAMERA)
+    rgb = img[..., :3].astype(float)
+    # (the colour map has no green: the unlabelled image has no such pixel)
+    green = int((rgb[..., 1] - np.maximum(rgb[..., 0], rgb[..., 2]) > 15).sum())
+    yellow = int(((rgb[..., 0] > 2 * rgb[..., 2]) & (rgb[..., 1] > 2 * rgb[..., 2])
+                  & (rgb[..., 1] > 0.6 * rgb[..., 0])).sum())
+    T.log("  serial label map: %d green, %d yellow pixels (%s)" % (green, yellow, path))
+    if green < 1000 or yellow < 1000:
+        failures.append("label map: %d green, %d yellow pixels (want 1000 each)"
+                        % (green, yellow))
+    ldisp.FerrovolMaskBlendFactor = 0.0
+    Render(view)
+    img0, _, _ = T.screenshot(view, "mpi-serial-labels-factor0")
+    T.compare("label map, blend factor 0, vs unlabelled", img0,
+              T.read_png(ref_path(LABEL_CAMERA)), 0.999, 50.0, failures)
+    ldisp.FerrovolMaskBlendFactor = 1.0
+    ldisp.FerrovolMaskType = "Binary"
+    Render(view)
+    imgb, _, _ = T.screenshot(view, "mpi-serial-binary-mask")
+    drawn = [T.coverage(i) for i in (img0, imgb)]
+    T.log("  binary mask: %.3f of the frame drawn, %.3f unmasked" % (drawn[1], drawn[0]))
+    if not drawn[1] < 0.8 * drawn[0]:
+        failures.append("binary mask: %.3f of the frame drawn, unmasked %.3f" % (drawn[1], drawn[0]))
+    Hide(calc, view)
+
     # Ordering matters: render the halves z <= 0 and z >= 0 (what two ranks hold) alone,
     # over black and over white (colour over black = premultiplied colour, the difference
     # gives alpha), and composite them back to front in both orders.
-    failures = []
     halves = []
     for voi in ([-10, 10, -10, 10, -10, 0], [-10, 10, -10, 10, 0, 10]):
         sub = ExtractSubset(Input=src)
@@ -217,6 +268,15 @@ def distributed():
         T.compare("mpi -n %d volumetric shadows (measured)" % T.nranks(), img,
                   T.read_png(gi_ref))
     set_gi(disp, False)
+    Hide(src, view)
+    show_labels(view, src)
+    T.set_camera(view, bounds, direction=CAMERAS[LABEL_CAMERA])
+    Render(view)
+    img, _, _ = T.screenshot(view, "mpi-n%d-labels-%s" % (T.nranks(), LABEL_CAMERA))
+    labels_ref = os.path.join(T.OUT_DIR, "mpi-serial-labels-%s.png" % LABEL_CAMERA)
+    if T.rank() == 0 and os.path.exists(labels_ref):
+        T.compare("mpi -n %d label map vs serial" % T.nranks(), img, T.read_png(labels_ref),
+                  MIN_SSIM, MIN_PSNR, failures)
     # Rank-local failures are printed by their ranks; rank 0 decides the exit status.
     if failures and T.rank() != 0:
         print("FAIL rank %d: %s" % (T.rank(), "; ".join(failures)), flush=True)
