@@ -56,11 +56,8 @@ override BLANKING: bool = false;
 @group(0) @binding(10) var mask_tex: texture_3d<u32>;
 override MASK: u32 = MASK_NONE;
 
-// The mask's value at the point nearest to index-space point p (VTK reads its mask texture
-// with nearest filtering).
 fn mask_at(p: vec3<f32>) -> u32 {
-    let q = clamp(p, vec3<f32>(0.0), frame.dims.xyz - 1.0);
-    return textureLoad(mask_tex, vec3<i32>(floor(q + 0.5)), 0).x;
+    return mask_value(mask_tex, p);
 }
 
 // Whether the sample at index-space point p is left out by blanking or a binary mask.
@@ -227,8 +224,8 @@ fn classify_one(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_
 // transfer function's classification (classify_one) by the blend factor frame.mask.x,
 // colour and opacity alike.
 fn classify_labelled(l: u32, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
-    let row = NCOMP + l - 1u;
-    var e = table_lookup(row, 0u, (s.x - frame.labels.x) * frame.labels.y);
+    let row = label_row(NCOMP, l);
+    var e = table_lookup(row, 0u, label_coord(s.x));
     if (e.a > 0.0 && (SHADE || GRAD_OPACITY)) {
         let g = world_gradient(gradient_at(p, s), 0u);
         if (GRAD_OPACITY) {
@@ -275,7 +272,7 @@ fn classify_sample(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, vi
     if (NCOMP == 1u) {
         if (MASK == MASK_LABELS) {
             let l = mask_at(p);
-            if (l > 0u && f32(l) <= frame.mask.y) {
+            if (labelled(l)) {
                 return classify_labelled(l, s, p, pos, view_dir);
             }
         }

@@ -157,8 +157,35 @@ fn inner_segment(r: Ray) -> vec2<f32> {
 }
 
 fn extinction(s: f32) -> f32 {
-    let a = min(raw_alpha(0u, s), PT_MAX_OPACITY);
+    return alpha_extinction(raw_alpha(0u, s));
+}
+
+fn alpha_extinction(alpha: f32) -> f32 {
+    let a = min(alpha, PT_MAX_OPACITY);
     return -log(1.0 - a) * pt.medium.z;
+}
+
+// A mask (Renderer::set_mask), one value per point of the grid: MASK_BINARY empties the
+// medium where the nearest point holds 0; MASK_LABELS gives a labelled point's medium its
+// label's colour and opacity, mixed with the transfer function's by frame.mask.x (one
+// component: the labels' rows follow the component's).
+@group(0) @binding(17) var mask_tex: texture_3d<u32>;
+override MASK: u32 = MASK_NONE;
+
+// The medium's colour (rgb) and opacity (a, not step-corrected) at index-space point p,
+// whose scalar is s.
+fn medium(p: vec3<f32>, s: f32) -> vec4<f32> {
+    let own = vec4<f32>(classify(0u, s).rgb, raw_alpha(0u, s));
+    if (MASK == MASK_LABELS) {
+        let l = mask_value(mask_tex, p);
+        if (labelled(l)) {
+            let row = label_row(1u, l);
+            let u = label_coord(s);
+            let e = vec4<f32>(table_lookup(row, 0u, u).rgb, table_lookup(row, 1u, u).x);
+            return mix(own, e, frame.mask.x);
+        }
+    }
+    return own;
 }
 
 // The probability that a collision where the gradient magnitude is m scatters by the BSDF
@@ -202,11 +229,16 @@ fn attenuates() -> bool {
 // nothing scatters and nothing attenuates).
 fn extinction_at(r: Ray, t: f32) -> f32 {
     let p = r.index_origin + t * r.index_dir;
-    if (CROP && !in_crop(p)) {
+    if ((CROP && !in_crop(p)) || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
         return 0.0;
     }
     let s = sample_scalars(p);
-    var sigma = extinction(s.x);
+    var sigma: f32;
+    if (MASK == MASK_LABELS) {
+        sigma = alpha_extinction(medium(p, s.x).a);
+    } else {
+        sigma = extinction(s.x);
+    }
     let partial = pt.options.z == PT_SCATTER_SURFACES || pt.options.z == PT_SCATTER_BETWEEN;
     if (HYBRID && !attenuates() && partial && sigma > 0.0) {
         let m = length(world_gradient(gradient_at(p, s), 0u));
@@ -356,7 +388,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         let p = r.index_origin + t * r.index_dir;
         let s = sample_scalars(p);
         var sc: Scatterer;
-        sc.b.color = classify(0u, s.x).rgb;
+        sc.b.color = medium(p, s.x).rgb;
         var share = 0.0;
         var grad = vec3<f32>(0.0);
         if (uses_gradient()) {

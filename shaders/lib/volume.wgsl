@@ -220,3 +220,25 @@ fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
 fn world_gradient(g: Gradient, c: u32) -> vec3<f32> {
     return (frame.gradient_to_world * vec4<f32>(g.x[c], g.y[c], g.z[c], 0.0)).xyz;
 }
+
+// A mask's value (Renderer::set_mask, one per point of the grid) at the point nearest to
+// index-space point p: VTK reads its mask texture with nearest filtering.
+fn mask_value(mask: texture_3d<u32>, p: vec3<f32>) -> u32 {
+    let q = clamp(p, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    return textureLoad(mask, vec3<i32>(floor(q + 0.5)), 0).x;
+}
+
+// MASK_LABELS: label l's table row (after the `components` components' rows), and whether
+// the label has rows (1 to the highest label with functions of its own, frame.mask.y).
+fn label_row(components: u32, l: u32) -> u32 {
+    return components + l - 1u;
+}
+
+fn labelled(l: u32) -> bool {
+    return l > 0u && f32(l) <= frame.mask.y;
+}
+
+// The labels' tables are read at scalar s here.
+fn label_coord(s: f32) -> f32 {
+    return (s - frame.labels.x) * frame.labels.y;
+}

@@ -130,17 +130,14 @@ public:
       vtkWarningWithObjectMacro(
         self, << "the ghost arrays' blanking is not applied (the cells are drawn): " << blanking);
     }
-    // Masks are read by ray casting; isosurfaces and path tracing draw the volume unmasked.
+    // Masks are read by ray casting and path tracing; isosurfaces draw the volume unmasked.
     vtkImageData* mask = self->GetMaskInput();
-    const uint32_t blend = this->Settings.GetBlend();
-    if (mask && (blend == FV_BLEND_MODE_ISOSURFACE || blend == FV_BLEND_MODE_PATH_TRACE))
+    if (mask && this->Settings.GetBlend() == FV_BLEND_MODE_ISOSURFACE)
     {
       if (this->FirstTime("mask-mode"))
       {
-        vtkWarningWithObjectMacro(self, << "MaskInput is applied by ray casting only: the "
-                                        << (blend == FV_BLEND_MODE_ISOSURFACE ? "isosurface"
-                                                                              : "path-traced")
-                                        << " image is drawn unmasked");
+        vtkWarningWithObjectMacro(self, << "MaskInput is applied by ray casting and path "
+                                           "tracing: the isosurface image is drawn unmasked");
       }
       mask = nullptr;
     }

@@ -152,7 +152,7 @@ class Masks(unittest.TestCase):
         fvtest.log("  isosurface with a mask -> " + (errors.warnings[-1].strip().splitlines()[-1]
                                                     if errors.warnings else "(no warning)"))
         self.assertEqual(errors.messages, [])
-        self.assertTrue(any("applied by ray casting only" in w for w in errors.warnings))
+        self.assertTrue(any("isosurface image is drawn unmasked" in w for w in errors.warnings))
         self.assertGreater(coverage(img), 0.05)
 
 

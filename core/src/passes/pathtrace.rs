@@ -42,14 +42,15 @@ use crate::gpu::pipeline::{
 use crate::gpu::readback::read_buffer;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{
-    flag_bits, PathTraceUniforms, ShowUniforms, PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND,
-    PT_FLAG_GUIDE, PT_MAX_OPACITY, TABLE_SIZE, UNIFORM_STRIDE,
+    flag_bits, PathTraceUniforms, ShowUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE,
+    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, PT_MAX_OPACITY, TABLE_SIZE,
+    UNIFORM_STRIDE,
 };
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, Convergence, CubeImage, GradientMethod, Interpolation, PathTraceParams,
-    RenderParams, ScatterRegions, Shading,
+    BlendMode, ComponentTransfer, Convergence, CubeImage, GradientMethod, Interpolation, MaskKind,
+    PathTraceParams, RenderParams, ScatterRegions, Shading,
 };
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
@@ -119,7 +120,9 @@ pub(crate) struct PathTracePass {
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
     /// The block majorants: (the volume and table upload counts they were computed at,
     /// buffer, the largest).
-    majorants: Option<((u32, u32), wgpu::TextureView, f32)>,
+    majorants: Option<((u32, u32, u64), wgpu::TextureView, f32)>,
+    /// Bound in place of the mask when the volume has none.
+    no_mask: wgpu::TextureView,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
     /// Sixteenths of a path per pixel accumulated (passes × 16 + subsets of the next).
@@ -153,6 +156,7 @@ impl PathTracePass {
                     V::D3,
                 ),
                 buffer_entry(16, B::Storage { read_only: false }),
+                sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
             ],
         });
         let pipelines =
@@ -186,6 +190,7 @@ impl PathTracePass {
             depth_check: None,
             env_dist: None,
             majorants: None,
+            no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
             key: String::new(),
             units: 0,
             unit_seconds: None,
@@ -250,6 +255,8 @@ pipeline_variant! {
         single_brick: bool => "SINGLE_BRICK",
         /// Cropping regions.
         crop: bool => "CROP",
+        /// What the mask does (MASK_NONE, MASK_BINARY or MASK_LABELS).
+        mask: u32 => "MASK",
     }
 }
 
@@ -344,15 +351,26 @@ impl PathTracePass {
         let tf = res.transfer_function()?;
         let vol = res.volume()?;
         let c = tf.component(0);
-        let [lo, hi] = c.table_range();
         let last = (TABLE_SIZE - 1) as f64;
-        let sigma: Vec<f64> = (0..TABLE_SIZE)
-            .map(|i| {
-                let x = lo + (hi - lo) * i as f64 / last;
-                let a = (c.opacity.eval(x)[0].clamp(0.0, 1.0) as f64).min(PT_MAX_OPACITY);
-                -(1.0 - a).ln() / c.unit_distance
-            })
-            .collect();
+        // Per table: its range and the extinction at each entry; a label map's labels'
+        // tables too (a labelled point's medium mixes its label's with the component's).
+        let table = |t: &ComponentTransfer, [lo, hi]: [f64; 2]| -> ([f64; 2], Vec<f64>) {
+            let sigma = (0..TABLE_SIZE)
+                .map(|i| {
+                    let x = lo + (hi - lo) * i as f64 / last;
+                    let a = (t.opacity.eval(x)[0].clamp(0.0, 1.0) as f64).min(PT_MAX_OPACITY);
+                    -(1.0 - a).ln() / c.unit_distance
+                })
+                .collect();
+            ([lo, hi], sigma)
+        };
+        let mut tables = vec![table(c, c.table_range())];
+        if res.mask_kind() == Some(MaskKind::LabelMap) {
+            let (range, _) = tf.label_ranges();
+            for label in 1..=tf.max_label() {
+                tables.push(table(&tf.label_transfer(label), range));
+            }
+        }
         let nc = vol.components as usize;
         Ok(vol
             .minmax
@@ -363,10 +381,14 @@ impl PathTracePass {
                 if mn > mx {
                     return 0.0;
                 }
-                let at = |v: f32| (v as f64 - lo) / (hi - lo) * last;
-                let i0 = at(mn).floor().clamp(0.0, last) as usize;
-                let i1 = at(mx).ceil().clamp(0.0, last) as usize;
-                sigma[i0..=i1].iter().copied().fold(0.0, f64::max) as f32
+                let mut m = 0.0f64;
+                for ([lo, hi], sigma) in &tables {
+                    let at = |v: f32| (v as f64 - lo) / (hi - lo) * last;
+                    let i0 = at(mn).floor().clamp(0.0, last) as usize;
+                    let i1 = at(mx).ceil().clamp(0.0, last) as usize;
+                    m = sigma[i0..=i1].iter().copied().fold(m, f64::max);
+                }
+                m as f32
             })
             .collect())
     }
@@ -374,7 +396,11 @@ impl PathTracePass {
     /// Uploads the block majorants when the volume or the transfer function changed (the
     /// upload counters say so: the tables are built for this frame before this is called).
     fn ensure_majorants(&mut self, ctx: &Context, res: &Resources) -> Result<f32> {
-        let key = (res.stats.volume_uploads, res.stats.table_uploads);
+        let key = (
+            res.stats.volume_uploads,
+            res.stats.table_uploads,
+            res.mask_generation,
+        );
         if let Some((k, _, max)) = self.majorants.as_ref() {
             if *k == key {
                 return Ok(*max);
@@ -438,10 +464,11 @@ impl PathTracePass {
             ..pp
         };
         let key = format!(
-            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{depth_input}",
+            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{}|{depth_input}",
             (res.stats.volume_uploads, res.stats.table_uploads),
             res.environment.generation,
-            res.generation
+            res.generation,
+            res.mask_generation
         );
         let nearest = params.interpolation == Interpolation::Nearest;
         let guided = pp.denoise || pp.denoise_until > 0;
@@ -454,6 +481,15 @@ impl PathTracePass {
             forward_diff: params.gradient == GradientMethod::Forward,
             single_brick,
             crop: params.cropping.is_some(),
+            mask: match res.mask_kind() {
+                Some(MaskKind::Binary) => MASK_BINARY,
+                Some(MaskKind::LabelMap)
+                    if params.mask_blend > 0.0 && res.transfer_function()?.max_label() > 0 =>
+                {
+                    MASK_LABELS
+                }
+                _ => MASK_NONE,
+            },
         };
         let pipeline = self.pipelines.get(ctx, variant)?;
         self.ensure_accum(ctx, view.width, view.height)?;
@@ -544,6 +580,12 @@ impl PathTracePass {
                 bind(14, dist.as_entire_binding()),
                 bind(15, wgpu::BindingResource::TextureView(majorant_buf)),
                 bind(16, acc.guide.as_entire_binding()),
+                bind(
+                    17,
+                    wgpu::BindingResource::TextureView(
+                        res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
+                    ),
+                ),
             ],
         });
         let brick = res.volume()?.bind_group(nearest);

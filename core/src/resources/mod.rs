@@ -38,6 +38,8 @@ pub(crate) struct Resources {
     pub blanking: Option<wgpu::TextureView>,
     /// The mask of the current volume (r8uint, one value per point) and what it means.
     pub mask: Option<(wgpu::TextureView, MaskKind)>,
+    /// Counts the masks set (and cleared).
+    pub mask_generation: u64,
     pub tf: Option<TransferFunction>,
     pub tables: Option<(TableKey, Tables)>,
     /// The pre-integration tables, built when a frame asks for pre-integration.
@@ -104,6 +106,7 @@ impl Resources {
             preintegration: None,
             blanking: None,
             mask: None,
+            mask_generation: 0,
             occupancy: None,
             targets: None,
             output_path: OutputPath::Readback,

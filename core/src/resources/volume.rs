@@ -219,6 +219,7 @@ impl Resources {
         self.occupancy = None;
         self.blanking = None;
         self.mask = None;
+        self.mask_generation += 1;
         self.stats.volume_uploads += 1;
         let uploaded = match whole {
             Some(texels) => self.upload_whole(ctx, &texels),
@@ -263,6 +264,7 @@ impl Resources {
     /// The mask of the current volume (Renderer::set_mask): one value per point of its
     /// grid, in one texture whatever the volume's bricking.
     pub fn set_mask(&mut self, ctx: &Context, mask: Option<(&[u8], MaskKind)>) -> Result<()> {
+        self.mask_generation += 1;
         let Some((values, kind)) = mask else {
             self.mask = None;
             return Ok(());
