@@ -41,6 +41,10 @@ override ISO_COMP: u32 = 0u;
 // A nearest-neighbour sampler (the renderer's): texels are fetched through it at their
 // centres, exactly, which is faster than textureLoad on lavapipe.
 @group(0) @binding(11) var texel_sampler: sampler;
+// A binary mask (Renderer::set_mask): samples whose nearest point holds 0 are left out, as
+// cropped ones are (MASK_BINARY; label maps do not change isosurfaces, as in VTK).
+@group(0) @binding(12) var mask_tex: texture_3d<u32>;
+override MASK: u32 = MASK_NONE;
 
 fn point_at(ray: Ray, t: f32) -> vec3<f32> {
     return ray.index_origin + t * ray.index_dir;
@@ -259,12 +263,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var have_prev = false;
     var t_prev = 0.0;
     var s_prev = 0.0;
+    // MASK_BINARY: masked samples lie between the previous sample and the current one (a
+    // crossing then lies at the current sample, where the mask ends).
+    var gap = false;
     if (STREAMING && st.color.w > 0.0) {
         k = st.color.z;
         have_prev = st.value.x > 0.0;
         t_prev = st.value.y;
         s_prev = st.value.z;
-        tail = st.value.w > 0.0;
+        tail = (u32(st.value.w) & 1u) != 0u;
+        gap = (u32(st.value.w) & 2u) != 0u;
     }
     var suspended = false;
     var done = false;
@@ -289,6 +297,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         loop {
             if (advance) {
                 advance = false;
+                gap = false;
                 have_prev = true;
                 t_prev = t;
                 s_prev = s;
@@ -326,6 +335,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             if (CROP && !in_crop(p)) {
                 have_prev = false;
+                k = k + 1.0;
+                continue;
+            }
+            if (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) {
+                // As VTK 9.2: a masked sample is skipped and the ray's state carries over it;
+                // a ray whose samples start masked starts below every iso-value.
+                if (!have_prev) {
+                    have_prev = true;
+                    t_prev = t;
+                    s_prev = -3.4e38;
+                }
+                gap = true;
                 k = k + 1.0;
                 continue;
             }
@@ -367,7 +388,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         var th: array<f32, 8>;
         for (var i = 0u; i < n_iso; i = i + 1u) {
             if ((crossed & (1u << i)) != 0u) {
-                th[i] = refine(ray, t_prev, t, iso_value(i), s_prev < iso_value(i));
+                th[i] = select(refine(ray, t_prev, t, iso_value(i), s_prev < iso_value(i)), t, gap);
             }
         }
         // Several iso-values crossed between two samples: emit them nearest first.
@@ -395,7 +416,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (STREAMING) {
         st.color.z = k;
         st.color.w = select(-1.0, 1.0, suspended);
-        st.value = vec4<f32>(select(0.0, 1.0, have_prev), t_prev, s_prev, select(0.0, 1.0, tail));
+        st.value = vec4<f32>(select(0.0, 1.0, have_prev), t_prev, s_prev,
+                             select(0.0, 1.0, tail) + select(0.0, 2.0, gap));
     }
     state[pix] = st;
 }

@@ -104,8 +104,8 @@ impl Renderer {
 
     /// Masks the current volume (VTK's MaskInput with MaskType): `values` holds one byte per
     /// point of the volume's grid, x fastest, read at the point nearest to each sample, as
-    /// `kind` says ([`MaskKind`]). Ray casting and path tracing read it; isosurfaces refuse a
-    /// masked volume. `None` clears it; a new volume clears it too.
+    /// `kind` says ([`MaskKind`]): ray casting, path tracing and (binary masks) the
+    /// isosurfaces' first hits read it. `None` clears it; a new volume clears it too.
     pub fn set_mask(&mut self, mask: Option<(&[u8], MaskKind)>) -> Result<()> {
         self.res.set_mask(&self.ctx, mask)
     }
@@ -315,13 +315,6 @@ impl Renderer {
         depth: DepthSource<'_>,
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
-        if self.res.mask.is_some() && params.blend == BlendMode::Isosurface {
-            return Err(Error::Unsupported(
-                "masks are read by ray casting and path tracing, not by the Isosurface blend \
-                 mode: clear the mask (Renderer::set_mask(None)) or choose another blend mode"
-                    .into(),
-            ));
-        }
         let (ctx, res) = (&self.ctx, &mut self.res);
         let input = |res| FrameInput {
             ctx,

@@ -143,8 +143,8 @@ pub unsafe extern "C" fn fv_renderer_set_blanking(
 /// nearest to each sample; `mask_type` an FvMaskType. FV_MASK_TYPE_BINARY leaves out the
 /// samples at points holding 0; FV_MASK_TYPE_LABEL_MAP classifies labelled samples with
 /// their labels' functions (fv_transfer_function_set_label_*), mixed by
-/// FvRenderParams::mask_blend_factor. Ray casting and path tracing read it; isosurfaces
-/// answer FV_STATUS_UNSUPPORTED while a mask is set. NULL clears it; setting a volume
+/// FvRenderParams::mask_blend_factor. Ray casting and path tracing read it, isosurfaces a
+/// binary one. NULL clears it; setting a volume
 /// clears it too.
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_set_mask(

@@ -549,15 +549,6 @@ fn masks_through_the_c_abi() {
         p.mask_blend_factor = 0.0;
         s.set_params(&p);
         let unlabelled = s.frame(16, 16).to_vec();
-        p.mask_blend_factor = 1.0;
-        p.blend_mode = FvBlendMode::Isosurface as u32;
-        s.set_params(&p);
-        let render = lib.f::<Render>("fv_renderer_render");
-        lib.expect(
-            render(s.r, 16, 16, null(), 0),
-            FvStatus::Unsupported,
-            "masks",
-        );
         lib.ok(set_mask(s.r, null(), 0, 0));
         println!(
             "centre: plain {:?}, binary {:?} / {:?}, labelled {:?} / {:?}",

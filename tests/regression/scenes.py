@@ -782,6 +782,10 @@ SCENES = [
     Scene("ct-binary-mask-mip", "skull CT, maximum intensity, the binary cutaway mask",
           "cranium", ct_mip_tf, views=one("maximum", ct_front(35, 15, 1.1)),
           configure=mask(cranium_cutaway_mask), fixed=False),
+    Scene("ct-binary-mask-isosurface", "skull CT, isosurfaces -300 and 400 HU, the binary "
+          "cutaway mask (surfaces capped where the mask ends, as VTK)", "cranium", ct_tf(),
+          views=one("isosurface", ct_front(35, 15, 1.1)), iso_values=(-300.0, 400.0),
+          configure=mask(cranium_cutaway_mask), fixed=False),
     Scene("frog-label-map", "frog tissues 500x470x136 uint8 as a label map of themselves: "
           "five labels their own colour and opacity, nearest", "frog", frog_tf(),
           views=one(camera=orbit(30, 20, 1.3)), configure=mask(frog_mask, label_map=True),

@@ -130,18 +130,8 @@ public:
       vtkWarningWithObjectMacro(
         self, << "the ghost arrays' blanking is not applied (the cells are drawn): " << blanking);
     }
-    // Masks are read by ray casting and path tracing; isosurfaces draw the volume unmasked.
-    vtkImageData* mask = self->GetMaskInput();
-    if (mask && this->Settings.GetBlend() == FV_BLEND_MODE_ISOSURFACE)
-    {
-      if (this->FirstTime("mask-mode"))
-      {
-        vtkWarningWithObjectMacro(self, << "MaskInput is applied by ray casting and path "
-                                           "tracing: the isosurface image is drawn unmasked");
-      }
-      mask = nullptr;
-    }
-    if (!this->Input.UpdateMask(mask, self->GetMaskType(), *this->Renderer, error))
+    if (!this->Input.UpdateMask(
+          self->GetMaskInput(), self->GetMaskType(), *this->Renderer, error))
     {
       error = "MaskInput: " + error;
       return false;

@@ -1,7 +1,7 @@
 """Masks (vtkGPUVolumeRayCastMapper's MaskInput, MaskType, MaskBlendFactor and
 vtkVolumeProperty's label functions), each scene against vtkGPUVolumeRayCastMapper: a binary
-mask in composite and MIP, a label map of three labels (colour, opacity and gradient opacity
-of their own), the blend factor; isosurfaces are drawn unmasked with a warning."""
+mask in composite, MIP and the isosurface mode, a label map of three labels (colour, opacity
+and gradient opacity of their own), the blend factor."""
 import unittest
 
 import numpy as np
@@ -138,22 +138,17 @@ class Masks(unittest.TestCase):
         self.assertLessEqual(diff, 1)
         self.assertGreater(coverage(images[0]), 0.05)
 
-    def test_isosurface_is_drawn_unmasked_with_a_warning(self):
-        import ferrovol
-        mapper = ferrovol.vtkFerroVolumeMapper()
-        errors = Errors(mapper)
-        mapper.SetMaskInput(self.ball)
-        mapper.SetMaskTypeToBinary()
-        mapper.SetBlendModeToIsoSurface()
-        prop = tf_property()
-        prop.GetIsoSurfaceValues().SetValue(0, 150.0)
-        scene = fvtest.Scene(mapper, self.image, prop, camera=view)
-        img = scene.render()
-        fvtest.log("  isosurface with a mask -> " + (errors.warnings[-1].strip().splitlines()[-1]
-                                                    if errors.warnings else "(no warning)"))
-        self.assertEqual(errors.messages, [])
-        self.assertTrue(any("isosurface image is drawn unmasked" in w for w in errors.warnings))
-        self.assertGreater(coverage(img), 0.05)
+    def test_binary_mask_isosurface(self):
+        def configure(m):
+            m.SetMaskInput(self.ball)
+            m.SetMaskTypeToBinary()
+            m.SetBlendModeToIsoSurface()
+
+        def prop():
+            p = shaded(tf_property(opacity=[(37.3531, 1.0), (276.829, 1.0)]))
+            p.GetIsoSurfaceValues().SetValue(0, 150.0)
+            return p
+        self.pair("mask-binary-isosurface", prop, configure, (0.95, 28.0))
 
 
 def shaded(prop):

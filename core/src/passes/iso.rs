@@ -32,11 +32,12 @@ use crate::gpu::binding::{
 use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::readback::{read_buffer, read_texture_layer};
-use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND};
+use crate::gpu::texture::block_grid;
+use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND, MASK_BINARY, MASK_NONE};
 use crate::gpu::Context;
 use crate::params::iso::MAX_SPECULAR_SAMPLES;
 use crate::params::{
-    BlendMode, GBuffer, IsoParams, IsoScatterMode, RenderParams, Shading, Shininess,
+    BlendMode, GBuffer, IsoParams, IsoScatterMode, MaskKind, RenderParams, Shading, Shininess,
     TransferFunction,
 };
 use crate::resources::environment::texel_solid_angle;
@@ -56,6 +57,8 @@ pipeline_variant! {
         streaming: bool => "STREAMING",
         /// The component the isosurfaces are of (iso_component).
         component: u32 => "ISO_COMP",
+        /// MASK_BINARY: samples whose nearest point the mask holds 0 at are left out.
+        mask: u32 => "MASK",
     }
 }
 
@@ -122,6 +125,8 @@ pub(crate) struct IsoPass {
     occupancy: Option<Occupancy<OccupancyKey>>,
     /// The pixels the last frame's first-hit pass covered.
     last_rect: [u32; 4],
+    /// Bound in place of the mask when the volume has none.
+    no_mask: wgpu::TextureView,
 }
 
 /// `n` unit vectors uniform over the sphere from a fixed seed (PCG), as vec4s.
@@ -170,6 +175,7 @@ impl IsoPass {
                 gb_write(9),
                 gb_write(10),
                 sampler_entry(11),
+                sampled_texture_entry(12, wgpu::TextureSampleType::Uint, V::D3),
             ],
         });
         let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -227,6 +233,7 @@ impl IsoPass {
             gbuffer: None,
             occupancy: None,
             last_rect: [0; 4],
+            no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
         })
     }
 
@@ -442,6 +449,11 @@ impl IsoPass {
             single_brick,
             streaming: plan.is_some(),
             component,
+            mask: if res.mask_kind() == Some(MaskKind::Binary) {
+                MASK_BINARY
+            } else {
+                MASK_NONE
+            },
         };
         let df = DeferredVariant {
             lights: f.lights(),
@@ -571,6 +583,12 @@ impl IsoPass {
                 bind(9, wgpu::BindingResource::TextureView(&gn)),
                 bind(10, wgpu::BindingResource::TextureView(&ge)),
                 bind(11, wgpu::BindingResource::Sampler(&res.nearest)),
+                bind(
+                    12,
+                    wgpu::BindingResource::TextureView(
+                        res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
+                    ),
+                ),
             ],
         });
         let deferred_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
