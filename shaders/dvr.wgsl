@@ -127,6 +127,43 @@ fn front_scalars(q: vec3<f32>, s: vec4<f32>) -> vec4<f32> {
     return v;
 }
 
+// 2D transfer functions (vtkVolumeProperty's TF_2D): per component with one (bit c of
+// TF2D), rows of colour and step-corrected opacity over its scalar range (x) and gradient
+// magnitude (y), the components' tables stacked (core/src/resources/tables.rs).
+@group(0) @binding(11) var tables_2d: texture_2d<f32>;
+override TF2D: u32 = 0u;
+
+fn has_2d(c: u32) -> bool {
+    return (TF2D & (1u << c)) != 0u;
+}
+
+// Component c's 2D table at scalar s and gradient magnitude m (world units), read as VTK
+// reads its texture: texel centres at (i + ½) / size of the range, clamped to the edge,
+// bilinear (nearest with NEAREST).
+fn table_2d(c: u32, s: f32, m: f32) -> vec4<f32> {
+    let dims = vec2<f32>(textureDimensions(tables_2d));
+    let h = dims.y / f32(NCOMP);
+    let u = clamp((s - frame.t2d_lo[c]) * frame.t2d_inv_width[c], 0.0, 1.0) * dims.x - 0.5;
+    let v = clamp(m * frame.t2d_inv_gmax[c], 0.0, 1.0) * h - 0.5;
+    let x = clamp(u, 0.0, dims.x - 1.0);
+    let y = clamp(v, 0.0, h - 1.0);
+    let base = f32(c) * h;
+    if (NEAREST) {
+        let xi = clamp(floor(u + 0.5), 0.0, dims.x - 1.0);
+        let yi = clamp(floor(v + 0.5), 0.0, h - 1.0);
+        return textureLoad(tables_2d, vec2<i32>(i32(xi), i32(base + yi)), 0);
+    }
+    let x0 = floor(x);
+    let y0 = floor(y);
+    let x1 = min(x0 + 1.0, dims.x - 1.0);
+    let y1 = min(y0 + 1.0, h - 1.0);
+    let t00 = textureLoad(tables_2d, vec2<i32>(i32(x0), i32(base + y0)), 0);
+    let t10 = textureLoad(tables_2d, vec2<i32>(i32(x1), i32(base + y0)), 0);
+    let t01 = textureLoad(tables_2d, vec2<i32>(i32(x0), i32(base + y1)), 0);
+    let t11 = textureLoad(tables_2d, vec2<i32>(i32(x1), i32(base + y1)), 0);
+    return mix(mix(t00, t10, x - x0), mix(t01, t11, x - x0), y - y0);
+}
+
 // Per min–max block, the first component's (min, max) over every point a sample in the
 // block interpolates from (nearest or trilinear), widened where the storage rounds the data
 // (MinMaxGrid::sample_bounds). Built once per volume upload; read by RANGE_SKIP only.
@@ -194,12 +231,21 @@ fn shading_gradient(p: vec3<f32>, g: Gradient) -> Gradient {
 
 // classify_sample of a one-component volume by its transfer function.
 fn classify_one(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
-    var e = classify_segment(0u, sf.x, s.x);
+    var e: vec4<f32>;
+    var gs: Gradient;
+    if (has_2d(0u)) {
+        gs = gradient_at(p, s);
+        e = table_2d(0u, s.x, length(world_gradient(gs, 0u)));
+    } else {
+        e = classify_segment(0u, sf.x, s.x);
+    }
     if (e.a <= 0.0 || frame.weights.x <= 0.0) {
         return vec4<f32>(0.0);
     }
     if (SHADE || GRAD_OPACITY) {
-        let gs = gradient_at(p, s);
+        if (!has_2d(0u)) {
+            gs = gradient_at(p, s);
+        }
         let g = world_gradient(gs, 0u);
         let a = e.a;
         if (GRAD_OPACITY) {
@@ -282,17 +328,26 @@ fn classify_sample(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, vi
     // added (Σ a·w·rgb, which may pass the brightest component's), opacity Σ a² / Σ a·w.
     var entry: array<vec4<f32>, 4>;
     var any = false;
+    var g: Gradient;
+    if (TF2D != 0u) {
+        g = gradient_at(p, s);
+    }
     for (var c = 0u; c < ncomp; c = c + 1u) {
-        entry[c] = classify_segment(c, sf[c], s[c]);
+        if (has_2d(c)) {
+            entry[c] = table_2d(c, s[c], length(world_gradient(g, c)));
+        } else {
+            entry[c] = classify_segment(c, sf[c], s[c]);
+        }
         any = any || entry[c].a * frame.weights[c] > 0.0;
     }
     if (!any) {
         return vec4<f32>(0.0);
     }
-    var g: Gradient;
     var gn: Gradient;
     if (need_grad) {
-        g = gradient_at(p, s);
+        if (TF2D == 0u) {
+            g = gradient_at(p, s);
+        }
         if (SHADE) {
             gn = shading_gradient(p, g);
         }

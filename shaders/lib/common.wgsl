@@ -61,6 +61,9 @@ struct Frame {
     slice: vec4<f32>,             // BLEND_SLICE: the index-space plane dot(xyz, p) + w = 0
     mask: vec4<f32>,              // x: label-map blend factor, y: highest label with own tables
     labels: vec4<f32>,            // labels' tables: scalar lo, 1 / width, gradient lo, 1 / width
+    t2d_lo: vec4<f32>,            // per component, its 2D table: scalar at the first column's edge,
+    t2d_inv_width: vec4<f32>,     // 1 / scalar range,
+    t2d_inv_gmax: vec4<f32>,      // 1 / gradient magnitude at the last row's edge (0: first row)
 }
 
 @group(0) @binding(0) var<uniform> frame_ubo: Frame;

@@ -56,6 +56,11 @@ pub struct FrameUniforms {
     /// The labels' tables: scalar at the first entry, 1 / scalar width, the same for
     /// gradient magnitude.
     pub labels: [f32; 4],
+    /// Per component, its 2D table's scalar at the first column's edge, 1 / the scalar
+    /// range, and 1 / the gradient magnitude at the last row's edge (0: the first row).
+    pub t2d_lo: [f32; 4],
+    pub t2d_inv_width: [f32; 4],
+    pub t2d_inv_gmax: [f32; 4],
 }
 
 #[repr(C)]
@@ -377,7 +382,10 @@ mod layout_tests {
                     component_materials,
                     slice,
                     mask,
-                    labels
+                    labels,
+                    t2d_lo,
+                    t2d_inv_width,
+                    t2d_inv_gmax
                 ]
             );
             let (_, ps) = wgsl_struct(&m, "PixelState");

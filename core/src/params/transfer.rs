@@ -92,6 +92,79 @@ pub struct ComponentTransfer {
     /// (vtkVolumeProperty's per-component shading) when components are independent; `None`:
     /// the render parameters' shading.
     pub material: Option<[f32; 4]>,
+    /// A 2D transfer function (vtkVolumeProperty's TF_2D mode) that classifies this
+    /// component instead of `color` and `opacity` in composite ray casting.
+    pub table_2d: Option<Table2D>,
+}
+
+/// A 2D transfer function: colour and opacity over scalar × gradient magnitude, as
+/// vtkVolumeProperty::SetTransferFunction2D's RGBA image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table2D {
+    pub width: u32,
+    pub height: u32,
+    /// `width × height` RGBA values, x (scalar) fastest, rows of increasing gradient
+    /// magnitude; opacity per `unit_distance` of the component, as `opacity` is.
+    pub rgba: Vec<[f32; 4]>,
+    /// The scalars the first and the last column's edges are at (VTK: the component's data
+    /// range): a scalar s reads the table at (s − lo) / (hi − lo) · width texels.
+    pub scalar_range: [f64; 2],
+    /// The gradient magnitude (scalar units per world unit) at the last row's far edge; a
+    /// sample reads the row of its gradient magnitude, clamped. `None`: every sample reads
+    /// the first row (VTK's TF_2D without gradient opacity).
+    pub gradient_max: Option<f64>,
+}
+
+impl Table2D {
+    /// Checks the sizes and numbers, naming what is wrong.
+    pub fn validate(&self) -> Result<()> {
+        match self.problem() {
+            Some(p) => Err(Error::InvalidTransferFunction(format!("2D table: {p}"))),
+            None => Ok(()),
+        }
+    }
+
+    fn problem(&self) -> Option<String> {
+        if self.width == 0 || self.height == 0 || self.width > 4096 || self.height > 4096 {
+            return Some(format!(
+                "{}x{} entries; each side must be 1 to 4096",
+                self.width, self.height
+            ));
+        }
+        let n = self.width as usize * self.height as usize;
+        if self.rgba.len() != n {
+            return Some(format!(
+                "{} RGBA values for {}x{} entries ({n})",
+                self.rgba.len(),
+                self.width,
+                self.height
+            ));
+        }
+        if let Some(i) = self
+            .rgba
+            .iter()
+            .position(|v| v.iter().any(|c| !c.is_finite()))
+        {
+            return Some(format!(
+                "entry {i} is {:?}; NaN and infinity are not allowed",
+                self.rgba[i]
+            ));
+        }
+        let [lo, hi] = self.scalar_range;
+        let finite = |v: f64| v.is_finite() && v.abs() <= MAX_TRANSFER_POSITION;
+        if !(finite(lo) && finite(hi) && hi > lo) {
+            return Some(format!(
+                "scalar range [{lo}, {hi}] must be finite (within ±{MAX_TRANSFER_POSITION:e}) \
+                 with lo < hi"
+            ));
+        }
+        match self.gradient_max {
+            Some(g) if !(g.is_finite() && g > 0.0) => Some(format!(
+                "gradient magnitude {g} of the last row must be positive"
+            )),
+            _ => None,
+        }
+    }
 }
 
 impl ComponentTransfer {
@@ -103,6 +176,7 @@ impl ComponentTransfer {
             unit_distance: 1.0,
             weight: 1.0,
             material: None,
+            table_2d: None,
         }
     }
 
@@ -198,6 +272,11 @@ impl TransferFunction {
                     c.weight
                 )));
             }
+            if let Some(p) = c.table_2d.as_ref().and_then(Table2D::problem) {
+                return Err(Error::InvalidTransferFunction(format!(
+                    "component {i}: 2D table: {p}"
+                )));
+            }
             if let Some(m) = c.material {
                 if !m.iter().all(|v| v.is_finite() && *v >= 0.0) {
                     return Err(Error::InvalidTransferFunction(format!(
@@ -273,6 +352,11 @@ impl TransferFunction {
             r.1 = [r.1[0].min(g[0]), r.1[1].max(g[1])];
         }
         r
+    }
+
+    /// Whether some component is classified by a 2D table.
+    pub fn has_2d(&self) -> bool {
+        self.components.iter().any(|c| c.table_2d.is_some())
     }
 
     /// Whether some label from 1 to [`Self::max_label`] has a gradient opacity function.

@@ -40,6 +40,8 @@ pipeline_variant! {
         clipped_voxel: bool => "CLIPPED_VOXEL",
         blanking: bool => "BLANKING",
         mask: u32 => "MASK",
+        /// Bit c: component c is classified by its 2D table.
+        tables_2d: u32 => "TF2D",
         precomputed_gradient: bool => "PRECOMPUTED_GRADIENT",
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
@@ -56,6 +58,8 @@ pub(crate) struct DvrPass {
     no_blanking: wgpu::TextureView,
     /// Bound in place of the pre-integration tables when a frame does not use them.
     no_preintegration: Tables,
+    /// Bound in place of the 2D tables when no component has one.
+    no_tables_2d: Tables,
 }
 
 impl DvrPass {
@@ -78,6 +82,7 @@ impl DvrPass {
                     sampled_texture_entry(8, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(9, true, V::D2),
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
+                    texture_entry(11, false, V::D2),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -87,6 +92,7 @@ impl DvrPass {
             pipelines,
             no_blanking,
             no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
+            no_tables_2d: Tables::new(&ctx.device, [1, 1]),
         })
     }
 
@@ -138,6 +144,24 @@ impl DvrPass {
             ));
         }
         let vol = res.volume()?;
+        let tf = res.transfer_function()?;
+        let tables_2d = (0..vol.components as usize)
+            .filter(|&c| tf.component(c).table_2d.is_some())
+            .fold(0u32, |bits, c| bits | 1 << c);
+        if tables_2d != 0 && params.blend != BlendMode::Composite {
+            return Err(Error::Unsupported(format!(
+                "2D transfer functions classify composite ray casting, not the {:?} blend \
+                 mode: use 1D functions or the composite mode",
+                params.blend
+            )));
+        }
+        if tables_2d != 0 && !f.independent && vol.components > 1 {
+            return Err(Error::Unsupported(
+                "2D transfer functions classify one or independent components: these are \
+                 dependent"
+                    .into(),
+            ));
+        }
         // Additive and average skip empty blocks too, counting the skipped samples (their
         // terms are 0), as long as every sample counts (no cropping, blanking or average
         // range) and the occupancy is of the components they sum (one or independent).
@@ -160,7 +184,9 @@ impl DvrPass {
             && (vol.components == 1 || f.independent)
             && (params.blend == BlendMode::Additive
                 || (params.blend == BlendMode::Average && params.average_range.is_none()));
+        // (the occupancy is the 1D tables': blocks are not skipped under 2D tables)
         let skip = params.empty_space_skipping
+            && tables_2d == 0
             && (params.blend == BlendMode::Composite || counts_all)
             && occupied < SKIP_MAX_OCCUPANCY;
         // MIP and MinIP skip blocks whose range cannot move the ray's extremum, on
@@ -195,7 +221,8 @@ impl DvrPass {
             && params.blend == BlendMode::Composite
             && (vol.components == 1 || f.independent)
             && !f.volumetric
-            && mask != MASK_LABELS;
+            && mask != MASK_LABELS
+            && tables_2d == 0;
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
@@ -213,6 +240,7 @@ impl DvrPass {
             opacity_normal,
             blanking: res.blanking.is_some(),
             mask,
+            tables_2d,
             clipped_voxel: params.clipped_voxel_value.is_some()
                 && !params.clip_planes.is_empty()
                 && params.blend == BlendMode::Composite
@@ -225,6 +253,9 @@ impl DvrPass {
         if preintegration {
             res.ensure_preintegration(ctx, step)?;
         }
+        if tables_2d != 0 {
+            res.ensure_tables_2d(ctx, step)?;
+        }
         let vol = res.volume()?;
         let dvr = self.pipelines.get(ctx, variant)?;
         let t = res.targets.as_ref().expect("targets allocated above");
@@ -233,6 +264,10 @@ impl DvrPass {
         let preintegrated = match &res.preintegration {
             Some((_, t)) if preintegration => t,
             _ => &self.no_preintegration,
+        };
+        let tables_2d_view = match &res.tables_2d {
+            Some((_, t)) if tables_2d != 0 => &t.view,
+            _ => &self.no_tables_2d.view,
         };
         let q = &ctx.queue;
         let d = &ctx.device;
@@ -266,6 +301,7 @@ impl DvrPass {
                         res.mask.as_ref().map_or(&self.no_blanking, |(m, _)| m),
                     ),
                 ),
+                bind(11, wgpu::BindingResource::TextureView(tables_2d_view)),
             ],
         });
         let rect = u.rect;

@@ -205,6 +205,11 @@ pub(crate) fn frame(
         u.go_lo[c] = glo as f32;
         u.go_inv_width[c] = (1.0 / (ghi - glo)) as f32;
         u.weights[c] = ct.weight;
+        if let Some(t) = &ct.table_2d {
+            u.t2d_lo[c] = t.scalar_range[0] as f32;
+            u.t2d_inv_width[c] = (1.0 / (t.scalar_range[1] - t.scalar_range[0])) as f32;
+            u.t2d_inv_gmax[c] = t.gradient_max.map_or(0.0, |g| (1.0 / g) as f32);
+        }
         u.additive_scale[c] = (step / ct.unit_distance) as f32;
         any_go |= ct.gradient_opacity.is_some() && (c as u32) < vol.components;
     }

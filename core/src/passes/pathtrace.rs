@@ -50,7 +50,7 @@ use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
     BlendMode, ComponentTransfer, Convergence, CubeImage, GradientMethod, Interpolation, MaskKind,
-    PathTraceParams, RenderParams, ScatterRegions, Shading,
+    PathTraceParams, RenderParams, ScatterRegions, Shading, TransferFunction,
 };
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
@@ -421,6 +421,11 @@ impl PathTracePass {
         let pp = *pp;
         pp.validate()?;
         let vol = res.volume()?;
+        if res.tf.as_ref().is_some_and(TransferFunction::has_2d) {
+            return Err(Error::Unsupported(
+                "path tracing reads 1D transfer functions: this one has a 2D table (TF_2D)".into(),
+            ));
+        }
         if vol.components != 1 {
             return Err(Error::Unsupported(format!(
                 "path tracing renders one-component volumes (this one has {} components): \

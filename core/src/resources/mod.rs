@@ -42,6 +42,8 @@ pub(crate) struct Resources {
     pub mask_generation: u64,
     pub tf: Option<TransferFunction>,
     pub tables: Option<(TableKey, Tables)>,
+    /// The 2D tables (Table2D) of the components that have one, built when a frame needs them.
+    pub tables_2d: Option<(TableKey, Tables)>,
     /// The pre-integration tables, built when a frame asks for pre-integration.
     pub preintegration: Option<(TableKey, Tables)>,
     /// Occupancy of the min–max blocks under the transfer function.
@@ -104,6 +106,7 @@ impl Resources {
             tf: None,
             tables: None,
             preintegration: None,
+            tables_2d: None,
             blanking: None,
             mask: None,
             mask_generation: 0,

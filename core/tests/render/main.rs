@@ -21,6 +21,7 @@ mod reference;
 mod silhouettes;
 mod sources;
 mod state;
+mod tables_2d;
 
 use common::raycast::to_pixel;
 

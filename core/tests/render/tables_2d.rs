@@ -1,0 +1,129 @@
+//! 2D transfer functions (vtkVolumeProperty's TF_2D): a table whose rows all hold the 1D
+//! function draws the 1D image; the gradient axis selects what is drawn; bad tables and the
+//! modes that do not read them are refused.
+
+use crate::common::gpu::{assert_error, renderer};
+use crate::common::images::save_enlarged;
+use crate::common::metrics::{footprint, image_diff};
+use crate::common::scenes::{blob_transfer, blob_volume, shaded};
+use ferrovol_core::*;
+
+const W: u32 = 256;
+const H: u32 = 64;
+
+/// blob_transfer's colour and opacity as a 2D table over [0, 1], every row alike, or the
+/// opacity where the row's gradient magnitude (up to `gmax`) passes `edge` only.
+fn table(gmax: Option<f64>, edge: Option<f64>) -> Table2D {
+    let c = blob_transfer();
+    let mut rgba = Vec::new();
+    for y in 0..H {
+        let g = (y as f64 + 0.5) / H as f64 * gmax.unwrap_or(1.0);
+        for x in 0..W {
+            let s = (x as f64 + 0.5) / W as f64;
+            let [r, gr, b] = c.color.eval(s);
+            let a = c.opacity.eval(s)[0];
+            let keep = edge.is_none_or(|e| g > e);
+            rgba.push([r, gr, b, if keep { a } else { 0.0 }]);
+        }
+    }
+    Table2D {
+        width: W,
+        height: H,
+        rgba,
+        scalar_range: [0.0, 1.0],
+        gradient_max: gmax,
+    }
+}
+
+fn with_table(t: Table2D) -> TransferFunction {
+    let mut c = blob_transfer();
+    c.table_2d = Some(t);
+    TransferFunction::single(c)
+}
+
+#[test]
+fn table_2d_equals_1d_and_reads_the_gradient() {
+    let mut r = renderer();
+    let vol = blob_volume(32);
+    r.set_volume(&vol).unwrap();
+    let view = View::fit(vol.bounds(), 96, 96);
+    for p in [RenderParams::default(), shaded()] {
+        r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+            .unwrap();
+        let one = r.render_image(&view, &p).unwrap();
+        r.set_transfer_function(&with_table(table(None, None)))
+            .unwrap();
+        let two = r.render_image(&view, &p).unwrap();
+        save_enlarged(&two, &format!("table_2d_flat_{}", p.shading.enabled));
+        let (mean, max) = image_diff(&one, &two);
+        println!(
+            "shade {}: 2D table of the 1D function vs 1D: mean {mean:.3}, max {max} levels",
+            p.shading.enabled
+        );
+        assert!(mean < 0.5 && max <= 6, "{mean} {max}");
+    }
+    // only steep gradients opaque: less drawn; the same table read at the first row only
+    // (no gradient range): nothing
+    let p = RenderParams::default();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let all = r.render_image(&view, &p).unwrap();
+    r.set_transfer_function(&with_table(table(Some(0.1), Some(0.05))))
+        .unwrap();
+    let steep = r.render_image(&view, &p).unwrap();
+    save_enlarged(&steep, "table_2d_steep");
+    r.set_transfer_function(&with_table(table(None, Some(0.05))))
+        .unwrap();
+    let first_row = r.render_image(&view, &p).unwrap();
+    let (mean, _) = image_diff(&all, &steep);
+    println!(
+        "steep gradients only: {mean:.2} levels from the 1D image; footprint {} vs {}; \
+         first row only: {} pixels",
+        footprint(&steep),
+        footprint(&all),
+        footprint(&first_row)
+    );
+    assert!(mean > 1.0);
+    assert!(footprint(&steep) > 100 && footprint(&steep) < footprint(&all));
+    assert_eq!(footprint(&first_row), 0);
+}
+
+#[test]
+fn table_2d_errors() {
+    let mut r = renderer();
+    let vol = blob_volume(16);
+    r.set_volume(&vol).unwrap();
+    let view = View::fit(vol.bounds(), 32, 32);
+    let mut t = table(None, None);
+    t.rgba.pop();
+    assert_error(
+        r.set_transfer_function(&with_table(t)),
+        "short table",
+        &["component 0", "2D table", "16383 RGBA values", "256x64"],
+    );
+    let mut t = table(None, None);
+    t.scalar_range = [1.0, 1.0];
+    assert_error(
+        r.set_transfer_function(&with_table(t)),
+        "empty range",
+        &["scalar range [1, 1]"],
+    );
+    let mut t = table(Some(0.0), None);
+    t.rgba[3][1] = f32::NAN;
+    assert_error(r.set_transfer_function(&with_table(t)), "NaN", &["entry 3"]);
+    r.set_transfer_function(&with_table(table(None, None)))
+        .unwrap();
+    for blend in [BlendMode::Maximum, BlendMode::PathTrace] {
+        assert_error(
+            r.render_image(
+                &view,
+                &RenderParams {
+                    blend,
+                    ..RenderParams::default()
+                },
+            ),
+            &format!("{blend:?}"),
+            &["2D"],
+        );
+    }
+}
