@@ -977,8 +977,8 @@ enum FvStatus fv_renderer_set_blanking(struct FvRenderer *renderer,
  * nearest to each sample; `mask_type` an FvMaskType. FV_MASK_TYPE_BINARY leaves out the
  * samples at points holding 0; FV_MASK_TYPE_LABEL_MAP classifies labelled samples with
  * their labels' functions (fv_transfer_function_set_label_*), mixed by
- * FvRenderParams::mask_blend_factor. Ray casting and path tracing read it; isosurfaces
- * answer FV_STATUS_UNSUPPORTED while a mask is set. NULL clears it; setting a volume
+ * FvRenderParams::mask_blend_factor. Ray casting and path tracing read it, isosurfaces a
+ * binary one. NULL clears it; setting a volume
  * clears it too.
  */
 enum FvStatus fv_renderer_set_mask(struct FvRenderer *renderer,
@@ -1246,6 +1246,24 @@ enum FvStatus fv_transfer_function_set_label_gradient_opacity(struct FvTransferF
                                                               uint32_t label,
                                                               const double *xa,
                                                               size_t count);
+
+/**
+ * One component's 2D transfer function (vtkVolumeProperty::SetTransferFunction2D, TF_2D):
+ * `width × height` RGBA floats at `rgba`, x (scalar) fastest, rows of increasing gradient
+ * magnitude, opacity per unit distance; the columns span the scalars `scalar_lo` to
+ * `scalar_hi` (VTK: the component's data range), the rows gradient magnitudes 0 to
+ * `gradient_max` (scalar units per world unit; 0: every sample reads the first row, as VTK
+ * without gradient opacity). It classifies composite ray casting instead of the colour and
+ * opacity functions; NULL `rgba` removes it.
+ */
+enum FvStatus fv_transfer_function_set_table_2d(struct FvTransferFunction *tf,
+                                                uint32_t component,
+                                                uint32_t width,
+                                                uint32_t height,
+                                                const float *rgba,
+                                                double scalar_lo,
+                                                double scalar_hi,
+                                                double gradient_max);
 
 /**
  * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of

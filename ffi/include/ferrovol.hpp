@@ -167,6 +167,20 @@ public:
     check(fv_transfer_function_set_label_gradient_opacity(
         h_.get(), label, detail::data_or_null(xa), xa.size() / 2));
   }
+  /// One component's 2D transfer function: width·height RGBA floats, x (scalar) fastest (see
+  /// fv_transfer_function_set_table_2d); an empty `rgba` removes it.
+  void set_table_2d(uint32_t component, uint32_t width, uint32_t height,
+                    const std::vector<float> &rgba, double scalar_lo, double scalar_hi,
+                    double gradient_max) {
+    if (!rgba.empty() && rgba.size() != 4 * static_cast<size_t>(width) * height) {
+      throw Error(FV_STATUS_INVALID_ARGUMENT, "2D table: rgba holds " +
+                                                  std::to_string(rgba.size()) +
+                                                  " floats, width * height * 4 needed");
+    }
+    check(fv_transfer_function_set_table_2d(h_.get(), component, width, height,
+                                            detail::data_or_null(rgba), scalar_lo, scalar_hi,
+                                            gradient_max));
+  }
   const FvTransferFunction *get() const noexcept { return h_.get(); }
 
 private:

@@ -34,7 +34,7 @@ pub use volume::*;
 
 use ferrovol_core::{
     ComponentTransfer, Context, Environment, Image, LabelTransfer, OutputPath, Piecewise, Renderer,
-    Scalars, TransferFunction, UploadOptions, View, VolumeData,
+    Scalars, Table2D, TransferFunction, UploadOptions, View, VolumeData,
 };
 use std::ffi::{c_char, c_void, CStr};
 

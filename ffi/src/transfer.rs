@@ -10,6 +10,7 @@ struct PartialComponent {
     unit_distance: Option<f64>,
     weight: Option<f32>,
     material: Option<[f32; 4]>,
+    table_2d: Option<Table2D>,
 }
 
 /// Colour, scalar opacity and gradient opacity per component (vtkVolumeProperty's
@@ -73,6 +74,7 @@ impl ToCore for FvTransferFunction {
             t.unit_distance = c.unit_distance.unwrap_or(t.unit_distance);
             t.weight = c.weight.unwrap_or(t.weight);
             t.material = c.material;
+            t.table_2d = c.table_2d.clone();
             components.push(t);
         }
         let labels = self
@@ -334,5 +336,53 @@ pub unsafe extern "C" fn fv_transfer_function_set_label_gradient_opacity(
 ) -> FvStatus {
     set_label_points(tf, label, "label gradient opacity points", xa, count, |l| {
         &mut l.gradient_opacity
+    })
+}
+
+/// One component's 2D transfer function (vtkVolumeProperty::SetTransferFunction2D, TF_2D):
+/// `width × height` RGBA floats at `rgba`, x (scalar) fastest, rows of increasing gradient
+/// magnitude, opacity per unit distance; the columns span the scalars `scalar_lo` to
+/// `scalar_hi` (VTK: the component's data range), the rows gradient magnitudes 0 to
+/// `gradient_max` (scalar units per world unit; 0: every sample reads the first row, as VTK
+/// without gradient opacity). It classifies composite ray casting instead of the colour and
+/// opacity functions; NULL `rgba` removes it.
+#[no_mangle]
+pub unsafe extern "C" fn fv_transfer_function_set_table_2d(
+    tf: *mut FvTransferFunction,
+    component: u32,
+    width: u32,
+    height: u32,
+    rgba: *const f32,
+    scalar_lo: f64,
+    scalar_hi: f64,
+    gradient_max: f64,
+) -> FvStatus {
+    guard(|| {
+        let c = mut_ref(tf, "tf")?.component(component)?;
+        if rgba.is_null() {
+            c.table_2d = None;
+            return Ok(());
+        }
+        if width == 0 || height == 0 || width > 4096 || height > 4096 {
+            return Err(FfiError::invalid(format!(
+                "2D table of {width}x{height} entries: each side must be 1 to 4096"
+            )));
+        }
+        let n = width as usize * height as usize;
+        // SAFETY: the caller guarantees width · height RGBA floats at `rgba`.
+        let flat = unsafe { std::slice::from_raw_parts(rgba, 4 * n) };
+        let t = Table2D {
+            width,
+            height,
+            rgba: flat
+                .chunks_exact(4)
+                .map(|v| [v[0], v[1], v[2], v[3]])
+                .collect(),
+            scalar_range: [scalar_lo, scalar_hi],
+            gradient_max: (gradient_max != 0.0).then_some(gradient_max),
+        };
+        t.validate().map_err(|e| FfiError::invalid(e.to_string()))?;
+        c.table_2d = Some(t);
+        Ok(())
     })
 }

@@ -568,6 +568,69 @@ fn masks_through_the_c_abi() {
 }
 
 #[test]
+fn table_2d_through_the_c_abi() {
+    let lib = Lib::open();
+    type SetTable = unsafe extern "C" fn(H, u32, u32, u32, *const f32, f64, f64, f64) -> FvStatus;
+    let mut s = Session::new(&lib);
+    s.set_volume([8, 8, 8], FvScalarType::U8, &vec![200u8; 512]);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0],
+        &[0.0, 0.0, 255.0, 0.5],
+    );
+    s.set_camera(&camera([3.5, 3.5, 18.0], [3.5, 3.5, 3.5], [0.1, 100.0]));
+    let white = s.frame(16, 16).to_vec();
+    let set_table = lib.f::<SetTable>("fv_transfer_function_set_table_2d");
+    // 4 x 2 entries: green and half as opaque as the 1D function over [0, 255]
+    let rgba: Vec<f32> = (0..8)
+        .flat_map(|_| [0.0, 1.0, 0.0, 0.5 * 200.0 / 255.0])
+        .collect();
+    // SAFETY: arguments follow the header; invalid ones are the test.
+    unsafe {
+        lib.expect(
+            set_table(s.tf, 0, 0, 2, rgba.as_ptr(), 0.0, 255.0, 0.0),
+            Invalid,
+            "0x2",
+        );
+        lib.expect(
+            set_table(s.tf, 1, 4, 2, rgba.as_ptr(), 0.0, 255.0, 0.0),
+            Invalid,
+            "component 1",
+        );
+        lib.expect(
+            set_table(s.tf, 0, 4, 2, rgba.as_ptr(), 5.0, 5.0, 0.0),
+            Invalid,
+            "scalar range",
+        );
+        lib.expect(
+            set_table(s.tf, 0, 4, 2, rgba.as_ptr(), 0.0, 255.0, -1.0),
+            Invalid,
+            "gradient magnitude -1",
+        );
+        lib.ok(set_table(s.tf, 0, 4, 2, rgba.as_ptr(), 0.0, 255.0, 0.0));
+        lib.ok(lib.f::<SetH>("fv_renderer_set_transfer_function")(
+            s.r, s.tf,
+        ));
+        let green = s.frame(16, 16).to_vec();
+        let i = 4 * (8 * 16 + 8);
+        println!(
+            "centre: 1D {:?}, 2D {:?}",
+            &white[i..i + 4],
+            &green[i..i + 4]
+        );
+        assert!(
+            green[i + 1] > 100 && green[i] == 0 && green[i + 2] == 0,
+            "green"
+        );
+        assert_eq!(green[i + 3], white[i + 3], "the same opacity");
+        lib.ok(set_table(s.tf, 0, 0, 0, null(), 0.0, 0.0, 0.0));
+        lib.ok(lib.f::<SetH>("fv_renderer_set_transfer_function")(
+            s.r, s.tf,
+        ));
+        assert_eq!(s.frame(16, 16), &white[..], "removed: the 1D image again");
+    }
+}
+
+#[test]
 fn last_error_is_per_thread_and_status_names_are_static() {
     let lib = Lib::open();
     let name = lib.f::<extern "C" fn(i32) -> *const c_char>("fv_status_name");
