@@ -248,7 +248,8 @@ fn classify_one(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, view_
         }
         let g = world_gradient(gs, 0u);
         let a = e.a;
-        if (GRAD_OPACITY) {
+        // (a 2D table replaces gradient opacity, as VTK 9.2 draws TF_2D)
+        if (GRAD_OPACITY && !has_2d(0u)) {
             e.a = e.a * gradient_opacity(0u, length(g));
         }
         if (SHADE) {
@@ -363,7 +364,7 @@ fn classify_sample(sf: vec4<f32>, s: vec4<f32>, p: vec3<f32>, pos: vec3<f32>, vi
         }
         var rgb = entry[c].rgb;
         if (need_grad) {
-            if (GRAD_OPACITY) {
+            if (GRAD_OPACITY && !has_2d(c)) {
                 a = a * gradient_opacity(c, length(world_gradient(g, c)));
             }
             if (SHADE) {

@@ -2,15 +2,19 @@
 
 #include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
+#include "vtkDataArray.h"
 #include "vtkGPUVolumeRayCastMapper.h"
+#include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 namespace
@@ -395,6 +399,84 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
   return true;
 }
 
+// Component c's 2D transfer function (vtkVolumeProperty::GetTransferFunction2D, TF_2D mode)
+// as VTK 9.2 reads it: the image's RGBA over the component's data range (x) and, where the
+// component has gradient opacity, over gradient magnitudes up to 0.25 · the data range in
+// VTK's units (y; without gradient opacity VTK reads the first row). VTK's gradient opacity
+// still multiplies the opacity, as the 1D functions set it.
+bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& range,
+  double gradientScale, ferrovol::TransferFunction& tf, std::string& error)
+{
+  vtkImageData* image = prop->GetTransferFunction2D(c);
+  vtkDataArray* scalars = image ? image->GetPointData()->GetScalars() : nullptr;
+  int dims[3] = { 0, 0, 0 };
+  if (image)
+  {
+    image->GetDimensions(dims);
+  }
+  if (!scalars || scalars->GetNumberOfComponents() != 4 || dims[2] != 1 || dims[0] < 1 ||
+    dims[1] < 1)
+  {
+    std::ostringstream os;
+    os << "TransferFunctionMode is TF_2D and component " << c << "'s TransferFunction2D is ";
+    if (!image)
+    {
+      os << "not set";
+    }
+    else
+    {
+      os << dims[0] << "x" << dims[1] << "x" << dims[2] << " with "
+         << (scalars ? scalars->GetNumberOfComponents() : 0)
+         << " components per point: it must be a 2D image of RGBA values";
+    }
+    error = os.str();
+    return false;
+  }
+  const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
+  std::vector<float> rgba(static_cast<size_t>(4) * n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    for (int k = 0; k < 4; ++k)
+    {
+      rgba[4 * i + k] = static_cast<float>(scalars->GetComponent(i, k));
+    }
+  }
+  const double width = range[1] - range[0];
+  const double lo = range[0];
+  const double hi = width > 0.0 ? range[1] : range[0] + 1.0;
+  const bool gradient = prop->HasGradientOpacity(c) && !prop->GetDisableGradientOpacity(c);
+  const double gmax = gradient ? 0.25 * (width != 0.0 ? width : 1.0) * gradientScale : 0.0;
+  return vtkFerroVolumeCall("set the 2D transfer function", error, [&] {
+    tf.set_table_2d(static_cast<uint32_t>(c), static_cast<uint32_t>(dims[0]),
+      static_cast<uint32_t>(dims[1]), rgba, lo, hi, gmax);
+  });
+}
+
+// Every component's 2D table in TF_2D mode (one or independent components; VTK's dependent
+// components read one table differently, which ferrovol does not do: an error).
+bool Build2D(bool twoD, vtkVolumeProperty* prop, const vtkFerroVolumeLookupTables::Key& key,
+  ferrovol::TransferFunction& tf, std::string& error)
+{
+  if (!twoD)
+  {
+    return true;
+  }
+  if (key.Components > 1 && !prop->GetIndependentComponents())
+  {
+    error = "2D transfer functions (TF_2D) with dependent components are not supported by "
+            "vtkFerroVolumeMapper: nothing is drawn";
+    return false;
+  }
+  for (int c = 0; c < key.Components; ++c)
+  {
+    if (!Table2DOf(prop, c, key.Ranges[c], key.GradientScale, tf, error))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
 // The latest modification of the property's label functions.
 vtkMTimeType LabelsMTime(vtkVolumeProperty* prop)
 {
@@ -416,7 +498,8 @@ bool vtkFerroVolumeLookupTables::Key::operator==(const Key& o) const
 {
   return this->Property == o.Property && this->PropertyMTime == o.PropertyMTime &&
     this->Components == o.Components && this->Ranges == o.Ranges && this->Types == o.Types &&
-    this->GradientScale == o.GradientScale && this->LabelsMTime == o.LabelsMTime;
+    this->GradientScale == o.GradientScale && this->LabelsMTime == o.LabelsMTime &&
+    this->Tables2DMTime == o.Tables2DMTime;
 }
 
 double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
@@ -429,12 +512,7 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   ferrovol::Renderer& renderer, std::string& error)
 {
   vtkVolumeProperty* prop = volume->GetProperty();
-  if (prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_1D)
-  {
-    error = "2D transfer functions (vtkVolumeProperty::TransferFunctionMode TF_2D) are not "
-            "supported by vtkFerroVolumeMapper: nothing is drawn";
-    return false;
-  }
+  const bool twoD = prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D;
   const double matrixScale = MatrixScale(volume);
   if (!(matrixScale > 0.0) || !std::isfinite(matrixScale))
   {
@@ -449,6 +527,16 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   key.Types = rangeTypes;
   key.GradientScale = 1.0 / (input.GetMeanSpacing() * matrixScale);
   key.LabelsMTime = LabelsMTime(prop);
+  if (twoD)
+  {
+    for (int c = 0; c < key.Components; ++c)
+    {
+      if (vtkImageData* image = prop->GetTransferFunction2D(c))
+      {
+        key.Tables2DMTime = std::max(key.Tables2DMTime, image->GetMTime());
+      }
+    }
+  }
   if (this->Uploaded && *this->Uploaded == key)
   {
     return true;
@@ -459,6 +547,7 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
         prop, key.Components, key.Ranges, key.Types, key.GradientScale, tf, error) ||
     (key.Components == 1 &&
       !BuildLabels(prop, key.Ranges[0], key.GradientScale, *tf, error)) ||
+    !Build2D(twoD, prop, key, *tf, error) ||
     !vtkFerroVolumeCall(
       "set the transfer function", error, [&] { renderer.set_transfer_function(*tf); }))
   {

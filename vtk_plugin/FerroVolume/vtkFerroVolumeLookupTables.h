@@ -48,7 +48,6 @@ public:
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }
 
-private:
   // What the uploaded tables were made from.
   struct Key
   {
@@ -59,10 +58,12 @@ private:
     RangeTypes Types;
     double GradientScale = 0.0;
     vtkMTimeType LabelsMTime = 0;
+    vtkMTimeType Tables2DMTime = 0;
 
     bool operator==(const Key& o) const;
   };
 
+private:
   std::optional<Key> Uploaded;
 };
 

@@ -565,7 +565,8 @@ void vtkFerroVolumeSettings::WarnUnsupported(
   if (self->GetTransfer2DYAxisArray() && warned.insert("transfer-2d-y").second)
   {
     vtkWarningWithObjectMacro(self, << "Transfer2DYAxisArray '" << self->GetTransfer2DYAxisArray()
-                                    << "' is not used: ferrovol has no 2D transfer functions");
+                                    << "' is not used: ferrovol's 2D transfer functions read "
+                                       "the gradient magnitude on their second axis");
   }
   for (int port = 1; port < self->GetNumberOfInputPorts(); ++port)
   {
