@@ -345,6 +345,34 @@ def frog_tf(shade=False):
     return make
 
 
+def ct_tf_2d(shade=True):
+    """The skull CT through a 2D transfer function: skin where the scalar is around -300 HU
+    and bone above 300 HU, each more opaque where the gradient is steep (their boundaries)."""
+    def make():
+        from vtk.util.numpy_support import numpy_to_vtk
+        p = ct_tf(shade=shade)()
+        lo, hi = cranium().GetPointData().GetScalars().GetRange()
+        nx, ny = 256, 128
+        s = lo + (np.arange(nx) + 0.5) / nx * (hi - lo)
+        g = (np.arange(ny) + 0.5) / ny
+        ss, gg = np.meshgrid(s, g)
+        skin = np.exp(-((ss + 300.0) / 120.0) ** 2)
+        bone = np.clip((ss - 300.0) / 400.0, 0.0, 1.0)
+        rgba = np.zeros((ny, nx, 4), np.float32)
+        rgba[..., 0] = 0.9 * skin + 1.0 * bone
+        rgba[..., 1] = 0.6 * skin + 0.95 * bone
+        rgba[..., 2] = 0.5 * skin + 0.85 * bone
+        rgba[..., 3] = (0.15 * skin + 0.8 * bone) * np.clip(0.2 + 4.0 * gg, 0.0, 1.0)
+        img = vtk.vtkImageData()
+        img.SetDimensions(nx, ny, 1)
+        img.GetPointData().SetScalars(
+            numpy_to_vtk(rgba.reshape(-1, 4), deep=True, array_type=vtk.VTK_FLOAT))
+        p.SetTransferFunction2D(img)
+        p.SetTransferFunctionMode(vtk.vtkVolumeProperty.TF_2D)
+        return p
+    return make
+
+
 # ---------------------------------------------------------------------------------------
 # Cameras, actors, mapper settings
 
@@ -786,6 +814,9 @@ SCENES = [
           "cutaway mask (surfaces capped where the mask ends, as VTK)", "cranium", ct_tf(),
           views=one("isosurface", ct_front(35, 15, 1.1)), iso_values=(-300.0, 400.0),
           configure=mask(cranium_cutaway_mask), fixed=False),
+    Scene("ct-transfer-2d", "skull CT through a 2D transfer function (scalar x gradient "
+          "magnitude: skin and bone boundaries), shaded", "cranium", ct_tf_2d(),
+          views=one(camera=ct_front(35, 15, 1.1)), fixed=False),
     Scene("frog-label-map", "frog tissues 500x470x136 uint8 as a label map of themselves: "
           "five labels their own colour and opacity, nearest", "frog", frog_tf(),
           views=one(camera=orbit(30, 20, 1.3)), configure=mask(frog_mask, label_map=True),

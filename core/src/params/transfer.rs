@@ -93,7 +93,8 @@ pub struct ComponentTransfer {
     /// the render parameters' shading.
     pub material: Option<[f32; 4]>,
     /// A 2D transfer function (vtkVolumeProperty's TF_2D mode) that classifies this
-    /// component instead of `color` and `opacity` in composite ray casting.
+    /// component instead of `color`, `opacity` and `gradient_opacity` in composite ray
+    /// casting.
     pub table_2d: Option<Table2D>,
 }
 
