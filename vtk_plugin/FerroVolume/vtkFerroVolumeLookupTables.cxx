@@ -400,10 +400,10 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
 }
 
 // Component c's 2D transfer function (vtkVolumeProperty::GetTransferFunction2D, TF_2D mode)
-// as VTK 9.2 reads it: the image's RGBA over the component's data range (x) and, where the
-// component has gradient opacity, over gradient magnitudes up to 0.25 · the data range in
-// VTK's units (y; without gradient opacity VTK reads the first row). VTK's gradient opacity
-// still multiplies the opacity, as the 1D functions set it.
+// as VTK 9.2 draws it: the image's RGBA over the component's data range (x) and gradient
+// magnitudes up to 0.25 · the data range in VTK's units (y). (VTK's shader reads the
+// gradient axis only with a gradient opacity function, but its mapper makes the property's
+// default one on the first render, so in effect always; the function does not multiply.)
 bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& range,
   double gradientScale, ferrovol::TransferFunction& tf, std::string& error)
 {
@@ -444,8 +444,7 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
   const double width = range[1] - range[0];
   const double lo = range[0];
   const double hi = width > 0.0 ? range[1] : range[0] + 1.0;
-  const bool gradient = prop->HasGradientOpacity(c) && !prop->GetDisableGradientOpacity(c);
-  const double gmax = gradient ? 0.25 * (width != 0.0 ? width : 1.0) * gradientScale : 0.0;
+  const double gmax = 0.25 * (width != 0.0 ? width : 1.0) * gradientScale;
   return vtkFerroVolumeCall("set the 2D transfer function", error, [&] {
     tf.set_table_2d(static_cast<uint32_t>(c), static_cast<uint32_t>(dims[0]),
       static_cast<uint32_t>(dims[1]), rgba, lo, hi, gmax);
