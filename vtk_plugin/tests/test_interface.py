@@ -53,14 +53,15 @@ def make_data(maximum=255.0):
     return img
 
 
-def make_mask():
-    """A binary mask of the volume's half (255 inside, 0 outside), as VTK's masks are."""
+def make_mask(inside=255):
+    """A mask of the volume's half (`inside` there, 0 elsewhere): a binary mask as VTK's masks
+    are, or a label map of one label."""
     mask = vtk.vtkImageData()
     mask.SetDimensions(32, 32, 32)
     mask.SetOrigin(-7.5, -7.5, -7.5)
     mask.SetSpacing(0.5, 0.5, 0.5)
     values = np.zeros((32, 32, 32), np.uint8)
-    values[:, :, :16] = 255
+    values[:, :, :16] = inside
     mask.GetPointData().SetScalars(numpy_to_vtk(values.reshape(-1), deep=True))
     return mask
 
@@ -96,6 +97,7 @@ class Rig:
         self.source2 = vtk.vtkTrivialProducer()
         self.source2.SetOutput(self.data2)
         self.mask = make_mask()
+        self.labels = make_mask(inside=1)
         self.prop = make_property()
         self.volume = vtk.vtkVolume()
         self.volume.SetProperty(self.prop)
@@ -183,6 +185,15 @@ def calls(*steps):
         for name, *args in steps:
             getattr(m, name)(*[a(rig) if callable(a) else a for a in args])
     return run
+
+
+def label_one_red(m, rig):
+    """The label map of rig.labels, its label 1 red on the rig's property."""
+    red = vtk.vtkColorTransferFunction()
+    red.AddRGBPoint(0.0, 1.0, 0.0, 0.0)
+    rig.prop.SetLabelColor(1, red)
+    m.SetMaskInput(rig.labels)
+    m.SetMaskTypeToLabelMap()
 
 
 def progress_events(m, rig):
@@ -429,17 +440,19 @@ SETTINGS = {
                                       prepare=calls(RTI, CROP_MID, ("CroppingOn",),
                                                     ("ClampDepthToBackfaceOn",))),
 
-    # not supported: warned
-    "SetMaskInput": warned(calls(("SetMaskInput", lambda r: r.mask)), "MaskInput"),
-    "SetMaskType": warned(calls(("SetMaskType", 0)), "MaskType",
-                          prepare=calls(("SetMaskInput", lambda r: r.mask))),
-    "SetMaskTypeToBinary": warned(calls(("SetMaskTypeToBinary",)), "MaskType",
-                                  prepare=calls(("SetMaskInput", lambda r: r.mask))),
-    "SetMaskTypeToLabelMap": warned(calls(("SetMaskTypeToLabelMap",)), "MaskType",
-                                    prepare=calls(("SetMaskInput", lambda r: r.mask),
-                                                  ("SetMaskTypeToBinary",))),
-    "SetMaskBlendFactor": warned(calls(("SetMaskBlendFactor", 0.5)), "MaskBlendFactor",
+    # masks (a binary mask of half the volume; a label map of it with label 1 red)
+    "SetMaskInput": image(calls(("SetMaskInput", lambda r: r.mask)),
+                          prepare=calls(("SetMaskTypeToBinary",))),
+    "SetMaskType": image(calls(("SetMaskType", 0)),
+                         prepare=calls(("SetMaskInput", lambda r: r.mask))),
+    "SetMaskTypeToBinary": image(calls(("SetMaskTypeToBinary",)),
                                  prepare=calls(("SetMaskInput", lambda r: r.mask))),
+    "SetMaskTypeToLabelMap": image(calls(("SetMaskTypeToLabelMap",)),
+                                   prepare=calls(("SetMaskInput", lambda r: r.mask),
+                                                 ("SetMaskTypeToBinary",))),
+    "SetMaskBlendFactor": image(calls(("SetMaskBlendFactor", 0.5)), prepare=label_one_red),
+
+    # not supported: warned
     "SetUseDepthPass": warned(calls(("SetUseDepthPass", 1)), "UseDepthPass"),
     "UseDepthPassOn": warned(calls(("UseDepthPassOn",)), "UseDepthPass"),
     "UseDepthPassOff": state(calls(("UseDepthPassOff",)), lambda m, r: m.GetUseDepthPass() == 0,
