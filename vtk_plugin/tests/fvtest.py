@@ -243,6 +243,38 @@ def render_pair(data, prop_factory, size=(160, 160), camera=None, configure=None
     return images[0], images[1], mappers[0]
 
 
+def assert_matches_vtk(test, name, data, prop_factory, floor, camera=None, configure=None):
+    """Renders the scene with vtkFerroVolumeMapper and vtkGPUVolumeRayCastMapper; asserts that
+    ferrovol raised no error, drew more than 5% of the frame and reached floor = (SSIM, PSNR)
+    against VTK's image. Returns ferrovol's image."""
+    errors = []
+
+    def observed(m):
+        if m.IsA("vtkFerroVolumeMapper"):
+            errors.append(Errors(m))
+        if configure:
+            configure(m)
+    ours, theirs, _ = render_pair(data, prop_factory, camera=camera, configure=observed)
+    s, p = compare(name, ours, theirs)
+    test.assertEqual(errors[0].messages, [])
+    test.assertGreater(coverage(ours), 0.05)
+    test.assertGreaterEqual(s, floor[0], name)
+    test.assertGreaterEqual(p, floor[1], name)
+    return ours
+
+
+def wavelet_image(n=31, start=(0, 0, 0)):
+    """The wavelet (fvtest.wavelet) as a vtkImageData whose extent starts at `start`."""
+    source = wavelet(n)
+    change = vtk.vtkImageChangeInformation()
+    change.SetInputConnection(source.GetOutputPort())
+    change.SetOutputExtentStart(*start)
+    change.Update()
+    img = vtk.vtkImageData()
+    img.DeepCopy(change.GetOutput())
+    return img
+
+
 def save(name, *images):
     """Writes the images side by side (and their difference, when two) as a PNG."""
     imgs = list(images)

@@ -10,18 +10,7 @@ import vtk
 from vtk.util.numpy_support import numpy_to_vtk
 
 import fvtest
-from fvtest import Errors, coverage, render_pair
-
-
-def wavelet_image(n=31):
-    source = fvtest.wavelet(n)
-    change = vtk.vtkImageChangeInformation()
-    change.SetInputConnection(source.GetOutputPort())
-    change.SetOutputExtentStart(0, 0, 0)
-    change.Update()
-    img = vtk.vtkImageData()
-    img.DeepCopy(change.GetOutput())
-    return img
+from fvtest import Errors, coverage
 
 
 def table_2d(rgb_low, rgb_high, bins=(256, 128), top=0.6):
@@ -79,18 +68,11 @@ def view(cam):
 class Transfer2D(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.image = wavelet_image()
+        cls.image = fvtest.wavelet_image()
         cls.table = table_2d((0.9, 0.5, 0.1), (0.2, 0.4, 1.0))
 
     def pair(self, name, data, prop, floor):
-        ours, theirs, mapper = render_pair(data, prop, camera=view)
-        errors = Errors(mapper)
-        s, p = fvtest.compare(name, ours, theirs)
-        self.assertEqual(errors.messages, [])
-        self.assertGreater(coverage(ours), 0.05)
-        self.assertGreaterEqual(s, floor[0], name)
-        self.assertGreaterEqual(p, floor[1], name)
-        return ours
+        return fvtest.assert_matches_vtk(self, name, data, prop, floor, camera=view)
 
     def test_one_component(self):
         self.pair("tf2d-gradient", self.image, lambda: property_2d(self.table), (0.98, 35.0))
