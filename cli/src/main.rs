@@ -74,6 +74,8 @@ enum SpecularArg {
 enum InterpArg {
     Nearest,
     Linear,
+    /// The cubic B-spline of the points (ray casting).
+    Cubic,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -743,10 +745,10 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             Mode::Pathtrace => BlendMode::PathTrace,
             Mode::Slice => BlendMode::Slice,
         },
-        interpolation: if a.interpolation == InterpArg::Nearest {
-            Interpolation::Nearest
-        } else {
-            Interpolation::Linear
+        interpolation: match a.interpolation {
+            InterpArg::Nearest => Interpolation::Nearest,
+            InterpArg::Linear => Interpolation::Linear,
+            InterpArg::Cubic => Interpolation::Cubic,
         },
         gradient: if a.gradient == GradArg::Forward {
             GradientMethod::Forward

@@ -115,6 +115,9 @@ pub enum FvBlendMode {
 pub enum FvInterpolation {
     Nearest = 0,
     Linear = 1,
+    /// The cubic B-spline of the points (not prefiltered: smooths at the scale of a voxel),
+    /// ray casting only; isosurfaces and path tracing answer FV_STATUS_UNSUPPORTED.
+    Cubic = 2,
 }
 
 /// Gradient estimator for shading and gradient opacity.
@@ -442,7 +445,11 @@ impl ToCore for FvRenderParams {
         let interpolation = enum_value(
             "interpolation",
             self.interpolation,
-            &[Interpolation::Nearest, Interpolation::Linear],
+            &[
+                Interpolation::Nearest,
+                Interpolation::Linear,
+                Interpolation::Cubic,
+            ],
         )?;
         let gradient = enum_value(
             "gradient_method",

@@ -122,10 +122,47 @@ fn pool_coord(p: vec3<f32>) -> vec3<f32> {
     return (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
 }
 
+// The cubic B-spline of the points instead of trilinear interpolation (Interpolation::Cubic;
+// a pipeline constant, with the linear sampler).
+override CUBIC: bool = false;
+
+// The cubic B-spline at pool texture coordinate tc, from eight trilinear fetches: along each
+// axis the four weights of the points around it fold into two linear fetches (Sigg and
+// Hadwiger, GPU Gems 2, ch. 20).
+fn cubic_bspline(tc: vec3<f32>) -> vec4<f32> {
+    let size = 1.0 / pool.inv_size.xyz;
+    let x = tc * size - 0.5;
+    let i = floor(x);
+    let f = x - i;
+    let g = 1.0 - f;
+    let w0 = g * g * g / 6.0;
+    let w1 = (4.0 - 6.0 * f * f + 3.0 * f * f * f) / 6.0;
+    let w3 = f * f * f / 6.0;
+    let w2 = 1.0 - w0 - w1 - w3;
+    let s0 = w0 + w1;
+    let s1 = w2 + w3;
+    // the two fetch positions per axis (texel centres at i + 0.5)
+    let h0 = (i - 0.5 + w1 / s0) * pool.inv_size.xyz;
+    let h1 = (i + 1.5 + w3 / s1) * pool.inv_size.xyz;
+    var out = vec4<f32>(0.0);
+    for (var c = 0u; c < 8u; c = c + 1u) {
+        let pick = vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u);
+        let at = select(h0, h1, pick);
+        let w = select(s0, s1, pick);
+        out = out + w.x * w.y * w.z * textureSampleLevel(volume_tex, volume_sampler, at, 0.0);
+    }
+    return out;
+}
+
 // Raw texel value (normalised storage) at index-space point p.
 fn sample_texel(p: vec3<f32>) -> vec4<f32> {
     let tc = pool_coord(p);
-    let v = textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
+    var v: vec4<f32>;
+    if (CUBIC) {
+        v = cubic_bspline(tc);
+    } else {
+        v = textureSampleLevel(volume_tex, volume_sampler, tc, 0.0);
+    }
     if (SINGLE_BRICK) {
         return v;
     }

@@ -249,6 +249,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , LastRenderProgressive(0)
   , LastRenderSize{ 0, 0 }
   , PreIntegration(0)
+  , CubicInterpolation(0)
   , Internals(new vtkInternals)
 {
   // ferrovol's default: the device's limit (vtkGPUVolumeRayCastMapper's constructor probed
@@ -735,6 +736,7 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
   os << indent << "ExtremumDepth: " << this->ExtremumDepth << "\n";
   os << indent << "PreIntegration: " << this->PreIntegration << "\n";
+  os << indent << "CubicInterpolation: " << this->CubicInterpolation << "\n";
   os << indent << "WholeExtent: " << this->WholeExtent[0] << " " << this->WholeExtent[1] << " "
      << this->WholeExtent[2] << " " << this->WholeExtent[3] << " " << this->WholeExtent[4] << " "
      << this->WholeExtent[5] << "\n";

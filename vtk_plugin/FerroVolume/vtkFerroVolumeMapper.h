@@ -170,6 +170,20 @@ public:
 
   ///@{
   /**
+   * Cubic interpolation: where the property's InterpolationType is linear, ray casting
+   * reconstructs the volume with the cubic B-spline of its points (not prefiltered: it
+   * smooths at the scale of a voxel and keeps linear fields as they are; Sigg and Hadwiger's
+   * eight trilinear fetches per sample) instead of trilinear interpolation. VTK 9.2's
+   * vtkVolumeProperty clamps InterpolationType to linear, so this is the mapper's setting.
+   * Isosurfaces and path tracing keep trilinear interpolation. Default off.
+   */
+  vtkSetClampMacro(CubicInterpolation, vtkTypeBool, 0, 1);
+  vtkGetMacro(CubicInterpolation, vtkTypeBool);
+  vtkBooleanMacro(CubicInterpolation, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * The whole extent of the dataset the input is a piece of, when each process of a
    * parallel run draws its own piece and the processes' frames are composited back to front
    * (ParaView sets it under MPI). Rays then sample on the whole volume's lattice and take a
@@ -733,6 +747,7 @@ protected:
   vtkTypeBool LastRenderProgressive;
   int LastRenderSize[2];
   vtkTypeBool PreIntegration;
+  vtkTypeBool CubicInterpolation;
 
 private:
   vtkFerroVolumeMapper(const vtkFerroVolumeMapper&) = delete;

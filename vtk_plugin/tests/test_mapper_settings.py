@@ -348,6 +348,22 @@ class Settings(unittest.TestCase):
         self.assertEqual(float(np.abs(off - plain).max()), 0.0)
         self.assertLess(err_pre, 0.5 * err_plain)
 
+    def test_cubic_interpolation_smooths_and_is_for_ray_casting(self):
+        # the B-spline changes the linear image a little (it smooths at the voxel scale);
+        # off again gives the linear image back exactly; isosurfaces keep trilinear
+        linear, mapper = self.render(None, tf_property(interpolation="linear"))
+        self.assertEqual(mapper.GetCubicInterpolation(), 0, "off by default")
+        cubic, _ = self.render(lambda m: m.CubicInterpolationOn(),
+                               tf_property(interpolation="linear"))
+        off, _ = self.render(lambda m: m.SetCubicInterpolation(0),
+                             tf_property(interpolation="linear"))
+        save("settings-cubic", linear, cubic)
+        d = mean_diff(linear, cubic)
+        print("cubic B-spline vs trilinear: mean |difference| %.2f levels" % d)
+        self.assertGreater(coverage(cubic), 0.2)
+        self.assertGreater(d, 0.2)
+        self.assertEqual(float(np.abs(off - linear).max()), 0.0)
+
     def test_memory_budget_streams_the_same_image(self):
         # wavelet(23): 48^3 float32, 432 KiB; a budget of a quarter of it (MaxMemoryInBytes x
         # MaxMemoryFraction) bricks the volume and streams the bricks in several passes

@@ -32,6 +32,7 @@ pipeline_variant! {
         range_skip: bool => "RANGE_SKIP",
         crop: bool => "CROP",
         nearest: bool => "NEAREST",
+        cubic: bool => "CUBIC",
         single_brick: bool => "SINGLE_BRICK",
         positional_lights: bool => "POSITIONAL_LIGHTS",
         lights: u32 => "NUM_LIGHTS",
@@ -136,6 +137,14 @@ impl DvrPass {
             ));
         }
         let streaming = plan.is_some();
+        if streaming && params.interpolation == Interpolation::Cubic {
+            return Err(Error::Unsupported(
+                "cubic interpolation reads two points around each sample, beyond what a \
+                 streamed brick keeps around it, and the bricks in view exceed the volume's \
+                 memory budget: raise the budget or interpolate linearly"
+                    .into(),
+            ));
+        }
         if streaming && params.blend == BlendMode::Slice {
             return Err(Error::Unsupported(
                 "the slice blend mode needs every brick in view resident, and they exceed \
@@ -233,6 +242,7 @@ impl DvrPass {
             range_skip,
             crop: params.cropping.is_some(),
             nearest: params.interpolation == Interpolation::Nearest,
+            cubic: params.interpolation == Interpolation::Cubic,
             single_brick: vol.single_brick(),
             positional_lights: f.positional_lights(),
             lights: f.lights(),

@@ -37,8 +37,8 @@ use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND, MASK_BINARY, M
 use crate::gpu::Context;
 use crate::params::iso::MAX_SPECULAR_SAMPLES;
 use crate::params::{
-    BlendMode, GBuffer, IsoParams, IsoScatterMode, MaskKind, RenderParams, Shading, Shininess,
-    TransferFunction,
+    BlendMode, GBuffer, Interpolation, IsoParams, IsoScatterMode, MaskKind, RenderParams, Shading,
+    Shininess, TransferFunction,
 };
 use crate::resources::environment::texel_solid_angle;
 use crate::resources::tables::{Occupancy, Tables};
@@ -365,6 +365,13 @@ impl IsoPass {
     pub fn render(&mut self, input: FrameInput<'_>, iso: Option<&IsoParams>) -> Result<()> {
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
+        if params.interpolation == Interpolation::Cubic {
+            return Err(Error::Unsupported(
+                "isosurfaces are found on the trilinear field: cubic interpolation is for ray \
+                 casting"
+                    .into(),
+            ));
+        }
         let iso = iso.ok_or_else(|| {
             Error::InvalidParameter(
                 "BlendMode::Isosurface needs iso-values: call Renderer::set_isosurface first"

@@ -421,6 +421,13 @@ impl PathTracePass {
         let pp = *pp;
         pp.validate()?;
         let vol = res.volume()?;
+        if params.interpolation == Interpolation::Cubic {
+            return Err(Error::Unsupported(
+                "path tracing samples the trilinear field: cubic interpolation is for ray \
+                 casting"
+                    .into(),
+            ));
+        }
         if res.tf.as_ref().is_some_and(TransferFunction::has_2d) {
             return Err(Error::Unsupported(
                 "path tracing reads 1D transfer functions: this one has a 2D table (TF_2D)".into(),

@@ -136,11 +136,38 @@ pub fn voxel(v: &VolumeData, c: [i64; 3]) -> f64 {
     v.value(i, j, k, 0)
 }
 
+/// The cubic B-spline of the points at index-space point p, the grid clamped at its edges
+/// (the texture sampler's ClampToEdge).
+pub fn cubic_bspline(v: &VolumeData, p: DVec3) -> f64 {
+    let weights = |f: f64| {
+        let g = 1.0 - f;
+        [
+            g * g * g / 6.0,
+            (4.0 - 6.0 * f * f + 3.0 * f * f * f) / 6.0,
+            (4.0 - 6.0 * g * g + 3.0 * g * g * g) / 6.0,
+            f * f * f / 6.0,
+        ]
+    };
+    let base: [i64; 3] = std::array::from_fn(|a| p[a].floor() as i64 - 1);
+    let w: [[f64; 4]; 3] = std::array::from_fn(|a| weights(p[a] - p[a].floor()));
+    let mut sum = 0.0;
+    for k in 0..4 {
+        for j in 0..4 {
+            for i in 0..4 {
+                let c = [base[0] + i as i64, base[1] + j as i64, base[2] + k as i64];
+                sum += w[0][i] * w[1][j] * w[2][k] * voxel(v, c);
+            }
+        }
+    }
+    sum
+}
+
 /// The scalar the renderer samples at index-space point p.
 pub fn sample(v: &VolumeData, p: DVec3, interp: Interpolation) -> f64 {
     match interp {
         Interpolation::Linear => trilinear(v, p),
         Interpolation::Nearest => voxel(v, nearest_voxel(v, p)),
+        Interpolation::Cubic => cubic_bspline(v, p),
     }
 }
 
@@ -152,13 +179,15 @@ pub fn gradient(v: &VolumeData, p: DVec3, interp: Interpolation, method: Gradien
     let e = [DVec3::X, DVec3::Y, DVec3::Z];
     let forward = method == GradientMethod::Forward;
     match interp {
-        Interpolation::Linear => DVec3::from_array(std::array::from_fn(|a| {
-            if forward {
-                trilinear(v, p + e[a]) - trilinear(v, p)
-            } else {
-                0.5 * (trilinear(v, p + e[a]) - trilinear(v, p - e[a]))
-            }
-        })),
+        Interpolation::Linear | Interpolation::Cubic => {
+            DVec3::from_array(std::array::from_fn(|a| {
+                if forward {
+                    trilinear(v, p + e[a]) - trilinear(v, p)
+                } else {
+                    0.5 * (trilinear(v, p + e[a]) - trilinear(v, p - e[a]))
+                }
+            }))
+        }
         Interpolation::Nearest => {
             let c = nearest_voxel(v, p);
             DVec3::from_array(std::array::from_fn(|a| {
@@ -183,7 +212,7 @@ pub fn gradient(v: &VolumeData, p: DVec3, interp: Interpolation, method: Gradien
 /// shaders/lib/common.wgsl table_lookup).
 pub fn classify(tf: &ComponentTransfer, s: f64, dt: f64, interp: Interpolation) -> ([f64; 3], f64) {
     let x = match interp {
-        Interpolation::Linear => s,
+        Interpolation::Linear | Interpolation::Cubic => s,
         Interpolation::Nearest => {
             let [lo, hi] = tf.table_range();
             let last = (TABLE_SIZE - 1) as f64;
