@@ -162,6 +162,11 @@ void vtkFerroVolumeRepresentation::SetPreIntegration(int value)
   this->GetFerroVolumeMapper()->SetPreIntegration(value != 0);
 }
 
+void vtkFerroVolumeRepresentation::SetCubicInterpolation(int value)
+{
+  this->GetFerroVolumeMapper()->SetCubicInterpolation(value != 0);
+}
+
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::SetMaxMemoryInBytes(vtkIdType value)
 {

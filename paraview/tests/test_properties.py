@@ -147,6 +147,24 @@ if p >= CHANGED_MAX_PSNR:
     failures.append("Specular does not change the shaded image")
 disp.Shade, disp.Specular, disp.SpecularPower = old
 
+# Cubic interpolation: the B-spline smooths at the voxel scale, so a change shows where the
+# opacity steps: a sharp step of the opacity function, cubic off against on.
+old = list(disp.ScalarOpacityFunction.Points)
+disp.ScalarOpacityFunction.Points = [37.35, 0.0, 0.5, 0.0, 159.0, 0.0, 0.5, 0.0,
+                                     161.0, 0.8, 0.5, 0.0, 276.8, 0.8, 0.5, 0.0]
+shots = []
+for cubic in (0, 1):
+    disp.FerrovolCubicInterpolation = cubic
+    Render(view)
+    shots.append(T.screenshot(view, "props-cubic-%d" % cubic)[0])
+disp.FerrovolCubicInterpolation = 0
+disp.ScalarOpacityFunction.Points = old
+p = T.psnr(shots[0], shots[1])
+T.log("  %-58s PSNR %6.2f dB -> %s" % ("opacity step: FerrovolCubicInterpolation 0 vs 1", p,
+                                       "changed" if p < CHANGED_MAX_PSNR else "same  FAIL"))
+if p >= CHANGED_MAX_PSNR:
+    failures.append("FerrovolCubicInterpolation does not change the image")
+
 # Isosurfaces: the shared BlendMode and IsosurfaceValues, against ParaView's own "Volume", and
 # the isosurface settings change the image.
 old = (disp.Shade, list(disp.IsosurfaceValues), disp.Specular, disp.SpecularPower)
