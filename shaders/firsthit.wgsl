@@ -131,6 +131,29 @@ fn exact_gradient(p: vec3<f32>) -> vec3<f32> {
     return 0.5 * frame.scalar_scale[ISO_COMP] * g;
 }
 
+// The field the surfaces are of at p, and its index-space gradient: the exact trilinear
+// ones, or with CUBIC the cubic B-spline's value and its central differences one voxel each
+// way (each sample making its own brick current).
+fn surface_scalar(p: vec3<f32>) -> f32 {
+    if (CUBIC) {
+        return sample_scalars(p)[ISO_COMP];
+    }
+    return exact_scalar(p);
+}
+
+fn surface_gradient(p: vec3<f32>) -> vec3<f32> {
+    if (!CUBIC) {
+        return exact_gradient(p);
+    }
+    var g = vec3<f32>(0.0);
+    for (var a = 0; a < 3; a = a + 1) {
+        var e = vec3<f32>(0.0);
+        e[a] = 1.0;
+        g[a] = 0.5 * (sample_scalars(p + e)[ISO_COMP] - sample_scalars(p - e)[ISO_COMP]);
+    }
+    return g;
+}
+
 // The distance in [t0, t1] where the field crosses v, `below` telling whether it is below v
 // at t0: interval bisection through the sampler (iso.counts.y halvings, one fetch each),
 // then the crossing of the line through the exactly interpolated values at the final
@@ -148,8 +171,8 @@ fn refine(ray: Ray, t0: f32, t1: f32, v: f32, below: bool) -> f32 {
             b = m;
         }
     }
-    let fa = exact_scalar(point_at(ray, a)) - v;
-    let fb = exact_scalar(point_at(ray, b)) - v;
+    let fa = surface_scalar(point_at(ray, a)) - v;
+    let fb = surface_scalar(point_at(ray, b)) - v;
     if (fa != fb) {
         return clamp(a + fa / (fa - fb) * (b - a), t0, t1);
     }
@@ -195,7 +218,7 @@ fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 
 // Writes G-buffer layer `layer` for the hit of iso-value `which` at distance t.
 fn write_hit(px: vec2<u32>, layer: u32, ray: Ray, t: f32, which: u32, below: bool) {
     let p = point_at(ray, t);
-    let gw = (frame.gradient_to_world * vec4<f32>(exact_gradient(p), 0.0)).xyz;
+    let gw = (frame.gradient_to_world * vec4<f32>(surface_gradient(p), 0.0)).xyz;
     let glen = length(gw);
     // The normal faces the side the ray came from: against the gradient when the field
     // rises along the ray.

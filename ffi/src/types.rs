@@ -116,7 +116,7 @@ pub enum FvInterpolation {
     Nearest = 0,
     Linear = 1,
     /// The cubic B-spline of the points (not prefiltered: smooths at the scale of a voxel),
-    /// ray casting only; isosurfaces and path tracing answer FV_STATUS_UNSUPPORTED.
+    /// in ray casting and isosurfaces; path tracing answers FV_STATUS_UNSUPPORTED.
     Cubic = 2,
 }
 

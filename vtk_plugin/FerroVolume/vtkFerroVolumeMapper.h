@@ -175,7 +175,8 @@ public:
    * smooths at the scale of a voxel and keeps linear fields as they are; Sigg and Hadwiger's
    * eight trilinear fetches per sample) instead of trilinear interpolation. VTK 9.2's
    * vtkVolumeProperty clamps InterpolationType to linear, so this is the mapper's setting.
-   * Isosurfaces and path tracing keep trilinear interpolation. Default off.
+   * Isosurfaces are those of the B-spline; path tracing keeps trilinear interpolation.
+   * Default off.
    */
   vtkSetClampMacro(CubicInterpolation, vtkTypeBool, 0, 1);
   vtkGetMacro(CubicInterpolation, vtkTypeBool);

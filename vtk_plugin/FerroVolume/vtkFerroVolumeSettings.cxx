@@ -312,10 +312,9 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       params.interpolation = FV_INTERPOLATION_NEAREST;
       break;
     case VTK_LINEAR_INTERPOLATION:
-      // (cubic for ray casting only: isosurfaces and path tracing find and trace the
-      // trilinear field)
-      params.interpolation = self->GetCubicInterpolation() &&
-          this->Blend != FV_BLEND_MODE_ISOSURFACE && this->Blend != FV_BLEND_MODE_PATH_TRACE
+      // (path tracing traces the trilinear field)
+      params.interpolation =
+        self->GetCubicInterpolation() && this->Blend != FV_BLEND_MODE_PATH_TRACE
         ? FV_INTERPOLATION_CUBIC
         : FV_INTERPOLATION_LINEAR;
       break;

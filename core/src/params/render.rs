@@ -63,8 +63,9 @@ pub enum Interpolation {
     Linear,
     /// The cubic B-spline of the points (not prefiltered: it approximates, smoothing at the
     /// scale of a voxel, and reproduces linear fields exactly), evaluated with eight trilinear
-    /// fetches per sample (Sigg and Hadwiger 2005). Composite and the other ray-casting
-    /// blend modes; gradients stay the central differences of the points.
+    /// fetches per sample (Sigg and Hadwiger 2005). Ray casting (gradients stay the central
+    /// differences of the points) and isosurfaces (the B-spline's surfaces and their
+    /// normals); path tracing and streamed volumes refuse it.
     Cubic,
 }
 

@@ -59,6 +59,8 @@ pipeline_variant! {
         component: u32 => "ISO_COMP",
         /// MASK_BINARY: samples whose nearest point the mask holds 0 at are left out.
         mask: u32 => "MASK",
+        /// The surfaces of the cubic B-spline (Interpolation::Cubic).
+        cubic: bool => "CUBIC",
     }
 }
 
@@ -365,13 +367,6 @@ impl IsoPass {
     pub fn render(&mut self, input: FrameInput<'_>, iso: Option<&IsoParams>) -> Result<()> {
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
-        if params.interpolation == Interpolation::Cubic {
-            return Err(Error::Unsupported(
-                "isosurfaces are found on the trilinear field: cubic interpolation is for ray \
-                 casting"
-                    .into(),
-            ));
-        }
         let iso = iso.ok_or_else(|| {
             Error::InvalidParameter(
                 "BlendMode::Isosurface needs iso-values: call Renderer::set_isosurface first"
@@ -461,7 +456,16 @@ impl IsoPass {
             } else {
                 MASK_NONE
             },
+            cubic: params.interpolation == Interpolation::Cubic,
         };
+        if fh.cubic && fh.streaming {
+            return Err(Error::Unsupported(
+                "cubic interpolation reads two points around each sample, beyond what a \
+                 streamed brick keeps around it, and the bricks in view exceed the volume's \
+                 memory budget: raise the budget or interpolate linearly"
+                    .into(),
+            ));
+        }
         let df = DeferredVariant {
             lights: f.lights(),
             positional_lights: f.positional_lights(),

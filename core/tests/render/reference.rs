@@ -368,3 +368,56 @@ fn cpu_reference_nearest() {
         }
     }
 }
+
+/// Isosurfaces of the cubic B-spline: on a linear field they are the trilinear ones (the
+/// B-spline keeps linear fields); on a field that changes within a few voxels they move.
+#[test]
+fn cubic_isosurfaces() {
+    let mut r = renderer();
+    let mut moved = Vec::new();
+    for (name, vol, value) in [
+        (
+            "ramp",
+            volume([20; 3], |x, _, z| 0.3 + 0.02 * z + 0.005 * x),
+            0.5,
+        ),
+        (
+            "waves",
+            volume([20; 3], |x, y, z| {
+                0.5 + 0.45 * (0.9 * x).sin() * (0.7 * y).cos() * (0.8 * z + 0.3).sin()
+            }),
+            0.7,
+        ),
+    ] {
+        r.set_volume(&vol).unwrap();
+        r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+            value,
+            [0.9, 0.8, 0.6],
+            1.0,
+        )]))
+        .unwrap();
+        let view = View::fit(vol.bounds(), 64, 64);
+        let p = |interpolation| RenderParams {
+            blend: BlendMode::Isosurface,
+            interpolation,
+            ..shaded()
+        };
+        let linear = r.render_image(&view, &p(Interpolation::Linear)).unwrap();
+        let cubic = r.render_image(&view, &p(Interpolation::Cubic)).unwrap();
+        save_enlarged(&cubic, &format!("cubic_isosurface_{name}"));
+        let (mean, max) = image_diff(&linear, &cubic);
+        println!("{name}: cubic vs trilinear isosurface: mean {mean:.3}, max {max} levels");
+        assert!(footprint(&cubic) > 400, "{name}: drawn");
+        moved.push(mean);
+    }
+    assert!(
+        moved[0] < 0.5,
+        "a linear field's surface moved by {}",
+        moved[0]
+    );
+    assert!(
+        moved[1] > 2.0,
+        "the waves' surfaces did not move ({})",
+        moved[1]
+    );
+}
