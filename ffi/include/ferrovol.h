@@ -120,7 +120,7 @@ typedef enum FvInterpolation {
   FV_INTERPOLATION_LINEAR = 1,
   /**
    * The cubic B-spline of the points (not prefiltered: smooths at the scale of a voxel),
-   * ray casting only; isosurfaces and path tracing answer FV_STATUS_UNSUPPORTED.
+   * in ray casting and isosurfaces; path tracing answers FV_STATUS_UNSUPPORTED.
    */
   FV_INTERPOLATION_CUBIC = 2,
 } FvInterpolation;
