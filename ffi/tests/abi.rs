@@ -415,7 +415,7 @@ fn renderer_errors() {
                 },
                 "finite origin",
             ),
-            (|p| p.interpolation = 2, "interpolation 2"),
+            (|p| p.interpolation = 3, "interpolation 3"),
             (|p| p.gradient_method = 9, "gradient_method 9"),
             (|p| p.sample_distance = -1.0, "sample_distance -1"),
             (|p| p.termination_threshold = 0.0, "termination threshold 0"),
