@@ -30,6 +30,7 @@ fn f32_volume(dims: [u32; 3], spacing: [f64; 3], origin: [f64; 3], data: Vec<f32
         direction: IDENTITY_DIRECTION,
         components: 1,
         scalars: Scalars::F32(data),
+        coordinates: None,
     };
     debug_assert!(v.validate().is_ok());
     v
@@ -113,6 +114,7 @@ pub fn wavelet_generated(extent: [i32; 6], ty: ScalarType) -> Result<VolumeData>
         direction: IDENTITY_DIRECTION,
         components: 1,
         scalars: Scalars::Source(Arc::new(WaveletSource { w, ty })),
+        coordinates: None,
     };
     v.validate()?;
     Ok(v)

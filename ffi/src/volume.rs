@@ -109,6 +109,7 @@ pub unsafe extern "C" fn fv_volume_new(
             direction,
             components: d.components,
             scalars: scalars_from_bytes(t, bytes),
+            coordinates: None,
         };
         v.validate()?;
         *slot = Box::into_raw(Box::new(FvVolume { data: Arc::new(v) }));

@@ -77,6 +77,7 @@ impl Layout {
             direction: geometry.direction,
             components: self.components as u32,
             scalars,
+            coordinates: None,
         };
         volume.validate().map_err(Problem::InvalidVolume)?;
         Ok(volume)

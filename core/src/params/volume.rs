@@ -215,7 +215,11 @@ pub type Direction = [[f64; 3]; 3];
 pub const IDENTITY_DIRECTION: Direction = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// A volume: a regular grid of point samples. Point `(i, j, k)` sits at
-/// `origin + direction · (spacing ⊙ (i, j, k))` in data (world) coordinates, as in VTK.
+/// `origin + direction · (spacing ⊙ (i, j, k))` in data (world) coordinates, as in VTK;
+/// with per-axis [`VolumeData::coordinates`] (VTK's vtkRectilinearGrid) it sits at
+/// `origin + direction · (x_i − x_0, y_j − y_0, z_k − z_0)` instead, and `origin` and
+/// `spacing` describe the uniform lattice over the same box (see
+/// [`VolumeData::with_coordinates`]).
 #[derive(Clone, Debug)]
 pub struct VolumeData {
     pub dims: [u32; 3],
@@ -225,6 +229,44 @@ pub struct VolumeData {
     /// Number of components per point, 1–4.
     pub components: u32,
     pub scalars: Scalars,
+    /// Per-axis point coordinates (strictly increasing, one per point), or none for a
+    /// uniform grid.
+    pub coordinates: Option<Arc<[Vec<f64>; 3]>>,
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Checks per-axis coordinates against the grid's dimensions: one per point, finite,
+/// strictly increasing; the error names the axis and the first offending value.
+fn check_coordinates(dims: [u32; 3], coordinates: &[Vec<f64>; 3]) -> Result<()> {
+    for (a, c) in coordinates.iter().enumerate() {
+        if c.len() != dims[a] as usize {
+            return Err(Error::InvalidVolume(format!(
+                "{} {} coordinates for a grid of {} points along {}: give one per point",
+                c.len(),
+                AXES[a],
+                dims[a],
+                AXES[a]
+            )));
+        }
+        if let Some(i) = c.iter().position(|x| !x.is_finite()) {
+            return Err(Error::InvalidVolume(format!(
+                "{} coordinate {i} is {}: coordinates must be finite",
+                AXES[a], c[i]
+            )));
+        }
+        if let Some(i) = c.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(Error::InvalidVolume(format!(
+                "{} coordinates {} and {} are {} and {}: coordinates must be strictly increasing",
+                AXES[a],
+                i,
+                i + 1,
+                c[i],
+                c[i + 1]
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The largest world coordinate (and extent) a volume's bounds may reach: the GPU
@@ -241,9 +283,28 @@ impl VolumeData {
             direction: IDENTITY_DIRECTION,
             components,
             scalars,
+            coordinates: None,
         };
         v.validate()?;
         Ok(v)
+    }
+
+    /// Places the points at per-axis coordinates (a rectilinear grid): `coordinates[a]`
+    /// holds one strictly increasing, finite coordinate per point along axis `a`. Sets
+    /// `origin` to the first coordinates and `spacing` to the uniform lattice over the
+    /// same box ((last − first) / (points − 1); an axis of one point keeps its spacing),
+    /// which rays march in; each sample is mapped to the grid's index space per axis.
+    pub fn with_coordinates(mut self, coordinates: [Vec<f64>; 3]) -> Result<Self> {
+        check_coordinates(self.dims, &coordinates)?;
+        for (a, c) in coordinates.iter().enumerate() {
+            self.origin[a] = c[0];
+            if c.len() > 1 {
+                self.spacing[a] = (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64;
+            }
+        }
+        self.coordinates = Some(Arc::new(coordinates));
+        self.validate()?;
+        Ok(self)
     }
 
     pub fn with_spacing(mut self, spacing: [f64; 3]) -> Result<Self> {
@@ -335,6 +396,21 @@ impl VolumeData {
                     self.dims[1],
                     self.dims[2]
                 )));
+            }
+        }
+        if let Some(c) = &self.coordinates {
+            check_coordinates(self.dims, c)?;
+            for (a, c) in c.iter().enumerate() {
+                let n = c.len();
+                let span = c[n - 1] - c[0];
+                let lattice = self.spacing[a] * (n - 1) as f64;
+                let tolerance = 1e-9 * span.abs().max(c[0].abs());
+                if (self.origin[a] - c[0]).abs() > tolerance || (lattice - span).abs() > tolerance {
+                    return Err(Error::InvalidVolume(format!(
+                        "the {} coordinates run from {} to {}, but the origin ({}) and spacing                          ({}) place the grid elsewhere: set the coordinates after the origin                          and spacing (with_coordinates sets both)",
+                        AXES[a], c[0], c[n - 1], self.origin[a], self.spacing[a]
+                    )));
+                }
             }
         }
         if let Some(i) = self.first_non_finite() {
@@ -517,6 +593,49 @@ mod tests {
             .and_then(|v| v.with_spacing([2e38, 1e30, 1.0]))
             .expect("bounds within the f32 range");
         assert_eq!(v.bounds()[..4], [-1e38, 1e38, 0.0, 1e30]);
+    }
+
+    /// Coordinates that are not one per point, not finite or not strictly increasing are
+    /// refused, naming the axis; good ones set the origin and the lattice spacing.
+    #[test]
+    fn coordinates_are_checked_per_axis() {
+        let ok = || [vec![0.0, 1.0, 3.0], vec![-1.0, 1.0], vec![5.0]];
+        for (coords, want) in [
+            (
+                [vec![0.0, 1.0], vec![-1.0, 1.0], vec![5.0]],
+                "2 x coordinates for a grid of 3 points along x",
+            ),
+            (
+                [vec![0.0, 1.0, 3.0], vec![-1.0, f64::NAN], vec![5.0]],
+                "y coordinate 1 is NaN",
+            ),
+            (
+                [vec![0.0, 1.0, 3.0], vec![-1.0, 1.0], vec![f64::INFINITY]],
+                "z coordinate 0 is inf",
+            ),
+            (
+                [vec![0.0, 1.0, 1.0], vec![-1.0, 1.0], vec![5.0]],
+                "x coordinates 1 and 2 are 1 and 1: coordinates must be strictly increasing",
+            ),
+            (
+                [vec![0.0, 1.0, 3.0], vec![1.0, -1.0], vec![5.0]],
+                "y coordinates 0 and 1",
+            ),
+        ] {
+            let e = volume([3, 2, 1])
+                .with_coordinates(coords)
+                .unwrap_err()
+                .to_string();
+            println!("{e}");
+            assert!(e.contains(want), "{e}");
+        }
+        let v = volume([3, 2, 1]).with_coordinates(ok()).unwrap();
+        assert_eq!(v.origin, [0.0, -1.0, 5.0]);
+        assert_eq!(v.spacing, [1.5, 2.0, 1.0]);
+        assert_eq!(v.bounds(), [0.0, 3.0, -1.0, 1.0, 5.0, 5.0]);
+        let e = v.with_spacing([1.0; 3]).unwrap_err().to_string();
+        println!("{e}");
+        assert!(e.contains("the x coordinates run from 0 to 3"), "{e}");
     }
 }
 
