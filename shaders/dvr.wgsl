@@ -45,6 +45,34 @@ override PREINT: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 
+// A rectilinear grid (VolumeData::coordinates): rays march the uniform lattice over the
+// grid's box, and each sample's lattice point is mapped to the grid's index space per axis
+// through a lookup built on the host (Resources::set_volume): row a holds the index-space
+// coordinate at evenly spaced lattice points, column j at j·(n_a − 1)/(width − 1), read
+// linearly between columns. A uniform grid binds a placeholder and leaves it unread.
+@group(0) @binding(12) var grid_lookup: texture_3d<f32>;
+override RECTILINEAR: bool = false;
+
+// The grid's index-space point for the lattice point p, and the rate it changes with p
+// per axis in `index_slope` (world_gradient's scale). Without RECTILINEAR, p itself.
+fn grid_point(p: vec3<f32>) -> vec3<f32> {
+    if (!RECTILINEAR) {
+        return p;
+    }
+    let w = f32(textureDimensions(grid_lookup).x) - 1.0;
+    var q = p;
+    for (var a = 0; a < 3; a = a + 1) {
+        let span = max(frame.dims[a] - 1.0, 1.0);
+        let x = clamp(p[a] / span, 0.0, 1.0) * w;
+        let i = min(floor(x), w - 1.0);
+        let f0 = textureLoad(grid_lookup, vec3<i32>(i32(i), a, 0), 0).x;
+        let f1 = textureLoad(grid_lookup, vec3<i32>(i32(i) + 1, a, 0), 0).x;
+        q[a] = mix(f0, f1, x - i);
+        index_slope[a] = select(1.0, (f1 - f0) * w / span, frame.dims[a] > 1.0);
+    }
+    return q;
+}
+
 // VTK's blanking (ghost arrays, vtkUniformGrid): per point of the grid, non-zero where the
 // point is hidden (Renderer::set_blanking); BLANKING is on when the volume has a mask.
 @group(0) @binding(8) var blanking_mask: texture_3d<u32>;
@@ -434,8 +462,9 @@ fn slice_state(ray: Ray, box: vec2<f32>, term: f32) -> PixelState {
         return st;
     }
     let cl = clip_interval(ray, vec2<f32>(t, t));
-    let p = ray.index_origin + t * ray.index_dir;
-    if (cl.x > cl.y || (CROP && !in_crop(p)) || left_out(p)) {
+    let lp = ray.index_origin + t * ray.index_dir;
+    let p = grid_point(lp);
+    if (cl.x > cl.y || (CROP && !in_crop(lp)) || left_out(p)) {
         return st;
     }
     let s = sample_scalars(p);
@@ -620,7 +649,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             break;
         }
         let t = seg.x + (k + jit) * dt;
-        let p = ray.index_origin + t * ray.index_dir;
+        let lp = ray.index_origin + t * ray.index_dir;
+        let p = grid_point(lp);
         var occupied = true;
         if (SKIP) {
             occupied = block_occupied(p);
@@ -628,7 +658,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // PREINT takes the sample after one taken in an occupied block even in an empty
         // block: its segment begins in the occupied one.
         if (SKIP && !occupied && !(PREINT && front_occupied && front_k == k - 1.0)) {
-            let next = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+            let next = max(k + 1.0, ceil((block_exit(ray, lp) - seg.x) / dt - jit));
             if (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE) {
                 // their terms there are 0, but the samples count
                 misc.x = misc.x + min(next, k_end) - k;
@@ -636,7 +666,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             k = next;
             continue;
         }
-        if ((CROP && !in_crop(p)) || left_out(p)) {
+        if ((CROP && !in_crop(lp)) || left_out(p)) {
             k = k + 1.0;
             continue;
         }
@@ -650,7 +680,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (PREINT) {
                 sf = front;
                 if (front_k != k - 1.0) {
-                    sf = front_scalars(p - dt * ray.index_dir, s);
+                    sf = front_scalars(grid_point(lp - dt * ray.index_dir), s);
+                    _ = grid_point(lp);
                 }
                 front = s;
                 front_k = k;

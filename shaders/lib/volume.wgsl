@@ -253,9 +253,14 @@ fn gradient_at(p: vec3<f32>, s: vec4<f32>) -> Gradient {
     return g;
 }
 
+// The index-space change per unit of the lattice rays march, per axis, at the current
+// sample: 1 on a uniform grid; dvr.wgsl's grid_point sets it on a rectilinear one.
+var<private> index_slope: vec3<f32> = vec3<f32>(1.0);
+
 // World-space gradient of component c.
 fn world_gradient(g: Gradient, c: u32) -> vec3<f32> {
-    return (frame.gradient_to_world * vec4<f32>(g.x[c], g.y[c], g.z[c], 0.0)).xyz;
+    let d = vec3<f32>(g.x[c], g.y[c], g.z[c]) * index_slope;
+    return (frame.gradient_to_world * vec4<f32>(d, 0.0)).xyz;
 }
 
 // A mask's value (Renderer::set_mask, one per point of the grid) at the point nearest to

@@ -236,6 +236,10 @@ pub struct VolumeData {
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
+/// Columns of a rectilinear grid's lookup per width of its narrowest cell
+/// ([`VolumeData::grid_lookup`]).
+const LOOKUP_COLUMNS_PER_CELL: f64 = 64.0;
+
 /// Checks per-axis coordinates against the grid's dimensions: one per point, finite,
 /// strictly increasing; the error names the axis and the first offending value.
 fn check_coordinates(dims: [u32; 3], coordinates: &[Vec<f64>; 3]) -> Result<()> {
@@ -508,6 +512,46 @@ impl VolumeData {
         glam::DMat4::from_cols(c0, c1, c2, c3)
     }
 
+    /// A rectilinear grid's lattice-to-index lookup (dvr.wgsl's `grid_lookup`), or none
+    /// for a uniform grid: `width` columns per axis (rows x, y, z, one after the other),
+    /// column j holding the index-space coordinate of the lattice point j·(n − 1)/(width − 1)
+    /// (the physical point `first + j/(width − 1)·(last − first)`), read linearly between
+    /// columns. The width resolves the narrowest cell by LOOKUP_COLUMNS_PER_CELL columns (at
+    /// most `max_width`): a column that straddles a coordinate, where the index's rate
+    /// changes, is off by at most a quarter of a column's width in the narrower cell's
+    /// units there, 1/256 of an index; a table capped by `max_width` is off by more.
+    pub fn grid_lookup(&self, max_width: u32) -> Option<(u32, Vec<f32>)> {
+        let coords = self.coordinates.as_ref()?;
+        let mut width = 2.0f64;
+        for c in coords.iter().filter(|c| c.len() > 1) {
+            let span = c[c.len() - 1] - c[0];
+            let narrowest = c
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .fold(f64::INFINITY, f64::min);
+            width = width.max((LOOKUP_COLUMNS_PER_CELL * span / narrowest).ceil() + 1.0);
+        }
+        let width = width.min(max_width.max(2) as f64) as u32;
+        let mut table = Vec::with_capacity(3 * width as usize);
+        for c in coords.iter() {
+            let n = c.len();
+            let mut cell = 0;
+            for j in 0..width {
+                if n == 1 {
+                    table.push(0.0);
+                    continue;
+                }
+                let x = c[0] + (c[n - 1] - c[0]) * j as f64 / (width - 1) as f64;
+                while cell + 2 < n && x > c[cell + 1] {
+                    cell += 1;
+                }
+                let f = (x - c[cell]) / (c[cell + 1] - c[cell]);
+                table.push((cell as f64 + f.clamp(0.0, 1.0)) as f32);
+            }
+        }
+        Some((width, table))
+    }
+
     /// Axis-aligned bounds of the volume in data coordinates: [xmin, xmax, ymin, ymax, zmin, zmax].
     pub fn bounds(&self) -> [f64; 6] {
         let m = self.index_to_data();
@@ -633,6 +677,17 @@ mod tests {
         assert_eq!(v.origin, [0.0, -1.0, 5.0]);
         assert_eq!(v.spacing, [1.5, 2.0, 1.0]);
         assert_eq!(v.bounds(), [0.0, 3.0, -1.0, 1.0, 5.0, 5.0]);
+        // x: the narrowest cell is 1 of a 3 span, 64 columns each: 193 columns
+        let (width, table) = v.grid_lookup(8192).unwrap();
+        assert_eq!(width, 193);
+        let at = |a: usize, x: f64| table[a * 193 + (x * 192.0).round() as usize];
+        assert_eq!(
+            [at(0, 0.0), at(0, 1.0 / 3.0), at(0, 2.0 / 3.0), at(0, 1.0)],
+            [0.0, 1.0, 1.5, 2.0]
+        );
+        assert_eq!([at(1, 0.0), at(1, 0.5), at(1, 1.0)], [0.0, 0.5, 1.0]);
+        assert_eq!(at(2, 0.7), 0.0);
+        assert_eq!(v.grid_lookup(100).unwrap().0, 100);
         let e = v.with_spacing([1.0; 3]).unwrap_err().to_string();
         println!("{e}");
         assert!(e.contains("the x coordinates run from 0 to 3"), "{e}");

@@ -47,6 +47,7 @@ pipeline_variant! {
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
         preintegration: bool => "PREINT",
+        rectilinear: bool => "RECTILINEAR",
     }
 }
 
@@ -61,6 +62,8 @@ pub(crate) struct DvrPass {
     no_preintegration: Tables,
     /// Bound in place of the 2D tables when no component has one.
     no_tables_2d: Tables,
+    /// Bound in place of a rectilinear grid's lookup for a uniform grid.
+    no_grid_lookup: wgpu::TextureView,
 }
 
 impl DvrPass {
@@ -84,6 +87,7 @@ impl DvrPass {
                     texture_entry(9, true, V::D2),
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(11, false, V::D2),
+                    texture_entry(12, false, V::D3),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -94,6 +98,7 @@ impl DvrPass {
             no_blanking,
             no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
             no_tables_2d: Tables::new(&ctx.device, [1, 1]),
+            no_grid_lookup: block_grid(ctx, "no grid lookup", [2, 3, 1], &[0f32; 6]),
         })
     }
 
@@ -153,6 +158,25 @@ impl DvrPass {
             ));
         }
         let vol = res.volume()?;
+        let rectilinear = vol.grid_lookup.is_some();
+        if rectilinear && f.volumetric {
+            return Err(Error::Unsupported(
+                "volumetric shadows march uniform grids, and this volume is rectilinear \
+                 (per-axis coordinates): turn the scattering blending off"
+                    .into(),
+            ));
+        }
+        let clipped_voxel = params.clipped_voxel_value.is_some()
+            && !params.clip_planes.is_empty()
+            && params.blend == BlendMode::Composite
+            && (params.shading.enabled || f.gradient_opacity);
+        if rectilinear && clipped_voxel {
+            return Err(Error::Unsupported(
+                "the clipped voxel value applies to uniform grids, and this volume is \
+                 rectilinear (per-axis coordinates): leave the clipped voxel value unset"
+                    .into(),
+            ));
+        }
         let tf = res.transfer_function()?;
         let tables_2d = (0..vol.components as usize)
             .filter(|&c| tf.component(c).table_2d.is_some())
@@ -194,13 +218,17 @@ impl DvrPass {
             && (params.blend == BlendMode::Additive
                 || (params.blend == BlendMode::Average && params.average_range.is_none()));
         // (the occupancy is the 1D tables': blocks are not skipped under 2D tables)
+        // (blocks and their exits are in the grid's index space, which rays on a
+        // rectilinear grid do not march)
         let skip = params.empty_space_skipping
+            && !rectilinear
             && tables_2d == 0
             && (params.blend == BlendMode::Composite || counts_all)
             && occupied < SKIP_MAX_OCCUPANCY;
         // MIP and MinIP skip blocks whose range cannot move the ray's extremum, on
         // one-component volumes (the range grid holds the first component).
         let range_skip = params.empty_space_skipping
+            && !rectilinear
             && matches!(params.blend, BlendMode::Maximum | BlendMode::Minimum)
             && vol.components == 1
             && !streaming;
@@ -251,14 +279,12 @@ impl DvrPass {
             blanking: res.blanking.is_some(),
             mask,
             tables_2d,
-            clipped_voxel: params.clipped_voxel_value.is_some()
-                && !params.clip_planes.is_empty()
-                && params.blend == BlendMode::Composite
-                && (params.shading.enabled || f.gradient_opacity),
+            clipped_voxel,
             precomputed_gradient: vol.gradients,
             forward_diff: params.gradient == GradientMethod::Forward,
             streaming,
             preintegration,
+            rectilinear,
         };
         if preintegration {
             res.ensure_preintegration(ctx, step)?;
@@ -312,6 +338,12 @@ impl DvrPass {
                     ),
                 ),
                 bind(11, wgpu::BindingResource::TextureView(tables_2d_view)),
+                bind(
+                    12,
+                    wgpu::BindingResource::TextureView(
+                        vol.grid_lookup.as_ref().unwrap_or(&self.no_grid_lookup),
+                    ),
+                ),
             ],
         });
         let rect = u.rect;

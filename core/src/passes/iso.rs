@@ -375,7 +375,13 @@ impl IsoPass {
         })?;
         iso.validate()?;
         frame::check_light_count(view)?;
-        res.volume()?;
+        if res.volume()?.grid_lookup.is_some() {
+            return Err(Error::Unsupported(
+                "isosurfaces are found on uniform grids, and this volume is rectilinear \
+                 (per-axis coordinates): use a ray-casting blend mode or resample the grid"
+                    .into(),
+            ));
+        }
         res.ensure_environment(ctx)?;
         let step = res.sample_distance(params)?;
         if iso.scattering.is_some() {

@@ -428,6 +428,13 @@ impl PathTracePass {
                     .into(),
             ));
         }
+        if vol.grid_lookup.is_some() {
+            return Err(Error::Unsupported(
+                "path tracing traces uniform grids, and this volume is rectilinear (per-axis \
+                 coordinates): use a ray-casting blend mode or resample the grid"
+                    .into(),
+            ));
+        }
         if res.tf.as_ref().is_some_and(TransferFunction::has_2d) {
             return Err(Error::Unsupported(
                 "path tracing reads 1D transfer functions: this one has a 2D table (TF_2D)".into(),

@@ -78,6 +78,9 @@ pub(crate) struct GpuVolume {
     pub ranges: wgpu::TextureView,
     /// The pool carries precomputed gradients (binding 3).
     pub gradients: bool,
+    /// A rectilinear grid's lattice-to-index lookup (VolumeData::grid_lookup), an r32float
+    /// grid of width × 3 × 1; none for a uniform grid.
+    pub grid_lookup: Option<wgpu::TextureView>,
     /// Bricked volumes: the data bricks are read from when they become resident.
     host: Option<Arc<VolumeData>>,
     /// The memory budget: most bytes of the pool (with precomputed gradients).
@@ -157,6 +160,15 @@ impl Resources {
             max_bytes,
             SLOT_POINTS,
         )?;
+        if v.coordinates.is_some() && grid.len() > 1 {
+            return Err(Error::Unsupported(format!(
+                "a rectilinear grid (per-axis coordinates) is rendered from one brick, and this                  {}x{}x{} one is bricked (larger than one texture of the device or than the                  memory budget): resample it to a uniform grid or raise the budget",
+                v.dims[0], v.dims[1], v.dims[2]
+            )));
+        }
+        let grid_lookup = v
+            .grid_lookup(info.limits.max_texture_dimension_3d)
+            .map(|(width, table)| block_grid(ctx, "grid lookup", [width, 3, 1], &table));
         let minmax = MinMaxGrid::new(v)?;
         let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
         let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
@@ -204,6 +216,7 @@ impl Resources {
             minmax,
             ranges,
             gradients,
+            grid_lookup,
             host,
             max_bytes,
             slots: Slots::new(grid.len()),

@@ -17,6 +17,7 @@ mod common;
 mod compositing;
 mod masks;
 mod preintegration;
+mod rectilinear;
 mod reference;
 mod silhouettes;
 mod sources;

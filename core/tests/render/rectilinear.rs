@@ -1,0 +1,159 @@
+//! Rectilinear grids (per-axis coordinates, VTK's vtkRectilinearGrid): rays march the box's
+//! uniform lattice and each sample is mapped to the grid's index space per axis.
+
+use crate::common::gpu::{assert_error, renderer};
+use crate::common::images::save_enlarged;
+use crate::common::metrics::{alpha, image_diff};
+use crate::common::raycast::to_pixel;
+use crate::common::scenes::{blob_transfer, blob_volume, shaded, volume, white};
+use ferrovol_core::*;
+use glam::DVec3;
+
+/// The coordinates of a uniform grid's points along each axis.
+fn uniform_coordinates(v: &VolumeData) -> [Vec<f64>; 3] {
+    std::array::from_fn(|a| {
+        (0..v.dims[a])
+            .map(|i| v.origin[a] + v.spacing[a] * i as f64)
+            .collect()
+    })
+}
+
+/// Coordinates that place the points where they already are draw the image of the uniform
+/// grid, in every ray-casting blend mode, shaded composite included.
+#[test]
+fn uniform_coordinates_draw_the_plain_volume() {
+    let mut r = renderer();
+    let plain = blob_volume(24)
+        .with_spacing([0.5, 0.75, 1.0])
+        .and_then(|v| v.with_origin([-3.0, 2.0, 1.0]))
+        .unwrap();
+    let coords = uniform_coordinates(&plain);
+    let rect = plain.clone().with_coordinates(coords).unwrap();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let mut view = View::fit(plain.bounds(), 64, 64);
+    view.camera.azimuth(30.0);
+    view.camera.elevation(20.0);
+    for (name, p) in [
+        ("composite", RenderParams::default()),
+        ("shaded", shaded()),
+        (
+            "mip",
+            RenderParams {
+                blend: BlendMode::Maximum,
+                ..Default::default()
+            },
+        ),
+        (
+            "average",
+            RenderParams {
+                blend: BlendMode::Average,
+                ..Default::default()
+            },
+        ),
+    ] {
+        r.set_volume(&plain).unwrap();
+        let a = r.render_image(&view, &p).unwrap();
+        r.set_volume(&rect).unwrap();
+        let b = r.render_image(&view, &p).unwrap();
+        let (mean, max) = image_diff(&a, &b);
+        println!("{name}: mean {mean:.4}, max {max} levels");
+        save_enlarged(&b, &format!("rectilinear_uniform_{name}"));
+        assert!(a.rgba.iter().any(|&x| x > 40), "{name}: an empty image");
+        // (the lookup reproduces the lattice up to f32 rounding of the index)
+        assert!(max <= 2, "{name}: the images differ by {max} levels");
+    }
+}
+
+/// A step between points 7 and 8 along x, on x coordinates i²: the value crosses 0.5
+/// between x = 49 and x = 64, at x = 56.5 (on the uniform lattice of the same box it would
+/// be at 112.5). Seen along z in perspective, the step's plane and the box's side show
+/// widest on the front face (z = 225, nearest to the camera): the pixels left of the plane
+/// there are empty and those right of it opaque.
+#[test]
+fn a_step_sits_at_its_physical_position() {
+    let mut r = renderer();
+    let v = volume([16, 6, 6], |i, _, _| if i >= 8.0 { 1.0 } else { 0.0 })
+        .with_coordinates([
+            (0..16).map(|i| (i * i) as f64).collect(),
+            (0..6).map(|j| 45.0 * j as f64).collect(),
+            (0..6).map(|k| 45.0 * k as f64).collect(),
+        ])
+        .unwrap();
+    r.set_volume(&v).unwrap();
+    r.set_transfer_function(&white(
+        &[(0.0, 0.0), (0.45, 0.0), (0.55, 1.0), (1.0, 1.0)],
+        1.0,
+    ))
+    .unwrap();
+    let view = View::fit(v.bounds(), 128, 128);
+    let img = r.render_image(&view, &RenderParams::default()).unwrap();
+    save_enlarged(&img, "rectilinear_step");
+    let c = view.camera.focal_point;
+    let col = |x: f64| to_pixel(&view, DVec3::new(x, c.y, 225.0)).0;
+    let row = to_pixel(&view, c).1 as u32;
+    let (lo, hi) = (col(55.0), col(58.0));
+    let (left, right) = (col(0.0), col(225.0));
+    let alphas: Vec<u8> = (0..128).map(|x| alpha(&img, x, row)).collect();
+    println!("step between columns {lo:.1} and {hi:.1} (box {left:.1} to {right:.1}; the uniform lattice's step at {:.1})", col(112.5));
+    println!("row {row}: {alphas:?}");
+    let mut checked = 0;
+    for (x, &a) in alphas.iter().enumerate() {
+        let x = x as f64 + 0.5;
+        if x > left.min(right) + 1.0 && x < lo.min(hi) - 1.0 {
+            assert_eq!(a, 0, "column {x}: before the step");
+            checked += 1;
+        }
+        if x > lo.max(hi) + 1.0 && x < left.max(right) - 1.0 {
+            assert!(a > 200, "column {x}: past the step, alpha {a}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 70, "{checked} columns checked");
+}
+
+/// What needs a uniform grid refuses a rectilinear one, naming the reason: isosurfaces,
+/// path tracing, bricks.
+#[test]
+fn rectilinear_grids_are_refused_where_unsupported() {
+    let mut r = renderer();
+    let plain = blob_volume(24);
+    let v = plain
+        .clone()
+        .with_coordinates(std::array::from_fn(|_| {
+            (0..24).map(|i| (i as f64).powf(1.5)).collect()
+        }))
+        .unwrap();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    r.set_volume(&v).unwrap();
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        0.3,
+        [0.9, 0.8, 0.6],
+        1.0,
+    )]))
+    .unwrap();
+    let view = View::fit(v.bounds(), 32, 32);
+    for blend in [BlendMode::Isosurface, BlendMode::PathTrace] {
+        let p = RenderParams {
+            blend,
+            ..Default::default()
+        };
+        assert_error(
+            r.render_image(&view, &p),
+            &format!("{blend:?}"),
+            &["rectilinear (per-axis coordinates)"],
+        );
+    }
+    assert_error(
+        r.set_volume_with(
+            &v,
+            UploadOptions {
+                max_brick_points: Some(16),
+                ..Default::default()
+            },
+        ),
+        "bricked",
+        &["rectilinear grid", "is bricked"],
+    );
+}
