@@ -288,7 +288,8 @@ typedef struct FvTransferFunction FvTransferFunction;
 /**
  * Volume data on the CPU (a copy of the caller's array), ready to upload to renderers;
  * renderers that keep a bricked volume's data share it (the caller may free the volume).
- * Thread use: immutable after creation; may be read from several threads at once.
+ * Thread use: immutable once its coordinates (if any) are set; may then be read from
+ * several threads at once.
  */
 typedef struct FvVolume FvVolume;
 
@@ -1280,6 +1281,22 @@ enum FvStatus fv_volume_new(const struct FvVolumeDesc *desc,
                             const void *data,
                             size_t data_bytes,
                             struct FvVolume **out);
+
+/**
+ * Places the volume's points at per-axis coordinates (a rectilinear grid, VTK's
+ * vtkRectilinearGrid): `x` holds `nx` values, one per point along x, strictly increasing
+ * and finite, and likewise `y` and `z`. The origin becomes the first coordinates and the
+ * spacing the uniform lattice over the same box. Ray casting renders such volumes;
+ * isosurfaces, path tracing and volumes too large for one texture refuse them. On an
+ * error the volume is unchanged. Not while another thread uses the volume.
+ */
+enum FvStatus fv_volume_set_coordinates(struct FvVolume *volume,
+                                        const double *x,
+                                        size_t nx,
+                                        const double *y,
+                                        size_t ny,
+                                        const double *z,
+                                        size_t nz);
 
 /**
  * Releases a volume (NULL is ignored). Renderers keep what they uploaded.

@@ -116,6 +116,12 @@ public:
     check(fv_volume_range(h_.get(), component, &r));
     return {r[0], r[1]};
   }
+  /// Per-axis point coordinates (fv_volume_set_coordinates).
+  void set_coordinates(const std::vector<double> &x, const std::vector<double> &y,
+                       const std::vector<double> &z) {
+    check(fv_volume_set_coordinates(h_.get(), x.data(), x.size(), y.data(), y.size(),
+                                    z.data(), z.size()));
+  }
   const FvVolume *get() const noexcept { return h_.get(); }
 
 private:

@@ -5,7 +5,8 @@ use std::sync::Arc;
 
 /// Volume data on the CPU (a copy of the caller's array), ready to upload to renderers;
 /// renderers that keep a bricked volume's data share it (the caller may free the volume).
-/// Thread use: immutable after creation; may be read from several threads at once.
+/// Thread use: immutable once its coordinates (if any) are set; may then be read from
+/// several threads at once.
 pub struct FvVolume {
     pub(crate) data: Arc<VolumeData>,
 }
@@ -113,6 +114,40 @@ pub unsafe extern "C" fn fv_volume_new(
         };
         v.validate()?;
         *slot = Box::into_raw(Box::new(FvVolume { data: Arc::new(v) }));
+        Ok(())
+    })
+}
+
+/// Places the volume's points at per-axis coordinates (a rectilinear grid, VTK's
+/// vtkRectilinearGrid): `x` holds `nx` values, one per point along x, strictly increasing
+/// and finite, and likewise `y` and `z`. The origin becomes the first coordinates and the
+/// spacing the uniform lattice over the same box. Ray casting renders such volumes;
+/// isosurfaces, path tracing and volumes too large for one texture refuse them. On an
+/// error the volume is unchanged. Not while another thread uses the volume.
+#[no_mangle]
+pub unsafe extern "C" fn fv_volume_set_coordinates(
+    volume: *mut FvVolume,
+    x: *const f64,
+    nx: usize,
+    y: *const f64,
+    ny: usize,
+    z: *const f64,
+    nz: usize,
+) -> FvStatus {
+    guard(|| {
+        let v = mut_ref(volume, "volume")?;
+        let mut axes: [Vec<f64>; 3] = Default::default();
+        for (out, (ptr, n, name)) in axes
+            .iter_mut()
+            .zip([(x, nx, "x"), (y, ny, "y"), (z, nz, "z")])
+        {
+            if ptr.is_null() {
+                return Err(FfiError::null(name));
+            }
+            // SAFETY: the caller guarantees `ptr` points to `n` readable doubles.
+            *out = unsafe { std::slice::from_raw_parts(ptr, n) }.to_vec();
+        }
+        Arc::make_mut(&mut v.data).set_coordinates(axes)?;
         Ok(())
     })
 }

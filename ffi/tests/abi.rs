@@ -76,6 +76,8 @@ type SetIso = unsafe extern "C" fn(H, *const FvIsoParams) -> FvStatus;
 type SetEnv = unsafe extern "C" fn(H, *const c_char, f32, *const f64, f64) -> FvStatus;
 type SetPt = unsafe extern "C" fn(H, *const FvPathTraceParams) -> FvStatus;
 type Accumulated = unsafe extern "C" fn(H, *mut u32) -> FvStatus;
+type SetCoords =
+    unsafe extern "C" fn(H, *const f64, usize, *const f64, usize, *const f64, usize) -> FvStatus;
 
 fn desc(dims: [u32; 3], components: u32, scalar_type: u32) -> FvVolumeDesc {
     FvVolumeDesc {
@@ -288,6 +290,56 @@ fn volume_errors() {
         assert!(v.is_null(), "a failed fv_volume_new must leave *out NULL");
         lib.ok(new(&d, bytes, 32, &mut v));
         assert!(!v.is_null());
+        lib.f::<Free>("fv_volume_free")(v);
+    }
+}
+
+/// fv_volume_set_coordinates: NULL arrays, a count that is not one per point, values not
+/// finite or not increasing are refused naming the axis, and leave the volume as it was.
+#[test]
+fn rectilinear_coordinates_through_the_c_abi() {
+    let lib = Lib::open();
+    let set = lib.f::<SetCoords>("fv_volume_set_coordinates");
+    let data = [
+        0f32, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0,
+    ];
+    let mut v: H = null_mut();
+    let (x, y, z) = ([0.0, 1.0, 4.0], [0.0, 2.0], [-1.0, 1.0]);
+    let (bad_order, nan) = ([0.0, 4.0, 1.0], [0.0, f64::NAN]);
+    // SAFETY (all calls below): arguments follow the header; invalid ones are the test.
+    unsafe {
+        lib.ok(lib.f::<NewVolume>("fv_volume_new")(
+            &desc([3, 2, 2], 1, FvScalarType::F32 as u32),
+            data.as_ptr().cast(),
+            48,
+            &mut v,
+        ));
+        let p = |a: &[f64]| a.as_ptr();
+        lib.expect(
+            set(null_mut(), p(&x), 3, p(&y), 2, p(&z), 2),
+            Null,
+            "volume",
+        );
+        lib.expect(set(v, p(&x), 3, null(), 2, p(&z), 2), Null, "y is NULL");
+        for (args, needle) in [
+            (
+                (p(&x), 2, p(&y), 2, p(&z), 2),
+                "2 x coordinates for a grid of 3 points along x",
+            ),
+            (
+                (p(&bad_order), 3, p(&y), 2, p(&z), 2),
+                "strictly increasing",
+            ),
+            ((p(&x), 3, p(&y), 2, p(&nan), 2), "z coordinate 1 is NaN"),
+        ] {
+            let (a, na, b, nb, c, nc) = args;
+            lib.expect(set(v, a, na, b, nb, c, nc), Invalid, needle);
+        }
+        lib.ok(set(v, p(&x), 3, p(&y), 2, p(&z), 2));
+        let mut r = [0.0; 2];
+        type Range = unsafe extern "C" fn(H, u32, *mut [f64; 2]) -> FvStatus;
+        lib.ok(lib.f::<Range>("fv_volume_range")(v, 0, &mut r));
+        assert_eq!(r, [0.0, 11.0]);
         lib.f::<Free>("fv_volume_free")(v);
     }
 }

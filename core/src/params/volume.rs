@@ -299,7 +299,14 @@ impl VolumeData {
     /// same box ((last − first) / (points − 1); an axis of one point keeps its spacing),
     /// which rays march in; each sample is mapped to the grid's index space per axis.
     pub fn with_coordinates(mut self, coordinates: [Vec<f64>; 3]) -> Result<Self> {
+        self.set_coordinates(coordinates)?;
+        Ok(self)
+    }
+
+    /// [`VolumeData::with_coordinates`] in place; on an error the volume is unchanged.
+    pub fn set_coordinates(&mut self, coordinates: [Vec<f64>; 3]) -> Result<()> {
         check_coordinates(self.dims, &coordinates)?;
+        let before = (self.origin, self.spacing, self.coordinates.take());
         for (a, c) in coordinates.iter().enumerate() {
             self.origin[a] = c[0];
             if c.len() > 1 {
@@ -307,8 +314,11 @@ impl VolumeData {
             }
         }
         self.coordinates = Some(Arc::new(coordinates));
-        self.validate()?;
-        Ok(self)
+        if let Err(e) = self.validate() {
+            (self.origin, self.spacing, self.coordinates) = before;
+            return Err(e);
+        }
+        Ok(())
     }
 
     pub fn with_spacing(mut self, spacing: [f64; 3]) -> Result<Self> {
