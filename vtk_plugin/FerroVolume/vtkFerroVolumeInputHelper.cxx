@@ -9,6 +9,7 @@
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkPointData.h"
+#include "vtkRectilinearGrid.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
@@ -342,6 +343,41 @@ bool PrepareVolume(
   out.MeanSpacing = (positive[0] + positive[1] + positive[2]) / 3.0;
   return true;
 }
+
+// A rectilinear grid's coordinates as the prepared volume's points: each axis's
+// coordinates, the cells' centres for cell data, and an axis of one point (or cell)
+// thickened as PrepareVolume thickens it, to a slab one spacing thick centred on it.
+std::array<std::vector<double>, 3> GridCoordinates(
+  vtkRectilinearGrid* grid, bool cells, const FvVolumeDesc& desc)
+{
+  vtkDataArray* arrays[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
+    grid->GetZCoordinates() };
+  std::array<std::vector<double>, 3> out;
+  for (int a = 0; a < 3; ++a)
+  {
+    std::vector<double> c;
+    const vtkIdType n = arrays[a] ? arrays[a]->GetNumberOfTuples() : 0;
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      c.push_back(arrays[a]->GetComponent(i, 0));
+    }
+    if (cells && c.size() > 1)
+    {
+      for (size_t i = 0; i + 1 < c.size(); ++i)
+      {
+        c[i] = 0.5 * (c[i] + c[i + 1]);
+      }
+      c.pop_back();
+    }
+    if (c.size() == 1 && desc.dims[a] == 2)
+    {
+      const double h = 0.5 * desc.spacing[a];
+      c = { c[0] - h, c[0] + h };
+    }
+    out[a] = std::move(c);
+  }
+  return out;
+}
 } // namespace
 
 bool vtkFerroVolumeInputHelper::Key::operator==(const Key& o) const
@@ -371,10 +407,19 @@ bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& 
   alg->Update();
   vtkDataSet* dataset = self->GetInput();
   vtkImageData* image = vtkImageData::SafeDownCast(dataset);
+  this->Grid = vtkRectilinearGrid::SafeDownCast(dataset);
+  if (this->Grid)
+  {
+    image = this->ImageOfGrid(error);
+    if (!image)
+    {
+      return false;
+    }
+  }
   if (!image)
   {
     error = std::string("the input is ") + (dataset ? dataset->GetClassName() : "empty") +
-      ": vtkFerroVolumeMapper renders vtkImageData";
+      ": vtkFerroVolumeMapper renders vtkImageData and vtkRectilinearGrid";
     return false;
   }
   vtkDataArray* scalars = FindScalars(self, image, this->CellFlag, error);
@@ -391,6 +436,62 @@ bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& 
   this->Scalars = scalars;
   this->CountGhosts();
   return true;
+}
+
+void vtkFerroVolumeInputHelper::GetCellSpacing(double spacing[3]) const
+{
+  if (!this->Grid)
+  {
+    this->Image->GetSpacing(spacing);
+    return;
+  }
+  double bounds[6];
+  int dims[3];
+  this->Grid->GetBounds(bounds);
+  this->Grid->GetDimensions(dims);
+  for (int a = 0; a < 3; ++a)
+  {
+    spacing[a] = (bounds[2 * a + 1] - bounds[2 * a]) / dims[a];
+  }
+}
+
+vtkImageData* vtkFerroVolumeInputHelper::ImageOfGrid(std::string& error)
+{
+  vtkRectilinearGrid* grid = this->Grid;
+  if (this->GridImage && this->GridImageMTime == grid->GetMTime())
+  {
+    return this->GridImage;
+  }
+  vtkDataArray* arrays[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
+    grid->GetZCoordinates() };
+  int dims[3];
+  grid->GetDimensions(dims);
+  double origin[3], spacing[3];
+  static const char* axisName[3] = { "x", "y", "z" };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!arrays[a] || arrays[a]->GetNumberOfTuples() != dims[a] || dims[a] < 1)
+    {
+      error = std::string("the rectilinear grid's ") + axisName[a] + " coordinates number " +
+        std::to_string(arrays[a] ? arrays[a]->GetNumberOfTuples() : 0) + " for " +
+        std::to_string(dims[a]) + " points along " + axisName[a] + ": give one per point";
+      return nullptr;
+    }
+    const vtkIdType n = dims[a];
+    origin[a] = arrays[a]->GetComponent(0, 0);
+    spacing[a] = n > 1 ? (arrays[a]->GetComponent(n - 1, 0) - origin[a]) / (n - 1) : 0.0;
+  }
+  this->GridImage = vtkSmartPointer<vtkImageData>::New();
+  this->GridImage->SetExtent(grid->GetExtent());
+  this->GridImage->SetSpacing(spacing);
+  // (the extent's first point is the origin the grid's coordinates give)
+  const int* e = grid->GetExtent();
+  this->GridImage->SetOrigin(origin[0] - spacing[0] * e[0], origin[1] - spacing[1] * e[2],
+    origin[2] - spacing[2] * e[4]);
+  this->GridImage->GetPointData()->ShallowCopy(grid->GetPointData());
+  this->GridImage->GetCellData()->ShallowCopy(grid->GetCellData());
+  this->GridImageMTime = grid->GetMTime();
+  return this->GridImage;
 }
 
 void vtkFerroVolumeInputHelper::CountGhosts()
@@ -443,7 +544,14 @@ bool vtkFerroVolumeInputHelper::Upload(
   }
   std::unique_ptr<ferrovol::Volume> volume;
   if (!vtkFerroVolumeCall("take the input volume", error,
-        [&] { volume.reset(new ferrovol::Volume(pv.Desc, pv.Data, pv.Bytes)); }) ||
+        [&] {
+          volume.reset(new ferrovol::Volume(pv.Desc, pv.Data, pv.Bytes));
+          if (this->Grid)
+          {
+            const auto c = GridCoordinates(this->Grid, this->CellFlag == 1, pv.Desc);
+            volume->set_coordinates(c[0], c[1], c[2]);
+          }
+        }) ||
     !vtkFerroVolumeCall("upload the volume", error, [&] {
       renderer.set_memory_budget(budget);
       renderer.set_volume(*volume);

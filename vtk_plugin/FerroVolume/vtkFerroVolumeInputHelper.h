@@ -1,11 +1,13 @@
-// vtkFerroVolumeInputHelper: the mapper's input (vtkImageData and the scalars VTK's mappers
-// would pick) → a ferrovol volume, uploaded only when the scalars (array, MTime, geometry)
+// vtkFerroVolumeInputHelper: the mapper's input (vtkImageData or vtkRectilinearGrid and the
+// scalars VTK's mappers would pick) → a ferrovol volume, uploaded only when the scalars (array, MTime, geometry)
 // changed; also each component's data range, which the tables span. Internal to the
 // FerroVolume module (not wrapped).
 #ifndef vtkFerroVolumeInputHelper_h
 #define vtkFerroVolumeInputHelper_h
 
 #include "vtkType.h"
+
+#include "vtkSmartPointer.h"
 
 #include "ferrovol.hpp"
 
@@ -19,6 +21,7 @@ class vtkDataArray;
 class vtkDataObject;
 class vtkFerroVolumeMapper;
 class vtkImageData;
+class vtkRectilinearGrid;
 
 class vtkFerroVolumeInputHelper
 {
@@ -36,7 +39,15 @@ public:
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }
 
+  // The input as an image: the vtkImageData itself, or for a vtkRectilinearGrid an image
+  // of the same extent and data on the uniform lattice over its box (whose points the
+  // upload then places at the grid's coordinates).
   vtkImageData* GetImage() const { return this->Image; }
+  // vtkOpenGLGPUVolumeRayCastMapper's cell spacing, which its sample distance comes from:
+  // the image's spacing, or a rectilinear grid's bounds per axis over its number of points.
+  void GetCellSpacing(double spacing[3]) const;
+  // Whether the input is a vtkRectilinearGrid.
+  bool IsRectilinear() const { return this->Grid != nullptr; }
   // Whether the selected scalars are cell data (the volume's points are the cell centres).
   bool UsesCellData() const { return this->CellFlag == 1; }
   int GetComponents() const { return this->Components; }
@@ -86,7 +97,15 @@ private:
 
   vtkImageData* Image = nullptr;
   vtkDataArray* Scalars = nullptr;
+  // A rectilinear input, its image (rebuilt when the grid's MTime changes) and that MTime.
+  vtkRectilinearGrid* Grid = nullptr;
+  vtkSmartPointer<vtkImageData> GridImage;
+  vtkMTimeType GridImageMTime = 0;
   int CellFlag = 0;
+
+  // The image of the rectilinear input (GetImage), made again when the grid changed; null
+  // with the reason when its coordinate arrays do not match its dimensions.
+  vtkImageData* ImageOfGrid(std::string& error);
 
   // Counts the marked entries of the image's ghost arrays, when they changed.
   void CountGhosts();

@@ -337,7 +337,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       // the input's spacing (by magnitude) and extent, whatever SampleDistance says.
       double spacing[3];
       int extent[6];
-      input.GetImage()->GetSpacing(spacing);
+      input.GetCellSpacing(spacing);
       input.GetImage()->GetExtent(extent);
       for (double& s : spacing)
       {
@@ -360,15 +360,16 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   }
   else if (this->Blend != FV_BLEND_MODE_PATH_TRACE)
   {
-    // vtkOpenGLGPUVolumeRayCastMapper: the smallest world spacing of the input, lengthened
-    // by the reduction factor the render time asks for. (Path tracing keeps the step: its
-    // accumulation would start over at each change, and its renders fill their time
-    // budget instead.)
+    // vtkOpenGLGPUVolumeRayCastMapper: the smallest world cell spacing of the input,
+    // lengthened by the reduction factor the render time asks for. (Path tracing keeps the
+    // step: its accumulation would start over at each change, and its renders fill their
+    // time budget instead.) The core's default is the same for an image; a rectilinear
+    // grid's cell spacing (GetCellSpacing) is its own.
     const double factor = this->UpdateReductionFactor(self, vol->GetAllocatedRenderTime());
-    if (factor < 1.0)
+    if (factor < 1.0 || input.IsRectilinear())
     {
       double spacing[3];
-      input.GetImage()->GetSpacing(spacing);
+      input.GetCellSpacing(spacing);
       vtkMatrix4x4* m = vol->GetMatrix();
       double smallest = VTK_DOUBLE_MAX;
       for (int axis = 0; axis < 3; ++axis)

@@ -119,19 +119,21 @@ class ErrorCases(unittest.TestCase):
         self.expect_error(["nothing-here", "cell"], configure=select)
         self.recover(lambda m: m.SetScalarModeToDefault())
 
-    def test_not_image_data(self):
+    def test_rectilinear_coordinates_not_increasing(self):
         grid = vtk.vtkRectilinearGrid()
         grid.SetDimensions(4, 4, 4)
-        for setter in (grid.SetXCoordinates, grid.SetYCoordinates, grid.SetZCoordinates):
+        for setter, values in ((grid.SetXCoordinates, (0, 1, 2, 3)),
+                               (grid.SetYCoordinates, (0, 1, 3, 2)),
+                               (grid.SetZCoordinates, (0, 1, 2, 3))):
             c = vtk.vtkDoubleArray()
-            for v in range(4):
+            for v in values:
                 c.InsertNextValue(v)
             setter(c)
         a = vtk.vtkFloatArray()
         a.SetNumberOfTuples(64)
         a.Fill(1.0)
         grid.GetPointData().SetScalars(a)
-        self.expect_error(["vtkRectilinearGrid", "vtkImageData"], data=grid)
+        self.expect_error(["y coordinates 2 and 3", "strictly increasing"], data=grid)
         self.recover()
 
     def test_zero_spacing(self):
