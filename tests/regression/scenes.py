@@ -174,8 +174,38 @@ def frog_mask():
     return m
 
 
+def _rectilinear(cells):
+    """VTK's wavelet, extent -32..31 (64^3 float32), on a vtkRectilinearGrid whose x steps
+    grow from 1 to 2.26 along the axis (y and z: steps of 1.5, float32 and int32
+    coordinates), as point scalars or, on one point more per axis, as cell scalars."""
+    from vtk.util.numpy_support import numpy_to_vtk
+    n = 64
+    values = _wavelet(-32, 31).GetPointData().GetScalars()
+    m = n + 1 if cells else n
+    xs = np.concatenate([[0.0], np.cumsum(1.0 + 0.02 * np.arange(m - 1))])
+    ys = 1.5 * np.arange(m)
+    grid = vtk.vtkRectilinearGrid()
+    grid.SetDimensions(m, m, m)
+    grid.SetXCoordinates(numpy_to_vtk(xs, deep=True))
+    grid.SetYCoordinates(numpy_to_vtk(ys.astype(np.float32), deep=True))
+    grid.SetZCoordinates(numpy_to_vtk(ys.astype(np.int32), deep=True))
+    (grid.GetCellData() if cells else grid.GetPointData()).SetScalars(values)
+    return grid
+
+
+@_cached
+def wavelet_rectilinear_points():
+    return _rectilinear(cells=False)
+
+
+@_cached
+def wavelet_rectilinear_cells():
+    return _rectilinear(cells=True)
+
+
 DATA = {f.__name__: f for f in (wavelet128, wavelet128_blanked, wavelet21, marschner_lobb,
-                                 cranium, colin27, heart, labels, frog)}
+                                 cranium, colin27, heart, labels, frog,
+                                 wavelet_rectilinear_points, wavelet_rectilinear_cells)}
 
 # ---------------------------------------------------------------------------------------
 # Volume properties
@@ -824,6 +854,12 @@ SCENES = [
     Scene("frog-label-map-blend", "frog label map, MaskBlendFactor 0.5, shaded", "frog",
           frog_tf(shade=True), views=one(camera=orbit(30, 20, 1.3)),
           configure=mask(frog_mask, label_map=True, blend_factor=0.5), fixed=False),
+    Scene("rectilinear-points", "wavelet 64^3 point data on a vtkRectilinearGrid whose x "
+          "spacing grows from 1 to 2.26", "wavelet_rectilinear_points", wavelet_tf("linear"),
+          fixed=False, quick=True),
+    Scene("rectilinear-cells", "wavelet 64^3 as cell data of a vtkRectilinearGrid whose x "
+          "spacing grows from 1 to 2.28", "wavelet_rectilinear_cells", wavelet_tf("linear"),
+          fixed=False),
     Scene("labels-composite", "label map 128x128x108 uint8 (skull CT in 4 tissues), "
           "categorical TF, nearest", "labels", label_tf, quick=True,
           views=one(camera=ct_front(30, 10))),
