@@ -421,8 +421,14 @@ impl VolumeData {
                 let tolerance = 1e-9 * span.abs().max(c[0].abs());
                 if (self.origin[a] - c[0]).abs() > tolerance || (lattice - span).abs() > tolerance {
                     return Err(Error::InvalidVolume(format!(
-                        "the {} coordinates run from {} to {}, but the origin ({}) and spacing                          ({}) place the grid elsewhere: set the coordinates after the origin                          and spacing (with_coordinates sets both)",
-                        AXES[a], c[0], c[n - 1], self.origin[a], self.spacing[a]
+                        "the {} coordinates run from {} to {}, but the origin ({}) and spacing \
+                         ({}) place the grid elsewhere: set the coordinates after the origin \
+                         and spacing (with_coordinates sets both)",
+                        AXES[a],
+                        c[0],
+                        c[n - 1],
+                        self.origin[a],
+                        self.spacing[a]
                     )));
                 }
             }

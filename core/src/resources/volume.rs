@@ -162,7 +162,9 @@ impl Resources {
         )?;
         if v.coordinates.is_some() && grid.len() > 1 {
             return Err(Error::Unsupported(format!(
-                "a rectilinear grid (per-axis coordinates) is rendered from one brick, and this                  {}x{}x{} one is bricked (larger than one texture of the device or than the                  memory budget): resample it to a uniform grid or raise the budget",
+                "a rectilinear grid (per-axis coordinates) is rendered from one brick, and this \
+                 {}x{}x{} one is bricked (larger than one texture of the device or than the \
+                 memory budget): resample it to a uniform grid or raise the budget",
                 v.dims[0], v.dims[1], v.dims[2]
             )));
         }
