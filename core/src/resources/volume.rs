@@ -247,25 +247,29 @@ impl Resources {
         uploaded
     }
 
+    /// The current volume's grid of points, which `count` values (of `what`) must cover one
+    /// per point.
+    fn point_grid(&self, what: &str, count: usize) -> Result<[u32; 3]> {
+        let d = self.volume()?.data_dims;
+        let n = d.iter().map(|&x| x as usize).product::<usize>();
+        if count != n {
+            return Err(Error::InvalidParameter(format!(
+                "the {what} has {count} values; the volume's {}x{}x{} grid needs {n}, one per \
+                 point",
+                d[0], d[1], d[2]
+            )));
+        }
+        Ok(d)
+    }
+
     /// The blanking mask of the current volume (Renderer::set_blanking).
     pub fn set_blanking(&mut self, ctx: &Context, mask: Option<&[u8]>) -> Result<()> {
         let Some(mask) = mask else {
             self.blanking = None;
             return Ok(());
         };
-        let vol = self.volume()?;
-        let d = vol.data_dims;
-        let n = d.iter().map(|&x| x as usize).product::<usize>();
-        if mask.len() != n {
-            return Err(Error::InvalidParameter(format!(
-                "the blanking mask has {} values; the volume's {}x{}x{} grid needs {n}",
-                mask.len(),
-                d[0],
-                d[1],
-                d[2]
-            )));
-        }
-        if !vol.single_brick() {
+        let d = self.point_grid("blanking mask", mask.len())?;
+        if !self.volume()?.single_brick() {
             return Err(Error::Unsupported(
                 "blanking needs the volume in one brick, and this one is bricked (larger than \
                  one texture or than the memory budget)"
@@ -284,17 +288,7 @@ impl Resources {
             self.mask = None;
             return Ok(());
         };
-        let d = self.volume()?.data_dims;
-        let n = d.iter().map(|&x| x as usize).product::<usize>();
-        if values.len() != n {
-            return Err(Error::InvalidParameter(format!(
-                "the mask has {} values; the volume's {}x{}x{} grid needs {n}, one per point",
-                values.len(),
-                d[0],
-                d[1],
-                d[2]
-            )));
-        }
+        let d = self.point_grid("mask", values.len())?;
         let max = ctx.info.limits.max_texture_dimension_3d;
         if d.iter().any(|&x| x > max) {
             return Err(Error::Unsupported(format!(
