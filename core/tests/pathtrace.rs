@@ -11,7 +11,7 @@ use glam::DVec3;
 use std::sync::MutexGuard;
 mod common;
 
-use common::gpu::{assert_error, pt_params, renderer, trace};
+use common::gpu::{assert_error, pt_params, renderer, trace, trace_with};
 use common::images::save;
 use common::scenes::{ball, component_transfer, volume, white};
 
@@ -868,27 +868,6 @@ fn opaque_depth_restarts_only_when_it_changes() {
     println!("accumulated paths per pixel with a depth input: {counts:?} (one pixel's depth changed before the third frame)");
     assert_eq!(counts, vec![2, 4, 2, 4, 6]);
     assert_eq!(r.stats().accumulation_restarts - restarts, 2);
-}
-
-/// Path-traced frames of `params` (with the path tracing blend mode) until `spp` paths per
-/// pixel: the mean per pixel.
-fn trace_with(
-    r: &mut Renderer,
-    view: &View,
-    params: &RenderParams,
-    p: &PathTraceParams,
-    spp: u32,
-) -> Vec<[f32; 4]> {
-    let p = PathTraceParams {
-        max_samples: spp,
-        ..*p
-    };
-    r.set_path_tracing(&p).unwrap();
-    r.reset_accumulation();
-    while r.accumulated_samples() < spp {
-        r.render(view, params, None).unwrap();
-    }
-    r.read_accumulation().unwrap()
 }
 
 /// Mean absolute difference of 4×4-pixel block means of two n×n images (rgb).

@@ -143,6 +143,17 @@ pub fn pt_params() -> RenderParams {
 
 /// Renders frames until `spp` paths per pixel are accumulated; returns the mean per pixel.
 pub fn trace(r: &mut Renderer, view: &View, p: &PathTraceParams, spp: u32) -> Vec<[f32; 4]> {
+    trace_with(r, view, &pt_params(), p, spp)
+}
+
+/// [`trace`] with these render parameters (their blend mode path tracing).
+pub fn trace_with(
+    r: &mut Renderer,
+    view: &View,
+    params: &RenderParams,
+    p: &PathTraceParams,
+    spp: u32,
+) -> Vec<[f32; 4]> {
     // (a budget of exactly `spp`: the last frame adds only what is missing)
     let p = PathTraceParams {
         max_samples: spp,
@@ -151,8 +162,7 @@ pub fn trace(r: &mut Renderer, view: &View, p: &PathTraceParams, spp: u32) -> Ve
     r.set_path_tracing(&p).expect("valid path tracing settings");
     r.reset_accumulation();
     while r.accumulated_samples() < spp {
-        r.render(view, &pt_params(), None)
-            .expect("a path-traced frame");
+        r.render(view, params, None).expect("a path-traced frame");
     }
     assert_eq!(r.accumulated_samples(), spp);
     r.read_accumulation().expect("the accumulation")
