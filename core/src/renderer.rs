@@ -115,12 +115,19 @@ impl Renderer {
         self.res.progress = progress;
     }
 
-    /// How much of the volume is on the device (zeros without a volume).
+    /// How much of the volume is on the device (zeros without a volume), and the level of
+    /// detail the last frame drew.
     pub fn residency(&self) -> Residency {
-        self.res
+        let mut r = self
+            .res
             .volume
             .as_ref()
-            .map_or(Residency::default(), |v| v.residency())
+            .map_or(Residency::default(), |v| v.residency());
+        let (dims, level_pool) = self.res.level_residency();
+        r.level = self.res.drawn_level;
+        r.level_dims = dims;
+        r.pool_bytes += level_pool;
+        r
     }
 
     /// Sets the transfer function; its tables are (re)built at the next frame if it changed.
@@ -316,6 +323,9 @@ impl Renderer {
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
         let (ctx, res) = (&self.ctx, &mut self.res);
+        if params.blend != BlendMode::PathTrace {
+            res.release_level();
+        }
         let input = |res| FrameInput {
             ctx,
             res,
@@ -336,7 +346,10 @@ impl Renderer {
                 let pass = ensure(&mut self.pt, || {
                     Ok(Box::new(PathTracePass::new(ctx, brick_bgl)?))
                 })?;
-                pass.render(input(res), &self.pt_params)
+                res.enter_level(ctx, params)?;
+                let done = pass.render(input(&mut *res), &self.pt_params);
+                res.leave_level();
+                done
             }
             _ => self.dvr.render(input(res)),
         }

@@ -11,9 +11,10 @@ use glam::DVec3;
 use std::sync::MutexGuard;
 mod common;
 
+use common::gpu::new_renderer;
 use common::gpu::{assert_error, pt_params, renderer, trace, trace_with};
 use common::images::save;
-use common::scenes::{ball, component_transfer, volume, white};
+use common::scenes::{ball, blob_volume, component_transfer, volume, white};
 
 /// Colour `rgb` everywhere, opacity ramping linearly over [0, 1] from `a0` to `a1`.
 fn medium(rgb: [f32; 3], a0: f32, a1: f32, unit: f64) -> TransferFunction {
@@ -980,4 +981,85 @@ fn masks_shape_the_medium() {
     assert!(d_binary < 2.0 * noise + 0.002, "binary mask: {d_binary}");
     assert!(d_labels < 2.0 * noise + 0.002, "label map: {d_labels}");
     assert!(d_plain > 5.0 * noise, "the scenes differ from each other");
+}
+
+/// A volume whose bricks exceed the memory budget is path traced at the finest coarser
+/// level that fits: the same accumulation as that level uploaded directly, close to the
+/// volume itself (the difference a level costs is printed); a ray-cast frame drops the
+/// level's pool and draws the volume itself; a mask, which is not downsampled, is refused.
+#[test]
+fn past_the_budget_a_coarser_level_is_traced() {
+    let vol = blob_volume(48);
+    let tf = medium([0.9, 0.7, 0.5], 0.0, 1.0, 3.0);
+    let dense = 48u64.pow(3) * 4;
+    let opts = |budget: Option<u64>| UploadOptions {
+        max_brick_points: Some(32),
+        memory_budget: budget,
+        ..Default::default()
+    };
+    let view = View::fit(vol.bounds(), 48, 48);
+    let p = PathTraceParams {
+        samples_per_frame: 16,
+        ..Default::default()
+    };
+    let traced = |v: &VolumeData, budget: Option<u64>| {
+        let mut r = new_renderer();
+        r.set_volume_with(v, opts(budget)).unwrap();
+        r.set_transfer_function(&tf).unwrap();
+        let acc = trace(&mut r, &view, &p, 64);
+        (r, acc)
+    };
+    let (mut r, coarse) = traced(&vol, Some(dense / 4));
+    save(&r.read_image().unwrap(), "pathtrace-coarser-level");
+    let res = r.residency();
+    println!("past the budget: {res:?}");
+    assert_eq!(
+        res.level, 2,
+        "a level 2x coarser fits a quarter of the volume"
+    );
+    assert_eq!(res.level_dims, [25; 3]);
+    assert!(res.pool_bytes <= dense / 4, "only the level's pool is held");
+    let (_, direct) = traced(&vol.downsampled(2).unwrap(), Some(dense / 4));
+    let same = coarse
+        .iter()
+        .zip(&direct)
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+        .fold(0f32, f32::max);
+    assert!(same < 1e-5, "the level traced as uploaded directly: {same}");
+    let (_, fine) = traced(&vol, None);
+    let level_cost = block_difference(&coarse, &fine, 48);
+    let noise = {
+        let (_, again) = traced(&vol, None);
+        let mut other = new_renderer();
+        other.set_volume(&vol).unwrap();
+        other.set_transfer_function(&tf).unwrap();
+        let q = PathTraceParams { seed: 7, ..p };
+        let reseeded = trace(&mut other, &view, &q, 64);
+        assert_eq!(again, fine, "the same seed traces the same paths");
+        block_difference(&reseeded, &fine, 48)
+    };
+    println!("coarser level against the volume: {level_cost:.4}; another seed: {noise:.4}");
+    assert!(
+        level_cost < 3.0 * noise + 0.01,
+        "a level 2x coarser of a smooth volume stays within the noise's order"
+    );
+    // a ray-cast frame draws the volume itself, within the budget
+    r.render(&view, &RenderParams::default(), None).unwrap();
+    let res = r.residency();
+    assert_eq!((res.level, res.level_dims), (1, [48; 3]));
+    assert!(
+        res.pool_bytes <= dense / 4,
+        "the level's pool is dropped: {res:?}"
+    );
+    let mask = vec![1u8; 48 * 48 * 48];
+    r.set_mask(Some((&mask, MaskKind::Binary))).unwrap();
+    assert_error(
+        r.render(&view, &pt_params(), None),
+        "a mask past the budget",
+        &[
+            "memory budget",
+            "coarser level",
+            "masks are not downsampled",
+        ],
+    );
 }

@@ -4,6 +4,7 @@
 
 pub mod camera;
 mod check;
+pub(crate) mod downsample;
 pub mod environment;
 pub mod iso;
 pub mod light;

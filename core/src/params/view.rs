@@ -41,8 +41,9 @@ pub struct UploadOptions {
     /// any precomputed gradients); `None` = the device's single-allocation limit. A volume
     /// larger than this is bricked and only the bricks a frame needs are resident; when
     /// even they do not fit, ray casting and isosurfaces stream them through the pool, front
-    /// to back, in several passes of one frame (path tracing, volumetric shadows, ambient
-    /// occlusion and scattering between isosurfaces report the sizes).
+    /// to back, in several passes of one frame; path tracing draws the finest coarser level
+    /// that fits ([`VolumeData::downsampled`], reported by [`Residency::level`]); volumetric
+    /// shadows, ambient occlusion and scattering between isosurfaces report the sizes.
     pub memory_budget: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
@@ -83,8 +84,15 @@ pub type StreamProgress = Box<dyn FnMut(u32, u32) + Send>;
 pub struct Residency {
     pub bricks: u32,
     pub resident: u32,
+    /// Bytes of the pools on the device: the volume's and a coarser level's.
     pub pool_bytes: u64,
     pub dense_bytes: u64,
+    /// Fine points per point, along each axis, of the level the last frame drew: 1 for the
+    /// volume itself; 2, 4, … when a path-traced frame's bricks exceed the memory budget and
+    /// it drew a level downsampled that much (the finest that fits).
+    pub level: u32,
+    /// That level's points per axis.
+    pub level_dims: [u32; 3],
 }
 
 /// A finished frame read back to the CPU.

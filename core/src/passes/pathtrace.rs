@@ -105,6 +105,9 @@ struct Accumulation {
 const _: () = assert!(std::mem::size_of::<PathTraceUniforms>() as u64 <= UNIFORM_STRIDE);
 
 /// The path tracer with its accumulation, created on first use.
+/// What the block majorants are built from: volume and table uploads, the mask, the level.
+type MajorantKey = (u32, u32, u64, u32);
+
 pub(crate) struct PathTracePass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<PathTraceVariant>,
@@ -120,7 +123,7 @@ pub(crate) struct PathTracePass {
     env_dist: Option<(u64, u32, wgpu::Buffer)>,
     /// The block majorants: (the volume and table upload counts they were computed at,
     /// buffer, the largest).
-    majorants: Option<((u32, u32, u64), wgpu::TextureView, f32)>,
+    majorants: Option<(MajorantKey, wgpu::TextureView, f32)>,
     /// Bound in place of the mask when the volume has none.
     no_mask: wgpu::TextureView,
     /// What the accumulated paths were traced with; a different key starts over.
@@ -400,6 +403,7 @@ impl PathTracePass {
             res.stats.volume_uploads,
             res.stats.table_uploads,
             res.mask_generation,
+            res.drawn_level,
         );
         if let Some((k, _, max)) = self.majorants.as_ref() {
             if *k == key {
@@ -484,7 +488,11 @@ impl PathTracePass {
         };
         let key = format!(
             "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{}|{depth_input}",
-            (res.stats.volume_uploads, res.stats.table_uploads),
+            (
+                res.stats.volume_uploads,
+                res.stats.table_uploads,
+                res.drawn_level,
+            ),
             res.environment.generation,
             res.generation,
             res.mask_generation

@@ -5,6 +5,7 @@
 pub(crate) mod bricks;
 pub(crate) mod environment;
 pub(crate) mod gradients;
+pub(crate) mod levels;
 pub(crate) mod residency;
 pub(crate) mod tables;
 pub(crate) mod targets;
@@ -34,6 +35,11 @@ pub(crate) struct Resources {
     /// The frame uniforms (lib/common.wgsl's Frame), written by each pass.
     pub frame_buf: wgpu::Buffer,
     pub volume: Option<GpuVolume>,
+    /// A coarser level of a bricked volume, built when a path-traced frame's bricks exceed
+    /// the memory budget (levels.rs).
+    pub level: Option<levels::Level>,
+    /// Fine points per point of the level the last frame drew (1: the volume itself).
+    pub drawn_level: u32,
     /// Per point of the volume's grid, non-zero where it is blanked (r8uint), or none.
     pub blanking: Option<wgpu::TextureView>,
     /// The mask of the current volume (r8uint, one value per point) and what it means.
@@ -103,6 +109,8 @@ impl Resources {
             nearest: sampler(wgpu::FilterMode::Nearest),
             frame_buf,
             volume: None,
+            level: None,
+            drawn_level: 1,
             tf: None,
             tables: None,
             preintegration: None,

@@ -8,6 +8,7 @@
 use super::bricks::{self, BrickGrid, FrontToBack, Layout, MinMaxGrid};
 use super::gradients::GradientPass;
 use super::residency::{self, Slots, NOT_LATER};
+use super::tables::{Occupancy, TableKey};
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::bind;
@@ -82,9 +83,9 @@ pub(crate) struct GpuVolume {
     /// grid of width × 3 × 1; none for a uniform grid.
     pub grid_lookup: Option<wgpu::TextureView>,
     /// Bricked volumes: the data bricks are read from when they become resident.
-    host: Option<Arc<VolumeData>>,
+    pub(super) host: Option<Arc<VolumeData>>,
     /// The memory budget: most bytes of the pool (with precomputed gradients).
-    max_bytes: u64,
+    pub(super) max_bytes: u64,
     /// Which brick is in which slot, and when each was last used.
     slots: Slots,
     /// Layers of slots the pool texture has.
@@ -97,6 +98,8 @@ pub(crate) struct GpuVolume {
     uniform: wgpu::Buffer,
     /// Bind groups through the linear and the nearest sampler, once the pool exists.
     groups: Option<[wgpu::BindGroup; 2]>,
+    /// What the volume was uploaded with (its coarser levels are uploaded alike).
+    pub opts: UploadOptions,
 }
 
 impl GpuVolume {
@@ -128,6 +131,8 @@ impl GpuVolume {
                 bytes([s.width, s.height, s.depth_or_array_layers])
             }),
             dense_bytes: bytes(self.data_dims),
+            level: 1,
+            level_dims: self.data_dims,
         }
     }
 }
@@ -141,96 +146,9 @@ impl Resources {
         host: HostVolume<'_>,
         opts: UploadOptions,
     ) -> Result<()> {
-        let v = host.data();
-        v.validate()?;
-        let info = &ctx.info;
-        let layout = bricks::choose_storage(v, info)?;
-        let texel_bytes = layout.texel_bytes;
-        let max_pool = info.limits.max_texture_dimension_3d;
-        let max_brick = opts.max_brick_points.unwrap_or(max_pool);
-        let max_bytes = opts
-            .memory_budget
-            .unwrap_or(u64::MAX)
-            .min(info.limits.max_buffer_size);
-        let grid = bricks::plan_bricks(
-            v.dims,
-            texel_bytes,
-            max_brick,
-            max_pool,
-            max_bytes,
-            SLOT_POINTS,
-        )?;
-        if v.coordinates.is_some() && grid.len() > 1 {
-            return Err(Error::Unsupported(format!(
-                "a rectilinear grid (per-axis coordinates) is rendered from one brick, and this \
-                 {}x{}x{} one is bricked (larger than one texture of the device or than the \
-                 memory budget): resample it to a uniform grid or raise the budget",
-                v.dims[0], v.dims[1], v.dims[2]
-            )));
-        }
-        let grid_lookup = v
-            .grid_lookup(info.limits.max_texture_dimension_3d)
-            .map(|(width, table)| block_grid(ctx, "grid lookup", [width, 3, 1], &table));
-        let minmax = MinMaxGrid::new(v)?;
-        let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
-        let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
-        let gradients = wants_gradients(v, &opts);
-        let nc = v.components as usize;
-        // Empty bricks read as a constant that lies in their range: the lowest value of each
-        // component (as a texel), transparent wherever the whole range is.
-        let mut constants = vec![[0f32; 4]; grid.len()];
-        for (i, c) in constants.iter_mut().enumerate() {
-            let mut lo = [f32::INFINITY; 4];
-            for block in grid.blocks_of(i, minmax.dims) {
-                for (comp, l) in lo.iter_mut().enumerate().take(nc) {
-                    *l = l.min(minmax.ranges[block * nc + comp][0]);
-                }
-            }
-            for comp in 0..nc {
-                c[comp] = (lo[comp] - layout.shift[comp]) / layout.scale[comp];
-            }
-        }
-        let page = vec![PAGE_EMPTY; grid.len()];
-        let page_table = block_grid_texture(ctx, "page table", grid.counts, &page);
-        let constants = block_grid_texture(ctx, "empty bricks' values", grid.counts, &constants);
-        let uniform = uniform_buffer(
-            ctx,
-            "pool uniforms",
-            std::mem::size_of::<PoolUniforms>() as u64,
-        );
-        let data_dims = v.dims;
-        let components = v.components;
-        let index_to_data = v.index_to_data();
-        let (host, whole) = if grid.len() == 1 {
-            (
-                None,
-                Some(bricks::brick_texels(v, &layout, [0; 3], v.dims)?),
-            )
-        } else {
-            (Some(host.into_shared()), None)
-        };
-        self.volume = Some(GpuVolume {
-            data_dims,
-            components,
-            index_to_data,
-            layout,
-            grid,
-            minmax,
-            ranges,
-            gradients,
-            grid_lookup,
-            host,
-            max_bytes,
-            slots: Slots::new(grid.len()),
-            layers: 0,
-            pool: None,
-            gradient: None,
-            page,
-            page_table,
-            constants,
-            uniform,
-            groups: None,
-        });
+        let (volume, whole) = new_volume(ctx, host, opts)?;
+        self.volume = Some(volume);
+        self.level = None;
         self.occupancy = None;
         self.blanking = None;
         self.mask = None;
@@ -246,7 +164,110 @@ impl Resources {
         }
         uploaded
     }
+}
 
+/// A volume on the device, not yet installed: its bricks planned, its min–max grid read,
+/// and, when it is one brick, the texels [`Resources::upload_whole`] uploads.
+pub(super) fn new_volume(
+    ctx: &Context,
+    host: HostVolume<'_>,
+    opts: UploadOptions,
+) -> Result<(GpuVolume, Option<Vec<u8>>)> {
+    let v = host.data();
+    v.validate()?;
+    let info = &ctx.info;
+    let layout = bricks::choose_storage(v, info)?;
+    let texel_bytes = layout.texel_bytes;
+    let max_pool = info.limits.max_texture_dimension_3d;
+    let max_brick = opts.max_brick_points.unwrap_or(max_pool);
+    let max_bytes = opts
+        .memory_budget
+        .unwrap_or(u64::MAX)
+        .min(info.limits.max_buffer_size);
+    let grid = bricks::plan_bricks(
+        v.dims,
+        texel_bytes,
+        max_brick,
+        max_pool,
+        max_bytes,
+        SLOT_POINTS,
+    )?;
+    if v.coordinates.is_some() && grid.len() > 1 {
+        return Err(Error::Unsupported(format!(
+            "a rectilinear grid (per-axis coordinates) is rendered from one brick, and this \
+                 {}x{}x{} one is bricked (larger than one texture of the device or than the \
+                 memory budget): resample it to a uniform grid or raise the budget",
+            v.dims[0], v.dims[1], v.dims[2]
+        )));
+    }
+    let grid_lookup = v
+        .grid_lookup(info.limits.max_texture_dimension_3d)
+        .map(|(width, table)| block_grid(ctx, "grid lookup", [width, 3, 1], &table));
+    let minmax = MinMaxGrid::new(v)?;
+    let bounds = minmax.sample_bounds(0, v.components as usize, &layout);
+    let ranges = block_grid(ctx, "block ranges", minmax.dims, &bounds);
+    let gradients = wants_gradients(v, &opts);
+    let nc = v.components as usize;
+    // Empty bricks read as a constant that lies in their range: the lowest value of each
+    // component (as a texel), transparent wherever the whole range is.
+    let mut constants = vec![[0f32; 4]; grid.len()];
+    for (i, c) in constants.iter_mut().enumerate() {
+        let mut lo = [f32::INFINITY; 4];
+        for block in grid.blocks_of(i, minmax.dims) {
+            for (comp, l) in lo.iter_mut().enumerate().take(nc) {
+                *l = l.min(minmax.ranges[block * nc + comp][0]);
+            }
+        }
+        for comp in 0..nc {
+            c[comp] = (lo[comp] - layout.shift[comp]) / layout.scale[comp];
+        }
+    }
+    let page = vec![PAGE_EMPTY; grid.len()];
+    let page_table = block_grid_texture(ctx, "page table", grid.counts, &page);
+    let constants = block_grid_texture(ctx, "empty bricks' values", grid.counts, &constants);
+    let uniform = uniform_buffer(
+        ctx,
+        "pool uniforms",
+        std::mem::size_of::<PoolUniforms>() as u64,
+    );
+    let data_dims = v.dims;
+    let components = v.components;
+    let index_to_data = v.index_to_data();
+    let (host, whole) = if grid.len() == 1 {
+        (
+            None,
+            Some(bricks::brick_texels(v, &layout, [0; 3], v.dims)?),
+        )
+    } else {
+        (Some(host.into_shared()), None)
+    };
+    let volume = GpuVolume {
+        data_dims,
+        components,
+        index_to_data,
+        layout,
+        grid,
+        minmax,
+        ranges,
+        gradients,
+        grid_lookup,
+        host,
+        max_bytes,
+        slots: Slots::new(grid.len()),
+        layers: 0,
+        pool: None,
+        gradient: None,
+        page,
+        page_table,
+        constants,
+        uniform,
+        groups: None,
+        opts,
+    };
+    Ok((volume, whole))
+}
+
+impl Resources {
     /// The current volume's grid of points, which `count` values (of `what`) must cover one
     /// per point.
     fn point_grid(&self, what: &str, count: usize) -> Result<[u32; 3]> {
@@ -303,7 +324,7 @@ impl Resources {
     }
 
     /// A one-brick volume: its texture (of `texels`) is the pool.
-    fn upload_whole(&mut self, ctx: &Context, texels: &[u8]) -> Result<()> {
+    pub(super) fn upload_whole(&mut self, ctx: &Context, texels: &[u8]) -> Result<()> {
         let vol = self.volume.as_mut().expect("set above");
         let pool = new_pool(ctx, vol, 1)?;
         upload_texture(&ctx.queue, &pool, texels, vol.layout.texel_bytes);
@@ -578,8 +599,16 @@ fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
         .collect()
 }
 
+/// The bricks overlapping a block `occupancy` flags (all bricks without), and the slots
+/// the memory budget holds.
+pub(super) fn demand(vol: &GpuVolume, occupancy: Option<&Occupancy<TableKey>>) -> (u32, u32) {
+    let needed = needed_bricks(vol, occupancy.map(|o| &o.flags[..]));
+    let count = needed.iter().filter(|&&n| n).count() as u32;
+    (count, capacity(vol))
+}
+
 /// Bytes of one slot: its points, with any precomputed gradients.
-fn slot_bytes(vol: &GpuVolume) -> u64 {
+pub(super) fn slot_bytes(vol: &GpuVolume) -> u64 {
     let point = vol.layout.texel_bytes as u64 + if vol.gradients { 8 } else { 0 };
     vol.grid.slot.iter().map(|&d| d as u64).product::<u64>() * point
 }
@@ -604,7 +633,7 @@ fn over_budget(vol: &GpuVolume, count: u32) -> Error {
 }
 
 /// Bytes as MiB below a GiB, GiB above.
-fn size_text(bytes: u64) -> String {
+pub(super) fn size_text(bytes: u64) -> String {
     let mib = bytes as f64 / (1u64 << 20) as f64;
     if mib < 1024.0 {
         format!("{mib:.1} MiB")
@@ -614,7 +643,7 @@ fn size_text(bytes: u64) -> String {
 }
 
 /// No brick resident and no pool (after a failed upload: the next frame starts again).
-fn forget(vol: &mut GpuVolume) {
+pub(super) fn forget(vol: &mut GpuVolume) {
     vol.slots = Slots::new(vol.grid.len());
     vol.page.fill(PAGE_EMPTY);
     vol.pool = None;

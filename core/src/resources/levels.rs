@@ -1,0 +1,169 @@
+//! Coarser levels of a bricked volume, for the pass whose rays go anywhere (path tracing):
+//! streaming front to back cannot serve its scattered rays, so when the bricks it needs
+//! exceed the memory budget it draws the finest level, downsampled by a power of two per
+//! axis, whose needed bricks fit. A level is built from the volume's host data (a source is
+//! read once, slab by slab, never whole) and kept until the volume changes; only one level
+//! holds a pool on the device at a time.
+
+use super::tables::{Occupancy, TableKey};
+use super::volume::{self, GpuVolume, HostVolume};
+use super::Resources;
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use crate::params::downsample::coarse_points;
+use crate::params::RenderParams;
+use std::sync::Arc;
+
+/// A coarser level of the current volume, swapped with it while a frame draws it.
+pub(crate) struct Level {
+    /// Fine points per coarse point along each axis (a power of two).
+    pub factor: u32,
+    /// The level's volume; the fine volume while the level is swapped in.
+    volume: Option<GpuVolume>,
+    occupancy: Option<Occupancy<TableKey>>,
+    /// Whether the level is the resources' volume now.
+    active: bool,
+}
+
+impl Resources {
+    /// Before a path-traced frame: leaves the volume as it is when the bricks the frame
+    /// needs fit the memory budget (dropping any coarser level's pool), otherwise swaps in
+    /// the finest coarser level whose needed bricks fit, building it if needed, and drops
+    /// the fine level's pool. [`Resources::leave_level`] swaps back after the frame.
+    pub fn enter_level(&mut self, ctx: &Context, params: &RenderParams) -> Result<()> {
+        self.drawn_level = 1;
+        if self.fits(ctx, params)? {
+            self.release_level();
+            return Ok(());
+        }
+        if self.mask.is_some() {
+            return Err(Error::Unsupported(
+                "the bricks this path-traced frame needs exceed the volume's memory budget, \
+                 so it would draw a coarser level of the volume, and masks are not \
+                 downsampled: raise the budget or clear the mask"
+                    .into(),
+            ));
+        }
+        // The first level tried: the finest whose occupied share of its points fits
+        // (without the bricks' aprons, so it may not; the next is tried then).
+        let fine = self.volume()?;
+        let (needed, _) = volume::demand(fine, self.occupancy.as_ref());
+        let share = needed as f64 / fine.grid.len() as f64;
+        let point = fine.layout.texel_bytes as f64 + if fine.gradients { 8.0 } else { 0.0 };
+        let budget = fine.max_bytes;
+        let level_bytes = |f: u32| {
+            let points: f64 = fine
+                .data_dims
+                .iter()
+                .map(|&n| coarse_points(n, f) as f64)
+                .product();
+            points * point * share
+        };
+        let mut factor = 2;
+        while level_bytes(factor) > budget as f64 && fine.data_dims.iter().any(|&n| n > factor) {
+            factor *= 2;
+        }
+        let dims = fine.data_dims;
+        volume::forget(self.volume.as_mut().expect("checked above"));
+        loop {
+            if self.level.as_ref().is_none_or(|l| l.factor < factor) {
+                self.build_level(ctx, factor)?;
+            }
+            self.swap_level();
+            if self.fits(ctx, params)? {
+                self.drawn_level = self.level.as_ref().expect("swapped in").factor;
+                return Ok(());
+            }
+            self.swap_level();
+            factor = self.level.as_ref().expect("built above").factor * 2;
+            if dims.iter().all(|&n| n <= 2 * factor) {
+                // (a level of 2 or 3 points per axis that does not fit: the budget is below
+                // what bricking itself needs, which building the level reports first)
+                return Err(Error::Unsupported(format!(
+                    "even a level of the volume {factor}x coarser per axis exceeds its memory \
+                     budget ({}): raise the budget",
+                    volume::size_text(budget)
+                )));
+            }
+        }
+    }
+
+    /// After a frame [`Resources::enter_level`] prepared: the fine volume back in place.
+    pub fn leave_level(&mut self) {
+        if self.level.as_ref().is_some_and(|l| l.active) {
+            self.swap_level();
+        }
+    }
+
+    /// Before a frame that draws the volume itself: any coarser level's pool is dropped, so
+    /// that the memory budget holds.
+    pub fn release_level(&mut self) {
+        self.drawn_level = 1;
+        if let Some(v) = self.level.as_mut().and_then(|l| l.volume.as_mut()) {
+            volume::forget(v);
+        }
+    }
+
+    /// Whether the bricks a frame with `params` needs at the current level (those the
+    /// transfer function makes visible) fit the memory budget.
+    fn fits(&mut self, ctx: &Context, params: &RenderParams) -> Result<bool> {
+        let step = self.sample_distance(params)?;
+        self.ensure_occupancy(ctx, step)?;
+        let vol = self.volume()?;
+        let (needed, capacity) = volume::demand(vol, self.occupancy.as_ref());
+        Ok(vol.host.is_none() || needed <= capacity)
+    }
+
+    /// Builds the level `factor` times coarser than the (fine, swapped-out) volume.
+    fn build_level(&mut self, ctx: &Context, factor: u32) -> Result<()> {
+        let fine = self.volume()?;
+        let host = fine
+            .host
+            .clone()
+            .expect("only a bricked volume exceeds its budget");
+        let opts = fine.opts;
+        self.level = None;
+        let data = host.downsampled(factor)?;
+        let (coarse, whole) = volume::new_volume(ctx, HostVolume::Shared(Arc::new(data)), opts)?;
+        self.level = Some(Level {
+            factor,
+            volume: Some(coarse),
+            occupancy: None,
+            active: false,
+        });
+        if let Some(texels) = whole {
+            self.swap_level();
+            let uploaded = self.upload_whole(ctx, &texels);
+            self.swap_level();
+            if uploaded.is_err() {
+                self.level = None;
+            }
+            uploaded?;
+        }
+        Ok(())
+    }
+
+    /// The points per axis of the level the last frame drew, and the bytes of a coarser
+    /// level's pool.
+    pub fn level_residency(&self) -> ([u32; 3], u64) {
+        let fine = self.volume.as_ref().map_or([0; 3], |v| v.data_dims);
+        match self.level.as_ref().and_then(|l| l.volume.as_ref()) {
+            Some(v) => {
+                let dims = if self.drawn_level > 1 {
+                    v.data_dims
+                } else {
+                    fine
+                };
+                (dims, v.residency().pool_bytes)
+            }
+            None => (fine, 0),
+        }
+    }
+
+    fn swap_level(&mut self) {
+        let l = self.level.as_mut().expect("a level");
+        std::mem::swap(&mut self.volume, &mut l.volume);
+        std::mem::swap(&mut self.occupancy, &mut l.occupancy);
+        l.active = !l.active;
+    }
+}
