@@ -45,6 +45,115 @@ override PREINT: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 
+// Volumes intermixed with the main one per sample (Renderer::set_intermixed_volumes, VTK's
+// vtkMultiVolume), INTERMIX of them (composite, one component each): their points in one
+// atlas, stacked along z from dims.w, classified by tables of their own (two rows each, as
+// lib/common.wgsl lays a component's out). The rays march the world box holding every
+// volume; each sample composites the main volume where its grid holds the sample, then each
+// intermixed volume in turn where its grid does, as VTK's multi-volume shader does.
+override INTERMIX: u32 = 0u;
+
+struct IntermixedVolume {
+    world_to_index: mat4x4<f32>,
+    gradient_to_world: mat4x4<f32>,
+    dims: vec4<f32>,
+    range: vec4<f32>,
+}
+
+struct Intermix {
+    box_lo: vec4<f32>,
+    box_hi: vec4<f32>,
+    volumes: array<IntermixedVolume, MAX_INTERMIXED>,
+}
+
+@group(0) @binding(13) var<uniform> intermix: Intermix;
+@group(0) @binding(14) var intermix_atlas: texture_3d<f32>;
+@group(0) @binding(15) var intermix_tables: texture_2d<f32>;
+
+// Whether index-space point p lies in the grid of `dims` points (its faces included).
+fn in_grid(p: vec3<f32>, dims: vec3<f32>) -> bool {
+    return all(p >= vec3<f32>(0.0)) && all(p <= dims - 1.0);
+}
+
+// Intermixed volume j's value at index-space point p (clamped to its grid, as a clamping
+// sampler reads): its nearest point with NEAREST, else trilinear between its points.
+fn intermixed_value(j: u32, p: vec3<f32>) -> f32 {
+    let d = intermix.volumes[j].dims;
+    let hi = d.xyz - 1.0;
+    let q = clamp(p, vec3<f32>(0.0), hi);
+    let z0 = vec3<i32>(0, 0, i32(d.w));
+    if (NEAREST) {
+        return textureLoad(intermix_atlas, vec3<i32>(floor(q + 0.5)) + z0, 0).x;
+    }
+    let lo = floor(q);
+    let f = q - lo;
+    let a = vec3<i32>(lo) + z0;
+    let b = vec3<i32>(min(lo + 1.0, hi)) + z0;
+    let c000 = textureLoad(intermix_atlas, a, 0).x;
+    let c100 = textureLoad(intermix_atlas, vec3<i32>(b.x, a.y, a.z), 0).x;
+    let c010 = textureLoad(intermix_atlas, vec3<i32>(a.x, b.y, a.z), 0).x;
+    let c110 = textureLoad(intermix_atlas, vec3<i32>(b.x, b.y, a.z), 0).x;
+    let c001 = textureLoad(intermix_atlas, vec3<i32>(a.x, a.y, b.z), 0).x;
+    let c101 = textureLoad(intermix_atlas, vec3<i32>(b.x, a.y, b.z), 0).x;
+    let c011 = textureLoad(intermix_atlas, vec3<i32>(a.x, b.y, b.z), 0).x;
+    let c111 = textureLoad(intermix_atlas, b, 0).x;
+    let x0 = mix(mix(c000, c100, f.x), mix(c010, c110, f.x), f.y);
+    let x1 = mix(mix(c001, c101, f.x), mix(c011, c111, f.x), f.y);
+    return mix(x0, x1, f.z);
+}
+
+// Colour (not premultiplied) and step-corrected opacity of intermixed volume j at world
+// point pos: zero outside its grid; shaded by its own gradient (central differences, one
+// point apart) when SHADE is on.
+fn intermixed_sample(j: u32, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
+    let v = intermix.volumes[j];
+    let p = (v.world_to_index * vec4<f32>(pos, 1.0)).xyz;
+    if (!in_grid(p, v.dims.xyz)) {
+        return vec4<f32>(0.0);
+    }
+    let s = intermixed_value(j, p);
+    let x = clamp((s - v.range.x) * v.range.y, 0.0, 1.0) * f32(TABLE_N - 1u);
+    let row = i32(2u * j);
+    var e: vec4<f32>;
+    if (NEAREST) {
+        e = textureLoad(intermix_tables, vec2<i32>(i32(x + 0.5), row), 0);
+    } else {
+        let i0 = u32(x);
+        let i1 = min(i0 + 1u, TABLE_N - 1u);
+        let t0 = textureLoad(intermix_tables, vec2<i32>(i32(i0), row), 0);
+        let t1 = textureLoad(intermix_tables, vec2<i32>(i32(i1), row), 0);
+        e = mix(t0, t1, x - f32(i0));
+    }
+    if (SHADE && e.a > 0.0) {
+        let ex = vec3<f32>(1.0, 0.0, 0.0);
+        let ey = vec3<f32>(0.0, 1.0, 0.0);
+        let ez = vec3<f32>(0.0, 0.0, 1.0);
+        let g = 0.5 * vec3<f32>(
+            intermixed_value(j, p + ex) - intermixed_value(j, p - ex),
+            intermixed_value(j, p + ey) - intermixed_value(j, p - ey),
+            intermixed_value(j, p + ez) - intermixed_value(j, p - ez));
+        let n = (v.gradient_to_world * vec4<f32>(g, 0.0)).xyz;
+        e = vec4<f32>(shade(e.rgb, n, pos, view_dir), e.a);
+    }
+    return e;
+}
+
+// Entry and exit distances of the ray through the world box [lo, hi].
+fn world_box_interval(r: Ray, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
+    let inv = 1.0 / r.dir;
+    let t0 = (lo - r.origin) * inv;
+    let t1 = (hi - r.origin) * inv;
+    let tmin = min(t0, t1);
+    let tmax = max(t0, t1);
+    return vec2<f32>(max(max(tmin.x, tmin.y), tmin.z), min(min(tmax.x, tmax.y), tmax.z));
+}
+
+// `color` with the sample c (colour not premultiplied) composited behind it.
+fn over(color: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
+    let w = (1.0 - color.a) * c.a;
+    return vec4<f32>(color.rgb + w * c.rgb, color.a + w);
+}
+
 // A rectilinear grid (VolumeData::coordinates): rays march the uniform lattice over the
 // grid's box, and each sample's lattice point is mapped to the grid's index space per axis
 // through a lookup built on the host (Resources::set_volume): row a holds the index-space
@@ -521,7 +630,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ray = make_ray(px);
     // The whole ray segment inside the volume, near/far planes, opaque depth and clip planes.
     let dt = frame.misc.x;
-    let box = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    var box = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    if (INTERMIX > 0u) {
+        box = world_box_interval(ray, intermix.box_lo.xyz, intermix.box_hi.xyz);
+    }
     var seg = vec2<f32>(max(box.x, 0.0), min(box.y, ray.far));
     // VTK 9.2: the ray ends at the opaque depth or a clipping plane, but its loop tests that
     // end only after stepping, so it samples up to one step past it (never past the box).
@@ -674,7 +786,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             suspended = true;
             break;
         }
-        let s = sample_scalars(p);
+        // (intermixed, the main volume's sample is read only inside its grid)
+        let s = sample_scalars(select(p, clamp(p, vec3<f32>(0.0), frame.dims.xyz - 1.0), INTERMIX > 0u));
         if (blend == BLEND_COMPOSITE) {
             var sf = s;
             if (PREINT) {
@@ -687,10 +800,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 front_k = k;
                 front_occupied = occupied;
             }
-            let c = classify_sample(sf, s, p, ray.origin + t * ray.dir, ray.dir);
-            if (c.a > 0.0) {
-                let w = (1.0 - color.a) * c.a;
-                color = vec4<f32>(color.rgb + w * c.rgb, color.a + w);
+            let pos = ray.origin + t * ray.dir;
+            var c = vec4<f32>(0.0);
+            if (INTERMIX == 0u || in_grid(p, frame.dims.xyz)) {
+                c = classify_sample(sf, s, p, pos, ray.dir);
+            }
+            for (var j = 0u; j < INTERMIX; j = j + 1u) {
+                color = over(color, c);
+                c = intermixed_sample(j, pos, ray.dir);
+            }
+            if (c.a > 0.0 || INTERMIX > 0u) {
+                color = over(color, c);
                 if (misc.z == 0.0 && color.a > frame.misc.z) {
                     depth_t = t;
                     misc.z = 1.0;

@@ -6,15 +6,16 @@ use crate::error::{Error, Result};
 use crate::gpu::interop::{OutputPath, SharedOutput};
 use crate::gpu::Context;
 use crate::params::{
-    BlendMode, BsdfParams, Convergence, CubeImage, Environment, GBuffer, Image, IsoParams,
-    MaskKind, PathTraceParams, RenderParams, Residency, Stats, StreamProgress, TransferFunction,
-    UploadOptions, View, VolumeData,
+    BlendMode, BsdfParams, Convergence, CubeImage, Environment, GBuffer, Image, IntermixedVolume,
+    IsoParams, MaskKind, PathTraceParams, RenderParams, Residency, Stats, StreamProgress,
+    TransferFunction, UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
 use crate::passes::frame::FrameInput;
 use crate::passes::iso::IsoPass;
 use crate::passes::pathtrace::PathTracePass;
 use crate::passes::scatter_check;
+use crate::resources::intermix::Intermix;
 use crate::resources::targets::DepthSource;
 use crate::resources::volume::HostVolume;
 use crate::resources::Resources;
@@ -108,6 +109,25 @@ impl Renderer {
     /// isosurfaces' first hits read it. `None` clears it; a new volume clears it too.
     pub fn set_mask(&mut self, mask: Option<(&[u8], MaskKind)>) -> Result<()> {
         self.res.set_mask(&self.ctx, mask)
+    }
+
+    /// Sets the volumes drawn with the main one, intermixed per sample (VTK's vtkMultiVolume:
+    /// the main volume is port 0, `volumes[i]` port i + 1): each ray marches the world box
+    /// holding them all at the main volume's sample distance, and at each sample composites
+    /// the main volume and then each intermixed volume that holds the sample, each classified
+    /// by its own transfer function (opacity corrected for the step by its own unit
+    /// distance) and shaded, when shading is on, by its own gradient with the main volume's
+    /// lights and material. Ray casting in the composite blend mode only; at most
+    /// [`MAX_INTERMIXED_VOLUMES`](crate::MAX_INTERMIXED_VOLUMES); an empty slice clears
+    /// them. Data shared with the previous call (the same `Arc`s) is not uploaded again.
+    pub fn set_intermixed_volumes(&mut self, volumes: &[IntermixedVolume]) -> Result<()> {
+        self.res.intermix = Intermix::new(&self.ctx, self.res.intermix.as_ref(), volumes)?;
+        Ok(())
+    }
+
+    /// The intermixed volumes set last.
+    pub fn intermixed_volumes(&self) -> &[IntermixedVolume] {
+        self.res.intermix.as_ref().map_or(&[], |m| &m.volumes)
     }
 
     /// Calls `progress` after each pass of a streamed frame (`None`: no calls).
@@ -325,6 +345,13 @@ impl Renderer {
         let (ctx, res) = (&self.ctx, &mut self.res);
         if params.blend != BlendMode::PathTrace {
             res.release_level();
+        }
+        if res.intermix.is_some() && params.blend != BlendMode::Composite {
+            return Err(Error::Unsupported(format!(
+                "intermixed volumes are ray cast in the composite blend mode, not {:?}: \
+                 clear them (set_intermixed_volumes with none) or use the composite mode",
+                params.blend
+            )));
         }
         let input = |res| FrameInput {
             ctx,

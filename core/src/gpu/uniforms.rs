@@ -157,6 +157,28 @@ pub struct EnvUniforms {
     pub params: [u32; 4],
 }
 
+/// One intermixed volume as dvr.wgsl reads it (`IntermixedVolume`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct IntermixedVolumeUniforms {
+    pub world_to_index: [f32; 16],
+    pub gradient_to_world: [f32; 16],
+    /// Points per axis, then the first z of the volume's points in the atlas.
+    pub dims: [f32; 4],
+    /// The transfer tables' scalar at the first entry and 1 / their scalar width.
+    pub range: [f32; 4],
+}
+
+/// The intermixed volumes' uniforms (`Intermix` in shaders/dvr.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct IntermixUniforms {
+    /// The world box the rays march: every volume's, the main one's included.
+    pub box_lo: [f32; 4],
+    pub box_hi: [f32; 4],
+    pub volumes: [IntermixedVolumeUniforms; MAX_INTERMIXED],
+}
+
 pub fn mat(m: glam::DMat4) -> [f32; 16] {
     m.as_mat4().to_cols_array()
 }
@@ -203,6 +225,8 @@ pub const MASK_LABELS: u32 = 2;
 /// Most lights and clipping planes a frame takes (the sizes of Frame's arrays).
 pub const MAX_LIGHTS: usize = 8;
 pub const MAX_CLIP_PLANES: usize = 8;
+/// Most volumes intermixed with the main one (IntermixUniforms' array).
+pub const MAX_INTERMIXED: usize = 3;
 /// Entries per transfer-function table.
 pub const TABLE_SIZE: usize = 1024;
 
@@ -264,6 +288,7 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("MASK_BINARY", Wgsl::U32(MASK_BINARY)),
     ("MASK_LABELS", Wgsl::U32(MASK_LABELS)),
     ("MAX_LIGHTS", Wgsl::U32(MAX_LIGHTS as u32)),
+    ("MAX_INTERMIXED", Wgsl::U32(MAX_INTERMIXED as u32)),
     ("PAGE_SLOT_BITS", Wgsl::U32(PAGE_SLOT_BITS)),
     ("PAGE_EMPTY", Wgsl::U32(PAGE_EMPTY)),
     ("PAGE_MISSING", Wgsl::U32(PAGE_MISSING)),
@@ -399,6 +424,13 @@ mod layout_tests {
             [position, spot, diffuse, specular, ambient, attenuation]
         );
         check!(m, "Pool", PoolUniforms, [brick, grid, slot, inv_size]);
+        check!(
+            m,
+            "IntermixedVolume",
+            IntermixedVolumeUniforms,
+            [world_to_index, gradient_to_world, dims, range]
+        );
+        check!(m, "Intermix", IntermixUniforms, [box_lo, box_hi, volumes]);
     }
 
     #[test]

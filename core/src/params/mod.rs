@@ -6,6 +6,7 @@ pub mod camera;
 mod check;
 pub(crate) mod downsample;
 pub mod environment;
+pub mod intermix;
 pub mod iso;
 pub mod light;
 pub mod pathtrace;
@@ -16,6 +17,7 @@ pub mod volume;
 
 pub use camera::Camera;
 pub use environment::{CubeImage, Environment, EnvironmentSource, Sky};
+pub use intermix::{IntermixedVolume, MAX_INTERMIXED_VOLUMES};
 pub use iso::{
     AmbientOcclusion, GBuffer, Hit, IsoParams, IsoScatterMode, IsoScattering, IsoValue, Shininess,
     SpecularMode, MAX_ISO_VALUES, MAX_SCATTER_SAMPLES,

@@ -11,14 +11,17 @@ use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
+use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
-use crate::gpu::uniforms::{MASK_BINARY, MASK_LABELS, MASK_NONE};
+use crate::gpu::uniforms::{IntermixUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
+use crate::resources::intermix::world_box;
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
+use glam::DMat4;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -48,6 +51,8 @@ pipeline_variant! {
         streaming: bool => "STREAMING",
         preintegration: bool => "PREINT",
         rectilinear: bool => "RECTILINEAR",
+        /// Number of volumes intermixed with the main one.
+        intermix: u32 => "INTERMIX",
     }
 }
 
@@ -64,6 +69,8 @@ pub(crate) struct DvrPass {
     no_tables_2d: Tables,
     /// Bound in place of a rectilinear grid's lookup for a uniform grid.
     no_grid_lookup: wgpu::TextureView,
+    /// Bound in place of the intermixed volumes' uniforms, atlas and tables without any.
+    no_intermix: (wgpu::Buffer, wgpu::TextureView),
 }
 
 impl DvrPass {
@@ -88,6 +95,9 @@ impl DvrPass {
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(11, false, V::D2),
                     texture_entry(12, false, V::D3),
+                    buffer_entry(13, B::Uniform),
+                    texture_entry(14, false, V::D3),
+                    texture_entry(15, false, V::D2),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -99,6 +109,14 @@ impl DvrPass {
             no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
             no_tables_2d: Tables::new(&ctx.device, [1, 1]),
             no_grid_lookup: block_grid(ctx, "no grid lookup", [2, 3, 1], &[0f32; 6]),
+            no_intermix: (
+                uniform_buffer(
+                    ctx,
+                    "no intermix",
+                    std::mem::size_of::<IntermixUniforms>() as u64,
+                ),
+                block_grid(ctx, "no intermix", [1; 3], &[0f32]),
+            ),
         })
     }
 
@@ -260,13 +278,46 @@ impl DvrPass {
             && !f.volumetric
             && mask != MASK_LABELS
             && tables_2d == 0;
+        let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
+        if intermix > 0 {
+            let refused = [
+                (
+                    streaming,
+                    "the bricks in view exceed the volume's memory budget",
+                ),
+                (params.cropping.is_some(), "cropping is on"),
+                (res.blanking.is_some(), "the main volume has blanking"),
+                (mask != MASK_NONE, "the main volume has a mask"),
+                (rectilinear, "the main volume is rectilinear"),
+                (f.volumetric, "volumetric shadows are on"),
+                (params.preintegration, "pre-integration is on"),
+                (vol.components > 1, "the main volume has several components"),
+                (tables_2d != 0, "the main volume has a 2D transfer function"),
+                (
+                    params.interpolation == Interpolation::Cubic,
+                    "the interpolation is cubic",
+                ),
+                (
+                    params.whole_box.is_some(),
+                    "the volume is a piece of a whole",
+                ),
+            ];
+            if let Some((_, why)) = refused.iter().find(|(on, _)| *on) {
+                return Err(Error::Unsupported(format!(
+                    "intermixed volumes are ray cast with one-component main volumes, \
+                     linear or nearest interpolation and no cropping, blanking, masks, \
+                     pre-integration, volumetric shadows or streaming, and {why}: clear the \
+                     intermixed volumes or turn that off"
+                )));
+            }
+        }
         let variant = DvrVariant {
             blend: params.blend.code(),
             components: vol.components,
             independent: f.independent,
             shade: params.shading.enabled,
             gradient_opacity: f.gradient_opacity,
-            skip,
+            skip: skip && intermix == 0,
             range_skip,
             crop: params.cropping.is_some(),
             nearest: params.interpolation == Interpolation::Nearest,
@@ -285,12 +336,28 @@ impl DvrPass {
             streaming,
             preintegration,
             rectilinear,
+            intermix,
         };
         if preintegration {
             res.ensure_preintegration(ctx, step)?;
         }
         if tables_2d != 0 {
             res.ensure_tables_2d(ctx, step)?;
+        }
+        let vol = res.volume()?;
+        let mut u = f.uniforms;
+        if intermix > 0 {
+            let main = world_box(params.volume_matrix * vol.index_to_data, vol.data_dims);
+            let m = res
+                .intermix
+                .as_mut()
+                .expect("intermixed volumes counted above");
+            let (lo, hi) = m.world_bounds();
+            let (lo, hi) = (lo.min(main.0), hi.max(main.1));
+            m.prepare(ctx, step, (lo, hi))?;
+            let vp = view.camera.view_projection(view.aspect());
+            let r = frame::screen_rect(vp, DMat4::IDENTITY, lo, hi, view.width, view.height);
+            u.rect = frame::union_rect(u.rect, r);
         }
         let vol = res.volume()?;
         let dvr = self.pipelines.get(ctx, variant)?;
@@ -307,7 +374,6 @@ impl DvrPass {
         };
         let q = &ctx.queue;
         let d = &ctx.device;
-        let u = f.uniforms;
         q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
@@ -343,6 +409,28 @@ impl DvrPass {
                     wgpu::BindingResource::TextureView(
                         vol.grid_lookup.as_ref().unwrap_or(&self.no_grid_lookup),
                     ),
+                ),
+                bind(
+                    13,
+                    match &res.intermix {
+                        Some(m) => m.uniforms.as_entire_binding(),
+                        None => self.no_intermix.0.as_entire_binding(),
+                    },
+                ),
+                bind(
+                    14,
+                    wgpu::BindingResource::TextureView(
+                        res.intermix
+                            .as_ref()
+                            .map_or(&self.no_intermix.1, |m| &m.atlas),
+                    ),
+                ),
+                bind(
+                    15,
+                    wgpu::BindingResource::TextureView(match &res.intermix {
+                        Some(m) => m.tables(),
+                        None => &self.no_tables_2d.view,
+                    }),
                 ),
             ],
         });

@@ -99,14 +99,15 @@ impl Frame {
 /// The pixels the index-space box `lo`…`hi` can cover: the bounding rectangle of its
 /// projected corners widened by a pixel, as [x0, y0, x1, y1) — or the whole image when a
 /// corner lies behind the camera (the camera is inside or beside the box).
-fn screen_rect(
+pub(crate) fn screen_rect(
     vp: DMat4,
     index_to_world: DMat4,
-    lo: [f64; 3],
-    hi: [f64; 3],
+    lo: impl Into<[f64; 3]>,
+    hi: impl Into<[f64; 3]>,
     width: u32,
     height: u32,
 ) -> [u32; 4] {
+    let (lo, hi) = (lo.into(), hi.into());
     let full = [0, 0, width, height];
     let (mut x0, mut y0, mut x1, mut y1) = (
         f64::INFINITY,
@@ -139,6 +140,21 @@ fn screen_rect(
         return [0, 0, 0, 0];
     }
     r
+}
+
+/// The smallest rectangle ([x0, y0, x1, y1)) holding `a` and `b` (either may be empty).
+pub(crate) fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+    let empty = |r: [u32; 4]| r[0] >= r[2] || r[1] >= r[3];
+    match (empty(a), empty(b)) {
+        (true, _) => b,
+        (_, true) => a,
+        _ => [
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ],
+    }
 }
 
 /// A world plane in index space as (n_i, w): dot(n_i, p) + w is the world distance to the

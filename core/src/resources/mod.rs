@@ -5,6 +5,7 @@
 pub(crate) mod bricks;
 pub(crate) mod environment;
 pub(crate) mod gradients;
+pub(crate) mod intermix;
 pub(crate) mod levels;
 pub(crate) mod residency;
 pub(crate) mod tables;
@@ -64,6 +65,8 @@ pub(crate) struct Resources {
     gradient_pass: Option<GradientPass>,
     /// Told of each pass of a streamed frame.
     pub progress: Option<StreamProgress>,
+    /// Volumes drawn with the main one, intermixed per sample.
+    pub intermix: Option<intermix::Intermix>,
 }
 
 impl Resources {
@@ -126,6 +129,7 @@ impl Resources {
             stats: Stats::default(),
             gradient_pass: None,
             progress: None,
+            intermix: None,
         }
     }
 

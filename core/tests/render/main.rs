@@ -15,6 +15,7 @@ mod bricks;
 #[path = "../common/mod.rs"]
 mod common;
 mod compositing;
+mod intermix;
 mod masks;
 mod preintegration;
 mod rectilinear;

@@ -1,0 +1,235 @@
+//! Volumes intermixed per sample (Renderer::set_intermixed_volumes): a volume cut in two
+//! halves, drawn as the main volume and an intermixed one, is the whole volume; an
+//! intermixed volume placed by its own matrix is the main volume placed by the same matrix;
+//! and what intermixing does not take is refused with an error naming it.
+
+use crate::common::gpu::{assert_error, new_renderer};
+use crate::common::images::save_enlarged;
+use crate::common::metrics::{footprint, image_diff};
+use crate::common::scenes::{blob_transfer, blob_volume, oblique, shaded, volume};
+use ferrovol_core::*;
+use glam::{DMat4, DVec3};
+use std::sync::Arc;
+
+/// Points `x0 ..= x1` (along x) of `v`, placed where they are in `v`.
+fn slab_x(v: &VolumeData, x0: u32, x1: u32) -> VolumeData {
+    let [_, ny, nz] = v.dims;
+    let mut out = volume([x1 - x0 + 1, ny, nz], |i, j, k| {
+        v.value(x0 + i as u32, j as u32, k as u32, 0)
+    });
+    out.origin = [
+        v.origin[0] + x0 as f64 * v.spacing[0],
+        v.origin[1],
+        v.origin[2],
+    ];
+    out.spacing = v.spacing;
+    out
+}
+
+fn tf(c: ComponentTransfer) -> TransferFunction {
+    TransferFunction::single(c)
+}
+
+#[test]
+fn halves_intermixed_equal_the_whole() {
+    let mut r = new_renderer();
+    let whole = blob_volume(41);
+    let view = oblique(&whole, 96);
+    let transfer = tf(blob_transfer());
+    for (name, params) in [("unshaded", RenderParams::default()), ("shaded", shaded())] {
+        r.set_intermixed_volumes(&[]).unwrap();
+        r.set_volume(&whole).unwrap();
+        r.set_transfer_function(&transfer).unwrap();
+        let reference = r.render_image(&view, &params).unwrap();
+        // The halves share the points x = 20; the main volume holds x ≤ 20, the intermixed
+        // one x ≥ 20 (a sample on the shared plane, where both would count, has measure 0).
+        r.set_volume(&slab_x(&whole, 0, 20)).unwrap();
+        r.set_intermixed_volumes(&[IntermixedVolume {
+            volume: Arc::new(slab_x(&whole, 20, 40)),
+            matrix: DMat4::IDENTITY,
+            transfer: transfer.clone(),
+        }])
+        .unwrap();
+        let img = r.render_image(&view, &params).unwrap();
+        save_enlarged(&img, &format!("intermix_halves_{name}"));
+        let (mean, max) = image_diff(&img, &reference);
+        println!(
+            "intermix halves ({name}): mean {mean:.4} max {max} levels, footprint {}",
+            footprint(&img)
+        );
+        assert!(footprint(&reference) > 2000, "the whole volume shows");
+        // Unshaded, the samples and their values are the whole's (the halves' points are
+        // the whole's; trilinear weights in f32 against the sampler's fixed-point ones).
+        // Shaded, central differences at the cut read clamped neighbours in each half (the
+        // whole reads across), which changes the normals within a point of the cut.
+        let (mean_max, max_max) = if name == "shaded" {
+            (0.1, 12)
+        } else {
+            (0.05, 4)
+        };
+        assert!(
+            mean < mean_max && max <= max_max,
+            "{name}: halves differ from the whole by mean {mean:.4} max {max}"
+        );
+    }
+}
+
+#[test]
+fn intermixed_matrix_places_the_volume() {
+    let mut r = new_renderer();
+    let vol = blob_volume(33);
+    let transfer = tf(blob_transfer());
+    // Scaled unevenly and moved: a world box of another size and place than the data's.
+    let m = DMat4::from_translation(DVec3::new(5.0, -3.0, 2.0))
+        * DMat4::from_scale(DVec3::new(1.5, 0.75, 1.0));
+    let b = vol.bounds();
+    let lo = m.transform_point3(DVec3::new(b[0], b[2], b[4]));
+    let hi = m.transform_point3(DVec3::new(b[1], b[3], b[5]));
+    let mut view = View::fit([lo.x, hi.x, lo.y, hi.y, lo.z, hi.z], 96, 96);
+    view.camera.azimuth(25.0);
+    view.camera.elevation(15.0);
+    view.camera.orthogonalize_view_up();
+    view.camera
+        .reset_clipping_range([lo.x, hi.x, lo.y, hi.y, lo.z, hi.z]);
+    for (name, base) in [("unshaded", RenderParams::default()), ("shaded", shaded())] {
+        let params = RenderParams {
+            volume_matrix: m,
+            ..base.clone()
+        };
+        r.set_intermixed_volumes(&[]).unwrap();
+        r.set_volume(&vol).unwrap();
+        r.set_transfer_function(&transfer).unwrap();
+        let reference = r.render_image(&view, &params).unwrap();
+        // The main volume the same, but transparent: what shows is the intermixed one.
+        let mut clear = blob_transfer();
+        clear.opacity = Piecewise::new(vec![(0.0, [0.0]), (1.0, [0.0])]).unwrap();
+        r.set_transfer_function(&tf(clear)).unwrap();
+        r.set_intermixed_volumes(&[IntermixedVolume {
+            volume: Arc::new(vol.clone()),
+            matrix: m,
+            transfer: transfer.clone(),
+        }])
+        .unwrap();
+        let img = r.render_image(&view, &params).unwrap();
+        save_enlarged(&img, &format!("intermix_matrix_{name}"));
+        let (mean, max) = image_diff(&img, &reference);
+        println!("intermix matrix ({name}): mean {mean:.4} max {max} levels");
+        assert!(footprint(&reference) > 2000, "the volume shows");
+        // The same samples (an axis-aligned matrix: the union box is the volume's), the
+        // same normals (the gradient taken to world by the inverse transpose).
+        assert!(
+            mean < 0.05 && max <= 4,
+            "{name}: intermixed differs from main by mean {mean:.4} max {max}"
+        );
+    }
+    r.set_intermixed_volumes(&[]).unwrap();
+}
+
+#[test]
+fn intermixed_volumes_composite_in_order_per_sample() {
+    // Two coincident uniform slabs: red first (main), then blue. Per sample the red one is
+    // composited in front of the blue one, so the pixel carries more red than blue.
+    let mut r = new_renderer();
+    let vol = volume([9, 9, 17], |_, _, _| 0.5);
+    let colour = |c: [f32; 3]| {
+        let mut t = ComponentTransfer::new(
+            Piecewise::new(vec![(0.0, c), (1.0, c)]).unwrap(),
+            Piecewise::new(vec![(0.0, [0.3]), (1.0, [0.3])]).unwrap(),
+        );
+        t.unit_distance = 1.0;
+        tf(t)
+    };
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&colour([1.0, 0.0, 0.0])).unwrap();
+    r.set_intermixed_volumes(&[IntermixedVolume {
+        volume: Arc::new(vol.clone()),
+        matrix: DMat4::IDENTITY,
+        transfer: colour([0.0, 0.0, 1.0]),
+    }])
+    .unwrap();
+    let mut view = View::fit(vol.bounds(), 17, 17);
+    view.camera.parallel = true;
+    view.camera.reset_clipping_range(vol.bounds());
+    let img = r.render_image(&view, &RenderParams::default()).unwrap();
+    let i = 4 * (8 * 17 + 8) as usize;
+    let p = &img.rgba[i..i + 4];
+    // Per sample: red adds 0.3 of what remains, blue 0.3 of what then remains (0.7 × 0.3):
+    // red / blue = 1 / 0.7 in every sample, so in the sum.
+    let ratio = p[0] as f64 / p[2] as f64;
+    println!(
+        "intermix order: pixel {p:?}, red / blue {ratio:.3} (expected {:.3})",
+        1.0 / 0.7
+    );
+    assert!(
+        p[3] > 200,
+        "16 samples at opacity 0.3 and 0.3 are nearly opaque: {p:?}"
+    );
+    assert!((ratio - 1.0 / 0.7).abs() < 0.03, "red / blue {ratio:.3}");
+}
+
+#[test]
+fn intermixing_refuses_what_it_does_not_take() {
+    let mut r = new_renderer();
+    let vol = blob_volume(17);
+    let transfer = tf(blob_transfer());
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&transfer).unwrap();
+    let one = IntermixedVolume {
+        volume: Arc::new(vol.clone()),
+        matrix: DMat4::IDENTITY,
+        transfer: transfer.clone(),
+    };
+    assert_error(
+        r.set_intermixed_volumes(&vec![one.clone(); MAX_INTERMIXED_VOLUMES + 1]),
+        "too many",
+        &["intermixed volumes", "at most 3"],
+    );
+    let two = VolumeData::new([4, 4, 4], 2, Scalars::F32(vec![0.0; 128])).unwrap();
+    assert_error(
+        r.set_intermixed_volumes(&[IntermixedVolume {
+            volume: Arc::new(two),
+            ..one.clone()
+        }]),
+        "two components",
+        &["intermixed volume 0", "2 components"],
+    );
+    assert_error(
+        r.set_intermixed_volumes(&[IntermixedVolume {
+            matrix: DMat4::ZERO,
+            ..one.clone()
+        }]),
+        "singular matrix",
+        &["intermixed volume 0", "singular"],
+    );
+    r.set_intermixed_volumes(&[one]).unwrap();
+    let view = oblique(&vol, 32);
+    for blend in [
+        BlendMode::Maximum,
+        BlendMode::Isosurface,
+        BlendMode::PathTrace,
+    ] {
+        let params = RenderParams {
+            blend,
+            ..RenderParams::default()
+        };
+        assert_error(
+            r.render_image(&view, &params),
+            &format!("{blend:?}"),
+            &["intermixed volumes", "composite"],
+        );
+    }
+    let cropped = RenderParams {
+        cropping: Some(Cropping {
+            planes: [2.0, 10.0, 2.0, 10.0, 2.0, 10.0],
+            regions: Cropping::SUBVOLUME,
+        }),
+        ..RenderParams::default()
+    };
+    assert_error(
+        r.render_image(&view, &cropped),
+        "cropping",
+        &["cropping is on"],
+    );
+    r.set_intermixed_volumes(&[]).unwrap();
+    assert!(r.render_image(&view, &RenderParams::default()).is_ok());
+}
