@@ -27,6 +27,11 @@
 #define FV_VERSION_PATCH 0
 
 /**
+ * Most volumes fv_renderer_set_intermixed_volumes takes beside the main volume.
+ */
+#define FV_MAX_INTERMIXED_VOLUMES 3
+
+/**
  * Most iso-values in one FvIsoParams.
  */
 #define FV_MAX_ISO_VALUES 8
@@ -326,6 +331,21 @@ typedef struct FvDeviceMemory {
   uint64_t buffer_bytes;
   uint64_t texture_bytes;
 } FvDeviceMemory;
+
+/**
+ * A volume drawn with the main one, intermixed per sample: its data (one component, a
+ * uniform grid), its transfer function (one component; colour and opacity only) and its
+ * placement. The renderer copies what it needs: both handles may be freed after the call.
+ */
+typedef struct FvIntermixedVolume {
+  const struct FvVolume *volume;
+  const struct FvTransferFunction *transfer_function;
+  /**
+   * The vtkVolume's matrix (data → world), column-major, as FvRenderParams::volume_matrix
+   * is for the main volume.
+   */
+  double matrix[16];
+} FvIntermixedVolume;
 
 /**
  * A VTK camera. Matrices are column-major (OpenGL order: element (row r, column c) at
@@ -935,6 +955,22 @@ const float *fv_frame_depth(const struct FvFrame *frame);
 enum FvStatus fv_frame_write_png(const struct FvFrame *frame,
                                  const char *path,
                                  const float (*background)[3]);
+
+/**
+ * Sets the volumes drawn with the main one (`count` at `volumes`, 0 clears them), as
+ * vtkGPUVolumeRayCastMapper draws the ports of a vtkMultiVolume (the main volume is port
+ * 0, volumes[i] port i + 1): each ray marches the world box holding them all at the main
+ * volume's sample distance and, at each sample, composites the main volume and then each
+ * intermixed volume that holds the sample, each classified by its own transfer function
+ * and shaded (when shading is on) by its own gradient with the main volume's lights and
+ * material. At most FV_MAX_INTERMIXED_VOLUMES. Frames then ray cast in the composite blend
+ * mode only, without cropping, blanking, masks, pre-integration, volumetric shadows or
+ * streaming, with a one-component main volume: others fail with FV_STATUS_UNSUPPORTED
+ * naming what is refused. Setting the same FvVolume handles again does not re-upload them.
+ */
+enum FvStatus fv_renderer_set_intermixed_volumes(struct FvRenderer *renderer,
+                                                 const struct FvIntermixedVolume *volumes,
+                                                 size_t count);
 
 /**
  * A renderer on `ctx` (which may be freed afterwards). `*out` receives it.

@@ -273,6 +273,13 @@ public:
     return p;
   }
   void set_volume(const Volume &v) { check(fv_renderer_set_volume(h_.get(), v.get())); }
+  /// Volumes intermixed per sample with the main one (fv_renderer_set_intermixed_volumes);
+  /// the handles each description points to may be released after the call. An empty
+  /// vector clears them.
+  void set_intermixed_volumes(const std::vector<FvIntermixedVolume> &volumes) {
+    check(fv_renderer_set_intermixed_volumes(h_.get(), detail::data_or_null(volumes),
+                                             volumes.size()));
+  }
   void set_transfer_function(const TransferFunction &tf) {
     check(fv_renderer_set_transfer_function(h_.get(), tf.get()));
   }

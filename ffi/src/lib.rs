@@ -11,6 +11,7 @@
 
 mod context;
 mod frame;
+mod intermix;
 mod iso;
 mod renderer;
 mod status;
@@ -23,6 +24,7 @@ mod volume;
 
 pub use context::*;
 pub use frame::*;
+pub use intermix::*;
 pub use iso::*;
 pub use renderer::*;
 pub use status::*;

@@ -4,8 +4,8 @@
 
 use ferrovol::FvStatus::{self, InvalidArgument as Invalid, NullArgument as Null};
 use ferrovol::{
-    FvBlendMode, FvCamera, FvIsoParams, FvLight, FvPathTraceParams, FvRenderParams, FvScalarType,
-    FvSharedImage, FvVolumeDesc,
+    FvBlendMode, FvCamera, FvIntermixedVolume, FvIsoParams, FvLight, FvPathTraceParams,
+    FvRenderParams, FvScalarType, FvSharedImage, FvVolumeDesc,
 };
 use libloading::{Library, Symbol};
 use std::ffi::{c_char, c_void, CStr};
@@ -616,6 +616,134 @@ fn masks_through_the_c_abi() {
         assert!(a > 100 && r > 100 && g == 0, "label 2 red");
         assert_eq!(pixel(&labelled, 12, 8), pixel(&plain, 12, 8));
         assert_eq!(unlabelled, plain, "blend factor 0 reads no label");
+    }
+}
+
+#[test]
+fn intermixed_volumes_through_the_c_abi() {
+    let lib = Lib::open();
+    type SetIntermixed = unsafe extern "C" fn(H, *const FvIntermixedVolume, usize) -> FvStatus;
+    let n = 8usize;
+    let mut s = Session::new(&lib);
+    s.set_volume([8, 8, 8], FvScalarType::U8, &vec![200u8; n * n * n]);
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0],
+        &[0.0, 0.0, 255.0, 0.2],
+    );
+    s.set_camera(&camera([3.5, 3.5, 18.0], [3.5, 3.5, 3.5], [0.1, 100.0]));
+    let pixel = |rgba: &[u8], x: usize, y: usize| -> [u8; 4] {
+        let i = 4 * (y * 16 + x);
+        [rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]]
+    };
+    let plain = s.frame(16, 16).to_vec();
+    let set = lib.f::<SetIntermixed>("fv_renderer_set_intermixed_volumes");
+    let mut red_volume: H = null_mut();
+    let mut red_tf: H = null_mut();
+    let mut two: H = null_mut();
+    // SAFETY: arguments follow the header; invalid ones are the test.
+    unsafe {
+        let data = vec![200u8; n * n * n];
+        lib.ok(lib.f::<NewVolume>("fv_volume_new")(
+            &desc([8, 8, 8], 1, FvScalarType::U8 as u32),
+            data.as_ptr().cast(),
+            data.len(),
+            &mut red_volume,
+        ));
+        lib.ok(lib.f::<NewTf>("fv_transfer_function_new")(
+            1,
+            true,
+            &mut red_tf,
+        ));
+        let red = [0.0, 1.0, 0.0, 0.0, 255.0, 1.0, 0.0, 0.0];
+        let opacity = [0.0, 0.0, 255.0, 0.2];
+        lib.ok(lib.f::<SetPoints>("fv_transfer_function_set_color")(
+            red_tf,
+            0,
+            red.as_ptr(),
+            2,
+        ));
+        lib.ok(lib.f::<SetPoints>("fv_transfer_function_set_opacity")(
+            red_tf,
+            0,
+            opacity.as_ptr(),
+            2,
+        ));
+        // the red volume moved half its width to +x: it covers the image's right half
+        let mut matrix = [0.0; 16];
+        for i in 0..4 {
+            matrix[5 * i] = 1.0;
+        }
+        matrix[12] = 4.0;
+        let one = FvIntermixedVolume {
+            volume: red_volume.cast_const().cast(),
+            transfer_function: red_tf.cast_const().cast(),
+            matrix,
+        };
+        lib.expect(
+            set(s.r, [one; 4].as_ptr(), 4),
+            FvStatus::Unsupported,
+            "at most 3",
+        );
+        lib.expect(set(s.r, null(), 1), Null, "volumes");
+        lib.expect(set(null_mut(), null(), 0), Null, "renderer");
+        let no_volume = FvIntermixedVolume {
+            volume: null(),
+            ..one
+        };
+        lib.expect(set(s.r, &no_volume, 1), Null, "volumes[0].volume");
+        let no_tf = FvIntermixedVolume {
+            transfer_function: null(),
+            ..one
+        };
+        lib.expect(set(s.r, &no_tf, 1), Null, "volumes[0].transfer_function");
+        let data2 = [0u8; 2 * 4 * 4 * 4];
+        lib.ok(lib.f::<NewVolume>("fv_volume_new")(
+            &desc([4, 4, 4], 2, FvScalarType::U8 as u32),
+            data2.as_ptr().cast(),
+            data2.len(),
+            &mut two,
+        ));
+        let two_comp = FvIntermixedVolume {
+            volume: two.cast_const().cast(),
+            ..one
+        };
+        lib.expect(
+            set(s.r, &two_comp, 1),
+            FvStatus::Unsupported,
+            "2 components",
+        );
+        lib.ok(set(s.r, &one, 1));
+        // the renderer keeps what it needs: the handles may go
+        lib.f::<Free>("fv_volume_free")(red_volume);
+        lib.f::<Free>("fv_transfer_function_free")(red_tf);
+        lib.f::<Free>("fv_volume_free")(two);
+        let mixed = s.frame(16, 16).to_vec();
+        let mut p = FvRenderParams::defaults();
+        p.blend_mode = FvBlendMode::Maximum as u32;
+        s.set_params(&p);
+        lib.expect(
+            lib.f::<Render>("fv_renderer_render")(s.r, 16, 16, null(), 0),
+            FvStatus::Unsupported,
+            "composite",
+        );
+        s.set_params(&FvRenderParams::defaults());
+        lib.ok(set(s.r, null(), 0));
+        let cleared = s.frame(16, 16).to_vec();
+        println!(
+            "intermixed: plain {:?} / {:?}, mixed {:?} / {:?}",
+            pixel(&plain, 5, 8),
+            pixel(&plain, 10, 8),
+            pixel(&mixed, 5, 8),
+            pixel(&mixed, 10, 8),
+        );
+        let [r, g, b, a] = pixel(&mixed, 10, 8);
+        assert!(
+            r > g && r > b && a > pixel(&plain, 10, 8)[3],
+            "red over white: {r} {g} {b} {a}"
+        );
+        let [r, g, b, _] = pixel(&mixed, 5, 8);
+        assert!(r == g && g == b, "the left half stays white");
+        assert_eq!(cleared, plain, "cleared: the main volume alone");
     }
 }
 
