@@ -70,9 +70,12 @@ struct Intermix {
 @group(0) @binding(14) var intermix_atlas: texture_3d<f32>;
 @group(0) @binding(15) var intermix_tables: texture_2d<f32>;
 
-// Whether index-space point p lies in the grid of `dims` points (its faces included).
+// Whether an intermixed frame samples the volume of `dims` points at index-space point p:
+// VTK's multi-volume shader tests the sample's texture coordinate against [0, 1], and a
+// point-data texture spans half a point beyond the outer points, so p may lie up to half a
+// point outside the grid (where the texture's clamping reads the outer points).
 fn in_grid(p: vec3<f32>, dims: vec3<f32>) -> bool {
-    return all(p >= vec3<f32>(0.0)) && all(p <= dims - 1.0);
+    return all(p >= vec3<f32>(-0.5)) && all(p <= dims - 0.5);
 }
 
 // Intermixed volume j's value at index-space point p (clamped to its grid, as a clamping
