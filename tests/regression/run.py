@@ -113,20 +113,39 @@ def render(scene, kind):
     win.SetSize(w, h)
     if scene.multisamples is not None:
         win.SetMultiSamples(scene.multisamples)
-    mappers, errors = [], []
+    mappers, errors, keep = [], [], []
     for view in scene.views:
         m = make_mapper(kind)
         errors.append(fvtest.Errors(m))
         getattr(m, "SetBlendModeTo" + BLEND[view.blend])()
-        m.SetInputData(data)
         prop = scene.prop()
         for i, v in enumerate(scene.iso_values):
             prop.GetIsoSurfaceValues().SetValue(i, v)
         vol = vtk.vtkVolume()
-        vol.SetMapper(m)
         vol.SetProperty(prop)
         if scene.volume:
             scene.volume(vol)
+        if scene.intermix:
+            # vtkMultiVolume: one mapper, an input and a vtkVolume per port
+            multi = vtk.vtkMultiVolume()
+            multi.SetMapper(m)
+            ports = [(data, vol)]
+            for key, make_prop, place in scene.intermix():
+                v = vtk.vtkVolume()
+                v.SetProperty(make_prop())
+                if place:
+                    place(v)
+                ports.append((S.DATA[key](), v))
+            for port, (image, v) in enumerate(ports):
+                producer = vtk.vtkTrivialProducer()
+                producer.SetOutput(image)
+                m.SetInputConnection(port, producer.GetOutputPort())
+                multi.SetVolume(v, port)
+                keep.extend((producer, v))
+            vol = multi
+        else:
+            m.SetInputData(data)
+            vol.SetMapper(m)
         if kind == "vtk-fixed":
             m.SetSampleDistance(auto_sample_distance(data, vol))
         if scene.configure:

@@ -576,6 +576,23 @@ def side_light(ren):
     ren.AddLight(light)
 
 
+def ml_in_wavelet(vol):
+    """Marschner-Lobb ([-1, 1]^3) grown to 70 units, turned and moved off the wavelet's
+    centre: it overlaps the wavelet's box in part and leaves it on one side."""
+    vol.SetScale(35.0, 35.0, 35.0)
+    vol.RotateZ(30.0)
+    vol.RotateX(20.0)
+    vol.SetPosition(60.0, 10.0, 0.0)
+
+
+def ml_intermixed(shade=False):
+    def make():
+        p = ml_tf(shade=shade)()
+        p.SetScalarOpacityUnitDistance(2.0)
+        return p
+    return make
+
+
 def rotate_scale(vol):
     vol.SetPosition(15.0, -5.0, 0.0)
     vol.RotateZ(30.0)
@@ -608,6 +625,9 @@ class Scene:
     lights: Optional[Callable] = None      # (vtkRenderer) -> None: scene lights
     iso_values: tuple = ()
     multisamples: Optional[int] = None     # window MSAA; None: VTK's default (8)
+    # further volumes on the mapper's ports 1, 2, ... drawn through a vtkMultiVolume with the
+    # scene's (port 0): () -> [(data key, prop, vtkVolume transform or None)]
+    intermix: Optional[Callable] = None
     fixed: bool = True                     # False: the fixed-point mapper lacks a setting used
     quick: bool = False
     note: str = ""                   # known, understood differences shown next to the images
@@ -860,6 +880,15 @@ SCENES = [
     Scene("rectilinear-cells", "wavelet 64^3 as cell data of a vtkRectilinearGrid whose x "
           "spacing grows from 1 to 2.28", "wavelet_rectilinear_cells", wavelet_tf("linear"),
           fixed=False),
+    Scene("intermix-wavelet-ml", "two volumes intermixed per sample (vtkMultiVolume): wavelet "
+          "128^3 on port 0, Marschner-Lobb 41^3 on port 1 scaled, turned and moved to overlap "
+          "it in part, each its own transfer function", "wavelet128", wavelet_tf("linear"),
+          intermix=lambda: [("marschner_lobb", ml_intermixed(), ml_in_wavelet)],
+          views=one(camera=orbit(30, 20, 1.1)), fixed=False, quick=True),
+    Scene("intermix-wavelet-ml-shaded", "intermix-wavelet-ml with shading on (port 0's "
+          "property turns it on for both, as VTK)", "wavelet128", wavelet_tf("linear", True),
+          intermix=lambda: [("marschner_lobb", ml_intermixed(True), ml_in_wavelet)],
+          views=one(camera=orbit(30, 20, 1.1)), fixed=False),
     Scene("labels-composite", "label map 128x128x108 uint8 (skull CT in 4 tissues), "
           "categorical TF, nearest", "labels", label_tf, quick=True,
           views=one(camera=ct_front(30, 10))),

@@ -506,6 +506,27 @@ double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
   return std::cbrt(std::fabs(volume->GetMatrix()->Determinant()));
 }
 
+bool vtkFerroVolumeLookupTables::BuildIntermixed(vtkVolumeProperty* prop,
+  const std::array<double, 2>& range, const RangeTypes& types,
+  std::unique_ptr<ferrovol::TransferFunction>& tf, std::string& error)
+{
+  if (prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D)
+  {
+    error = "its property has a 2D transfer function: intermixed volumes are classified by "
+            "1D colour and scalar opacity functions";
+    return false;
+  }
+  if (prop->HasGradientOpacity(0) && !prop->GetDisableGradientOpacity(0))
+  {
+    error = "its property has a gradient opacity function: intermixed volumes are classified "
+            "by colour and scalar opacity only (DisableGradientOpacityOn)";
+    return false;
+  }
+  vtkFerroVolumeInputHelper::Ranges ranges{};
+  ranges[0] = range;
+  return BuildTransferFunction(prop, 1, ranges, types, 1.0, tf, error);
+}
+
 bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   const vtkFerroVolumeInputHelper& input, const RangeTypes& rangeTypes,
   ferrovol::Renderer& renderer, std::string& error)

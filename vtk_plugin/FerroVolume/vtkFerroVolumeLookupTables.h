@@ -12,6 +12,8 @@
 
 #include "ferrovol.hpp"
 
+#include <array>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -44,6 +46,13 @@ public:
   // volume's matrix cannot be rendered.
   bool Update(vtkVolume* volume, const vtkFerroVolumeInputHelper& input,
     const RangeTypes& rangeTypes, ferrovol::Renderer& renderer, std::string& error);
+
+  // The transfer function of `prop`'s first component over the data range `range`, for a
+  // volume intermixed with the main one (colour and scalar opacity: a gradient opacity or
+  // 2D function is refused); false with the reason.
+  static bool BuildIntermixed(vtkVolumeProperty* prop, const std::array<double, 2>& range,
+    const RangeTypes& types, std::unique_ptr<ferrovol::TransferFunction>& tf,
+    std::string& error);
 
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }

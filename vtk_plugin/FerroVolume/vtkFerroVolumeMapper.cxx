@@ -22,6 +22,7 @@
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeDepthReader.h"
 #include "vtkFerroVolumeInputHelper.h"
+#include "vtkFerroVolumeIntermix.h"
 #include "vtkFerroVolumeLookupTables.h"
 #include "vtkFerroVolumeOutput.h"
 #include "vtkFerroVolumeRefinement.h"
@@ -33,6 +34,7 @@
 #include "vtkInformationObjectBaseVectorKey.h"
 #include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
+#include "vtkMultiVolume.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLRenderPass.h"
@@ -61,6 +63,7 @@ public:
   unsigned RendererGeneration = 0;
   vtkFerroVolumeInputHelper Input;
   vtkFerroVolumeLookupTables Tables;
+  vtkFerroVolumeIntermix Intermix;
   vtkFerroVolumeSettings Settings;
   vtkFerroVolumeOutput Output;
   vtkFerroVolumeRenderToImage Image;
@@ -107,9 +110,11 @@ public:
     }
   }
 
-  // The input selected and uploaded (on change) within the mapper's memory budget, and the
-  // property's tables (on change); false with the reason.
-  bool Prepare(vtkFerroVolumeMapper* self, vtkVolume* vol, std::string& error)
+  // The input selected and uploaded (on change) within the mapper's memory budget, the
+  // property's tables (on change) and the volumes of `multi`'s other ports (none: cleared);
+  // false with the reason.
+  bool Prepare(
+    vtkFerroVolumeMapper* self, vtkVolume* vol, vtkMultiVolume* multi, std::string& error)
   {
     const vtkIdType bytes = self->GetMaxMemoryInBytes();
     const uint64_t budget = bytes > 0
@@ -136,7 +141,8 @@ public:
       error = "MaskInput: " + error;
       return false;
     }
-    return this->Tables.Update(vol, this->Input, types, *this->Renderer, error);
+    return this->Tables.Update(vol, this->Input, types, *this->Renderer, error) &&
+      this->Intermix.Update(self, multi, types, *this->Renderer, error);
   }
 
   // A warning said once per mapper for `key`.
@@ -147,6 +153,7 @@ public:
     this->Renderer.reset();
     this->Input.Reset();
     this->Tables.Reset();
+    this->Intermix.Reset();
     this->Settings.Reset();
     this->Convergence.reset();
   }
@@ -382,7 +389,14 @@ bool vtkFerroVolumeMapper::PreLoadData(vtkRenderer* vtkNotUsed(ren), vtkVolume* 
     vtkErrorMacro(<< "PreLoadData needs the vtkVolume whose property gives the tables");
     return false;
   }
-  if (!this->Internals->Prepare(this, vol, error))
+  vtkMultiVolume* multi = vtkMultiVolume::SafeDownCast(vol);
+  vtkVolume* main = multi ? multi->GetVolume(0) : vol;
+  if (!main)
+  {
+    vtkErrorMacro(<< "the vtkMultiVolume has no vtkVolume on port 0 (SetVolume(volume, 0))");
+    return false;
+  }
+  if (!this->Internals->Prepare(this, main, multi, error))
   {
     vtkErrorMacro(<< error);
     return false;
@@ -534,9 +548,20 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     in->ReleaseDeviceResources(win);
   }
 
+  // A vtkMultiVolume (vtkGPUVolumeRayCastMapper's several inputs): port 0's vtkVolume
+  // places and classifies the main volume, the other ports' volumes are intermixed with it;
+  // the multi-volume itself gives the box of them all.
+  vtkMultiVolume* multi = vtkMultiVolume::SafeDownCast(vol);
+  vtkVolume* main = multi ? multi->GetVolume(0) : vol;
+  if (!main)
+  {
+    vtkErrorMacro(<< "the vtkMultiVolume has no vtkVolume on port 0 (SetVolume(volume, 0))");
+    return;
+  }
+
   // Blend mode, input, volume (on change), tables (on change), frame parameters.
   std::string error;
-  if (!in->Settings.SelectBlendMode(this, error) || !in->Prepare(this, vol, error))
+  if (!in->Settings.SelectBlendMode(this, error) || !in->Prepare(this, main, multi, error))
   {
     vtkErrorMacro(<< error);
     return;
@@ -578,8 +603,9 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     traceBudget = in->Refinement.TraceBudget(
       vtkFerroVolumeRefinement::FrameBudget(this->PathTracingTimeBudget, win), denoised);
   }
+  in->Settings.SetIntermixing(multi != nullptr);
   switch (
-    in->Settings.Apply(this, ren, vol, in->Input, *in->Renderer, traceBudget, in->Warned, error))
+    in->Settings.Apply(this, ren, main, in->Input, *in->Renderer, traceBudget, in->Warned, error))
   {
     case vtkFerroVolumeSettings::Result::Failed:
       vtkErrorMacro(<< error);
@@ -640,7 +666,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
       depthType = VTK_FLOAT;
     }
     vtkNew<vtkMatrix4x4> boxToClip;
-    vtkFerroVolumeRenderToImage::BoxToClip(ren, vol, image, boxToClip);
+    vtkFerroVolumeRenderToImage::BoxToClip(ren, main, image, boxToClip);
     if (!in->Image.Capture(req, in->Output.ColorTexture(), in->Output.DepthTexture(), depthType,
           boxToClip, this->ClampDepthToBackface != 0, error))
     {

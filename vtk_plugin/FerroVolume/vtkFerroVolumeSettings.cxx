@@ -575,12 +575,13 @@ void vtkFerroVolumeSettings::WarnUnsupported(
   }
   for (int port = 1; port < self->GetNumberOfInputPorts(); ++port)
   {
-    if (self->GetNumberOfInputConnections(port) > 0 &&
+    if (!this->Intermixing && self->GetNumberOfInputConnections(port) > 0 &&
       warned.insert("port-" + std::to_string(port)).second)
     {
       vtkWarningWithObjectMacro(self, << "the input on port " << port
-                                      << " is not drawn: ferrovol renders one volume, the "
-                                         "input on port 0 (no vtkMultiVolume)");
+                                      << " is not drawn: the inputs of ports other than 0 are "
+                                         "drawn through a vtkMultiVolume (SetVolume(volume, "
+                                      << port << ") and the vtkMultiVolume in the renderer)");
     }
   }
 }

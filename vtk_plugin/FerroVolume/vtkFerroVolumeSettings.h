@@ -52,11 +52,15 @@ public:
   // Whether the last frame shows the environment behind the volume: it then covers the
   // whole viewport.
   bool CoversViewport() const { return this->Background; }
+  // Whether the frame draws the other ports' inputs through a vtkMultiVolume (otherwise
+  // an input there is warned about, once).
+  void SetIntermixing(bool on) { this->Intermixing = on; }
 
   // Forget the environment given to the renderer (the renderer is gone).
   void Reset();
 
 private:
+  bool Intermixing = false;
   // Warns, once per mapper and setting, about each vtkGPUVolumeRayCastMapper setting in
   // effect that ferrovol does not honour.
   void WarnUnsupported(vtkFerroVolumeMapper* self, std::set<std::string>& warned) const;
