@@ -158,12 +158,14 @@ bench: build
 # vtkGPUVolumeRayCastMapper in a VTK window, the same benchmark scene, alternating rounds:
 # in VTK's default (multisampled) window, then in one without multisampling; then the
 # equal-fidelity table (bench/fidelity.py): frame time and error against each renderer's
-# converged reference, scene by scene.
+# converged reference, scene by scene; then two volumes intermixed (bench/multi_volume.py).
 bench-vtk: vtk
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 1 >/dev/null
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/vtk_mappers.py --frames 10 --rounds 5 --multisamples 0
 	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/fidelity.py
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/multi_volume.py
+	. build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 bench/multi_volume.py --shade
 
 # The soak test (vtk_plugin/tests/soak.py): 10 000 renders of vtkFerroVolumeMapper while
 # everything changes; fails on an error or memory growth over 5%, plots the memory curve.
