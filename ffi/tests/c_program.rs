@@ -84,6 +84,7 @@ fn cpp_raii_wrapper_renders_and_throws() {
         out.contains("FV_STATUS_INVALID_ARGUMENT: blend_mode 42"),
         "{out}"
     );
+    assert!(out.contains("four intermixed volumes refused"), "{out}");
 }
 
 /// Handles shared between threads as the header allows (one context and volume, a renderer

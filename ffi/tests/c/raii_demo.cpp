@@ -1,5 +1,6 @@
-// Drives the C++ RAII wrapper (ferrovol.hpp): renders a small sphere volume, then checks that
-// a bad call throws ferrovol::Error with the right status and a message.
+// Drives the C++ RAII wrapper (ferrovol.hpp): renders a small sphere volume, then a second
+// one intermixed with it, then checks that bad calls throw ferrovol::Error with the right
+// status and a message.
 // Built with -std=c++17 -Wall -Wextra -Werror -pedantic by ffi/tests/c_program.rs.
 #include "ferrovol.hpp"
 
@@ -56,6 +57,39 @@ int main(int argc, char **argv) {
       std::fprintf(stderr, "the sphere is missing from the centre of the frame\n");
       return 1;
     }
+    {
+      // A second sphere, red, moved 8 points to +x and intermixed with the first; its
+      // handles go before the frame (the renderer keeps what it needs).
+      ferrovol::Volume second(desc, data.data(), data.size());
+      ferrovol::TransferFunction red;
+      red.set_color(0, {0, 1, 0, 0, 255, 1, 0, 0});
+      red.set_opacity(0, {0, 0, 255, 0.2});
+      FvIntermixedVolume iv{};
+      iv.volume = second.get();
+      iv.transfer_function = red.get();
+      iv.matrix[0] = iv.matrix[5] = iv.matrix[10] = iv.matrix[15] = 1.0;
+      iv.matrix[12] = 8.0;
+      renderer.set_intermixed_volumes({iv});
+      try {
+        renderer.set_intermixed_volumes(std::vector<FvIntermixedVolume>(4, iv));
+        std::fprintf(stderr, "four intermixed volumes were accepted\n");
+        return 1;
+      } catch (const ferrovol::Error &e) {
+        std::printf("four intermixed volumes refused: %s\n", e.what());
+        if (e.status() != FV_STATUS_UNSUPPORTED) {
+          return 1;
+        }
+      }
+    }
+    renderer.render(200, 150);
+    ferrovol::Frame mixed = renderer.read_frame();
+    const uint8_t *right = mixed.rgba() + 4 * (75 * 200 + 100);
+    std::printf("intermixed centre %u %u %u %u\n", right[0], right[1], right[2], right[3]);
+    if (!(right[0] > right[1] && right[3] > centre[3])) {
+      std::fprintf(stderr, "the red sphere does not show over the first\n");
+      return 1;
+    }
+    renderer.set_intermixed_volumes({});
     try {
       FvRenderParams bad = ferrovol::Renderer::default_params();
       bad.blend_mode = 42;
