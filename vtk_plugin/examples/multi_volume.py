@@ -37,6 +37,8 @@ def volume_property(colors, opacities, unit_distance):
 def wavelet(extent):
     src = vtk.vtkRTAnalyticSource()
     src.SetWholeExtent(-extent, extent, -extent, extent, -extent, extent)
+    # (updated now: the vtkMultiVolume's bounds, which ResetCamera reads, are its inputs')
+    src.Update()
     return src
 
 
