@@ -79,13 +79,14 @@ fn in_grid(p: vec3<f32>, dims: vec3<f32>) -> bool {
 }
 
 // Intermixed volume j's value at index-space point p (clamped to its grid, as a clamping
-// sampler reads): its nearest point with NEAREST, else trilinear between its points.
+// sampler reads): its nearest point where the volume says so (range.z), else trilinear
+// between its points.
 fn intermixed_value(j: u32, p: vec3<f32>) -> f32 {
     let d = intermix.volumes[j].dims;
     let hi = d.xyz - 1.0;
     let q = clamp(p, vec3<f32>(0.0), hi);
     let z0 = vec3<i32>(0, 0, i32(d.w));
-    if (NEAREST) {
+    if (intermix.volumes[j].range.z > 0.0) {
         return textureLoad(intermix_atlas, vec3<i32>(floor(q + 0.5)) + z0, 0).x;
     }
     let lo = floor(q);
@@ -118,7 +119,7 @@ fn intermixed_sample(j: u32, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
     let x = clamp((s - v.range.x) * v.range.y, 0.0, 1.0) * f32(TABLE_N - 1u);
     let row = i32(2u * j);
     var e: vec4<f32>;
-    if (NEAREST) {
+    if (v.range.z > 0.0) {
         e = textureLoad(intermix_tables, vec2<i32>(i32(x + 0.5), row), 0);
     } else {
         let i0 = u32(x);

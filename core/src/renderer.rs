@@ -116,7 +116,7 @@ impl Renderer {
     /// holding them all at the main volume's sample distance, and at each sample composites
     /// the main volume and then each intermixed volume that holds the sample, each classified
     /// by its own transfer function (opacity corrected for the step by its own unit
-    /// distance) and shaded, when shading is on, by its own gradient with the main volume's
+    /// distance) and read with its own interpolation, and shaded, when shading is on, by its own gradient with the main volume's
     /// lights and material. Ray casting in the composite blend mode only; at most
     /// [`MAX_INTERMIXED_VOLUMES`](crate::MAX_INTERMIXED_VOLUMES); an empty slice clears
     /// them. Data shared with the previous call (the same `Arc`s) is not uploaded again.

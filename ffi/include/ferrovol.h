@@ -345,6 +345,11 @@ typedef struct FvIntermixedVolume {
    * is for the main volume.
    */
   double matrix[16];
+  /**
+   * FV_INTERPOLATION_NEAREST or FV_INTERPOLATION_LINEAR: how this volume and its tables are
+   * read (its property's InterpolationType).
+   */
+  uint32_t interpolation;
 } FvIntermixedVolume;
 
 /**

@@ -1,7 +1,7 @@
 //! Volumes intermixed with the renderer's main volume per sample (VTK's vtkMultiVolume).
 
 use super::*;
-use ferrovol_core::{IntermixedVolume, MAX_INTERMIXED_VOLUMES};
+use ferrovol_core::{IntermixedVolume, Interpolation, MAX_INTERMIXED_VOLUMES};
 
 /// Most volumes fv_renderer_set_intermixed_volumes takes beside the main volume.
 pub const FV_MAX_INTERMIXED_VOLUMES: usize = 3;
@@ -18,6 +18,9 @@ pub struct FvIntermixedVolume {
     /// The vtkVolume's matrix (data → world), column-major, as FvRenderParams::volume_matrix
     /// is for the main volume.
     pub matrix: [f64; 16],
+    /// FV_INTERPOLATION_NEAREST or FV_INTERPOLATION_LINEAR: how this volume and its tables are
+    /// read (its property's InterpolationType).
+    pub interpolation: u32,
 }
 
 /// Sets the volumes drawn with the main one (`count` at `volumes`, 0 clears them), as
@@ -63,10 +66,21 @@ pub unsafe extern "C" fn fv_renderer_set_intermixed_volumes(
                 v.transfer_function,
                 &format!("volumes[{i}].transfer_function"),
             )?;
+            let interpolation = match v.interpolation {
+                x if x == FvInterpolation::Nearest as u32 => Interpolation::Nearest,
+                x if x == FvInterpolation::Linear as u32 => Interpolation::Linear,
+                x => {
+                    return Err(FfiError::invalid(format!(
+                        "volumes[{i}].interpolation {x}: intermixed volumes are read \
+                         nearest (0) or linear (1)"
+                    )))
+                }
+            };
             core.push(IntermixedVolume {
                 volume: data.data.clone(),
                 matrix: column_major(&v.matrix),
                 transfer: tf.to_core()?,
+                interpolation,
             });
         }
         r.r.set_intermixed_volumes(&core)?;

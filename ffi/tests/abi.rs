@@ -678,7 +678,13 @@ fn intermixed_volumes_through_the_c_abi() {
             volume: red_volume.cast_const().cast(),
             transfer_function: red_tf.cast_const().cast(),
             matrix,
+            interpolation: 1,
         };
+        let cubic = FvIntermixedVolume {
+            interpolation: 2,
+            ..one
+        };
+        lib.expect(set(s.r, &cubic, 1), Invalid, "volumes[0].interpolation 2");
         lib.expect(
             set(s.r, [one; 4].as_ptr(), 4),
             FvStatus::Unsupported,

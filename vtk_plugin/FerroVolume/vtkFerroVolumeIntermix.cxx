@@ -190,6 +190,9 @@ bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* 
       p.Property = nullptr;
       return false;
     }
+    given[i].interpolation = p.Property->GetInterpolationType() == VTK_NEAREST_INTERPOLATION
+      ? FV_INTERPOLATION_NEAREST
+      : FV_INTERPOLATION_LINEAR;
     given[i].volume = p.Volume->get();
     given[i].transfer_function = tfs[i]->get();
     std::copy(p.Matrix, p.Matrix + 16, given[i].matrix);

@@ -89,6 +89,19 @@ class MultiVolume(unittest.TestCase):
         self.assertGreater(s, 0.995)
         self.assertGreater(p, 50.0)
 
+    def test_each_volume_its_own_interpolation(self):
+        # The second volume read at its nearest points (its property's InterpolationType),
+        # the first linearly, as VTK reads each port's texture.
+        def nearest_second(scene):
+            scene.volumes[1].GetProperty().SetInterpolationTypeToNearest()
+
+        ours, theirs = self.render_both(nearest_second)
+        s, p = fvtest.compare("multi-volume-nearest", ours, theirs)  # 0.9999 / 61.9 dB
+        self.assertGreater(s, 0.995)
+        self.assertGreater(p, 50.0)
+        linear = self.render_both(lambda scene: None)[0]
+        self.assertLess(fvtest.ssim(ours, linear), 0.9999, "nearest changes the image")
+
     def test_shaded_against_vtk(self):
         """Shaded, VTK 9.2's multi-volume shader lights each volume with directions from
         the ray's entry point in the bounding box's coordinates (its min corner at 0) to

@@ -165,7 +165,8 @@ pub struct IntermixedVolumeUniforms {
     pub gradient_to_world: [f32; 16],
     /// Points per axis, then the first z of the volume's points in the atlas.
     pub dims: [f32; 4],
-    /// The transfer tables' scalar at the first entry and 1 / their scalar width.
+    /// The transfer tables' scalar at the first entry, 1 / their scalar width, and 1 where
+    /// the volume and its tables are read at the nearest point and entry (0: linearly).
     pub range: [f32; 4],
 }
 

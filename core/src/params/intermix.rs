@@ -1,6 +1,7 @@
 //! Further volumes drawn with the main one, intermixed per sample (VTK's vtkMultiVolume
 //! with vtkGPUVolumeRayCastMapper's extra input ports).
 
+use super::render::Interpolation;
 use super::transfer::TransferFunction;
 use super::volume::VolumeData;
 use crate::error::{Error, Result};
@@ -24,6 +25,9 @@ pub struct IntermixedVolume {
     pub matrix: DMat4,
     /// One component, 1D tables (no 2D table, no labels, no gradient opacity).
     pub transfer: TransferFunction,
+    /// How this volume and its tables are read between points and entries (its property's
+    /// InterpolationType in VTK): nearest or linear.
+    pub interpolation: Interpolation,
 }
 
 impl IntermixedVolume {
@@ -48,6 +52,12 @@ impl IntermixedVolume {
         if !self.matrix.is_finite() || self.matrix.determinant().abs() < 1e-12 {
             return Err(Error::InvalidParameter(format!(
                 "{name}: its matrix is singular or not finite"
+            )));
+        }
+        if self.interpolation == Interpolation::Cubic {
+            return Err(Error::Unsupported(format!(
+                "{name}: cubic interpolation; intermixed volumes are read linearly or at the \
+                 nearest point"
             )));
         }
         let tf = &self.transfer;

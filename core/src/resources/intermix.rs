@@ -7,7 +7,9 @@ use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::{mat, IntermixUniforms, TABLE_SIZE};
 use crate::gpu::Context;
-use crate::params::{build_tables, IntermixedVolume, VolumeData, MAX_INTERMIXED_VOLUMES};
+use crate::params::{
+    build_tables, IntermixedVolume, Interpolation, VolumeData, MAX_INTERMIXED_VOLUMES,
+};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -121,7 +123,13 @@ impl Intermix {
             g.world_to_index = mat(world_to_index);
             g.gradient_to_world = mat(world_to_index.transpose());
             g.dims = [d[0] as f32, d[1] as f32, d[2] as f32, self.z0[j] as f32];
-            g.range = [lo as f32, (1.0 / (hi - lo)) as f32, 0.0, 0.0];
+            let nearest = v.interpolation == Interpolation::Nearest;
+            g.range = [
+                lo as f32,
+                (1.0 / (hi - lo)) as f32,
+                f32::from(u8::from(nearest)),
+                0.0,
+            ];
         }
         ctx.queue
             .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));

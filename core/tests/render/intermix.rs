@@ -46,7 +46,15 @@ fn halves_intermixed_equal_the_whole() {
     });
     let view = oblique(&whole, 96);
     let transfer = tf(blob_transfer());
-    for (name, params) in [("unshaded", RenderParams::default()), ("shaded", shaded())] {
+    let nearest = RenderParams {
+        interpolation: Interpolation::Nearest,
+        ..RenderParams::default()
+    };
+    for (name, params) in [
+        ("unshaded", RenderParams::default()),
+        ("shaded", shaded()),
+        ("nearest", nearest),
+    ] {
         r.set_intermixed_volumes(&[]).unwrap();
         r.set_volume(&whole).unwrap();
         r.set_transfer_function(&transfer).unwrap();
@@ -56,6 +64,7 @@ fn halves_intermixed_equal_the_whole() {
             volume: Arc::new(slab_x(&whole, 21, 40)),
             matrix: DMat4::IDENTITY,
             transfer: transfer.clone(),
+            interpolation: params.interpolation,
         }])
         .unwrap();
         let img = r.render_image(&view, &params).unwrap();
@@ -110,6 +119,7 @@ fn intermixed_matrix_places_the_volume() {
             volume: Arc::new(vol.clone()),
             matrix: m,
             transfer: transfer.clone(),
+            interpolation: params.interpolation,
         }])
         .unwrap();
         let img = r.render_image(&view, &params).unwrap();
@@ -147,6 +157,7 @@ fn intermixed_volumes_composite_in_order_per_sample() {
         volume: Arc::new(vol.clone()),
         matrix: DMat4::IDENTITY,
         transfer: colour([0.0, 0.0, 1.0]),
+        interpolation: Interpolation::Linear,
     }])
     .unwrap();
     let mut view = View::fit(vol.bounds(), 17, 17);
@@ -180,6 +191,7 @@ fn intermixing_refuses_what_it_does_not_take() {
         volume: Arc::new(vol.clone()),
         matrix: DMat4::IDENTITY,
         transfer: transfer.clone(),
+        interpolation: Interpolation::Linear,
     };
     assert_error(
         r.set_intermixed_volumes(&vec![one.clone(); MAX_INTERMIXED_VOLUMES + 1]),
@@ -202,6 +214,14 @@ fn intermixing_refuses_what_it_does_not_take() {
         }]),
         "singular matrix",
         &["intermixed volume 0", "singular"],
+    );
+    assert_error(
+        r.set_intermixed_volumes(&[IntermixedVolume {
+            interpolation: Interpolation::Cubic,
+            ..one.clone()
+        }]),
+        "cubic",
+        &["intermixed volume 0", "cubic"],
     );
     r.set_intermixed_volumes(&[one]).unwrap();
     let view = oblique(&vol, 32);

@@ -69,6 +69,7 @@ int main(int argc, char **argv) {
       iv.transfer_function = red.get();
       iv.matrix[0] = iv.matrix[5] = iv.matrix[10] = iv.matrix[15] = 1.0;
       iv.matrix[12] = 8.0;
+      iv.interpolation = FV_INTERPOLATION_LINEAR;
       renderer.set_intermixed_volumes({iv});
       try {
         renderer.set_intermixed_volumes(std::vector<FvIntermixedVolume>(4, iv));
