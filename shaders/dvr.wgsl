@@ -69,6 +69,10 @@ struct Intermix {
 @group(0) @binding(13) var<uniform> intermix: Intermix;
 @group(0) @binding(14) var intermix_atlas: texture_3d<f32>;
 @group(0) @binding(15) var intermix_tables: texture_2d<f32>;
+// Linear where r32float is filterable (INTERMIX_FILTERED: one fetch per value, weighted as
+// VTK's textures are), else nearest and unused (the shader interpolates eight loads).
+@group(0) @binding(16) var intermix_sampler: sampler;
+override INTERMIX_FILTERED: bool = false;
 
 // Whether an intermixed frame samples the volume of `dims` points at index-space point p:
 // VTK's multi-volume shader tests the sample's texture coordinate against [0, 1], and a
@@ -88,6 +92,13 @@ fn intermixed_value(j: u32, p: vec3<f32>) -> f32 {
     let z0 = vec3<i32>(0, 0, i32(d.w));
     if (intermix.volumes[j].range.z > 0.0) {
         return textureLoad(intermix_atlas, vec3<i32>(floor(q + 0.5)) + z0, 0).x;
+    }
+    if (INTERMIX_FILTERED) {
+        // (q is clamped to the volume's points: a texel of the next volume in the atlas
+        // gets weight 0)
+        let size = vec3<f32>(textureDimensions(intermix_atlas));
+        let c = (q + vec3<f32>(0.0, 0.0, d.w) + 0.5) / size;
+        return textureSampleLevel(intermix_atlas, intermix_sampler, c, 0.0).x;
     }
     let lo = floor(q);
     let f = q - lo;

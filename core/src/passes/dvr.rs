@@ -9,7 +9,7 @@ use super::frame::{
 };
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
-    bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
+    bind, buffer_entry, entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
@@ -53,6 +53,9 @@ pipeline_variant! {
         rectilinear: bool => "RECTILINEAR",
         /// Number of volumes intermixed with the main one.
         intermix: u32 => "INTERMIX",
+        /// The intermixed volumes' atlas is read through a linear sampler (r32float is
+        /// filterable on this device).
+        intermix_filtered: bool => "INTERMIX_FILTERED",
     }
 }
 
@@ -71,12 +74,16 @@ pub(crate) struct DvrPass {
     no_grid_lookup: wgpu::TextureView,
     /// Bound in place of the intermixed volumes' uniforms, atlas and tables without any.
     no_intermix: (wgpu::Buffer, wgpu::TextureView),
+    /// Reads the intermixed volumes' atlas: linear where r32float is filterable, else
+    /// nearest (the shader then interpolates).
+    intermix_sampler: wgpu::Sampler,
 }
 
 impl DvrPass {
     pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
+        let filterable = ctx.info.float32_filterable;
         let bgl = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -96,8 +103,16 @@ impl DvrPass {
                     texture_entry(11, false, V::D2),
                     texture_entry(12, false, V::D3),
                     buffer_entry(13, B::Uniform),
-                    texture_entry(14, false, V::D3),
+                    texture_entry(14, filterable, V::D3),
                     texture_entry(15, false, V::D2),
+                    entry(
+                        16,
+                        wgpu::BindingType::Sampler(if filterable {
+                            wgpu::SamplerBindingType::Filtering
+                        } else {
+                            wgpu::SamplerBindingType::NonFiltering
+                        }),
+                    ),
                 ],
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
@@ -117,6 +132,23 @@ impl DvrPass {
                 ),
                 block_grid(ctx, "no intermix", [1; 3], &[0f32]),
             ),
+            intermix_sampler: ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("intermix atlas"),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: if filterable {
+                    wgpu::FilterMode::Linear
+                } else {
+                    wgpu::FilterMode::Nearest
+                },
+                min_filter: if filterable {
+                    wgpu::FilterMode::Linear
+                } else {
+                    wgpu::FilterMode::Nearest
+                },
+                ..Default::default()
+            }),
         })
     }
 
@@ -337,6 +369,7 @@ impl DvrPass {
             preintegration,
             rectilinear,
             intermix,
+            intermix_filtered: intermix > 0 && ctx.info.float32_filterable,
         };
         if preintegration {
             res.ensure_preintegration(ctx, step)?;
@@ -432,6 +465,7 @@ impl DvrPass {
                         None => &self.no_tables_2d.view,
                     }),
                 ),
+                bind(16, wgpu::BindingResource::Sampler(&self.intermix_sampler)),
             ],
         });
         let rect = u.rect;
