@@ -824,6 +824,16 @@ typedef struct FvResidency {
    */
   uint64_t pool_bytes;
   uint64_t dense_bytes;
+  /**
+   * Fine points per point, along each axis, of the level the last frame drew: 1 for the
+   * volume itself; 2, 4, … when a path-traced frame's bricks exceed the memory budget
+   * and it traced a level downsampled that much (the finest that fits).
+   */
+  uint32_t level;
+  /**
+   * That level's points per axis.
+   */
+  uint32_t level_dims[3];
 } FvResidency;
 
 /**

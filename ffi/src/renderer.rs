@@ -531,6 +531,8 @@ pub unsafe extern "C" fn fv_renderer_residency(
             brick_uploads: r.r.stats().brick_uploads,
             pool_bytes: s.pool_bytes,
             dense_bytes: s.dense_bytes,
+            level: s.level,
+            level_dims: s.level_dims,
         };
         Ok(())
     })

@@ -330,6 +330,12 @@ pub struct FvResidency {
     /// of the whole volume as one texture.
     pub pool_bytes: u64,
     pub dense_bytes: u64,
+    /// Fine points per point, along each axis, of the level the last frame drew: 1 for the
+    /// volume itself; 2, 4, … when a path-traced frame's bricks exceed the memory budget
+    /// and it traced a level downsampled that much (the finest that fits).
+    pub level: u32,
+    /// That level's points per axis.
+    pub level_dims: [u32; 3],
 }
 
 /// What a context holds on its device now (every renderer on it together), from wgpu's

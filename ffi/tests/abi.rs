@@ -1161,6 +1161,52 @@ fn streamed_frames_report_progress() {
     assert!(streamed.chunks(4).any(|p| p[3] > 50), "drawn");
 }
 
+/// Path tracing past the memory budget traces a coarser level, and fv_renderer_residency
+/// says which: 2 fine points per point for a budget of a quarter of the volume; a ray-cast
+/// frame after it draws the volume itself again.
+#[test]
+fn path_tracing_past_the_budget_reports_its_level() {
+    let lib = Lib::open();
+    let n = 32usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    let mut s = Session::new(&lib);
+    let budget = lib.f::<unsafe extern "C" fn(H, u64) -> FvStatus>("fv_renderer_set_memory_budget");
+    let residency = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus>(
+        "fv_renderer_residency",
+    );
+    let read = |s: &Session| {
+        let mut res = ferrovol::FvResidency::default();
+        // SAFETY: a valid handle and out-pointer.
+        unsafe { lib.ok(residency(s.r, &mut res)) };
+        res
+    };
+    // SAFETY: a valid handle.
+    unsafe { lib.ok(budget(s.r, (n * n * n) as u64)) }; // a quarter of the float32 volume
+    s.set_volume([32, 32, 32], FvScalarType::F32, &data);
+    s.set_transfer_function(
+        &[0.0, 0.9, 0.8, 0.7, 31.0, 0.9, 0.8, 0.7],
+        &[0.0, 0.0, 31.0, 0.5],
+    );
+    s.set_camera(&camera([15.5, 15.5, 100.0], [15.5; 3], [1.0, 300.0]));
+    let mut p = FvRenderParams::defaults();
+    p.blend_mode = FvBlendMode::PathTrace as u32;
+    s.set_params(&p);
+    let traced = s.frame(24, 24).to_vec();
+    let res = read(&s);
+    println!("path traced past the budget: {res:?}");
+    assert!(traced.chunks(4).any(|p| p[3] > 20), "drawn");
+    assert_eq!((res.level, res.level_dims), (2, [17; 3]));
+    assert!(
+        res.pool_bytes <= (n * n * n) as u64,
+        "within the budget: {res:?}"
+    );
+    p.blend_mode = FvBlendMode::Composite as u32;
+    s.set_params(&p);
+    s.frame(24, 24);
+    let res = read(&s);
+    assert_eq!((res.level, res.level_dims), (1, [32; 3]), "{res:?}");
+}
+
 /// The context's device memory counters: a renderer's frames allocate once (repeated
 /// frames hold the same buffers and textures), and a renderer freed and made again holds no
 /// more than the first one did.
