@@ -172,8 +172,8 @@ struct RenderArgs {
     brick: Option<u32>,
     /// Most MiB the volume may take on the device. A larger volume is bricked with only the
     /// bricks a frame needs resident; when even those exceed it, ray casting and isosurfaces
-    /// stream them through the pool in several passes, and path tracing traces the finest
-    /// coarser level that fits (volumetric shadows, AO and scattering report the sizes).
+    /// stream them through the pool in several passes; path tracing, volumetric shadows, AO
+    /// and scattering, whose rays go anywhere, draw the finest coarser level that fits.
     #[arg(long, value_name = "MIB")]
     gpu_memory: Option<u64>,
     /// Render this many frames and print the mean time per frame (the first, which builds
@@ -848,8 +848,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     if res.level > 1 {
         let [x, y, z] = res.level_dims;
         println!(
-            "ferrovol: the bricks a path-traced frame needs exceed --gpu-memory: traced a level \
-             {} times coarser per axis ({x}x{y}x{z})",
+            "ferrovol: the bricks this frame's rays need exceed --gpu-memory: drew a level {} \
+             times coarser per axis ({x}x{y}x{z})",
             res.level
         );
     }

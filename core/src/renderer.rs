@@ -10,12 +10,13 @@ use crate::params::{
     IsoParams, MaskKind, PathTraceParams, RenderParams, Residency, Stats, StreamProgress,
     TransferFunction, UploadOptions, View, VolumeData,
 };
-use crate::passes::dvr::DvrPass;
+use crate::passes::dvr::{self, DvrPass};
 use crate::passes::frame::FrameInput;
-use crate::passes::iso::IsoPass;
+use crate::passes::iso::{self, IsoPass};
 use crate::passes::pathtrace::PathTracePass;
 use crate::passes::scatter_check;
 use crate::resources::intermix::Intermix;
+use crate::resources::levels::LevelDemand;
 use crate::resources::targets::DepthSource;
 use crate::resources::volume::HostVolume;
 use crate::resources::Resources;
@@ -343,8 +344,25 @@ impl Renderer {
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
         let (ctx, res) = (&self.ctx, &mut self.res);
-        if params.blend != BlendMode::PathTrace {
-            res.release_level();
+        // Rays that go anywhere cannot stream: past the budget such a frame draws a coarser
+        // level of the volume.
+        let anywhere = match params.blend {
+            BlendMode::PathTrace => Some((LevelDemand::Visible, "a path-traced frame")),
+            BlendMode::Isosurface => match self.iso_params.as_ref() {
+                Some(iso) if res.volume.is_some() => iso::level_demand(iso, res)?
+                    .map(|d| (d, "ambient occlusion or scattering between isosurfaces")),
+                _ => None,
+            },
+            _ if dvr::casts_shadows(view, params) => {
+                Some((LevelDemand::Visible, "a frame with volumetric shadows"))
+            }
+            _ => None,
+        };
+        match &anywhere {
+            Some((demand, what)) if res.intermix.is_none() => {
+                res.enter_level(ctx, params, demand, what)?
+            }
+            _ => res.release_level(),
         }
         if res.intermix.is_some() && params.blend != BlendMode::Composite {
             return Err(Error::Unsupported(format!(
@@ -360,26 +378,25 @@ impl Renderer {
             params,
             depth,
         };
-        match params.blend {
+        let done = match params.blend {
             BlendMode::Isosurface => {
                 let brick_bgl = &res.brick_bgl;
                 let pass = ensure(&mut self.iso, || {
                     Ok(Box::new(IsoPass::new(ctx, brick_bgl)?))
                 })?;
-                pass.render(input(res), self.iso_params.as_ref())
+                pass.render(input(&mut *res), self.iso_params.as_ref())
             }
             BlendMode::PathTrace => {
                 let brick_bgl = &res.brick_bgl;
                 let pass = ensure(&mut self.pt, || {
                     Ok(Box::new(PathTracePass::new(ctx, brick_bgl)?))
                 })?;
-                res.enter_level(ctx, params)?;
-                let done = pass.render(input(&mut *res), &self.pt_params);
-                res.leave_level();
-                done
+                pass.render(input(&mut *res), &self.pt_params)
             }
-            _ => self.dvr.render(input(res)),
-        }
+            _ => self.dvr.render(input(&mut *res)),
+        };
+        res.leave_level();
+        done
     }
 
     /// The output texture (premultiplied RGBA8) of the last frame.

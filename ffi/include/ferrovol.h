@@ -826,8 +826,10 @@ typedef struct FvResidency {
   uint64_t dense_bytes;
   /**
    * Fine points per point, along each axis, of the level the last frame drew: 1 for the
-   * volume itself; 2, 4, … when a path-traced frame's bricks exceed the memory budget
-   * and it traced a level downsampled that much (the finest that fits).
+   * volume itself; 2, 4, … when the bricks of a frame whose rays go anywhere (path
+   * tracing, volumetric shadows, ambient occlusion, scattering between isosurfaces)
+   * exceed the memory budget and it drew a level downsampled that much (the finest that
+   * fits).
    */
   uint32_t level;
   /**
@@ -1007,8 +1009,9 @@ enum FvStatus fv_renderer_set_max_brick_points(struct FvRenderer *renderer, uint
  * Most bytes a later volume upload may take on the device (0 = the device's limit). A
  * larger volume is bricked with only the bricks a frame needs resident; when even those
  * exceed the budget, ray casting and isosurfaces stream them through the pool in several
- * passes of one frame, and path tracing, volumetric shadows and isosurfaces with ambient
- * occlusion or scattering fail with FV_STATUS_UNSUPPORTED naming the sizes.
+ * passes of one frame; path tracing, volumetric shadows and isosurfaces with ambient
+ * occlusion or scattering, whose rays go anywhere, draw the finest coarser level of the
+ * volume whose needed bricks fit (fv_renderer_residency says which).
  */
 enum FvStatus fv_renderer_set_memory_budget(struct FvRenderer *renderer, uint64_t bytes);
 

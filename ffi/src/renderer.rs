@@ -89,8 +89,9 @@ pub unsafe extern "C" fn fv_renderer_set_max_brick_points(
 /// Most bytes a later volume upload may take on the device (0 = the device's limit). A
 /// larger volume is bricked with only the bricks a frame needs resident; when even those
 /// exceed the budget, ray casting and isosurfaces stream them through the pool in several
-/// passes of one frame, and path tracing, volumetric shadows and isosurfaces with ambient
-/// occlusion or scattering fail with FV_STATUS_UNSUPPORTED naming the sizes.
+/// passes of one frame; path tracing, volumetric shadows and isosurfaces with ambient
+/// occlusion or scattering, whose rays go anywhere, draw the finest coarser level of the
+/// volume whose needed bricks fit (fv_renderer_residency says which).
 #[no_mangle]
 pub unsafe extern "C" fn fv_renderer_set_memory_budget(
     renderer: *mut FvRenderer,

@@ -331,8 +331,10 @@ pub struct FvResidency {
     pub pool_bytes: u64,
     pub dense_bytes: u64,
     /// Fine points per point, along each axis, of the level the last frame drew: 1 for the
-    /// volume itself; 2, 4, … when a path-traced frame's bricks exceed the memory budget
-    /// and it traced a level downsampled that much (the finest that fits).
+    /// volume itself; 2, 4, … when the bricks of a frame whose rays go anywhere (path
+    /// tracing, volumetric shadows, ambient occlusion, scattering between isosurfaces)
+    /// exceed the memory budget and it drew a level downsampled that much (the finest that
+    /// fits).
     pub level: u32,
     /// That level's points per axis.
     pub level_dims: [u32; 3],

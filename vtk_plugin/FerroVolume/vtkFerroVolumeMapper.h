@@ -48,8 +48,9 @@
  *   none); the fraction defaults to 0.75. A larger volume is split into bricks of which only
  *   those a frame needs are on the device; when even those exceed the budget, ray casting
  *   and isosurfaces stream them in several passes of one frame (the same image; each pass
- *   fires the ProgressEvent while ReportProgress is on) and path tracing, volumetric shadows
- *   and isosurface ambient occlusion report the sizes. Takes effect at the next upload;
+ *   fires the ProgressEvent while ReportProgress is on); path tracing, volumetric shadows
+ *   and isosurface ambient occlusion or scattering draw the finest coarser level of the
+ *   volume whose needed bricks fit. Takes effect at the next upload;
  * - volumetric shadows (single scattering) with vtkGPUVolumeRayCastMapper's
  *   VolumetricScatteringBlending and GlobalIlluminationReach, in the composite blend mode
  *   with Shade on and at least one light, the anisotropy being the property's

@@ -41,9 +41,10 @@ pub struct UploadOptions {
     /// any precomputed gradients); `None` = the device's single-allocation limit. A volume
     /// larger than this is bricked and only the bricks a frame needs are resident; when
     /// even they do not fit, ray casting and isosurfaces stream them through the pool, front
-    /// to back, in several passes of one frame; path tracing draws the finest coarser level
-    /// that fits ([`VolumeData::downsampled`], reported by [`Residency::level`]); volumetric
-    /// shadows, ambient occlusion and scattering between isosurfaces report the sizes.
+    /// to back, in several passes of one frame; path tracing, volumetric shadows, ambient
+    /// occlusion and scattering between isosurfaces, whose rays go anywhere, draw the finest
+    /// coarser level that fits ([`VolumeData::downsampled`], reported by
+    /// [`Residency::level`]).
     pub memory_budget: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
     /// brick (8 bytes per point), so that shading reads one fetch instead of six (the same
@@ -88,8 +89,10 @@ pub struct Residency {
     pub pool_bytes: u64,
     pub dense_bytes: u64,
     /// Fine points per point, along each axis, of the level the last frame drew: 1 for the
-    /// volume itself; 2, 4, … when a path-traced frame's bricks exceed the memory budget and
-    /// it drew a level downsampled that much (the finest that fits).
+    /// volume itself; 2, 4, … when the bricks of a frame whose rays go anywhere (path
+    /// tracing, volumetric shadows, ambient occlusion, scattering between isosurfaces)
+    /// exceed the memory budget and it drew a level downsampled that much (the finest that
+    /// fits).
     pub level: u32,
     /// That level's points per axis.
     pub level_dims: [u32; 3],

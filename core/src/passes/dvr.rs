@@ -16,7 +16,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{IntermixUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
+use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind, RenderParams, View};
 use crate::resources::intermix::world_box;
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
@@ -169,9 +169,7 @@ impl DvrPass {
         };
         // Volumetric shadows' rays leave the pixels' lines: every needed brick, in view or
         // not.
-        let s = &params.shading;
-        let shadows = s.enabled && s.volumetric_blending > 0.0 && !view.lights.is_empty();
-        let in_view = if shadows {
+        let in_view = if casts_shadows(view, params) {
             None
         } else {
             Some(bricks_in_view(res, view, params)?)
@@ -509,4 +507,14 @@ impl DvrPass {
         res.stats.frames += 1;
         Ok(())
     }
+}
+
+/// Whether a ray-cast frame draws VTK's volumetric shadows, whose rays leave the pixels'
+/// lines (so it cannot stream; past the budget it draws a coarser level, `levels.rs`).
+pub(crate) fn casts_shadows(view: &View, params: &RenderParams) -> bool {
+    let s = &params.shading;
+    s.enabled
+        && s.volumetric_blending > 0.0
+        && !view.lights.is_empty()
+        && params.blend == BlendMode::Composite
 }

@@ -41,6 +41,7 @@ use crate::params::{
     Shininess, TransferFunction,
 };
 use crate::resources::environment::texel_solid_angle;
+use crate::resources::levels::LevelDemand;
 use crate::resources::tables::{Occupancy, Tables};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
@@ -103,6 +104,21 @@ struct GBufferTargets {
     extra: wgpu::Texture,
 }
 
+/// The bricks a frame of the isosurfaces `iso` needs when its rays leave the pixels' lines
+/// (ambient occlusion, scattering between the surfaces), so that past the budget it draws a
+/// coarser level (`levels.rs`); none for a frame that streams.
+pub(crate) fn level_demand(iso: &IsoParams, res: &Resources) -> Result<Option<LevelDemand>> {
+    let ao = iso.ambient_occlusion.is_some_and(|a| a.samples > 0);
+    if !ao && iso.scattering.is_none() {
+        return Ok(None);
+    }
+    Ok(Some(LevelDemand::Surfaces {
+        values: iso.values.iter().map(|v| v.value as f32).collect(),
+        component: iso_component(res.tf.as_ref(), res.volume()?.components),
+        visible: iso.scattering.is_some(),
+    }))
+}
+
 /// The occupancy of the min–max blocks for a set of iso-values: a block is occupied when
 /// one of the values lies within its range.
 #[derive(PartialEq)]
@@ -110,6 +126,8 @@ struct OccupancyKey {
     values: Vec<u64>,
     component: u32,
     volume_upload: u32,
+    /// The level of the volume drawn (`Resources::drawn_level`): its blocks are its own.
+    level: u32,
 }
 
 /// The isosurface passes (first hit, deferred shading) with their state, created on first
@@ -338,20 +356,14 @@ impl IsoPass {
             values: values.iter().map(|v| v.to_bits() as u64).collect(),
             component,
             volume_upload: res.stats.volume_uploads,
+            level: res.drawn_level,
         };
         if Occupancy::current(&self.occupancy, &key) {
             return Ok(());
         }
-        let nc = vol.components as usize;
-        let occ: Vec<u32> = vol
+        let occ = vol
             .minmax
-            .ranges
-            .chunks(nc)
-            .map(|r| {
-                let [lo, hi] = r[component as usize];
-                values.iter().any(|&v| v >= lo && v <= hi) as u32
-            })
-            .collect();
+            .blocks_holding(values, component as usize, vol.components as usize);
         self.occupancy = Some(Occupancy::new(
             ctx,
             "iso occupancy",

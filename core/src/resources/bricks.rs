@@ -458,6 +458,17 @@ impl MinMaxGrid {
         Ok(MinMaxGrid { dims, ranges })
     }
 
+    /// Per block, 1 where component `c` (of `nc`) takes one of `values` (an isosurface of it
+    /// may lie there), else 0.
+    pub fn blocks_holding(&self, values: &[f32], c: usize, nc: usize) -> Vec<u32> {
+        self.ranges
+            .iter()
+            .skip(c)
+            .step_by(nc)
+            .map(|&[lo, hi]| values.iter().any(|&v| v >= lo && v <= hi) as u32)
+            .collect()
+    }
+
     /// Component `c`'s range per block as the device samples it: the data's own values
     /// where the storage keeps them exactly (8/16-bit normalised, float32), widened by the
     /// storage's rounding where it does not (float16 keeps 11 bits of the normalised value).

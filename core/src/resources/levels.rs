@@ -1,9 +1,10 @@
-//! Coarser levels of a bricked volume, for the pass whose rays go anywhere (path tracing):
-//! streaming front to back cannot serve its scattered rays, so when the bricks it needs
-//! exceed the memory budget it draws the finest level, downsampled by a power of two per
-//! axis, whose needed bricks fit. A level is built from the volume's host data (a source is
-//! read once, slab by slab, never whole) and kept until the volume changes; only one level
-//! holds a pool on the device at a time.
+//! Coarser levels of a bricked volume, for the frames whose rays go anywhere (path tracing,
+//! volumetric shadows, ambient occlusion and scattering between isosurfaces): streaming
+//! front to back cannot serve rays that leave the pixels' lines, so when the bricks such a
+//! frame needs exceed the memory budget it draws the finest level, downsampled by a power of
+//! two per axis, whose needed bricks fit. A level is built from the volume's host data (a
+//! source is read once, slab by slab, never whole) and kept until the volume changes; only
+//! one level holds a pool on the device at a time.
 
 use super::tables::{Occupancy, TableKey};
 use super::volume::{self, GpuVolume, HostVolume};
@@ -25,29 +26,49 @@ pub(crate) struct Level {
     active: bool,
 }
 
+/// The bricks a frame whose rays go anywhere needs resident, at whatever level it draws.
+pub(crate) enum LevelDemand {
+    /// Those the transfer function makes visible (path tracing, volumetric shadows).
+    Visible,
+    /// Those where component `component` takes one of `values` (ambient occlusion around
+    /// isosurfaces), and the visible ones too where `visible` (scattering between the
+    /// surfaces reads the opacity between them).
+    Surfaces {
+        values: Vec<f32>,
+        component: u32,
+        visible: bool,
+    },
+}
+
 impl Resources {
-    /// Before a path-traced frame: leaves the volume as it is when the bricks the frame
-    /// needs fit the memory budget (dropping any coarser level's pool), otherwise swaps in
-    /// the finest coarser level whose needed bricks fit, building it if needed, and drops
-    /// the fine level's pool. [`Resources::leave_level`] swaps back after the frame.
-    pub fn enter_level(&mut self, ctx: &Context, params: &RenderParams) -> Result<()> {
+    /// Before a frame whose rays go anywhere (`what` names it in errors): leaves the volume
+    /// as it is when the bricks `demand` names fit the memory budget (dropping any coarser
+    /// level's pool), otherwise swaps in the finest coarser level whose needed bricks fit,
+    /// building it if needed, and drops the fine level's pool. [`Resources::leave_level`]
+    /// swaps back after the frame.
+    pub fn enter_level(
+        &mut self,
+        ctx: &Context,
+        params: &RenderParams,
+        demand: &LevelDemand,
+        what: &str,
+    ) -> Result<()> {
         self.drawn_level = 1;
-        if self.fits(ctx, params)? {
+        if self.fits(ctx, params, demand)? {
             self.release_level();
             return Ok(());
         }
         if self.mask.is_some() {
-            return Err(Error::Unsupported(
-                "the bricks this path-traced frame needs exceed the volume's memory budget, \
-                 so it would draw a coarser level of the volume, and masks are not \
-                 downsampled: raise the budget or clear the mask"
-                    .into(),
-            ));
+            return Err(Error::Unsupported(format!(
+                "the bricks {what} needs exceed the volume's memory budget, so it would draw \
+                 a coarser level of the volume, and masks are not downsampled: raise the \
+                 budget or clear the mask"
+            )));
         }
         // The first level tried: the finest whose occupied share of its points fits
         // (without the bricks' aprons, so it may not; the next is tried then).
+        let (needed, _) = self.demand(ctx, params, demand)?;
         let fine = self.volume()?;
-        let (needed, _) = volume::demand(fine, self.occupancy.as_ref());
         let share = needed as f64 / fine.grid.len() as f64;
         let point = fine.layout.texel_bytes as f64 + if fine.gradients { 8.0 } else { 0.0 };
         let budget = fine.max_bytes;
@@ -70,7 +91,7 @@ impl Resources {
                 self.build_level(ctx, factor)?;
             }
             self.swap_level();
-            if self.fits(ctx, params)? {
+            if self.fits(ctx, params, demand)? {
                 self.drawn_level = self.level.as_ref().expect("swapped in").factor;
                 return Ok(());
             }
@@ -104,14 +125,45 @@ impl Resources {
         }
     }
 
-    /// Whether the bricks a frame with `params` needs at the current level (those the
-    /// transfer function makes visible) fit the memory budget.
-    fn fits(&mut self, ctx: &Context, params: &RenderParams) -> Result<bool> {
-        let step = self.sample_distance(params)?;
-        self.ensure_occupancy(ctx, step)?;
+    /// Whether the bricks `demand` names at the current level fit the memory budget.
+    fn fits(&mut self, ctx: &Context, params: &RenderParams, demand: &LevelDemand) -> Result<bool> {
+        let (needed, capacity) = self.demand(ctx, params, demand)?;
+        Ok(self.volume()?.host.is_none() || needed <= capacity)
+    }
+
+    /// The bricks `demand` names at the current level, and the slots the budget holds.
+    fn demand(
+        &mut self,
+        ctx: &Context,
+        params: &RenderParams,
+        demand: &LevelDemand,
+    ) -> Result<(u32, u32)> {
+        let visible = match demand {
+            LevelDemand::Visible => true,
+            LevelDemand::Surfaces { visible, .. } => *visible,
+        };
+        if visible {
+            let step = self.sample_distance(params)?;
+            self.ensure_occupancy(ctx, step)?;
+        }
         let vol = self.volume()?;
-        let (needed, capacity) = volume::demand(vol, self.occupancy.as_ref());
-        Ok(vol.host.is_none() || needed <= capacity)
+        let occupied = self.occupancy.as_ref().map(|o| &o.flags[..]);
+        let flags = match demand {
+            LevelDemand::Visible => occupied.map(<[u32]>::to_vec),
+            LevelDemand::Surfaces {
+                values, component, ..
+            } => {
+                let nc = vol.components as usize;
+                let mut flags = vol.minmax.blocks_holding(values, *component as usize, nc);
+                if let Some(occupied) = occupied.filter(|_| visible) {
+                    for (f, o) in flags.iter_mut().zip(occupied) {
+                        *f |= o;
+                    }
+                }
+                Some(flags)
+            }
+        };
+        Ok(volume::demand(vol, flags.as_deref()))
     }
 
     /// Builds the level `factor` times coarser than the (fine, swapped-out) volume.
@@ -157,6 +209,18 @@ impl Resources {
                 (dims, v.residency().pool_bytes)
             }
             None => (fine, 0),
+        }
+    }
+
+    /// The volume itself, also while a coarser level is swapped in for a frame (whose
+    /// default sample distance stays the volume's, so the level changes the data only).
+    pub(super) fn fine_volume(&self) -> Result<&GpuVolume> {
+        match self.level.as_ref().filter(|l| l.active) {
+            Some(l) => Ok(l
+                .volume
+                .as_ref()
+                .expect("the fine volume while a level is in")),
+            None => self.volume(),
         }
     }
 

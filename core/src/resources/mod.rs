@@ -152,9 +152,10 @@ impl Resources {
         self.mask.as_ref().map(|(_, k)| *k)
     }
 
-    /// The world distance between samples these parameters give for the current volume.
+    /// The world distance between samples these parameters give for the current volume (the
+    /// volume itself while a coarser level is drawn).
     pub fn sample_distance(&self, params: &RenderParams) -> Result<f64> {
-        let vol = self.volume()?;
+        let vol = self.fine_volume()?;
         Ok(match params.sample_distance {
             Some(d) => d,
             None => {

@@ -8,7 +8,6 @@
 use super::bricks::{self, BrickGrid, FrontToBack, Layout, MinMaxGrid};
 use super::gradients::GradientPass;
 use super::residency::{self, Slots, NOT_LATER};
-use super::tables::{Occupancy, TableKey};
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::bind;
@@ -599,10 +598,10 @@ fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
         .collect()
 }
 
-/// The bricks overlapping a block `occupancy` flags (all bricks without), and the slots
-/// the memory budget holds.
-pub(super) fn demand(vol: &GpuVolume, occupancy: Option<&Occupancy<TableKey>>) -> (u32, u32) {
-    let needed = needed_bricks(vol, occupancy.map(|o| &o.flags[..]));
+/// The bricks overlapping a block `flags` marks (all bricks without), and the slots the
+/// memory budget holds.
+pub(super) fn demand(vol: &GpuVolume, flags: Option<&[u32]>) -> (u32, u32) {
+    let needed = needed_bricks(vol, flags);
     let count = needed.iter().filter(|&&n| n).count() as u32;
     (count, capacity(vol))
 }

@@ -621,7 +621,8 @@ fn only_visible_bricks_are_resident() {
 /// Streaming: with a memory budget of a quarter of the volume, a frame whose visible bricks
 /// exceed it is drawn in several passes, front to back, each with a group of bricks in the
 /// pool; the image equals the in-core one in every ray-casting mode and for isosurfaces.
-/// Ambient occlusion, whose rays reach around the surfaces' bricks, reports the budget.
+/// Ambient occlusion and volumetric shadows, whose rays leave the pixels' lines, draw a
+/// coarser level instead.
 #[test]
 fn streamed_frames_equal_in_core_ones() {
     let mut r = renderer();
@@ -734,15 +735,63 @@ fn streamed_frames_equal_in_core_ones() {
     assert!(passes >= 2, "isosurfaces: the frame was streamed");
     assert_eq!(g_streamed.counts, g_in_core.counts, "the same layers");
     assert!(max <= 2, "isosurfaces: streamed {max}/255 off");
-    r.set_isosurface(&surfaces(Some(AmbientOcclusion::default())))
-        .unwrap();
-    let err = r.render_image(&view, &iso_params).unwrap_err().to_string();
     r.set_progress(None);
-    println!("isosurfaces with AO over the budget: {err}");
-    assert!(
-        err.contains("memory budget") && err.contains("ambient occlusion"),
-        "{err}"
-    );
+    // Rays that go anywhere cannot stream: ambient occlusion around the surfaces and
+    // volumetric shadows draw the finest coarser level whose needed bricks fit, exactly as
+    // that level uploaded as the volume draws at the volume's sample distance and AO radius
+    // (one voxel and eight: the level's own defaults would be in its coarser voxels).
+    let mut shadows = shaded();
+    shadows.shading.volumetric_blending = 1.0;
+    let ao = AmbientOcclusion {
+        radius: Some(8.0),
+        ..Default::default()
+    };
+    let cases = [
+        ("isosurfaces with AO", Some(ao), iso_params.clone()),
+        ("volumetric shadows", None, shadows),
+    ];
+    for (name, ao, params) in cases {
+        let params = RenderParams {
+            sample_distance: Some(1.0),
+            ..params
+        };
+        // (the gradient-magnitude range of the shininess given too: its default is a
+        // voxel's)
+        r.set_isosurface(&IsoParams {
+            shininess: Shininess::GradientMagnitude {
+                range: Some([0.0, 0.25]),
+                exponents: [8.0, 64.0],
+            },
+            ..surfaces(ao)
+        })
+        .unwrap();
+        r.set_volume_with(&vol, budget).unwrap();
+        let coarse = r.render_image(&view, &params).unwrap();
+        let res = r.residency();
+        r.set_volume_with(&vol.downsampled(res.level).unwrap(), budget)
+            .unwrap();
+        let direct = r.render_image(&view, &params).unwrap();
+        let (mean, max) = image_diff(&coarse, &direct);
+        println!(
+            "{name} over the budget: level {} ({:?}), pool {} of {} bytes; against that level \
+             as the volume: mean {mean:.4}/255, max {max}/255",
+            res.level,
+            res.level_dims,
+            res.pool_bytes,
+            dense / 4
+        );
+        assert_content(&coarse, name);
+        let points = 39u32.div_ceil(res.level.max(1)) + 1;
+        assert!(res.level >= 2, "{name}: a coarser level");
+        assert_eq!(res.level_dims, [points; 3], "{name}");
+        assert!(res.pool_bytes <= dense / 4, "{name}: within the budget");
+        assert_eq!(
+            r.residency().level,
+            1,
+            "{name}: the level drawn as a volume"
+        );
+        assert_eq!(max, 0, "{name}: the level drawn as uploaded");
+    }
 }
 
 /// Residency across frames: a zoomed-in camera path of a volume that exceeds the memory
