@@ -153,16 +153,6 @@ fn intermixed_sample(j: u32, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
     return e;
 }
 
-// Entry and exit distances of the ray through the world box [lo, hi].
-fn world_box_interval(r: Ray, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
-    let inv = 1.0 / r.dir;
-    let t0 = (lo - r.origin) * inv;
-    let t1 = (hi - r.origin) * inv;
-    let tmin = min(t0, t1);
-    let tmax = max(t0, t1);
-    return vec2<f32>(max(max(tmin.x, tmin.y), tmin.z), min(min(tmax.x, tmax.y), tmax.z));
-}
-
 // `color` with the sample c (colour not premultiplied) composited behind it.
 fn over(color: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
     let w = (1.0 - color.a) * c.a;
@@ -647,7 +637,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let dt = frame.misc.x;
     var box = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
     if (INTERMIX > 0u) {
-        box = world_box_interval(ray, intermix.box_lo.xyz, intermix.box_hi.xyz);
+        box = slab_interval(ray.origin, ray.dir, intermix.box_lo.xyz, intermix.box_hi.xyz);
     }
     var seg = vec2<f32>(max(box.x, 0.0), min(box.y, ray.far));
     // VTK 9.2: the ray ends at the opaque depth or a clipping plane, but its loop tests that

@@ -54,14 +54,19 @@ fn ray_through(ndc: vec2<f32>) -> Ray {
     return r;
 }
 
-// Entry and exit distances of the ray through the box [lo, hi] (index space).
-fn box_interval(r: Ray, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
-    let inv = 1.0 / r.index_dir;
-    let t0 = (lo - r.index_origin) * inv;
-    let t1 = (hi - r.index_origin) * inv;
+// Entry and exit distances of the line origin + t·dir through the box [lo, hi] (slabs).
+fn slab_interval(origin: vec3<f32>, dir: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
+    let inv = 1.0 / dir;
+    let t0 = (lo - origin) * inv;
+    let t1 = (hi - origin) * inv;
     let tmin = min(t0, t1);
     let tmax = max(t0, t1);
     return vec2<f32>(max(max(tmin.x, tmin.y), tmin.z), min(min(tmax.x, tmax.y), tmax.z));
+}
+
+// Entry and exit distances of the ray through the box [lo, hi] (index space).
+fn box_interval(r: Ray, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
+    return slab_interval(r.index_origin, r.index_dir, lo, hi);
 }
 
 // Distance along the ray of a window depth value (0 near … 1 far).
