@@ -182,7 +182,8 @@ fn refine(ray: Ray, t0: f32, t1: f32, v: f32, below: bool) -> f32 {
 // Ambient accessibility at index-space point p with world normal n: the fraction of
 // iso.counts.w directions (Hammersley, uniform over the hemisphere around n) whose short
 // ray (iso.options.x steps over iso.ao.x world units) never reaches the other side of
-// iso-value v. A ray that leaves the volume counts as open.
+// iso-value v. A ray that leaves the volume counts as open; masked samples (MASK_BINARY)
+// are left out, as the surfaces leave them out, so a masked region occludes nothing.
 fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 {
     let count = iso.counts.w;
     if (count == 0u) {
@@ -202,6 +203,9 @@ fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 
             let q = p + f32(j) * step;
             if (any(q < lo) || any(q > hi)) {
                 break;
+            }
+            if (MASK == MASK_BINARY && mask_value(mask_tex, q) == 0u) {
+                continue;
             }
             if ((sample_scalars(q)[ISO_COMP] < v) != front_below) {
                 hit = true;

@@ -5,7 +5,7 @@ use crate::common::gpu::{assert_error, renderer, set_bricked};
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{image_diff, rgba};
 use crate::common::raycast::to_pixel;
-use crate::common::scenes::{blob_transfer, blob_volume, piecewise1, piecewise3, shaded};
+use crate::common::scenes::{blob_transfer, blob_volume, piecewise1, piecewise3, shaded, volume};
 use ferrovol_core::*;
 use glam::DVec3;
 
@@ -103,6 +103,56 @@ fn binary_mask_leaves_out_samples() {
         assert!(max <= 1, "{blend:?}: bricking changes the masked image");
         r.set_volume(&vol).unwrap();
     }
+}
+
+/// Ambient-occlusion rays leave masked samples out, as the surfaces do: a floor facing the
+/// camera with a pillar standing on it at x < 10, the mask leaving out x < 12. The floor's
+/// hits the mask leaves where they were are at least as open as without it, and those
+/// beside the (masked) pillar more open.
+#[test]
+fn ambient_occlusion_rays_leave_masked_samples_out() {
+    let mut r = renderer();
+    let vol = volume([N as u32; 3], |x, _, z| {
+        f64::from(u8::from(z < 8.0 || (x < 10.0 && z < 20.0)))
+    });
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 64, 64);
+    r.set_isosurface(&IsoParams {
+        ambient_occlusion: Some(AmbientOcclusion::default()),
+        ..IsoParams::with_values(vec![IsoValue::new(0.5, [0.9, 0.8, 0.6], 1.0)])
+    })
+    .unwrap();
+    let p = params(BlendMode::Isosurface);
+    r.render_image(&view, &p).unwrap();
+    let plain = r.read_gbuffer().unwrap();
+    r.set_mask(Some((&by_x(|x| u8::from(x >= 12)), MaskKind::Binary)))
+        .unwrap();
+    r.render_image(&view, &p).unwrap();
+    let masked = r.read_gbuffer().unwrap();
+    let (mut same, mut opener, mut closer) = (0, 0, 0);
+    for y in 0..64 {
+        for x in 0..64 {
+            let (a, b) = (plain.hits(x, y), masked.hits(x, y));
+            let (Some(a), Some(b)) = (a.first(), b.first()) else {
+                continue;
+            };
+            if (a.distance - b.distance).abs() > 1e-4 || a.iso_index != b.iso_index {
+                continue;
+            }
+            same += 1;
+            if b.ambient_access > a.ambient_access + 1e-6 {
+                opener += 1;
+            } else if b.ambient_access < a.ambient_access - 1e-6 {
+                closer += 1;
+            }
+        }
+    }
+    println!("{same} hits the mask left in place: {opener} more open, {closer} less");
+    assert!(same > 200, "the unmasked side's hits");
+    assert_eq!(closer, 0, "a masked region occludes nothing");
+    assert!(opener > 20, "rays into the masked half see it empty");
 }
 
 /// A label map: labels classify with their own functions (one left out is the first
