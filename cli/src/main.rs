@@ -176,6 +176,11 @@ struct RenderArgs {
     /// and scattering, whose rays go anywhere, draw the finest coarser level that fits.
     #[arg(long, value_name = "MIB")]
     gpu_memory: Option<u64>,
+    /// With --gpu-memory: a frame whose bricks exceed it draws the finest coarser level
+    /// that fits in one pass, as an interactive frame would, instead of streaming the volume
+    /// itself (the still image)
+    #[arg(long)]
+    preview_level: bool,
     /// Render this many frames and print the mean time per frame (the first, which builds
     /// pipelines and maps, is not counted). Path tracing: each timed frame starts the
     /// accumulation over, as a moving camera does, and traces --spp paths per pixel.
@@ -759,6 +764,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         jitter: a.jitter,
         empty_space_skipping: !a.no_skip,
         preintegration: a.preintegration,
+        preview_level: a.preview_level,
         slice_plane: (a.mode == Mode::Slice).then(|| {
             let b = vol.bounds();
             let p = a.slice_plane.unwrap_or([

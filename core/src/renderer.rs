@@ -11,7 +11,7 @@ use crate::params::{
     TransferFunction, UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::{self, DvrPass};
-use crate::passes::frame::FrameInput;
+use crate::passes::frame::{self, FrameInput};
 use crate::passes::iso::{self, IsoPass};
 use crate::passes::pathtrace::PathTracePass;
 use crate::passes::scatter_check;
@@ -31,6 +31,24 @@ pub struct Renderer {
     pt: Option<Box<PathTracePass>>,
     iso_params: Option<IsoParams>,
     pt_params: PathTraceParams,
+}
+
+/// The bricks a preview frame ([`RenderParams::preview_level`]) of a mode that streams
+/// needs at whatever level it draws; none for the slice mode.
+fn preview_demand(
+    res: &Resources,
+    params: &RenderParams,
+    iso: Option<&IsoParams>,
+) -> Result<Option<LevelDemand>> {
+    Ok(match params.blend {
+        BlendMode::Composite => Some(LevelDemand::Visible),
+        BlendMode::Isosurface => match iso {
+            Some(iso) if res.volume.is_some() => Some(iso::surfaces_demand(iso, res, false)?),
+            _ => None,
+        },
+        BlendMode::Slice | BlendMode::PathTrace => None,
+        _ => Some(LevelDemand::All),
+    })
 }
 
 /// The pass in `slot`, created by `new` on first use.
@@ -358,9 +376,22 @@ impl Renderer {
             }
             _ => None,
         };
-        match &anywhere {
-            Some((demand, what)) if res.intermix.is_none() => {
-                res.enter_level(ctx, params, demand, what)?
+        let in_view = |res: &Resources| frame::bricks_in_view(res, view, params);
+        let level = match anywhere {
+            Some((demand, what)) => Some((demand, None, what)),
+            None if params.preview_level => preview_demand(res, params, self.iso_params.as_ref())?
+                .map(|d| {
+                    (
+                        d,
+                        Some(&in_view as &dyn Fn(&Resources) -> Result<Vec<bool>>),
+                        "a preview frame",
+                    )
+                }),
+            None => None,
+        };
+        match &level {
+            Some((demand, in_view, what)) if res.intermix.is_none() => {
+                res.enter_level(ctx, params, (demand, *in_view), what)?
             }
             _ => res.release_level(),
         }

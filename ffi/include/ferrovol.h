@@ -548,6 +548,13 @@ typedef struct FvRenderParams {
    * components'; 0 reads no label.
    */
   float mask_blend_factor;
+  /**
+   * An interactive frame: when the bricks it needs exceed the memory budget, draw the
+   * finest coarser level of the volume whose needed bricks fit, in one pass, rather than
+   * stream the volume itself in several (false, the default: the frame streams and
+   * equals the in-core image). fv_renderer_residency says which level was drawn.
+   */
+  bool preview_level;
 } FvRenderParams;
 
 /**

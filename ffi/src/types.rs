@@ -299,6 +299,11 @@ pub struct FvRenderParams {
     /// from its label's functions (fv_transfer_function_set_label_*) rather than the
     /// components'; 0 reads no label.
     pub mask_blend_factor: f32,
+    /// An interactive frame: when the bricks it needs exceed the memory budget, draw the
+    /// finest coarser level of the volume whose needed bricks fit, in one pass, rather than
+    /// stream the volume itself in several (false, the default: the frame streams and
+    /// equals the in-core image). fv_renderer_residency says which level was drawn.
+    pub preview_level: bool,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -428,6 +433,7 @@ impl FvRenderParams {
                 normal: [0.0, 0.0, 1.0],
             },
             mask_blend_factor: d.mask_blend,
+            preview_level: d.preview_level,
         }
     }
 }
@@ -524,6 +530,7 @@ impl ToCore for FvRenderParams {
                 normal: DVec3::from_array(self.slice_plane.normal),
             }),
             mask_blend: self.mask_blend_factor,
+            preview_level: self.preview_level,
         };
         p.validate()?;
         Ok(p)

@@ -50,7 +50,8 @@
  *   and isosurfaces stream them in several passes of one frame (the same image; each pass
  *   fires the ProgressEvent while ReportProgress is on); path tracing, volumetric shadows
  *   and isosurface ambient occlusion or scattering draw the finest coarser level of the
- *   volume whose needed bricks fit. Takes effect at the next upload;
+ *   volume whose needed bricks fit, as an interactive render (DesiredUpdateRate > 1) does
+ *   instead of streaming. Takes effect at the next upload;
  * - volumetric shadows (single scattering) with vtkGPUVolumeRayCastMapper's
  *   VolumetricScatteringBlending and GlobalIlluminationReach, in the composite blend mode
  *   with Shade on and at least one light, the anisotropy being the property's

@@ -386,6 +386,38 @@ class Settings(unittest.TestCase):
         self.assertLessEqual(d, 2.0)
         self.assertGreater(coverage(streamed), 0.2)
 
+    def test_interactive_render_over_the_budget_draws_a_coarser_level(self):
+        # A quarter budget, the window rendering interactively (DesiredUpdateRate above 1 s⁻¹,
+        # as an interactor sets it while the camera moves): one pass of a coarser level, no
+        # pass reported between 0 and 1 (the pipeline's own update reports those two); the
+        # still render after it streams the volume itself.
+        full, _ = self.render()
+        progress = []
+
+        def configure(m):
+            m.SetMaxMemoryInBytes(48 ** 3 * 4 // 4)
+            m.SetMaxMemoryFraction(1.0)
+            m.AddObserver(vtk.vtkCommand.ProgressEvent,
+                          lambda o, e: progress.append(o.GetProgress()))
+        preview, _ = self.render(configure,
+                                 scene_hook=lambda s: s.window.SetDesiredUpdateRate(15.0))
+        passes = [p for p in progress if 0.0 < p < 1.0]
+        progress.clear()
+        self._keep.window.SetDesiredUpdateRate(0.0001)
+        still = self._keep.render()
+        still_passes = [p for p in progress if 0.0 < p < 1.0]
+        save("settings-interactive-level", full, preview, still)
+        print("interactive render under a quarter budget: %d passes reported, mean |difference| "
+              "to unlimited %.2f levels; still render: %d, max %.1f" % (
+                  len(passes), mean_diff(preview, full), len(still_passes),
+                  float(np.abs(still - full).max())))
+        self.assertEqual(passes, [], "the interactive render does not stream")
+        self.assertGreater(coverage(preview), 0.2)
+        self.assertGreater(mean_diff(preview, full), 0.0, "a coarser level")
+        self.assertLess(mean_diff(preview, full), 4.0)
+        self.assertGreater(len(still_passes), 0, "the still render streams")
+        self.assertLessEqual(float(np.abs(still - full).max()), 2.0)
+
     def test_volume_matrix(self):
         # Parallel projection: moving the volume by 10 world units moves its image by
         # 10 / (2 * parallel scale) of the window height.

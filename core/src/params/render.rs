@@ -212,6 +212,12 @@ pub struct RenderParams {
     /// much of a labelled sample's colour and opacity come from its label's functions
     /// rather than the transfer function's components (0: the mask is not read).
     pub mask_blend: f32,
+    /// An interactive frame of a volume whose needed bricks exceed the memory budget: draw
+    /// the finest coarser level whose needed bricks fit, in one pass, rather than stream the
+    /// volume itself through the pool in several (a still frame streams, and equals the
+    /// in-core image). Ray casting (not the slice mode) and isosurfaces; the frames whose
+    /// rays go anywhere draw a coarser level past the budget anyway.
+    pub preview_level: bool,
 }
 
 impl Default for RenderParams {
@@ -236,6 +242,7 @@ impl Default for RenderParams {
             preintegration: false,
             slice_plane: None,
             mask_blend: 1.0,
+            preview_level: false,
         }
     }
 }

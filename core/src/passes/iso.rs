@@ -112,11 +112,20 @@ pub(crate) fn level_demand(iso: &IsoParams, res: &Resources) -> Result<Option<Le
     if !ao && iso.scattering.is_none() {
         return Ok(None);
     }
-    Ok(Some(LevelDemand::Surfaces {
+    surfaces_demand(iso, res, iso.scattering.is_some()).map(Some)
+}
+
+/// The bricks the surfaces of `iso` lie in, and the visible ones too where `visible`.
+pub(crate) fn surfaces_demand(
+    iso: &IsoParams,
+    res: &Resources,
+    visible: bool,
+) -> Result<LevelDemand> {
+    Ok(LevelDemand::Surfaces {
         values: iso.values.iter().map(|v| v.value as f32).collect(),
         component: iso_component(res.tf.as_ref(), res.volume()?.components),
-        visible: iso.scattering.is_some(),
-    }))
+        visible,
+    })
 }
 
 /// The occupancy of the min–max blocks for a set of iso-values: a block is occupied when

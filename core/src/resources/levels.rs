@@ -26,8 +26,11 @@ pub(crate) struct Level {
     active: bool,
 }
 
-/// The bricks a frame whose rays go anywhere needs resident, at whatever level it draws.
+/// The bricks a frame that draws a coarser level past the budget needs resident, at
+/// whatever level it draws.
 pub(crate) enum LevelDemand {
+    /// Every brick (a preview of MIP, MinIP, average or additive).
+    All,
     /// Those the transfer function makes visible (path tracing, volumetric shadows).
     Visible,
     /// Those where component `component` takes one of `values` (ambient occlusion around
@@ -40,21 +43,25 @@ pub(crate) enum LevelDemand {
     },
 }
 
+/// Of a level's bricks, those some pixel's ray can reach (a frame whose rays stay on their
+/// pixels' lines: a preview); none for rays that go anywhere.
+pub(crate) type InView<'a> = Option<&'a dyn Fn(&Resources) -> Result<Vec<bool>>>;
+
 impl Resources {
-    /// Before a frame whose rays go anywhere (`what` names it in errors): leaves the volume
-    /// as it is when the bricks `demand` names fit the memory budget (dropping any coarser
-    /// level's pool), otherwise swaps in the finest coarser level whose needed bricks fit,
-    /// building it if needed, and drops the fine level's pool. [`Resources::leave_level`]
-    /// swaps back after the frame.
+    /// Before a frame that cannot stream, or should not (`what` names it in errors): leaves
+    /// the volume as it is when the bricks `demand` names (within the view where `in_view`
+    /// says) fit the memory budget, dropping any coarser level's pool; otherwise swaps in
+    /// the finest coarser level whose needed bricks fit, building it if needed, and drops
+    /// the fine level's pool. [`Resources::leave_level`] swaps back after the frame.
     pub fn enter_level(
         &mut self,
         ctx: &Context,
         params: &RenderParams,
-        demand: &LevelDemand,
+        (demand, in_view): (&LevelDemand, InView<'_>),
         what: &str,
     ) -> Result<()> {
         self.drawn_level = 1;
-        if self.fits(ctx, params, demand)? {
+        if self.fits(ctx, params, demand, in_view)? {
             self.release_level();
             return Ok(());
         }
@@ -67,7 +74,7 @@ impl Resources {
         }
         // The first level tried: the finest whose occupied share of its points fits
         // (without the bricks' aprons, so it may not; the next is tried then).
-        let (needed, _) = self.demand(ctx, params, demand)?;
+        let (needed, _) = self.demand(ctx, params, demand, in_view)?;
         let fine = self.volume()?;
         let share = needed as f64 / fine.grid.len() as f64;
         let point = fine.layout.texel_bytes as f64 + if fine.gradients { 8.0 } else { 0.0 };
@@ -91,7 +98,7 @@ impl Resources {
                 self.build_level(ctx, factor)?;
             }
             self.swap_level();
-            if self.fits(ctx, params, demand)? {
+            if self.fits(ctx, params, demand, in_view)? {
                 self.drawn_level = self.level.as_ref().expect("swapped in").factor;
                 return Ok(());
             }
@@ -126,19 +133,28 @@ impl Resources {
     }
 
     /// Whether the bricks `demand` names at the current level fit the memory budget.
-    fn fits(&mut self, ctx: &Context, params: &RenderParams, demand: &LevelDemand) -> Result<bool> {
-        let (needed, capacity) = self.demand(ctx, params, demand)?;
+    fn fits(
+        &mut self,
+        ctx: &Context,
+        params: &RenderParams,
+        demand: &LevelDemand,
+        in_view: InView<'_>,
+    ) -> Result<bool> {
+        let (needed, capacity) = self.demand(ctx, params, demand, in_view)?;
         Ok(self.volume()?.host.is_none() || needed <= capacity)
     }
 
-    /// The bricks `demand` names at the current level, and the slots the budget holds.
+    /// The bricks `demand` names at the current level (in view where `in_view` says), and
+    /// the slots the budget holds.
     fn demand(
         &mut self,
         ctx: &Context,
         params: &RenderParams,
         demand: &LevelDemand,
+        in_view: InView<'_>,
     ) -> Result<(u32, u32)> {
         let visible = match demand {
+            LevelDemand::All => false,
             LevelDemand::Visible => true,
             LevelDemand::Surfaces { visible, .. } => *visible,
         };
@@ -149,6 +165,7 @@ impl Resources {
         let vol = self.volume()?;
         let occupied = self.occupancy.as_ref().map(|o| &o.flags[..]);
         let flags = match demand {
+            LevelDemand::All => None,
             LevelDemand::Visible => occupied.map(<[u32]>::to_vec),
             LevelDemand::Surfaces {
                 values, component, ..
@@ -163,7 +180,8 @@ impl Resources {
                 Some(flags)
             }
         };
-        Ok(volume::demand(vol, flags.as_deref()))
+        let in_view = in_view.map(|f| f(self)).transpose()?;
+        Ok(volume::demand(vol, flags.as_deref(), in_view.as_deref()))
     }
 
     /// Builds the level `factor` times coarser than the (fine, swapped-out) volume.

@@ -794,6 +794,87 @@ fn streamed_frames_equal_in_core_ones() {
     }
 }
 
+/// Interactive frames ([`RenderParams::preview_level`]) of a volume whose needed bricks
+/// exceed the budget draw the finest coarser level that fits, in one pass, exactly as that
+/// level uploaded as the volume draws; the still frame after them streams and equals the
+/// in-core image; a volume that fits draws itself.
+#[test]
+fn preview_frames_draw_a_coarser_level_in_one_pass() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    r.set_isosurface(&IsoParams {
+        shininess: Shininess::Constant(32.0),
+        ..IsoParams::with_values(vec![IsoValue::new(0.3, [0.4, 0.6, 1.0], 1.0)])
+    })
+    .unwrap();
+    let view = View::fit(vol.bounds(), 64, 64);
+    let dense = 40u64.pow(3) * 4;
+    let budget = UploadOptions {
+        max_brick_points: Some(12),
+        memory_budget: Some(dense / 4),
+        ..Default::default()
+    };
+    for blend in [
+        BlendMode::Composite,
+        BlendMode::Maximum,
+        BlendMode::Isosurface,
+    ] {
+        let still = RenderParams {
+            blend,
+            sample_distance: Some(1.0),
+            ..Default::default()
+        };
+        let preview = RenderParams {
+            preview_level: true,
+            ..still.clone()
+        };
+        r.set_volume(&vol).unwrap();
+        let in_core = r.render_image(&view, &still).unwrap();
+        let fits = r.render_image(&view, &preview).unwrap();
+        assert_eq!(
+            image_diff(&in_core, &fits).1,
+            0,
+            "{blend:?}: fits, drawn itself"
+        );
+        r.set_volume_with(&vol, budget).unwrap();
+        let passes = r.stats().streamed_passes;
+        let coarse = r.render_image(&view, &preview).unwrap();
+        let res = r.residency();
+        assert_eq!(
+            r.stats().streamed_passes,
+            passes,
+            "{blend:?}: the preview streams not"
+        );
+        let streamed = r.render_image(&view, &still).unwrap();
+        let still_passes = r.stats().streamed_passes - passes;
+        let still_level = r.residency().level;
+        r.set_volume_with(&vol.downsampled(res.level).unwrap(), budget)
+            .unwrap();
+        let direct = r.render_image(&view, &still).unwrap();
+        let (mean, max) = image_diff(&coarse, &direct);
+        let (_, still_max) = image_diff(&streamed, &in_core);
+        println!(
+            "{blend:?}: preview at level {} ({:?}) in one pass, against that level as the \
+             volume: mean {mean:.4}/255, max {max}/255; the still frame in {still_passes} \
+             passes, {still_max}/255 from in core",
+            res.level, res.level_dims
+        );
+        assert_content(&coarse, &format!("{blend:?} preview"));
+        assert!(
+            res.level >= 2 && res.pool_bytes <= dense / 4,
+            "{blend:?}: {res:?}"
+        );
+        assert_eq!(max, 0, "{blend:?}: the level drawn as uploaded");
+        assert!(
+            still_passes >= 2 && still_level == 1,
+            "{blend:?}: the still frame streams"
+        );
+        assert!(still_max <= 2, "{blend:?}: and equals the in-core image");
+    }
+}
+
 /// Residency across frames: a zoomed-in camera path of a volume that exceeds the memory
 /// budget. Only the bricks in view are needed (rays never leave the view) and they stay
 /// resident between frames. Where they fit the budget no frame streams, and a frame a
