@@ -43,6 +43,10 @@ override ISO_COMP: u32 = 0u;
 @group(0) @binding(13) var env_sampler: sampler;
 // Random unit vectors, uniform over the sphere (the cone scheme's precomputed directions).
 @group(0) @binding(14) var<storage, read> lobe_dirs: array<vec4<f32>>;
+// A binary mask (Renderer::set_mask): the medium between the surfaces is empty where the
+// nearest point holds 0, as the surfaces leave those samples out (MASK_BINARY).
+@group(0) @binding(15) var mask_tex: texture_3d<u32>;
+override MASK: u32 = MASK_NONE;
 
 fn env_direction(d: vec3<f32>) -> vec3<f32> {
     return (iso.env_rotation * vec4<f32>(d, 0.0)).xyz;
@@ -127,6 +131,9 @@ fn shade_surface(color: vec3<f32>, pos: vec3<f32>, n: vec3<f32>, gmag: f32, ao: 
 // −ln(1 − α) per unit distance, scaled).
 fn absorption_at(x: vec3<f32>) -> f32 {
     let p = (frame.world_to_index * vec4<f32>(x, 1.0)).xyz;
+    if (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) {
+        return 0.0;
+    }
     let a = min(raw_alpha(ISO_COMP, sample_scalars(p)[ISO_COMP]), 0.9999);
     return -log(1.0 - a) * iso.scatter.x;
 }

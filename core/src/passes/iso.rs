@@ -74,6 +74,8 @@ pipeline_variant! {
         scatter: u32 => "SCATTER",
         single_brick: bool => "SINGLE_BRICK",
         component: u32 => "ISO_COMP",
+        /// MASK_BINARY: the medium between the surfaces is empty where the mask holds 0.
+        mask: u32 => "MASK",
     }
 }
 
@@ -222,6 +224,7 @@ impl IsoPass {
                 texture_entry(12, true, V::Cube),
                 sampler_entry(13),
                 buffer_entry(14, B::Storage { read_only: true }),
+                sampled_texture_entry(15, wgpu::TextureSampleType::Uint, V::D3),
                 texture_entry(1, false, V::D2),
             ],
         });
@@ -472,17 +475,18 @@ impl IsoPass {
             .map_or(1.0, |tf| tf.component(component as usize).unit_distance);
         let full = [0, 0, view.width, view.height];
         let occupied = self.occupancy.as_ref().map_or(1.0, |o| o.fraction);
+        let mask = if res.mask_kind() == Some(MaskKind::Binary) {
+            MASK_BINARY
+        } else {
+            MASK_NONE
+        };
         let fh = FirstHitVariant {
             skip: params.empty_space_skipping && occupied < SKIP_MAX_OCCUPANCY,
             crop: params.cropping.is_some(),
             single_brick,
             streaming: plan.is_some(),
             component,
-            mask: if res.mask_kind() == Some(MaskKind::Binary) {
-                MASK_BINARY
-            } else {
-                MASK_NONE
-            },
+            mask,
             cubic: params.interpolation == Interpolation::Cubic,
         };
         if fh.cubic && fh.streaming {
@@ -503,6 +507,7 @@ impl IsoPass {
             },
             single_brick,
             component,
+            mask,
         };
         let firsthit = self.firsthit.get(ctx, fh)?;
         let deferred = self.deferred.get(ctx, df)?;
@@ -645,6 +650,12 @@ impl IsoPass {
                 bind(12, wgpu::BindingResource::TextureView(&env.irradiance_view)),
                 bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
                 bind(14, self.lobe_dirs.as_entire_binding()),
+                bind(
+                    15,
+                    wgpu::BindingResource::TextureView(
+                        res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
+                    ),
+                ),
                 bind(1, wgpu::BindingResource::TextureView(&tables.view)),
             ],
         });

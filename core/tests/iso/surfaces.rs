@@ -582,4 +582,40 @@ fn scattering_between_isosurfaces() {
     }
     // (the absorbed case is visibly darker)
     assert!(traced_ratio.0 / traced_ratio.1 < 0.5);
+    // A binary mask empties the medium it leaves out: a mask of ones changes nothing; one
+    // leaving out the shell 13 < d < 23 between the surfaces (their crossings kept) leaves
+    // about 2 of the L units absorbing.
+    let (absorbed, _) = run(&mut r, IsoScatterMode::Preview, 1.0);
+    let shell: Vec<u8> = (0..64 * 64 * 64)
+        .map(|i| {
+            let p = [i % 64, (i / 64) % 64, i / 4096].map(|v| v as f64 - 31.5);
+            let d = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            u8::from(!(13.0..23.0).contains(&d))
+        })
+        .collect();
+    r.set_mask(Some((&[1u8; 64 * 64 * 64][..], MaskKind::Binary)))
+        .unwrap();
+    let (ones, _) = run(&mut r, IsoScatterMode::Preview, 1.0);
+    assert_eq!(ones.rgba, absorbed.rgba, "a mask of ones");
+    r.set_mask(Some((&shell, MaskKind::Binary))).unwrap();
+    let (masked, g) = run(&mut r, IsoScatterMode::Preview, 1.0);
+    r.set_mask(None).unwrap();
+    let (mut got, mut free) = (0.0, 0.0);
+    for y in 0..64 {
+        for x in 0..64 {
+            let hits = g.hits(x, y);
+            if hits.len() < 2 || hits[1].iso_index != 1 {
+                continue;
+            }
+            let v = (view.camera.position - hits[0].position).normalize();
+            let f = f0 + (1.0 - f0) * (1.0 - hits[0].normal.dot(v).clamp(0.0, 1.0)).powi(5);
+            got += masked.pixel(x, y)[1] as f64;
+            free += (1.0 - f) * inner[1] as f64;
+        }
+    }
+    println!(
+        "mean transmittance² with the shell between the surfaces masked: {:.3}",
+        got / free
+    );
+    assert!(got / free > 0.7, "the masked medium absorbs nothing");
 }
