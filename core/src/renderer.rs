@@ -379,14 +379,16 @@ impl Renderer {
         let in_view = |res: &Resources| frame::bricks_in_view(res, view, params);
         let level = match anywhere {
             Some((demand, what)) => Some((demand, None, what)),
-            None if params.preview_level => preview_demand(res, params, self.iso_params.as_ref())?
-                .map(|d| {
+            // (masks are not downsampled: a masked preview streams)
+            None if params.preview_level && res.mask.is_none() => {
+                preview_demand(res, params, self.iso_params.as_ref())?.map(|d| {
                     (
                         d,
                         Some(&in_view as &dyn Fn(&Resources) -> Result<Vec<bool>>),
                         "a preview frame",
                     )
-                }),
+                })
+            }
             None => None,
         };
         match &level {

@@ -215,8 +215,9 @@ pub struct RenderParams {
     /// An interactive frame of a volume whose needed bricks exceed the memory budget: draw
     /// the finest coarser level whose needed bricks fit, in one pass, rather than stream the
     /// volume itself through the pool in several (a still frame streams, and equals the
-    /// in-core image). Ray casting (not the slice mode) and isosurfaces; the frames whose
-    /// rays go anywhere draw a coarser level past the budget anyway.
+    /// in-core image). Ray casting (not the slice mode) and isosurfaces, without a mask
+    /// (masks are not downsampled: a masked frame streams); the frames whose rays go
+    /// anywhere draw a coarser level past the budget anyway.
     pub preview_level: bool,
 }
 

@@ -797,7 +797,7 @@ fn streamed_frames_equal_in_core_ones() {
 /// Interactive frames ([`RenderParams::preview_level`]) of a volume whose needed bricks
 /// exceed the budget draw the finest coarser level that fits, in one pass, exactly as that
 /// level uploaded as the volume draws; the still frame after them streams and equals the
-/// in-core image; a volume that fits draws itself.
+/// in-core image; a volume that fits draws itself, and so does a masked one (streamed).
 #[test]
 fn preview_frames_draw_a_coarser_level_in_one_pass() {
     let mut r = renderer();
@@ -873,6 +873,21 @@ fn preview_frames_draw_a_coarser_level_in_one_pass() {
         );
         assert!(still_max <= 2, "{blend:?}: and equals the in-core image");
     }
+    // masks are not downsampled: a masked preview streams the volume itself
+    r.set_volume_with(&vol, budget).unwrap();
+    r.set_mask(Some((&vec![1u8; 40 * 40 * 40], MaskKind::Binary)))
+        .unwrap();
+    let passes = r.stats().streamed_passes;
+    let preview = RenderParams {
+        preview_level: true,
+        ..Default::default()
+    };
+    assert_content(&r.render_image(&view, &preview).unwrap(), "masked preview");
+    assert!(
+        r.stats().streamed_passes > passes,
+        "a masked preview streams"
+    );
+    assert_eq!(r.residency().level, 1);
 }
 
 /// Residency across frames: a zoomed-in camera path of a volume that exceeds the memory
