@@ -527,6 +527,23 @@ fn scattering_between_isosurfaces() {
         let img = r.render_image(&view, &dark).unwrap();
         (img, r.read_gbuffer().unwrap())
     };
+    // The pixels whose ray crosses both spheres: (x, y, Schlick's F at the outer surface,
+    // the distance between the surfaces).
+    let both_spheres = |g: &GBuffer| {
+        let mut found = Vec::new();
+        for y in 0..64 {
+            for x in 0..64 {
+                let hits = g.hits(x, y);
+                if hits.len() < 2 || hits[1].iso_index != 1 {
+                    continue;
+                }
+                let v = (view.camera.position - hits[0].position).normalize();
+                let f = f0 + (1.0 - f0) * (1.0 - hits[0].normal.dot(v).clamp(0.0, 1.0)).powi(5);
+                found.push((x, y, f, (hits[1].position - hits[0].position).length()));
+            }
+        }
+        found
+    };
     let sigma = -(1.0 - sigma_alpha as f64).ln();
     let mut worst = [0.0f64; 3];
     let mut count = 0;
@@ -541,28 +558,19 @@ fn scattering_between_isosurfaces() {
     {
         let (img, g) = run(&mut r, mode, absorption);
         save(&img, &format!("iso-scatter-{k}"));
-        for y in 0..64 {
-            for x in 0..64 {
-                let hits = g.hits(x, y);
-                if hits.len() < 2 || hits[1].iso_index != 1 {
-                    continue;
-                }
-                let v = (view.camera.position - hits[0].position).normalize();
-                let f = f0 + (1.0 - f0) * (1.0 - hits[0].normal.dot(v).clamp(0.0, 1.0)).powi(5);
-                let len = (hits[1].position - hits[0].position).length();
-                let t2 = (-2.0 * sigma * absorption as f64 * len).exp();
-                let got = img.pixel(x, y);
-                for ch in 0..3 {
-                    let want = (1.0 - f) * inner[ch] as f64 * t2;
-                    worst[k] = worst[k].max((got[ch] as f64 - want).abs());
-                }
-                if k == 0 {
-                    count += 1;
-                }
-                if k == 2 {
-                    traced_ratio.0 += got[1] as f64;
-                    traced_ratio.1 += (1.0 - f) * inner[1] as f64;
-                }
+        for (x, y, f, len) in both_spheres(&g) {
+            let t2 = (-2.0 * sigma * absorption as f64 * len).exp();
+            let got = img.pixel(x, y);
+            for ch in 0..3 {
+                let want = (1.0 - f) * inner[ch] as f64 * t2;
+                worst[k] = worst[k].max((got[ch] as f64 - want).abs());
+            }
+            if k == 0 {
+                count += 1;
+            }
+            if k == 2 {
+                traced_ratio.0 += got[1] as f64;
+                traced_ratio.1 += (1.0 - f) * inner[1] as f64;
             }
         }
     }
@@ -601,17 +609,9 @@ fn scattering_between_isosurfaces() {
     let (masked, g) = run(&mut r, IsoScatterMode::Preview, 1.0);
     r.set_mask(None).unwrap();
     let (mut got, mut free) = (0.0, 0.0);
-    for y in 0..64 {
-        for x in 0..64 {
-            let hits = g.hits(x, y);
-            if hits.len() < 2 || hits[1].iso_index != 1 {
-                continue;
-            }
-            let v = (view.camera.position - hits[0].position).normalize();
-            let f = f0 + (1.0 - f0) * (1.0 - hits[0].normal.dot(v).clamp(0.0, 1.0)).powi(5);
-            got += masked.pixel(x, y)[1] as f64;
-            free += (1.0 - f) * inner[1] as f64;
-        }
+    for (x, y, f, _) in both_spheres(&g) {
+        got += masked.pixel(x, y)[1] as f64;
+        free += (1.0 - f) * inner[1] as f64;
     }
     println!(
         "mean transmittance² with the shell between the surfaces masked: {:.3}",
