@@ -8,6 +8,7 @@
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
 #include "lib/march.wgsl"
+#include "lib/intermix.wgsl"
 #include "lib/shading.wgsl"
 #include "lib/shadow.wgsl"
 #include "lib/output.wgsl"
@@ -45,76 +46,15 @@ override PREINT: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 
-// Volumes intermixed with the main one per sample (Renderer::set_intermixed_volumes, VTK's
-// vtkMultiVolume), INTERMIX of them (composite, one component each): their points in one
-// atlas, stacked along z from dims.w, classified by tables of their own (two rows each, as
-// lib/common.wgsl lays a component's out). The rays march the world box holding every
+// The intermixed volumes (lib/intermix.wgsl): the rays march the world box holding every
 // volume; each sample composites the main volume where its grid holds the sample, then each
-// intermixed volume in turn where its grid does, as VTK's multi-volume shader does.
-override INTERMIX: u32 = 0u;
-
-struct IntermixedVolume {
-    world_to_index: mat4x4<f32>,
-    gradient_to_world: mat4x4<f32>,
-    dims: vec4<f32>,
-    range: vec4<f32>,
-}
-
-struct Intermix {
-    box_lo: vec4<f32>,
-    box_hi: vec4<f32>,
-    volumes: array<IntermixedVolume, MAX_INTERMIXED>,
-}
-
-@group(0) @binding(13) var<uniform> intermix: Intermix;
-@group(0) @binding(14) var intermix_atlas: texture_3d<f32>;
-@group(0) @binding(15) var intermix_tables: texture_2d<f32>;
-// Linear where r32float is filterable (INTERMIX_FILTERED: one fetch per value, weighted as
-// VTK's textures are), else nearest and unused (the shader interpolates eight loads).
-@group(0) @binding(16) var intermix_sampler: sampler;
-override INTERMIX_FILTERED: bool = false;
-
-// Whether an intermixed frame samples the volume of `dims` points at index-space point p:
-// VTK's multi-volume shader tests the sample's texture coordinate against [0, 1], and a
-// point-data texture spans half a point beyond the outer points, so p may lie up to half a
-// point outside the grid (where the texture's clamping reads the outer points).
+// intermixed volume in turn where its grid does, as VTK's multi-volume shader does. A grid
+// of `dims` points holds index-space point p (in_grid) as that shader decides: it tests
+// the sample's texture coordinate against [0, 1], and a point-data texture spans half a
+// point beyond the outer points, so p may lie up to half a point outside the grid (where
+// the texture's clamping reads the outer points).
 fn in_grid(p: vec3<f32>, dims: vec3<f32>) -> bool {
     return all(p >= vec3<f32>(-0.5)) && all(p <= dims - 0.5);
-}
-
-// Intermixed volume j's value at index-space point p (clamped to its grid, as a clamping
-// sampler reads): its nearest point where the volume says so (range.z), else trilinear
-// between its points.
-fn intermixed_value(j: u32, p: vec3<f32>) -> f32 {
-    let d = intermix.volumes[j].dims;
-    let hi = d.xyz - 1.0;
-    let q = clamp(p, vec3<f32>(0.0), hi);
-    let z0 = vec3<i32>(0, 0, i32(d.w));
-    if (intermix.volumes[j].range.z > 0.0) {
-        return textureLoad(intermix_atlas, vec3<i32>(floor(q + 0.5)) + z0, 0).x;
-    }
-    if (INTERMIX_FILTERED) {
-        // (q is clamped to the volume's points: a texel of the next volume in the atlas
-        // gets weight 0)
-        let size = vec3<f32>(textureDimensions(intermix_atlas));
-        let c = (q + vec3<f32>(0.0, 0.0, d.w) + 0.5) / size;
-        return textureSampleLevel(intermix_atlas, intermix_sampler, c, 0.0).x;
-    }
-    let lo = floor(q);
-    let f = q - lo;
-    let a = vec3<i32>(lo) + z0;
-    let b = vec3<i32>(min(lo + 1.0, hi)) + z0;
-    let c000 = textureLoad(intermix_atlas, a, 0).x;
-    let c100 = textureLoad(intermix_atlas, vec3<i32>(b.x, a.y, a.z), 0).x;
-    let c010 = textureLoad(intermix_atlas, vec3<i32>(a.x, b.y, a.z), 0).x;
-    let c110 = textureLoad(intermix_atlas, vec3<i32>(b.x, b.y, a.z), 0).x;
-    let c001 = textureLoad(intermix_atlas, vec3<i32>(a.x, a.y, b.z), 0).x;
-    let c101 = textureLoad(intermix_atlas, vec3<i32>(b.x, a.y, b.z), 0).x;
-    let c011 = textureLoad(intermix_atlas, vec3<i32>(a.x, b.y, b.z), 0).x;
-    let c111 = textureLoad(intermix_atlas, b, 0).x;
-    let x0 = mix(mix(c000, c100, f.x), mix(c010, c110, f.x), f.y);
-    let x1 = mix(mix(c001, c101, f.x), mix(c011, c111, f.x), f.y);
-    return mix(x0, x1, f.z);
 }
 
 // Colour (not premultiplied) and step-corrected opacity of intermixed volume j at world
@@ -122,23 +62,11 @@ fn intermixed_value(j: u32, p: vec3<f32>) -> f32 {
 // point apart) when SHADE is on.
 fn intermixed_sample(j: u32, pos: vec3<f32>, view_dir: vec3<f32>) -> vec4<f32> {
     let v = intermix.volumes[j];
-    let p = (v.world_to_index * vec4<f32>(pos, 1.0)).xyz;
+    let p = intermixed_point(j, pos);
     if (!in_grid(p, v.dims.xyz)) {
         return vec4<f32>(0.0);
     }
-    let s = intermixed_value(j, p);
-    let x = clamp((s - v.range.x) * v.range.y, 0.0, 1.0) * f32(TABLE_N - 1u);
-    let row = i32(2u * j);
-    var e: vec4<f32>;
-    if (v.range.z > 0.0) {
-        e = textureLoad(intermix_tables, vec2<i32>(i32(x + 0.5), row), 0);
-    } else {
-        let i0 = u32(x);
-        let i1 = min(i0 + 1u, TABLE_N - 1u);
-        let t0 = textureLoad(intermix_tables, vec2<i32>(i32(i0), row), 0);
-        let t1 = textureLoad(intermix_tables, vec2<i32>(i32(i1), row), 0);
-        e = mix(t0, t1, x - f32(i0));
-    }
+    var e = intermixed_entry(j, 0u, intermixed_value(j, p));
     if (SHADE && e.a > 0.0) {
         let ex = vec3<f32>(1.0, 0.0, 0.0);
         let ey = vec3<f32>(0.0, 1.0, 0.0);

@@ -26,10 +26,15 @@
 // (transmittance by ratio tracking); Russian roulette after 3 bounces, at most
 // pt.counts.z scattering events. Camera paths that miss the medium see the environment
 // when it is the background; alpha is the fraction of paths that met the medium.
+// Intermixed volumes (lib/intermix.wgsl) add their media: the extinctions add up (their
+// summed majorants on top of each block's), a real collision takes the colour of the
+// medium it met, drawn in proportion to the extinctions, and intermixed media, read without
+// gradients, scatter as the main volume's where its gradient is zero.
 #include "lib/common.wgsl"
 #include "lib/ray.wgsl"
 #include "lib/volume.wgsl"
 #include "lib/march.wgsl"
+#include "lib/intermix.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/phase.wgsl"
 #include "lib/bsdf.wgsl"
@@ -38,7 +43,7 @@ struct PathTrace {
     env_rotation: mat4x4<f32>,  // world → environment directions
     medium: vec4<f32>,          // x largest block majorant (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
     surface: vec4<f32>,         // x gradient threshold ψ (world units; 3e38: none), y stochastic blend rate k (0: the hard switch), z GGX roughness, w Fresnel reflectance at normal incidence
-    lobe: vec4<f32>,            // x transmitted share of the BSDF's non-specular part, y its Phong exponent, zw unused
+    lobe: vec4<f32>,            // x transmitted share of the BSDF's non-specular part, y its Phong exponent, z the intermixed volumes' summed majorant (per world unit), w unused
     counts: vec4<u32>,          // x paths per primary ray, y paths accumulated before this one, z most scattering events, w seed
     options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, z scattering regions (PT_SCATTER_*), w pixels traced: stride | x offset << 8 | y offset << 16 within rect
     rect: vec4<u32>,            // the frame's pixels: x0, y0, x1, y1 (exclusive)
@@ -149,11 +154,51 @@ fn env_sample(u: vec3<f32>) -> vec3<f32> {
     return transpose(m) * e;
 }
 
-// The part of a secondary ray inside the volume and on the kept side of the clipping planes.
+// The part of ray r inside the medium's box: the volume's, or with intermixed volumes the
+// world box holding them all.
+fn medium_box(r: Ray) -> vec2<f32> {
+    if (INTERMIX > 0u) {
+        return slab_interval(r.origin, r.dir, intermix.box_lo.xyz, intermix.box_hi.xyz);
+    }
+    return box_interval(r, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+}
+
+// The part of a camera ray in the medium, before the near plane, the far plane and the
+// host's opaque depth, on the kept side of the clipping planes.
+fn camera_segment(r: Ray, px: vec2<u32>) -> vec2<f32> {
+    var seg = medium_box(r);
+    seg.x = max(seg.x, 0.0);
+    seg.y = min(seg.y, r.far);
+    if (has_flag(FLAG_DEPTH_INPUT)) {
+        let d = textureLoad(depth_in, vec2<i32>(px), 0).x;
+        seg.y = min(seg.y, depth_to_distance(r, px, d));
+    }
+    return clip_interval(r, seg);
+}
+
+// The part of a secondary ray inside the medium and on the kept side of the clipping planes.
 fn inner_segment(r: Ray) -> vec2<f32> {
-    var seg = box_interval(r, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    var seg = medium_box(r);
     seg.x = max(seg.x, 0.0);
     return clip_interval(r, seg);
+}
+
+// Whether index-space point p lies in the main volume's grid (intermixed, the rays also
+// cross space outside it, where its medium is empty).
+fn in_main(p: vec3<f32>) -> bool {
+    return INTERMIX == 0u || (all(p >= vec3<f32>(0.0)) && all(p <= frame.dims.xyz - 1.0));
+}
+
+// Intermixed volume j's extinction (per world unit) at world point x: empty outside its
+// grid; σ from its opacity as given and its own unit distance.
+fn intermixed_extinction(j: u32, x: vec3<f32>) -> f32 {
+    let v = intermix.volumes[j];
+    let p = intermixed_point(j, x);
+    if (any(p < vec3<f32>(0.0)) || any(p > v.dims.xyz - 1.0)) {
+        return 0.0;
+    }
+    let a = min(intermixed_entry(j, 1u, intermixed_value(j, p)).x, PT_MAX_OPACITY);
+    return -log(1.0 - a) * v.range.w;
 }
 
 fn extinction(s: f32) -> f32 {
@@ -224,12 +269,57 @@ fn attenuates() -> bool {
     return (pt.options.x & PT_FLAG_ATTENUATION) != 0u;
 }
 
-// The extinction the paths meet at t: the medium's, less the collisions that neither
+// The extinction the paths meet at t: the media's, less the collisions that neither
 // scatter nor absorb when attenuation is off (the host sets no majorant at all when
-// nothing scatters and nothing attenuates).
+// nothing scatters and nothing attenuates). Intermixed volumes are read without their
+// gradients: their collisions scatter as the main volume's where its gradient is zero.
 fn extinction_at(r: Ray, t: f32) -> f32 {
+    var sigma = main_extinction(r, t);
+    if (INTERMIX > 0u) {
+        let x = r.origin + t * r.dir;
+        var others = 0.0;
+        for (var j = 0u; j < INTERMIX; j = j + 1u) {
+            others = others + intermixed_extinction(j, x);
+        }
+        sigma = sigma + others * intermixed_share();
+    }
+    return sigma;
+}
+
+// The medium a real collision at t met: the main volume's (MAX_INTERMIXED) or intermixed
+// volume j's, drawn in proportion to their shares of extinction_at.
+fn collided_medium(r: Ray, t: f32, rng: ptr<function, Rng>) -> u32 {
+    let x = r.origin + t * r.dir;
+    let share = intermixed_share();
+    var u = rand(rng) * extinction_at(r, t) - main_extinction(r, t);
+    for (var j = 0u; j < INTERMIX; j = j + 1u) {
+        if (u < 0.0) {
+            break;
+        }
+        let e = intermixed_extinction(j, x) * share;
+        if (u < e) {
+            return j;
+        }
+        u = u - e;
+    }
+    return MAX_INTERMIXED;
+}
+
+// The share of the intermixed volumes' collisions that the paths meet: all of them with
+// attenuation, else those that scatter where the gradient is zero (the BSDF's share is
+// then 0: ψ ≥ 0).
+fn intermixed_share() -> f32 {
+    let partial = pt.options.z == PT_SCATTER_SURFACES || pt.options.z == PT_SCATTER_BETWEEN;
+    if (HYBRID && !attenuates() && partial) {
+        return scatter_share(0.0);
+    }
+    return 1.0;
+}
+
+// The main volume's part of extinction_at.
+fn main_extinction(r: Ray, t: f32) -> f32 {
     let p = r.index_origin + t * r.index_dir;
-    if ((CROP && !in_crop(p)) || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
+    if (!in_main(p) || (CROP && !in_crop(p)) || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
         return 0.0;
     }
     let s = sample_scalars(p);
@@ -274,10 +364,17 @@ fn scatter_sample(sc: Scatterer, d: vec3<f32>, rng: ptr<function, Rng>) -> vec3<
 
 // The majorant over the block the ray is in at t (just past t, so that a ray on a block
 // boundary sees the block ahead) and the distance where it leaves that block (at least a
-// little past t, so that every step advances).
+// little past t, so that every step advances). Intermixed volumes add their summed
+// majorant everywhere; outside the main volume's grid the span ends where the ray enters it.
 fn block_span(r: Ray, t: f32) -> vec2<f32> {
     let p = r.index_origin + (t + 1e-4) * r.index_dir;
-    return vec2<f32>(textureLoad(majorants, block_coord(p), 0).x, max(block_exit(r, p), t + 1e-4));
+    if (!in_main(p)) {
+        let b = box_interval(r, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+        let end = select(3.0e38, b.x, b.x > t + 1e-4 && b.x < b.y);
+        return vec2<f32>(pt.lobe.z, end);
+    }
+    let m = textureLoad(majorants, block_coord(p), 0).x + pt.lobe.z;
+    return vec2<f32>(m, max(block_exit(r, p), t + 1e-4));
 }
 
 // One step of tracking over [t, t1): the next tentative collision, drawn against the
@@ -348,7 +445,7 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng) -> vec4<f32> {
     let background = (pt.options.x & PT_FLAG_BACKGROUND) != 0u;
     var r = camera_ray;
-    var seg = ray_segment(r, px);
+    var seg = camera_segment(r, px);
     var beta = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
     var hit = 0.0;
@@ -372,7 +469,10 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
             *rng = secondary;
             if (GUIDE && (pt.options.x & PT_FLAG_GUIDE) != 0u) {
                 let p0 = r.index_origin + t * r.index_dir;
-                let g0 = world_gradient(gradient_at(p0, sample_scalars(p0)), 0u);
+                var g0 = vec3<f32>(0.0);
+                if (in_main(p0)) {
+                    g0 = world_gradient(gradient_at(p0, sample_scalars(p0)), 0u);
+                }
                 var n0 = -r.dir;
                 if (dot(g0, g0) > 1e-20) {
                     n0 = normalize(g0);
@@ -386,14 +486,23 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         }
         let x = r.origin + t * r.dir;
         let p = r.index_origin + t * r.index_dir;
-        let s = sample_scalars(p);
         var sc: Scatterer;
-        sc.b.color = medium(p, s.x).rgb;
         var share = 0.0;
         var grad = vec3<f32>(0.0);
-        if (uses_gradient()) {
-            grad = world_gradient(gradient_at(p, s), 0u);
-            share = bsdf_share(length(grad));
+        var which = MAX_INTERMIXED;
+        if (INTERMIX > 0u) {
+            which = collided_medium(r, t, rng);
+        }
+        if (which < MAX_INTERMIXED) {
+            // an intermixed volume's medium: its colour; no gradient, so no BSDF (share 0)
+            sc.b.color = intermixed_entry(which, 0u, intermixed_value(which, intermixed_point(which, x))).rgb;
+        } else {
+            let s = sample_scalars(p);
+            sc.b.color = medium(p, s.x).rgb;
+            if (uses_gradient()) {
+                grad = world_gradient(gradient_at(p, s), 0u);
+                share = bsdf_share(length(grad));
+            }
         }
         if (attenuates()) {
             // the absorbing share of the collisions (without attenuation, extinction_at
@@ -509,7 +618,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Depth: where the pixel's centre ray enters the medium's segment, once any path met it.
     if (sum.a > 0.0) {
         let centre = make_ray(px);
-        let seg = ray_segment(centre, px);
+        let seg = camera_segment(centre, px);
         if (seg.x < seg.y) {
             m.z = distance_to_depth(centre, seg.x);
         }

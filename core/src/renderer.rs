@@ -131,16 +131,21 @@ impl Renderer {
     }
 
     /// Sets the volumes drawn with the main one, intermixed per sample (VTK's vtkMultiVolume:
-    /// the main volume is port 0, `volumes[i]` port i + 1): each ray marches the world box
-    /// holding them all at the main volume's sample distance, and at each sample composites
-    /// the main volume and then each intermixed volume that holds the sample, each classified
-    /// by its own transfer function (opacity corrected for the step by its own unit
-    /// distance) and read with its own interpolation, and shaded, when shading is on, by its own gradient with the main volume's
-    /// lights and material. Ray casting in the composite blend mode only; at most
+    /// the main volume is port 0, `volumes[i]` port i + 1). Ray casting (the composite blend
+    /// mode) marches the world box holding them all at the main volume's sample distance,
+    /// and at each sample composites the main volume and then each intermixed volume that
+    /// holds the sample, each classified by its own transfer function (opacity corrected for
+    /// the step by its own unit distance) and read with its own interpolation, and shaded,
+    /// when shading is on, by its own gradient with the main volume's lights and material.
+    /// The path tracer adds their media: at a point the extinctions add up, and a collision
+    /// scatters with the colour of the medium it met, drawn in proportion to the media's
+    /// extinctions; intermixed volumes are read without their gradients (they scatter as the
+    /// main volume's medium where its gradient is zero). At most
     /// [`MAX_INTERMIXED_VOLUMES`](crate::MAX_INTERMIXED_VOLUMES); an empty slice clears
     /// them. Data shared with the previous call (the same `Arc`s) is not uploaded again.
     pub fn set_intermixed_volumes(&mut self, volumes: &[IntermixedVolume]) -> Result<()> {
         self.res.intermix = Intermix::new(&self.ctx, self.res.intermix.as_ref(), volumes)?;
+        self.res.intermix_generation += 1;
         Ok(())
     }
 
@@ -397,10 +402,13 @@ impl Renderer {
             }
             _ => res.release_level(),
         }
-        if res.intermix.is_some() && params.blend != BlendMode::Composite {
+        if res.intermix.is_some()
+            && !matches!(params.blend, BlendMode::Composite | BlendMode::PathTrace)
+        {
             return Err(Error::Unsupported(format!(
-                "intermixed volumes are ray cast in the composite blend mode, not {:?}: \
-                 clear them (set_intermixed_volumes with none) or use the composite mode",
+                "intermixed volumes are drawn in the composite blend mode and path traced, \
+                 not in {:?}: clear them (set_intermixed_volumes with none) or use one of \
+                 those modes",
                 params.blend
             )));
         }

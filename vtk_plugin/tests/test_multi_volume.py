@@ -1,6 +1,7 @@
 """Several volumes intermixed per sample (vtkMultiVolume): one vtkFerroVolumeMapper with an
 input per port and a vtkVolume per port (placement and property), compared with
-vtkGPUVolumeRayCastMapper drawing the same vtkMultiVolume; what intermixing does not take
+vtkGPUVolumeRayCastMapper drawing the same vtkMultiVolume; path traced, the media add up;
+what intermixing does not take
 (another blend mode, a gradient opacity function, a port without a vtkVolume) is one
 vtkErrorMacro naming it, and the volume draws again once it is fixed."""
 import unittest
@@ -142,6 +143,40 @@ class MultiVolume(unittest.TestCase):
         s, p = fvtest.compare("multi-volume-shaded-control", *self.render_both(shared_coordinates))
         self.assertGreater(s, 0.975)
         self.assertGreater(p, 32.0)
+
+    def test_path_traced(self):
+        """The path tracer draws a vtkMultiVolume's media together (the extinctions add
+        up): the second volume's medium shows where it alone lies, and moving it starts
+        the accumulation over."""
+        mapper = ferrovol.vtkFerroVolumeMapper()
+        mapper.SetRenderModeToPathTrace()
+        mapper.SetSamplesPerPixel(8)
+        errors = Errors(mapper)
+        scene = MultiScene(mapper, size=(64, 64))
+        both = scene.render()
+        self.assertEqual(errors.messages, [])
+        self.assertEqual(mapper.GetAccumulatedSamples(), 8)
+        clear = vtk.vtkPiecewiseFunction()
+        clear.AddPoint(0.0, 0.0)
+        clear.AddPoint(300.0, 0.0)
+        scene.volumes[1].GetProperty().SetScalarOpacity(clear)
+        first = scene.render()
+        scene.volumes[1].GetProperty().SetScalarOpacity(second_property().GetScalarOpacity())
+        scene.volumes[1].AddPosition(0.0, -6.0, 0.0)
+        moved = scene.render()
+        def orange(img):
+            """The share of pixels where the second volume's orange shows."""
+            rgb = img[..., :3].astype(float)
+            return float(((rgb[..., 0] > 60) & (rgb[..., 0] > 2.0 * rgb[..., 2])).mean())
+
+        fvtest.log("path-traced multi-volume: orange pixels %.3f, the second volume clear "
+                   "%.3f, moved %.3f" % (orange(both), orange(first), orange(moved)))
+        fvtest.save("multi-volume-pathtrace", both, first, moved)
+        self.assertEqual(errors.messages, [])
+        self.assertGreater(orange(both), 0.03)
+        self.assertLess(orange(first), 0.005)
+        self.assertEqual(mapper.GetAccumulatedSamples(), 8)
+        self.assertLess(fvtest.ssim(moved, both), 0.99, "moving the second volume shows")
 
     def test_refusals_name_the_problem(self):
         mapper = ferrovol.vtkFerroVolumeMapper()

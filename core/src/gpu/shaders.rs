@@ -50,6 +50,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../../shaders/lib/shadow.wgsl"),
     ),
     (
+        "lib/intermix.wgsl",
+        include_str!("../../../shaders/lib/intermix.wgsl"),
+    ),
+    (
         "lib/surface.wgsl",
         include_str!("../../../shaders/lib/surface.wgsl"),
     ),

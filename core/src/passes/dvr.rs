@@ -9,19 +9,17 @@ use super::frame::{
 };
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
-    bind, buffer_entry, entry, sampled_texture_entry, storage_texture_entry, texture_entry,
+    bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
-use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
-use crate::gpu::uniforms::{IntermixUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE};
+use crate::gpu::uniforms::{MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind, RenderParams, View};
-use crate::resources::intermix::world_box;
+use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
-use glam::DMat4;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -72,18 +70,14 @@ pub(crate) struct DvrPass {
     no_tables_2d: Tables,
     /// Bound in place of a rectilinear grid's lookup for a uniform grid.
     no_grid_lookup: wgpu::TextureView,
-    /// Bound in place of the intermixed volumes' uniforms, atlas and tables without any.
-    no_intermix: (wgpu::Buffer, wgpu::TextureView),
-    /// Reads the intermixed volumes' atlas: linear where r32float is filterable, else
-    /// nearest (the shader then interpolates).
-    intermix_sampler: wgpu::Sampler,
+    /// The intermixed volumes' bindings.
+    intermix_binding: IntermixBinding,
 }
 
 impl DvrPass {
     pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
-        let filterable = ctx.info.float32_filterable;
         let bgl = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -102,18 +96,10 @@ impl DvrPass {
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(11, false, V::D2),
                     texture_entry(12, false, V::D3),
-                    buffer_entry(13, B::Uniform),
-                    texture_entry(14, filterable, V::D3),
-                    texture_entry(15, false, V::D2),
-                    entry(
-                        16,
-                        wgpu::BindingType::Sampler(if filterable {
-                            wgpu::SamplerBindingType::Filtering
-                        } else {
-                            wgpu::SamplerBindingType::NonFiltering
-                        }),
-                    ),
-                ],
+                ]
+                .into_iter()
+                .chain(IntermixBinding::layout_entries(ctx))
+                .collect::<Vec<_>>(),
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
         let no_blanking = block_grid(ctx, "no blanking", [1; 3], &[0u8]);
@@ -124,31 +110,7 @@ impl DvrPass {
             no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
             no_tables_2d: Tables::new(&ctx.device, [1, 1]),
             no_grid_lookup: block_grid(ctx, "no grid lookup", [2, 3, 1], &[0f32; 6]),
-            no_intermix: (
-                uniform_buffer(
-                    ctx,
-                    "no intermix",
-                    std::mem::size_of::<IntermixUniforms>() as u64,
-                ),
-                block_grid(ctx, "no intermix", [1; 3], &[0f32]),
-            ),
-            intermix_sampler: ctx.device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("intermix atlas"),
-                address_mode_u: wgpu::AddressMode::ClampToEdge,
-                address_mode_v: wgpu::AddressMode::ClampToEdge,
-                address_mode_w: wgpu::AddressMode::ClampToEdge,
-                mag_filter: if filterable {
-                    wgpu::FilterMode::Linear
-                } else {
-                    wgpu::FilterMode::Nearest
-                },
-                min_filter: if filterable {
-                    wgpu::FilterMode::Linear
-                } else {
-                    wgpu::FilterMode::Nearest
-                },
-                ..Default::default()
-            }),
+            intermix_binding: IntermixBinding::new(ctx),
         })
     }
 
@@ -375,21 +337,8 @@ impl DvrPass {
         if tables_2d != 0 {
             res.ensure_tables_2d(ctx, step)?;
         }
-        let vol = res.volume()?;
         let mut u = f.uniforms;
-        if intermix > 0 {
-            let main = world_box(params.volume_matrix * vol.index_to_data, vol.data_dims);
-            let m = res
-                .intermix
-                .as_mut()
-                .expect("intermixed volumes counted above");
-            let (lo, hi) = m.world_bounds();
-            let (lo, hi) = (lo.min(main.0), hi.max(main.1));
-            m.prepare(ctx, step, (lo, hi))?;
-            let vp = view.camera.view_projection(view.aspect());
-            let r = frame::screen_rect(vp, DMat4::IDENTITY, lo, hi, view.width, view.height);
-            u.rect = frame::union_rect(u.rect, r);
-        }
+        u.rect = frame::prepare_intermix(ctx, res, params, view, step, u.rect)?;
         let vol = res.volume()?;
         let dvr = self.pipelines.get(ctx, variant)?;
         let t = res.targets.as_ref().expect("targets allocated above");
@@ -441,30 +390,10 @@ impl DvrPass {
                         vol.grid_lookup.as_ref().unwrap_or(&self.no_grid_lookup),
                     ),
                 ),
-                bind(
-                    13,
-                    match &res.intermix {
-                        Some(m) => m.uniforms.as_entire_binding(),
-                        None => self.no_intermix.0.as_entire_binding(),
-                    },
-                ),
-                bind(
-                    14,
-                    wgpu::BindingResource::TextureView(
-                        res.intermix
-                            .as_ref()
-                            .map_or(&self.no_intermix.1, |m| &m.atlas),
-                    ),
-                ),
-                bind(
-                    15,
-                    wgpu::BindingResource::TextureView(match &res.intermix {
-                        Some(m) => m.tables(),
-                        None => &self.no_tables_2d.view,
-                    }),
-                ),
-                bind(16, wgpu::BindingResource::Sampler(&self.intermix_sampler)),
-            ],
+            ]
+            .into_iter()
+            .chain(self.intermix_binding.entries(res.intermix.as_ref()))
+            .collect::<Vec<_>>(),
         });
         let rect = u.rect;
         let gr = groups(rect);

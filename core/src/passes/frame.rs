@@ -12,6 +12,7 @@ use crate::params::{
     BlendMode, ClipPlane, LightSpace, MaskKind, RenderParams, TransferFunction, View, MAX_LIGHTS,
 };
 use crate::resources::bricks::{FrontToBack, BLOCK_SIZE};
+use crate::resources::intermix::world_box;
 use crate::resources::targets::DepthSource;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -143,6 +144,30 @@ pub(crate) fn screen_rect(
 }
 
 /// The smallest rectangle ([x0, y0, x1, y1)) holding `a` and `b` (either may be empty).
+/// Prepares the intermixed volumes, if any, for a frame at sample distance `step` (their
+/// tables, and their uniforms with the world box the rays cross: every volume's, the main
+/// one's included) and returns `rect` grown by that box's rectangle on the screen.
+pub(crate) fn prepare_intermix(
+    ctx: &Context,
+    res: &mut Resources,
+    params: &RenderParams,
+    view: &View,
+    step: f64,
+    rect: [u32; 4],
+) -> Result<[u32; 4]> {
+    let vol = res.volume()?;
+    let main = world_box(params.volume_matrix * vol.index_to_data, vol.data_dims);
+    let Some(m) = res.intermix.as_mut() else {
+        return Ok(rect);
+    };
+    let (lo, hi) = m.world_bounds();
+    let (lo, hi) = (lo.min(main.0), hi.max(main.1));
+    m.prepare(ctx, step, (lo, hi))?;
+    let vp = view.camera.view_projection(view.aspect());
+    let r = screen_rect(vp, DMat4::IDENTITY, lo, hi, view.width, view.height);
+    Ok(union_rect(rect, r))
+}
+
 pub(crate) fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
     let empty = |r: [u32; 4]| r[0] >= r[2] || r[1] >= r[3];
     match (empty(a), empty(b)) {

@@ -7,5 +7,6 @@ pub(crate) mod depth_check;
 pub(crate) mod dvr;
 pub(crate) mod frame;
 pub(crate) mod iso;
+pub(crate) mod medium;
 pub(crate) mod pathtrace;
 pub(crate) mod scatter_check;

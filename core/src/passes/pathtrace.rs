@@ -30,6 +30,7 @@
 use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::depth_check::DepthCheck;
 use super::frame::{self, groups, FrameInput};
+use super::medium;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, bind_block, buffer_entry, dynamic_uniform_entry, sampled_texture_entry, sampler_entry,
@@ -43,15 +44,16 @@ use crate::gpu::readback::read_buffer;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{
     flag_bits, PathTraceUniforms, ShowUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE,
-    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, PT_MAX_OPACITY, TABLE_SIZE,
+    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, 
     UNIFORM_STRIDE,
 };
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, ComponentTransfer, Convergence, CubeImage, GradientMethod, Interpolation, MaskKind,
+    BlendMode, Convergence, GradientMethod, Interpolation, MaskKind,
     PathTraceParams, RenderParams, ScatterRegions, Shading, TransferFunction,
 };
+use crate::resources::intermix::IntermixBinding;
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 use crate::resources::Resources;
@@ -126,6 +128,8 @@ pub(crate) struct PathTracePass {
     majorants: Option<(MajorantKey, wgpu::TextureView, f32)>,
     /// Bound in place of the mask when the volume has none.
     no_mask: wgpu::TextureView,
+    /// The intermixed volumes' bindings.
+    intermix_binding: IntermixBinding,
     /// What the accumulated paths were traced with; a different key starts over.
     key: String,
     /// Sixteenths of a path per pixel accumulated (passes × 16 + subsets of the next).
@@ -160,7 +164,10 @@ impl PathTracePass {
                 ),
                 buffer_entry(16, B::Storage { read_only: false }),
                 sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
-            ],
+            ]
+            .into_iter()
+            .chain(IntermixBinding::layout_entries(ctx))
+            .collect::<Vec<_>>(),
         });
         let pipelines =
             PipelineCache::new(ctx, "pathtrace.wgsl", "path tracing", &[&bgl, brick_bgl])?;
@@ -194,6 +201,7 @@ impl PathTracePass {
             env_dist: None,
             majorants: None,
             no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
+            intermix_binding: IntermixBinding::new(ctx),
             key: String::new(),
             units: 0,
             unit_seconds: None,
@@ -260,140 +268,18 @@ pipeline_variant! {
         crop: bool => "CROP",
         /// What the mask does (MASK_NONE, MASK_BINARY or MASK_LABELS).
         mask: u32 => "MASK",
+        /// Number of volumes intermixed with the main one.
+        intermix: u32 => "INTERMIX",
+        /// The intermixed volumes' atlas is read through a linear sampler.
+        intermix_filtered: bool => "INTERMIX_FILTERED",
     }
-}
-
-/// Texels per face edge of the cube the environment is importance-sampled on (at most).
-const ENV_DIST_SIZE: u32 = 32;
-/// Share of the environment's sampling probability spread uniformly over the sphere, so
-/// every direction keeps some (the distribution is built from a coarse mip level).
-const ENV_DIST_UNIFORM: f64 = 0.1;
-
-/// The cumulative sampling probabilities of the texels of a cube image: luminance × solid
-/// angle, mixed with a uniform share (pathtrace.wgsl: env_sample, env_pdf).
-fn environment_cdf(cube: &CubeImage) -> Vec<f32> {
-    let n = cube.size as usize;
-    let mut weights = Vec::with_capacity(6 * n * n);
-    let mut solid = Vec::with_capacity(6 * n * n);
-    for face in &cube.faces {
-        for (i, t) in face.iter().enumerate() {
-            let sc = 2.0 * ((i % n) as f64 + 0.5) / n as f64 - 1.0;
-            let tc = 2.0 * ((i / n) as f64 + 0.5) / n as f64 - 1.0;
-            let q = 1.0 + sc * sc + tc * tc;
-            let omega = 4.0 / (n * n) as f64 / (q * q.sqrt());
-            let lum = 0.2126 * t[0] as f64 + 0.7152 * t[1] as f64 + 0.0722 * t[2] as f64;
-            weights.push(lum.max(0.0) * omega);
-            solid.push(omega);
-        }
-    }
-    let total: f64 = weights.iter().sum();
-    let total_solid: f64 = solid.iter().sum();
-    let mut acc = 0.0;
-    let mut cdf: Vec<f32> = weights
-        .iter()
-        .zip(&solid)
-        .map(|(w, o)| {
-            let lum_share = if total > 0.0 {
-                w / total
-            } else {
-                o / total_solid
-            };
-            acc += (1.0 - ENV_DIST_UNIFORM) * lum_share + ENV_DIST_UNIFORM * o / total_solid;
-            acc as f32
-        })
-        .collect();
-    if let Some(last) = cdf.last_mut() {
-        *last = 1.0;
-    }
-    cdf
 }
 
 impl PathTracePass {
-    /// Builds the environment's sampling distribution when the environment changed.
-    fn ensure_environment_distribution(&mut self, ctx: &Context, res: &Resources) -> Result<()> {
-        let generation = res.environment.generation;
-        if self
-            .env_dist
-            .as_ref()
-            .is_some_and(|(gen, _, _)| *gen == generation)
-        {
-            return Ok(());
-        }
-        let (size, mips) = {
-            let env = res.current_environment()?;
-            (env.size, env.mips)
-        };
-        let mut level = 0;
-        while level + 1 < mips && (size >> level) > ENV_DIST_SIZE {
-            level += 1;
-        }
-        let cube = res.read_environment(ctx, level)?;
-        let cdf = environment_cdf(&cube);
-        let buf = buffer(
-            ctx,
-            "environment sampling distribution",
-            (4 * cdf.len()) as u64,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        );
-        ctx.queue.write_buffer(&buf, 0, bytemuck::cast_slice(&cdf));
-        self.env_dist = Some((generation, cube.size, buf));
-        Ok(())
-    }
-
     /// Starts the accumulation over at the next path-traced frame.
     pub fn reset_accumulation(&mut self) {
         self.units = 0;
         self.key.clear();
-    }
-
-    /// The medium's majorant per min–max block: the largest extinction (per world unit) the
-    /// first component's transfer function gives on the table entries the block's scalar
-    /// range touches (the table is linear between entries, so its maximum over the range is
-    /// at one of them).
-    fn block_majorants(res: &Resources) -> Result<Vec<f32>> {
-        let tf = res.transfer_function()?;
-        let vol = res.volume()?;
-        let c = tf.component(0);
-        let last = (TABLE_SIZE - 1) as f64;
-        // Per table: its range and the extinction at each entry; a label map's labels'
-        // tables too (a labelled point's medium mixes its label's with the component's).
-        let table = |t: &ComponentTransfer, [lo, hi]: [f64; 2]| -> ([f64; 2], Vec<f64>) {
-            let sigma = (0..TABLE_SIZE)
-                .map(|i| {
-                    let x = lo + (hi - lo) * i as f64 / last;
-                    let a = (t.opacity.eval(x)[0].clamp(0.0, 1.0) as f64).min(PT_MAX_OPACITY);
-                    -(1.0 - a).ln() / c.unit_distance
-                })
-                .collect();
-            ([lo, hi], sigma)
-        };
-        let mut tables = vec![table(c, c.table_range())];
-        if res.mask_kind() == Some(MaskKind::LabelMap) {
-            let (range, _) = tf.label_ranges();
-            for label in 1..=tf.max_label() {
-                tables.push(table(&tf.label_transfer(label), range));
-            }
-        }
-        let nc = vol.components as usize;
-        Ok(vol
-            .minmax
-            .ranges
-            .chunks(nc)
-            .map(|r| {
-                let [mn, mx] = r[0];
-                if mn > mx {
-                    return 0.0;
-                }
-                let mut m = 0.0f64;
-                for ([lo, hi], sigma) in &tables {
-                    let at = |v: f32| (v as f64 - lo) / (hi - lo) * last;
-                    let i0 = at(mn).floor().clamp(0.0, last) as usize;
-                    let i1 = at(mx).ceil().clamp(0.0, last) as usize;
-                    m = sigma[i0..=i1].iter().copied().fold(m, f64::max);
-                }
-                m as f32
-            })
-            .collect())
     }
 
     /// Uploads the block majorants when the volume or the transfer function changed (the
@@ -410,7 +296,7 @@ impl PathTracePass {
                 return Ok(*max);
             }
         }
-        let m = Self::block_majorants(res)?;
+        let m = medium::block_majorants(res)?;
         let max = m.iter().copied().fold(0.0f32, f32::max);
         let dims = res.volume()?.minmax.dims;
         let grid = block_grid(ctx, "path tracing block majorants", dims, &m);
@@ -451,6 +337,14 @@ impl PathTracePass {
                 vol.components
             )));
         }
+        let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
+        if intermix > 0 && (params.cropping.is_some() || res.mask.is_some()) {
+            return Err(Error::Unsupported(
+                "intermixed volumes are path traced without cropping or a mask on the main \
+                 volume: clear the intermixed volumes or turn cropping and the mask off"
+                    .into(),
+            ));
+        }
         let single_brick = vol.single_brick();
         frame::check_light_count(view)?;
         let unit = res
@@ -464,7 +358,11 @@ impl PathTracePass {
         res.ensure_environment(ctx)?;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
-        self.ensure_environment_distribution(ctx, res)?;
+        let generation = res.environment.generation;
+        if self.env_dist.as_ref().map(|d| d.0) != Some(generation) {
+            let (size, buf) = medium::environment_distribution(ctx, res)?;
+            self.env_dist = Some((generation, size, buf));
+        }
         let majorant = self.ensure_majorants(ctx, res)?;
         // The view's directional lights light the medium whatever `shading.enabled` says.
         let lit = RenderParams {
@@ -487,7 +385,7 @@ impl PathTracePass {
             ..pp
         };
         let key = format!(
-            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{}|{depth_input}",
+            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{:?}|{depth_input}",
             (
                 res.stats.volume_uploads,
                 res.stats.table_uploads,
@@ -495,7 +393,7 @@ impl PathTracePass {
             ),
             res.environment.generation,
             res.generation,
-            res.mask_generation
+            (res.mask_generation, res.intermix_generation)
         );
         let nearest = params.interpolation == Interpolation::Nearest;
         let guided = pp.denoise || pp.denoise_until > 0;
@@ -517,6 +415,8 @@ impl PathTracePass {
                 }
                 _ => MASK_NONE,
             },
+            intermix,
+            intermix_filtered: intermix > 0 && ctx.info.float32_filterable,
         };
         let pipeline = self.pipelines.get(ctx, variant)?;
         self.ensure_accum(ctx, view.width, view.height)?;
@@ -554,14 +454,16 @@ impl PathTracePass {
             return Ok(());
         }
         let full = [0, 0, view.width, view.height];
-        let rect = if pp.background { full } else { frame.rect };
+        let rect = frame::prepare_intermix(ctx, res, params, view, step, frame.rect)?;
+        let rect = if pp.background { full } else { rect };
+        let others = res.intermix.as_ref().map_or(0.0, |m| m.majorant());
         let env = res.current_environment()?;
         let mut u = PathTraceUniforms::zeroed();
         u.env_rotation = DMat4::from_mat3(env.rotation).as_mat4().to_cols_array();
         // Nothing scatters and nothing absorbs: no collisions at all.
         let transparent = pp.scatter == ScatterRegions::Nowhere && !pp.attenuation;
         u.medium = [
-            if transparent { 0.0 } else { majorant },
+            if transparent { 0.0 } else { majorant + others },
             pp.anisotropy,
             (1.0 / unit) as f32,
             pp.environment_light,
@@ -572,7 +474,7 @@ impl PathTracePass {
             pp.bsdf.roughness,
             pp.bsdf.fresnel,
         ];
-        u.lobe = [pp.bsdf.transmission, pp.bsdf.lobe_exponent(), 0.0, 0.0];
+        u.lobe = [pp.bsdf.transmission, pp.bsdf.lobe_exponent(), others, 0.0];
         u.counts = [pp.secondary_rays, 0, pp.max_bounces, pp.seed];
         let (_, dist_size, dist) = self.env_dist.as_ref().expect("built above");
         let (_, majorant_buf, _) = self.majorants.as_ref().expect("built above");
@@ -613,7 +515,10 @@ impl PathTracePass {
                         res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
                     ),
                 ),
-            ],
+            ]
+            .into_iter()
+            .chain(self.intermix_binding.entries(res.intermix.as_ref()))
+            .collect::<Vec<_>>(),
         });
         let brick = res.volume()?.bind_group(nearest);
         let budget = pp.time_budget as f64;

@@ -1,11 +1,13 @@
 //! The intermixed volumes on the device (params::IntermixedVolume): one r32float atlas
 //! holding every volume's points, the volumes stacked along z, their transfer tables and
-//! the uniforms dvr.wgsl reads them with.
+//! the uniforms lib/intermix.wgsl reads them with (ray casting and path tracing).
 
+use super::tables::Tables;
 use crate::error::{Error, Result};
+use crate::gpu::binding::{bind, buffer_entry, entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
-use crate::gpu::uniforms::{mat, IntermixUniforms, TABLE_SIZE};
+use crate::gpu::uniforms::{mat, IntermixUniforms, PT_MAX_OPACITY, TABLE_SIZE};
 use crate::gpu::Context;
 use crate::params::{
     build_tables, IntermixedVolume, Interpolation, VolumeData, MAX_INTERMIXED_VOLUMES,
@@ -128,7 +130,7 @@ impl Intermix {
                 lo as f32,
                 (1.0 / (hi - lo)) as f32,
                 f32::from(u8::from(nearest)),
-                0.0,
+                (1.0 / v.transfer.component(0).unit_distance) as f32,
             ];
         }
         ctx.queue
@@ -139,6 +141,91 @@ impl Intermix {
     /// The tables [`Intermix::prepare`] built.
     pub fn tables(&self) -> &wgpu::TextureView {
         &self.tables.as_ref().expect("tables built by prepare").2
+    }
+
+    /// The largest extinction (per world unit) the volumes' media can add up to at a
+    /// point: per volume the largest its opacity function takes (σ = −ln(1 − α) / unit
+    /// distance, α clamped as the path tracer clamps it; the tables are linear between
+    /// entries, so their largest entry bounds them), summed.
+    pub fn majorant(&self) -> f32 {
+        let last = (TABLE_SIZE - 1) as f64;
+        self.volumes
+            .iter()
+            .map(|v| {
+                let c = v.transfer.component(0);
+                let [lo, hi] = c.table_range();
+                let alpha = (0..TABLE_SIZE)
+                    .map(|i| c.opacity.eval(lo + (hi - lo) * i as f64 / last)[0] as f64)
+                    .fold(0.0f64, f64::max)
+                    .clamp(0.0, PT_MAX_OPACITY);
+                -(1.0 - alpha).ln() / c.unit_distance
+            })
+            .sum::<f64>() as f32
+    }
+}
+
+/// What a pass binds for the intermixed volumes (lib/intermix.wgsl, bindings 18 to 21):
+/// their uniforms, atlas and tables and the atlas's sampler, or placeholders without any.
+pub(crate) struct IntermixBinding {
+    none: (wgpu::Buffer, wgpu::TextureView, Tables),
+    /// Linear where r32float is filterable, else nearest (the shader then interpolates).
+    sampler: wgpu::Sampler,
+}
+
+impl IntermixBinding {
+    pub fn new(ctx: &Context) -> IntermixBinding {
+        let filter = if ctx.info.float32_filterable {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        };
+        IntermixBinding {
+            none: (
+                uniform_buffer(
+                    ctx,
+                    "no intermix",
+                    std::mem::size_of::<IntermixUniforms>() as u64,
+                ),
+                block_grid(ctx, "no intermix", [1; 3], &[0f32]),
+                Tables::new(&ctx.device, [1, 1]),
+            ),
+            sampler: ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("intermix atlas"),
+                mag_filter: filter,
+                min_filter: filter,
+                ..Default::default()
+            }),
+        }
+    }
+
+    /// The layout entries of the four bindings.
+    pub fn layout_entries(ctx: &Context) -> [wgpu::BindGroupLayoutEntry; 4] {
+        let filterable = ctx.info.float32_filterable;
+        let sampler = if filterable {
+            wgpu::SamplerBindingType::Filtering
+        } else {
+            wgpu::SamplerBindingType::NonFiltering
+        };
+        [
+            buffer_entry(18, wgpu::BufferBindingType::Uniform),
+            texture_entry(19, filterable, wgpu::TextureViewDimension::D3),
+            texture_entry(20, false, wgpu::TextureViewDimension::D2),
+            entry(21, wgpu::BindingType::Sampler(sampler)),
+        ]
+    }
+
+    /// The bind group entries for `intermix` (prepared), or the placeholders.
+    pub fn entries<'a>(&'a self, intermix: Option<&'a Intermix>) -> [wgpu::BindGroupEntry<'a>; 4] {
+        let (uniforms, atlas, tables) = match intermix {
+            Some(m) => (&m.uniforms, m.atlas.as_ref(), m.tables()),
+            None => (&self.none.0, &self.none.1, &self.none.2.view),
+        };
+        [
+            bind(18, uniforms.as_entire_binding()),
+            bind(19, wgpu::BindingResource::TextureView(atlas)),
+            bind(20, wgpu::BindingResource::TextureView(tables)),
+            bind(21, wgpu::BindingResource::Sampler(&self.sampler)),
+        ]
     }
 }
 

@@ -67,6 +67,8 @@ pub(crate) struct Resources {
     pub progress: Option<StreamProgress>,
     /// Volumes drawn with the main one, intermixed per sample.
     pub intermix: Option<intermix::Intermix>,
+    /// Counts the sets of intermixed volumes set (and cleared).
+    pub intermix_generation: u64,
 }
 
 impl Resources {
@@ -130,6 +132,7 @@ impl Resources {
             gradient_pass: None,
             progress: None,
             intermix: None,
+            intermix_generation: 0,
         }
     }
 

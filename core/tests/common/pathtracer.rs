@@ -9,7 +9,8 @@
 //! scattering events; the environment (weighted by `environment_light`) and the view's
 //! directional lights (the headlight shining along each camera path) light it; paths that
 //! miss the medium bring nothing (no background), and coverage is the fraction of paths
-//! that met it.
+//! that met it. Intermixed volumes ([`Intermixed`], each placed by its own matrix) add
+//! their media: the extinctions add up, and a collision scatters as the medium it met.
 //!
 //! The hybrid model: at a collision the gradient ∇s by central differences one voxel apart
 //! of the interpolated scalar (lib/volume.wgsl: gradient_at) gives the BSDF's share P (1 if
@@ -88,12 +89,69 @@ impl Hybrid {
 
 /// What a real collision does with the path: scatters by the BSDF with weight `bsdf`
 /// (oriented by `n`, facing the arriving path, with Fresnel term `fresnel`) and by albedo ×
-/// Henyey–Greenstein with weight `hg`; the weights' sum short of 1 is absorbed.
+/// Henyey–Greenstein with weight `hg` (the albedo `hg_albedo`: the media's, weighted by
+/// their shares of the collision); the weights' sum short of 1 is absorbed.
 struct Kernel {
     bsdf: f64,
     hg: f64,
+    hg_albedo: DVec3,
     n: DVec3,
     fresnel: f64,
+}
+
+/// A volume intermixed with the main one: its medium adds to the main one's (extinction from
+/// its own linear opacity ramp over [0, 1] and unit distance, its own albedo), read without
+/// its gradient (it scatters as the main medium where the gradient is zero), empty outside
+/// its grid.
+pub struct Intermixed {
+    pub volume: VolumeData,
+    /// World → the volume's index space.
+    pub world_to_index: DMat4,
+    pub alpha: [f64; 2],
+    pub inv_unit: f64,
+    pub albedo: DVec3,
+}
+
+impl Intermixed {
+    /// Its extinction at world point p.
+    fn sigma(&self, p: DVec3) -> f64 {
+        let q = self.world_to_index.transform_point3(p);
+        let (lo, hi) = index_box(&self.volume);
+        if q.cmplt(lo).any() || q.cmpgt(hi).any() {
+            return 0.0;
+        }
+        ramp_extinction(self.alpha, trilinear(&self.volume, q), self.inv_unit)
+    }
+
+    /// The largest extinction its ramp takes.
+    pub fn majorant(&self) -> f64 {
+        ramp_extinction(self.alpha, 1.0, self.inv_unit)
+    }
+
+    /// Its world box (lo, hi).
+    fn world_box(&self) -> (DVec3, DVec3) {
+        let (lo, hi) = index_box(&self.volume);
+        let to_world = self.world_to_index.inverse();
+        let mut b = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for c in 0..8 {
+            let corner = DVec3::select(
+                glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0),
+                hi,
+                lo,
+            );
+            let w = to_world.transform_point3(corner);
+            b = (b.0.min(w), b.1.max(w));
+        }
+        b
+    }
+}
+
+/// σ = −ln(1 − α) / unit distance for the opacity ramp `alpha` over scalars [0, 1] at s
+/// (clamped), α clamped as the path tracer clamps it.
+fn ramp_extinction(alpha: [f64; 2], s: f64, inv_unit: f64) -> f64 {
+    let s = s.clamp(0.0, 1.0);
+    let a = (alpha[0] + (alpha[1] - alpha[0]) * s).min(0.9999);
+    -(1.0 - a).ln() * inv_unit
 }
 
 /// Probabilities with which the reference draws a BSDF continuation from GGX half vectors,
@@ -114,8 +172,11 @@ pub struct Scene {
     pub g: f64,
     pub hybrid: Option<Hybrid>,
     pub max_bounces: u32,
-    /// The largest σ anywhere (the opacity ramp rises, so at scalar 1).
+    /// The largest σ anywhere (the opacity ramps rise, so at scalar 1; the intermixed
+    /// volumes' added).
     pub majorant: f64,
+    /// Volumes intermixed with the main one.
+    pub intermixed: Vec<Intermixed>,
     pub env_weight: f64,
     /// The world direction that is up in the sky, and its upper and lower radiance.
     pub env_up: DVec3,
@@ -163,11 +224,25 @@ impl Scene {
         )
     }
 
-    /// The medium's extinction at p.
+    /// The main medium's extinction at p (empty outside its grid).
     fn sigma(&self, p: DVec3) -> f64 {
-        let s = self.scalar(p).clamp(0.0, 1.0);
-        let a = (self.alpha[0] + (self.alpha[1] - self.alpha[0]) * s).min(0.9999);
-        -(1.0 - a).ln() * self.inv_unit
+        let (lo, hi) = index_box(&self.volume);
+        if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+            return 0.0;
+        }
+        ramp_extinction(self.alpha, self.scalar(p), self.inv_unit)
+    }
+
+    /// The share of an intermixed medium's collisions that happen: its gradient taken as
+    /// zero, the BSDF's share there is 0; without attenuation only the scattering ones.
+    fn intermixed_share(&self) -> f64 {
+        match &self.hybrid {
+            Some(h) if !h.attenuation => match h.regions {
+                ScatterRegions::Nowhere | ScatterRegions::Surfaces => 0.0,
+                ScatterRegions::Between | ScatterRegions::Everywhere => 1.0,
+            },
+            _ => 1.0,
+        }
     }
 
     /// The shares of the collisions at p that scatter by the BSDF and by HG, by the
@@ -188,6 +263,11 @@ impl Scene {
     /// The extinction paths meet at p: without attenuation the collisions that do not
     /// scatter do not happen.
     fn extinction(&self, p: DVec3) -> f64 {
+        self.main_extinction(p) + self.intermixed_extinction(p)
+    }
+
+    /// The main medium's part of `extinction`.
+    fn main_extinction(&self, p: DVec3) -> f64 {
         let sigma = self.sigma(p);
         match &self.hybrid {
             Some(h) if !h.attenuation && sigma > 0.0 => {
@@ -198,12 +278,63 @@ impl Scene {
         }
     }
 
-    /// What a real collision at p does with a path propagating along d.
+    /// The intermixed media's part of `extinction`, and their albedo weighted by it.
+    fn intermixed_parts(&self, p: DVec3) -> (f64, DVec3) {
+        let share = self.intermixed_share();
+        self.intermixed.iter().fold((0.0, DVec3::ZERO), |(e, a), v| {
+            let s = v.sigma(p) * share;
+            (e + s, a + s * v.albedo)
+        })
+    }
+
+    fn intermixed_extinction(&self, p: DVec3) -> f64 {
+        self.intermixed_parts(p).0
+    }
+
+    /// What a real collision at p does with a path propagating along d: the expected kernel
+    /// over the media it may have met, each in proportion to its share of the extinction.
     fn kernel(&self, p: DVec3, d: DVec3) -> Kernel {
+        let k = self.main_kernel(p, d);
+        if self.intermixed.is_empty() {
+            return k;
+        }
+        let main = self.main_extinction(p);
+        let (others, albedo) = self.intermixed_parts(p);
+        let total = main + others;
+        if total <= 0.0 {
+            return k;
+        }
+        let w = main / total;
+        // an intermixed medium's collision scatters by Henyey–Greenstein with its albedo:
+        // always, or with attenuation as the regions let it where the BSDF's share is 0
+        let kept = match &self.hybrid {
+            Some(h) if h.attenuation => match h.regions {
+                ScatterRegions::Nowhere | ScatterRegions::Surfaces => 0.0,
+                ScatterRegions::Between | ScatterRegions::Everywhere => 1.0,
+            },
+            _ => 1.0,
+        };
+        let hg = w * k.hg + (1.0 - w) * kept;
+        let hg_albedo = if hg > 0.0 {
+            (w * k.hg * k.hg_albedo + kept * albedo / total) / hg
+        } else {
+            DVec3::ZERO
+        };
+        Kernel {
+            bsdf: w * k.bsdf,
+            hg,
+            hg_albedo,
+            ..k
+        }
+    }
+
+    /// What a real collision in the main medium at p does with a path propagating along d.
+    fn main_kernel(&self, p: DVec3, d: DVec3) -> Kernel {
         let Some(h) = &self.hybrid else {
             return Kernel {
                 bsdf: 0.0,
                 hg: 1.0,
+                hg_albedo: self.albedo,
                 n: DVec3::ZERO,
                 fresnel: 0.0,
             };
@@ -230,6 +361,7 @@ impl Scene {
         Kernel {
             bsdf: sb,
             hg: sh,
+            hg_albedo: self.albedo,
             n,
             fresnel,
         }
@@ -318,7 +450,7 @@ impl Scene {
     /// The kernel's value toward w (per steradian, rgb): what a path arriving along d
     /// carries on toward w.
     fn kernel_value(&self, k: &Kernel, d: DVec3, w: DVec3) -> DVec3 {
-        let mut value = k.hg * self.phase(d.dot(w)) * self.albedo;
+        let mut value = k.hg * self.phase(d.dot(w)) * k.hg_albedo;
         if k.bsdf > 0.0 {
             value += k.bsdf * self.bsdf(k, d, w);
         }
@@ -328,7 +460,7 @@ impl Scene {
     /// A continuation for the kernel and its weight (value / density).
     fn kernel_sample(&self, k: &Kernel, d: DVec3, rng: &mut Rng) -> (DVec3, DVec3) {
         if k.bsdf <= 0.0 {
-            return (self.scatter(d, rng), k.hg * self.albedo);
+            return (self.scatter(d, rng), k.hg * k.hg_albedo);
         }
         // HG and the BSDF's mixture in proportion to their weights
         let q = k.hg / (k.hg + k.bsdf);
@@ -341,9 +473,14 @@ impl Scene {
         (w, self.kernel_value(k, d, w) / pdf)
     }
 
-    /// Parameter interval of the ray o + t·d inside the volume's box, from t = 0 on.
+    /// Parameter interval of the ray o + t·d inside the medium's box (the volume's, or the
+    /// world box holding every volume), from t = 0 on.
     fn box_interval(&self, o: DVec3, d: DVec3) -> (f64, f64) {
-        let (lo, hi) = index_box(&self.volume);
+        let (lo, hi) = self
+            .intermixed
+            .iter()
+            .map(Intermixed::world_box)
+            .fold(index_box(&self.volume), |(a, b), (c, e)| (a.min(c), b.max(e)));
         let (t0, t1) = box_interval(o, d, lo, hi);
         (t0.max(0.0), t1)
     }

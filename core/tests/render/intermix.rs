@@ -225,11 +225,7 @@ fn intermixing_refuses_what_it_does_not_take() {
     );
     r.set_intermixed_volumes(&[one]).unwrap();
     let view = oblique(&vol, 32);
-    for blend in [
-        BlendMode::Maximum,
-        BlendMode::Isosurface,
-        BlendMode::PathTrace,
-    ] {
+    for blend in [BlendMode::Maximum, BlendMode::Isosurface] {
         let params = RenderParams {
             blend,
             ..RenderParams::default()
@@ -251,6 +247,15 @@ fn intermixing_refuses_what_it_does_not_take() {
         r.render_image(&view, &cropped),
         "cropping",
         &["cropping is on"],
+    );
+    let traced = RenderParams {
+        blend: BlendMode::PathTrace,
+        ..cropped
+    };
+    assert_error(
+        r.render_image(&view, &traced),
+        "path tracing with cropping",
+        &["intermixed volumes", "path traced", "cropping"],
     );
     r.set_intermixed_volumes(&[]).unwrap();
     assert!(r.render_image(&view, &RenderParams::default()).is_ok());
