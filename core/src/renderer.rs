@@ -10,7 +10,7 @@ use crate::params::{
     IsoParams, MaskKind, PathTraceParams, RenderParams, Residency, Stats, StreamProgress,
     TransferFunction, UploadOptions, View, VolumeData,
 };
-use crate::passes::dvr::{self, DvrPass};
+use crate::passes::dvr::DvrPass;
 use crate::passes::frame::{self, FrameInput};
 use crate::passes::iso::{self, IsoPass};
 use crate::passes::pathtrace::PathTracePass;
@@ -376,7 +376,7 @@ impl Renderer {
                     .map(|d| (d, "ambient occlusion or scattering between isosurfaces")),
                 _ => None,
             },
-            _ if dvr::casts_shadows(view, params) => {
+            _ if frame::casts_shadows(view, params) => {
                 Some((LevelDemand::Visible, "a frame with volumetric shadows"))
             }
             _ => None,

@@ -37,6 +37,8 @@ fn bump_scene(r: &mut Renderer, size: u32, zoom: f64, p: &PathTraceParams) -> (V
     let n = DIMS as u32;
     let vol = volume([n, n, n], bump);
     r.set_volume(&vol).unwrap();
+    // (the renderer is shared by the tests: no intermixed volumes left by another)
+    r.set_intermixed_volumes(&[]).unwrap();
     // Constant colour (the albedo, not grey) and a linear opacity ramp over the table's
     // range [0, 1]: both exact under the lookup tables' linear interpolation. A unit
     // distance of 1.5 checks the scaling of σ.

@@ -341,7 +341,8 @@ pub unsafe extern "C" fn fv_transfer_function_set_label_gradient_opacity(
 
 /// One component's 2D transfer function (vtkVolumeProperty::SetTransferFunction2D, TF_2D):
 /// `width × height` RGBA floats at `rgba`, x (scalar) fastest, rows of increasing gradient
-/// magnitude, opacity per unit distance; the columns span the scalars `scalar_lo` to
+/// magnitude, opacity per sample (not corrected for the sample distance or the unit
+/// distance, as VTK 9.2 reads it); the columns span the scalars `scalar_lo` to
 /// `scalar_hi` (VTK: the component's data range), the rows gradient magnitudes 0 to
 /// `gradient_max` (scalar units per world unit; 0: every sample reads the first row, as VTK
 /// without gradient opacity). It classifies composite ray casting instead of the colour and

@@ -5,7 +5,10 @@
 #include "vtkDataArray.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
+#include "vtkImageResize.h"
+#include "vtkMath.h"
 #include "vtkMatrix4x4.h"
+#include "vtkNew.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
 #include "vtkVolume.h"
@@ -401,9 +404,13 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
 
 // Component c's 2D transfer function (vtkVolumeProperty::GetTransferFunction2D, TF_2D mode)
 // as VTK 9.2 draws it: the image's RGBA over the component's data range (x) and gradient
-// magnitudes up to 0.25 · the data range in VTK's units (y). (VTK's shader reads the
-// gradient axis only with a gradient opacity function, but its mapper makes the property's
-// default one on the first render, so in effect always; the function does not multiply.)
+// magnitudes up to 0.25 · the data range in VTK's units (y), its opacity per sample. (VTK's
+// shader reads the gradient axis only with a gradient opacity function, but its mapper makes
+// the property's default one on the first render, so in effect always; the function does not
+// multiply.) VTK uploads the image as a texture of at least 1024 texels per side that has
+// more than one (a power of two), resampled to it with vtkImageResize's defaults (Lanczos,
+// corner points on corner texels): so is the table handed to ferrovol, which then reads it
+// as VTK's texture is read.
 bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& range,
   double gradientScale, ferrovol::TransferFunction& tf, std::string& error)
 {
@@ -432,6 +439,20 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
     error = os.str();
     return false;
   }
+  const auto texels = [](int n) { return std::max(1024, vtkMath::NearestPowerOfTwo(n)); };
+  const int width = texels(dims[0]);
+  const int height = dims[1] > 1 ? texels(dims[1]) : 1;
+  vtkNew<vtkImageResize> resize;
+  if (width != dims[0] || height != dims[1])
+  {
+    resize->SetInputData(image);
+    resize->SetResizeMethodToOutputDimensions();
+    resize->SetOutputDimensions(width, height, 1);
+    resize->Update();
+    scalars = resize->GetOutput()->GetPointData()->GetScalars();
+    dims[0] = width;
+    dims[1] = height;
+  }
   const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
   std::vector<float> rgba(static_cast<size_t>(4) * n);
   for (vtkIdType i = 0; i < n; ++i)
@@ -441,10 +462,10 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
       rgba[4 * i + k] = static_cast<float>(scalars->GetComponent(i, k));
     }
   }
-  const double width = range[1] - range[0];
+  const double span = range[1] - range[0];
   const double lo = range[0];
-  const double hi = width > 0.0 ? range[1] : range[0] + 1.0;
-  const double gmax = 0.25 * (width != 0.0 ? width : 1.0) * gradientScale;
+  const double hi = span > 0.0 ? range[1] : range[0] + 1.0;
+  const double gmax = 0.25 * (span != 0.0 ? span : 1.0) * gradientScale;
   return vtkFerroVolumeCall("set the 2D transfer function", error, [&] {
     tf.set_table_2d(static_cast<uint32_t>(c), static_cast<uint32_t>(dims[0]),
       static_cast<uint32_t>(dims[1]), rgba, lo, hi, gmax);

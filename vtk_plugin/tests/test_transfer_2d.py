@@ -7,7 +7,7 @@ import unittest
 
 import numpy as np
 import vtk
-from vtk.util.numpy_support import numpy_to_vtk
+from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
 import fvtest
 from fvtest import Errors, coverage
@@ -59,6 +59,11 @@ def property_2d(image, gradient=True, shade=False, components=1):
     return p
 
 
+def with_unit_distance(prop, unit):
+    prop.SetScalarOpacityUnitDistance(unit)
+    return prop
+
+
 def view(cam):
     cam.Azimuth(35.0)
     cam.Elevation(25.0)
@@ -81,10 +86,25 @@ class Transfer2D(unittest.TestCase):
         self.pair("tf2d-shaded", self.image, lambda: property_2d(self.table, shade=True),
                   (0.98, 35.0))
 
+    def test_coarse_table(self):
+        """A 10 x 8 table of hard-edged boxes (ParaView's editor builds them so): VTK
+        resamples it onto its 1024 x 1024 texture (vtkImageResize: Lanczos, corner points
+        on corner texels), and so does the mapper before handing it to ferrovol."""
+        coarse = table_2d((0.9, 0.2, 0.1), (0.1, 0.4, 1.0), bins=(10, 8), top=0.5)
+        a = vtk_to_numpy(coarse.GetPointData().GetScalars())
+        a[:, 3] = np.where(a[:, 3] > 0.1, a[:, 3], 0.0)
+        coarse.Modified()
+        self.pair("tf2d-coarse", self.image, lambda: property_2d(coarse), (0.98, 35.0))
+
+    def test_opacity_is_per_sample(self):
+        """VTK 9.2 uploads the 2D table as it is (no correction by the unit distance or the
+        sample distance): its opacity is per sample."""
+        self.pair("tf2d-unit-distance", self.image,
+                  lambda: with_unit_distance(property_2d(self.table), 3.0), (0.98, 35.0))
+
     def test_independent_components(self):
         """Each component's table holds its 1D functions on every row: the 1D image."""
         import ferrovol
-        from vtk.util.numpy_support import vtk_to_numpy
         nx, ny, nz = self.image.GetDimensions()
         a = vtk_to_numpy(self.image.GetPointData().GetScalars()).reshape(nz, ny, nx)
         two = np.stack([a, a[:, :, ::-1]], axis=-1).astype(np.float32)

@@ -28,7 +28,7 @@ pub use render::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
     MAX_CLIP_PLANES, MAX_LIGHTS,
 };
-pub(crate) use transfer::{build_preintegration, build_tables, build_tables_over, correct_opacity};
+pub(crate) use transfer::{build_preintegration, build_tables, build_tables_over};
 pub use transfer::{
     ComponentTransfer, LabelTransfer, Piecewise, Table2D, TransferFunction, MAX_TRANSFER_POSITION,
     TABLE_SIZE,

@@ -105,7 +105,8 @@ pub struct Table2D {
     pub width: u32,
     pub height: u32,
     /// `width × height` RGBA values, x (scalar) fastest, rows of increasing gradient
-    /// magnitude; opacity per `unit_distance` of the component, as `opacity` is.
+    /// magnitude; the opacity of one sample, whatever the sample distance and the
+    /// component's `unit_distance` (VTK 9.2 uploads its 2D table as it is).
     pub rgba: Vec<[f32; 4]>,
     /// The scalars the first and the last column's edges are at (VTK: the component's data
     /// range): a scalar s reads the table at (s − lo) / (hi − lo) · width texels.

@@ -15,7 +15,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind, RenderParams, View};
+use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
@@ -131,7 +131,7 @@ impl DvrPass {
         };
         // Volumetric shadows' rays leave the pixels' lines: every needed brick, in view or
         // not.
-        let in_view = if casts_shadows(view, params) {
+        let in_view = if frame::casts_shadows(view, params) {
             None
         } else {
             Some(bricks_in_view(res, view, params)?)
@@ -335,7 +335,7 @@ impl DvrPass {
             res.ensure_preintegration(ctx, step)?;
         }
         if tables_2d != 0 {
-            res.ensure_tables_2d(ctx, step)?;
+            res.ensure_tables_2d(ctx)?;
         }
         let mut u = f.uniforms;
         u.rect = frame::prepare_intermix(ctx, res, params, view, step, u.rect)?;
@@ -436,14 +436,4 @@ impl DvrPass {
         res.stats.frames += 1;
         Ok(())
     }
-}
-
-/// Whether a ray-cast frame draws VTK's volumetric shadows, whose rays leave the pixels'
-/// lines (so it cannot stream; past the budget it draws a coarser level, `levels.rs`).
-pub(crate) fn casts_shadows(view: &View, params: &RenderParams) -> bool {
-    let s = &params.shading;
-    s.enabled
-        && s.volumetric_blending > 0.0
-        && !view.lights.is_empty()
-        && params.blend == BlendMode::Composite
 }

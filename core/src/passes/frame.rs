@@ -168,6 +168,17 @@ pub(crate) fn prepare_intermix(
     Ok(union_rect(rect, r))
 }
 
+/// Whether a ray-cast frame draws VTK's volumetric shadows (composite, shaded, lit), whose
+/// rays leave the pixels' lines (so it cannot stream; past the budget it draws a coarser
+/// level, `levels.rs`).
+pub(crate) fn casts_shadows(view: &View, params: &RenderParams) -> bool {
+    let s = &params.shading;
+    s.enabled
+        && s.volumetric_blending > 0.0
+        && !view.lights.is_empty()
+        && params.blend == BlendMode::Composite
+}
+
 pub(crate) fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
     let empty = |r: [u32; 4]| r[0] >= r[2] || r[1] >= r[3];
     match (empty(a), empty(b)) {
@@ -364,9 +375,8 @@ pub(crate) fn frame(
         (params.extremum_depth, FLAG_EXTREMUM_DEPTH),
         (params.whole_box.is_some(), FLAG_PIECE),
     ]);
-    // VTK's volumetric shadows: composite, shaded, lit; one component.
-    let volumetric =
-        s.enabled && s.volumetric_blending > 0.0 && nl > 0 && params.blend == BlendMode::Composite;
+    // VTK's volumetric shadows: one component.
+    let volumetric = casts_shadows(view, params);
     if volumetric {
         if vol.components != 1 {
             return Err(Error::Unsupported(format!(

@@ -44,14 +44,13 @@ use crate::gpu::readback::read_buffer;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{
     flag_bits, PathTraceUniforms, ShowUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE,
-    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, 
-    UNIFORM_STRIDE,
+    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, UNIFORM_STRIDE,
 };
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, Convergence, GradientMethod, Interpolation, MaskKind,
-    PathTraceParams, RenderParams, ScatterRegions, Shading, TransferFunction,
+    BlendMode, Convergence, GradientMethod, Interpolation, MaskKind, PathTraceParams, RenderParams,
+    ScatterRegions, Shading, TransferFunction,
 };
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::targets::{clear_outputs, DepthSource};

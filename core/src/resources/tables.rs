@@ -5,9 +5,7 @@ use crate::error::{Error, Result};
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
-use crate::params::{
-    build_preintegration, build_tables, build_tables_over, correct_opacity, TransferFunction,
-};
+use crate::params::{build_preintegration, build_tables, build_tables_over, TransferFunction};
 
 /// The pre-integration tables' texel format.
 pub(crate) const PREINTEGRATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -134,23 +132,21 @@ fn table_rows(tf: &TransferFunction, comps: usize, step: f64) -> Vec<[f32; 4]> {
 /// The 2D tables of every component (params::Table2D), each resampled (nearest texel) to the
 /// largest width and height among them and stacked by component, opacity corrected for the
 /// step as the 1D tables are; a component without one is zeros. (rgba, [width, height]).
-fn table_2d_rows(tf: &TransferFunction, comps: usize, step: f64) -> (Vec<[f32; 4]>, [u32; 2]) {
+fn table_2d_rows(tf: &TransferFunction, comps: usize) -> (Vec<[f32; 4]>, [u32; 2]) {
     let tables: Vec<_> = (0..comps)
         .map(|c| tf.component(c).table_2d.as_ref())
         .collect();
     let w = tables.iter().flatten().map(|t| t.width).max().unwrap_or(1);
     let h = tables.iter().flatten().map(|t| t.height).max().unwrap_or(1);
     let mut data = Vec::with_capacity(comps * (w * h) as usize);
-    for (c, t) in tables.iter().enumerate() {
-        let unit = tf.component(c).unit_distance;
+    for t in &tables {
         for y in 0..h {
             for x in 0..w {
                 data.push(match t {
                     Some(t) => {
                         let sx = ((x as u64 * 2 + 1) * t.width as u64 / (2 * w as u64)) as usize;
                         let sy = ((y as u64 * 2 + 1) * t.height as u64 / (2 * h as u64)) as usize;
-                        let [r, g, b, a] = t.rgba[sy * t.width as usize + sx];
-                        [r, g, b, correct_opacity(a, step, unit)]
+                        t.rgba[sy * t.width as usize + sx]
                     }
                     None => [0.0; 4],
                 });
@@ -161,15 +157,16 @@ fn table_2d_rows(tf: &TransferFunction, comps: usize, step: f64) -> (Vec<[f32; 4
 }
 
 impl Resources {
-    /// Builds the 2D tables for the transfer function at sample distance `step`, unless
-    /// they are current (a transfer function without 2D tables needs none).
-    pub fn ensure_tables_2d(&mut self, ctx: &Context, step: f64) -> Result<()> {
-        let key = TableKey::new(self.transfer_function()?, step);
+    /// Builds the 2D tables for the transfer function, unless they are current (a transfer
+    /// function without 2D tables needs none). Their opacities are per sample, whatever the
+    /// sample distance, as VTK 9.2 uploads its 2D table.
+    pub fn ensure_tables_2d(&mut self, ctx: &Context) -> Result<()> {
+        let key = TableKey::new(self.transfer_function()?, 0.0);
         if self.tables_2d.as_ref().is_some_and(|(k, _)| *k == key) {
             return Ok(());
         }
         let comps = self.volume.as_ref().map_or(1, |v| v.components) as usize;
-        let (data, size) = table_2d_rows(&key.tf, comps, step);
+        let (data, size) = table_2d_rows(&key.tf, comps);
         let tables = Tables::with_format(&ctx.device, size, wgpu::TextureFormat::Rgba32Float);
         upload_texture(&ctx.queue, &tables.texture, bytemuck::cast_slice(&data), 16);
         self.tables_2d = Some((key, tables));

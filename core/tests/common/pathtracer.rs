@@ -134,11 +134,8 @@ impl Intermixed {
         let to_world = self.world_to_index.inverse();
         let mut b = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for c in 0..8 {
-            let corner = DVec3::select(
-                glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0),
-                hi,
-                lo,
-            );
+            let corner =
+                DVec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo);
             let w = to_world.transform_point3(corner);
             b = (b.0.min(w), b.1.max(w));
         }
@@ -281,10 +278,12 @@ impl Scene {
     /// The intermixed media's part of `extinction`, and their albedo weighted by it.
     fn intermixed_parts(&self, p: DVec3) -> (f64, DVec3) {
         let share = self.intermixed_share();
-        self.intermixed.iter().fold((0.0, DVec3::ZERO), |(e, a), v| {
-            let s = v.sigma(p) * share;
-            (e + s, a + s * v.albedo)
-        })
+        self.intermixed
+            .iter()
+            .fold((0.0, DVec3::ZERO), |(e, a), v| {
+                let s = v.sigma(p) * share;
+                (e + s, a + s * v.albedo)
+            })
     }
 
     fn intermixed_extinction(&self, p: DVec3) -> f64 {
@@ -480,7 +479,9 @@ impl Scene {
             .intermixed
             .iter()
             .map(Intermixed::world_box)
-            .fold(index_box(&self.volume), |(a, b), (c, e)| (a.min(c), b.max(e)));
+            .fold(index_box(&self.volume), |(a, b), (c, e)| {
+                (a.min(c), b.max(e))
+            });
         let (t0, t1) = box_interval(o, d, lo, hi);
         (t0.max(0.0), t1)
     }
