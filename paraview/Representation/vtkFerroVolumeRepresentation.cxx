@@ -124,7 +124,20 @@ int vtkFerroVolumeRepresentation::DrawnBlendMode() const
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::SetAutoAdjustSampleDistances(int value)
 {
-  this->GetFerroVolumeMapper()->SetAutoAdjustSampleDistances(value != 0);
+  this->AutoSampleDistance = value != 0;
+  this->UpdateSampleDistanceMode();
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::UpdateSampleDistanceMode()
+{
+  // A 2D transfer function's opacities are per sample (as VTK reads them), so its image
+  // depends on the sample distance: Auto Sample Distance then takes the distance ParaView's
+  // Volume takes (vtkSmartVolumeMapper's default, locked to the input's spacing).
+  vtkFerroVolumeMapper* mapper = this->GetFerroVolumeMapper();
+  const bool lock = this->UseTransfer2D && this->AutoSampleDistance;
+  mapper->SetAutoAdjustSampleDistances(this->AutoSampleDistance && !lock);
+  mapper->SetLockSampleDistanceToInputSpacing(lock);
 }
 
 //------------------------------------------------------------------------------------------
@@ -587,11 +600,15 @@ bool vtkFerroVolumeRepresentation::WarnAboutSettings(int drawn)
         ". Set Ferrovol Blend Mode to \"Follow Blend Mode\" to draw what Blend Mode says.");
     }
   }
-  if (this->UseTransfer2D)
+  // A 2D transfer function (the superclass puts it on the property in TF_2D mode) over the
+  // scalar and its gradient magnitude, as vtkGPUVolumeRayCastMapper reads it; another array
+  // on the second axis (vtkMultiBlockVolumeMapper's Transfer2DYAxisArray) is not read.
+  if (this->UseTransfer2D && !this->UseGradientForTransfer2D && !this->ColorArray2Name.empty())
   {
-    warnings.emplace_back("\"Use 2D Transfer Function\" is not supported by ferrovol yet: the "
-                          "volume is hidden while it is on. Turn it off to draw with the colour "
-                          "map and the opacity function.");
+    warnings.emplace_back("the 2D transfer function's second axis is array \"" +
+      this->ColorArray2Name +
+      "\": ferrovol reads the gradient magnitude there (choose \"Gradient Magnitude\"), so the "
+      "volume is hidden while another array is chosen.");
     draw = false;
   }
   if (this->RequestedRenderMode != 0)
@@ -625,6 +642,7 @@ void vtkFerroVolumeRepresentation::UpdateMapperParameters()
   // SliceFunction (Slice Type), which the superclass sets.
   this->VolumeMapper->SetBlendMode(drawable ? drawn : vtkVolumeMapper::COMPOSITE_BLEND);
   this->UpdateMask();
+  this->UpdateSampleDistanceMode();
 
   if (!this->WarnAboutSettings(drawn) || !this->InputIsImageData)
   {

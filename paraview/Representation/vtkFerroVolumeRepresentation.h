@@ -275,6 +275,9 @@ protected:
    * volume must be hidden.
    */
   bool WarnAboutSettings(int drawn);
+  // Auto Sample Distance onto the mapper: AutoAdjustSampleDistances, or with a 2D transfer
+  // function LockSampleDistanceToInputSpacing.
+  void UpdateSampleDistanceMode();
 
   int FerrovolBlendMode = FOLLOW_BLEND_MODE;
   int SharedBlendMode = 0;
@@ -282,6 +285,8 @@ protected:
   // the warnings that applied at the last render (each said once while it applies)
   std::vector<std::string> SettingsWarnings;
   bool InputIsImageData = true;
+  // Auto Sample Distance (UpdateSampleDistanceMode).
+  bool AutoSampleDistance = true;
   std::string Adapter;
   std::string OutputPath;
   int LastRenderSize[2] = { 0, 0 };

@@ -8,8 +8,8 @@
    combo box shows) and one frame drawn by ferrovol.
 In 1-3 the properties panel's groups are checked too: with "Ferrovol Volume" the panel
 shows the Ferrovol group and the standard volume properties ferrovol draws (Shade, opacity,
-unit distance, cropping, Blend Mode and Ferrovol Blend Mode, isosurface values, Slice Type),
-and not those it warns about (Volume Rendering Mode, 2D transfer functions); "Volume"
+unit distance, cropping, Blend Mode and Ferrovol Blend Mode, isosurface values, Slice Type,
+Use 2D Transfer Function), and not Volume Rendering Mode, which it warns about; "Volume"
 keeps all of its own.
 
 Run with any Python 3 (it starts pvpython, pvbatch and paraview itself):
@@ -61,8 +61,8 @@ for i in range(p.GetNumberOfPropertyGroups()):
 shown = ["Shade", "ScalarOpacityFunction", "ScalarOpacityUnitDistance", "UseCropping",
          "CroppingOrigin", "IsosurfaceValues", "BlendMode", "FerrovolBlendMode",
          "FerrovolSampleDistance", "FerrovolUseJittering", "FerrovolEnvironmentLighting",
-         "FerrovolAmbientOcclusionSamples", "SliceFunction"]
-hidden = ["VolumeRenderingMode", "UseTransfer2D"]
+         "FerrovolAmbientOcclusionSamples", "SliceFunction", "UseTransfer2D"]
+hidden = ["VolumeRenderingMode"]
 # Ferrovol Blend Mode sits in a group "Volume" shows too; its own hint shows it for
 # "Ferrovol Volume" only.
 fbm = p.GetProperty("FerrovolBlendMode")

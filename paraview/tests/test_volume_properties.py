@@ -65,6 +65,11 @@ lut2.RGBPoints = [37.35, 0.0, 0.6, 0.2, 276.8, 1.0, 1.0, 0.0]
 pwf2 = GetOpacityTransferFunction("Other")
 pwf2.Points = [37.35, 0.0, 0.5, 0.0, 200.0, 0.0, 0.5, 0.0, 276.8, 1.0, 0.5, 0.0]
 tf2d = GetTransferFunction2D("RTData")
+# Two boxes as ParaView's 2D editor makes them (x, y, width, height, r, g, b, opacity over
+# the function's range: RTData by a gradient range of [0, 1] here): red at middle values and
+# weak gradients, blue at low values and stronger ones.
+tf2d.Boxes = [150.0, 0.0, 60.0, 0.6, 1.0, 0.2, 0.1, 0.6, 70.0, 0.3, 70.0, 0.7, 0.1, 0.4, 1.0, 0.5]
+tf2d.Build()
 
 
 def captured(fn):
@@ -213,13 +218,15 @@ CASES = {
     "IsosurfaceValues": ({"BlendMode": "Isosurface", "IsosurfaceValues": [160.0]},
                          {"IsosurfaceValues": [120.0, 200.0]}, DRAWN, 0.80, 22.0),
     "Pickable": ({}, {"Pickable": 0}, NO_EFFECT, None, None),
-    "UseGradientForTransfer2D": ({}, {"UseGradientForTransfer2D": 0}, NO_EFFECT, None, None),
+    "UseGradientForTransfer2D": ({"TransferFunction2D": tf2d, "UseTransfer2D": 1,
+                                  "ColorArray2Name": ["POINTS", "Other"]},
+                                 {"UseGradientForTransfer2D": 0}, WARNED_HIDDEN, None,
+                                 "second axis is array \"Other\""),
     "ColorArray2Name": ({}, {"ColorArray2Name": ["POINTS", "Other"]}, NO_EFFECT, None, None),
     "ColorArray2Component": ({"ColorArray2Name": ["POINTS", "Two"]}, {"ColorArray2Component": 1},
                              NO_EFFECT, None, None),
     "TransferFunction2D": ({}, {"TransferFunction2D": tf2d}, NO_EFFECT, None, None),
-    "UseTransfer2D": ({"TransferFunction2D": tf2d}, {"UseTransfer2D": 1}, WARNED_HIDDEN, None,
-                      "\"Use 2D Transfer Function\""),
+    "UseTransfer2D": ({"TransferFunction2D": tf2d}, {"UseTransfer2D": 1}, DRAWN, 0.97, 33.0),
     "SliceFunction": ({"BlendMode": "Slice"}, {"SliceFunction.Normal": [0, 0.6, 0.8]},
                       DRAWN, 0.95, 32.0),
     "VolumeRenderingMode": ({}, {"VolumeRenderingMode": "GPU Based"}, WARNED_UNCHANGED, None,

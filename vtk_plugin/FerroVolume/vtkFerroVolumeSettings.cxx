@@ -334,11 +334,17 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     if (self->GetLockSampleDistanceToInputSpacing())
     {
       // vtkOpenGLGPUVolumeRayCastMapper: vtkVolumeMapper::SpacingAdjustedSampleDistance of
-      // the input's spacing (by magnitude) and extent, whatever SampleDistance says.
+      // the input's spacing (by magnitude) and extent, whatever SampleDistance says; a piece
+      // of a whole (WholeExtent) takes the whole's extent, so every piece samples alike.
       double spacing[3];
       int extent[6];
       input.GetCellSpacing(spacing);
       input.GetImage()->GetExtent(extent);
+      const int* whole = self->GetWholeExtent();
+      if (whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5])
+      {
+        std::copy(whole, whole + 6, extent);
+      }
       for (double& s : spacing)
       {
         s = std::fabs(s);
