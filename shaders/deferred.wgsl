@@ -26,6 +26,7 @@
 #include "lib/surface.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/iso.wgsl"
+#include "lib/blanking.wgsl"
 
 // 0: no scattering; 1: the preview; 2: traced (pipeline constant).
 override SCATTER: u32 = 0u;
@@ -131,7 +132,7 @@ fn shade_surface(color: vec3<f32>, pos: vec3<f32>, n: vec3<f32>, gmag: f32, ao: 
 // −ln(1 − α) per unit distance, scaled).
 fn absorption_at(x: vec3<f32>) -> f32 {
     let p = (frame.world_to_index * vec4<f32>(x, 1.0)).xyz;
-    if (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) {
+    if ((MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) || blanked(p)) {
         return 0.0;
     }
     let a = min(raw_alpha(ISO_COMP, sample_scalars(p)[ISO_COMP]), 0.9999);

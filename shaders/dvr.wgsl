@@ -9,6 +9,7 @@
 #include "lib/volume.wgsl"
 #include "lib/march.wgsl"
 #include "lib/intermix.wgsl"
+#include "lib/blanking.wgsl"
 #include "lib/shading.wgsl"
 #include "lib/shadow.wgsl"
 #include "lib/output.wgsl"
@@ -115,11 +116,6 @@ fn grid_point(p: vec3<f32>) -> vec3<f32> {
     return q;
 }
 
-// VTK's blanking (ghost arrays, vtkUniformGrid): per point of the grid, non-zero where the
-// point is hidden (Renderer::set_blanking); BLANKING is on when the volume has a mask.
-@group(0) @binding(8) var blanking_mask: texture_3d<u32>;
-override BLANKING: bool = false;
-
 // A mask (Renderer::set_mask), one value per point of the grid: MASK_BINARY leaves out the
 // samples whose nearest point holds 0, MASK_LABELS classifies samples by their nearest
 // point's label (classify_labelled); the blanking mask's placeholder otherwise.
@@ -132,29 +128,9 @@ fn mask_at(p: vec3<f32>) -> u32 {
 
 // Whether the sample at index-space point p is left out by blanking or a binary mask.
 fn left_out(p: vec3<f32>) -> bool {
-    return (BLANKING && blanked(p)) || (MASK == MASK_BINARY && mask_at(p) == 0u);
+    return blanked(p) || (MASK == MASK_BINARY && mask_at(p) == 0u);
 }
 
-// Whether the sample at index-space point p is blanked: vtkGPUVolumeRayCastMapper skips it
-// when the point nearest to it, or either point around it along an axis (the others
-// rounded), is hidden.
-fn blanked(p: vec3<f32>) -> bool {
-    let hi = vec3<i32>(frame.dims.xyz) - 1;
-    let q = clamp(p, vec3<f32>(0.0), vec3<f32>(hi));
-    let r = vec3<i32>(floor(q + 0.5));
-    let lo = vec3<i32>(floor(q));
-    let up = min(lo + 1, hi);
-    var any = textureLoad(blanking_mask, r, 0).x != 0u;
-    for (var a = 0; a < 3; a = a + 1) {
-        var below = r;
-        var above = r;
-        below[a] = lo[a];
-        above[a] = up[a];
-        any = any || textureLoad(blanking_mask, below, 0).x != 0u
-                  || textureLoad(blanking_mask, above, 0).x != 0u;
-    }
-    return any;
-}
 
 
 // Per component c, rows c·TABLE_N + f: for a segment whose front scalar is at table entry f

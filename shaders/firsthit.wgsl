@@ -13,6 +13,7 @@
 #include "lib/march.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/iso.wgsl"
+#include "lib/blanking.wgsl"
 
 // Pipeline constants (core/src/passes/iso.rs, FirstHitVariant).
 override SKIP: bool = false;
@@ -204,7 +205,7 @@ fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 
             if (any(q < lo) || any(q > hi)) {
                 break;
             }
-            if (MASK == MASK_BINARY && mask_value(mask_tex, q) == 0u) {
+            if ((MASK == MASK_BINARY && mask_value(mask_tex, q) == 0u) || blanked(q)) {
                 continue;
             }
             if ((sample_scalars(q)[ISO_COMP] < v) != front_below) {
@@ -290,8 +291,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var have_prev = false;
     var t_prev = 0.0;
     var s_prev = 0.0;
-    // MASK_BINARY: masked samples lie between the previous sample and the current one (a
-    // crossing then lies at the current sample, where the mask ends).
+    // Masked (MASK_BINARY) or blanked samples lie between the previous sample and the
+    // current one (a crossing then lies at the current sample, where they end).
     var gap = false;
     if (STREAMING && st.color.w > 0.0) {
         k = st.color.z;
@@ -365,9 +366,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 k = k + 1.0;
                 continue;
             }
-            if (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) {
-                // As VTK 9.2: a masked sample is skipped and the ray's state carries over it;
-                // a ray whose samples start masked starts below every iso-value.
+            if ((MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) || blanked(p)) {
+                // As VTK 9.2: a masked or blanked sample is skipped and the ray's state
+                // carries over it; a ray whose samples start masked starts below every
+                // iso-value.
                 if (!have_prev) {
                     have_prev = true;
                     t_prev = t;

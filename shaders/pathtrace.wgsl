@@ -35,6 +35,7 @@
 #include "lib/volume.wgsl"
 #include "lib/march.wgsl"
 #include "lib/intermix.wgsl"
+#include "lib/blanking.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/phase.wgsl"
 #include "lib/bsdf.wgsl"
@@ -319,7 +320,8 @@ fn intermixed_share() -> f32 {
 // The main volume's part of extinction_at.
 fn main_extinction(r: Ray, t: f32) -> f32 {
     let p = r.index_origin + t * r.index_dir;
-    if (!in_main(p) || (CROP && !in_crop(p)) || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
+    if (!in_main(p) || (CROP && !in_crop(p)) || blanked(p)
+        || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
         return 0.0;
     }
     let s = sample_scalars(p);

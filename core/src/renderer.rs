@@ -384,8 +384,8 @@ impl Renderer {
         let in_view = |res: &Resources| frame::bricks_in_view(res, view, params);
         let level = match anywhere {
             Some((demand, what)) => Some((demand, None, what)),
-            // (masks are not downsampled: a masked preview streams)
-            None if params.preview_level && res.mask.is_none() => {
+            // (masks and blanking are not downsampled: such a preview streams)
+            None if params.preview_level && res.mask.is_none() && res.blanking.is_none() => {
                 preview_demand(res, params, self.iso_params.as_ref())?.map(|d| {
                     (
                         d,

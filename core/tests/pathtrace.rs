@@ -1059,7 +1059,7 @@ fn past_the_budget_a_coarser_level_is_traced() {
         &[
             "memory budget",
             "coarser level",
-            "masks are not downsampled",
+            "not downsampled",
         ],
     );
 }

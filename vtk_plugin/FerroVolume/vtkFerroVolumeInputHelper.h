@@ -65,7 +65,6 @@ public:
     vtkIdType Points = 0;
     vtkIdType Cells = 0;
   };
-  const Ghosts& GetGhosts() const { return this->GhostCounts; }
 
   // Gives the renderer the blanking mask of the ghost arrays (or clears it) when they or the
   // uploaded volume changed; false with the reason when the renderer refuses it.

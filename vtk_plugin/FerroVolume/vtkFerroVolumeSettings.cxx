@@ -396,16 +396,6 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   params.shade = prop->GetShade(0) != 0 &&
     (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface || this->Blend == FV_BLEND_MODE_SLICE);
   this->WarnUnsupported(self, warned);
-  const vtkFerroVolumeInputHelper::Ghosts& ghosts = input.GetGhosts();
-  if ((ghosts.Points > 0 || ghosts.Cells > 0) &&
-    (isosurface || this->Blend == FV_BLEND_MODE_PATH_TRACE) && warned.insert("ghosts").second)
-  {
-    vtkWarningWithObjectMacro(self, << "the input's ghost arrays mark " << ghosts.Points
-                                    << " points and " << ghosts.Cells
-                                    << " cells (hidden or duplicate, as vtkUniformGrid "
-                                       "blanking): ferrovol leaves them out in ray casting; "
-                                       "isosurfaces and path tracing draw them");
-  }
   if (self->GetMaskInput() &&
     self->GetMaskType() == vtkGPUVolumeRayCastMapper::LabelMapMaskType &&
     this->Blend == FV_BLEND_MODE_COMPOSITE && input.GetComponents() > 1 &&

@@ -50,6 +50,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../../shaders/lib/shadow.wgsl"),
     ),
     (
+        "lib/blanking.wgsl",
+        include_str!("../../../shaders/lib/blanking.wgsl"),
+    ),
+    (
         "lib/intermix.wgsl",
         include_str!("../../../shaders/lib/intermix.wgsl"),
     ),

@@ -19,6 +19,7 @@ use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::volume::blanking_layout_entry;
 use crate::resources::volume::Needed;
 
 pipeline_variant! {
@@ -91,7 +92,7 @@ impl DvrPass {
                     storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
                     storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
                     buffer_entry(7, B::Storage { read_only: false }),
-                    sampled_texture_entry(8, wgpu::TextureSampleType::Uint, V::D3),
+                    blanking_layout_entry(),
                     texture_entry(9, true, V::D2),
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(11, false, V::D2),
@@ -370,12 +371,7 @@ impl DvrPass {
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
                 bind(6, wgpu::BindingResource::TextureView(&depth_view)),
                 bind(7, t.state.as_entire_binding()),
-                bind(
-                    8,
-                    wgpu::BindingResource::TextureView(
-                        res.blanking.as_ref().unwrap_or(&self.no_blanking),
-                    ),
-                ),
+                res.blanking_entry(&self.no_blanking),
                 bind(9, wgpu::BindingResource::TextureView(&preintegrated.view)),
                 bind(
                     10,

@@ -44,6 +44,7 @@ use crate::resources::environment::texel_solid_angle;
 use crate::resources::levels::LevelDemand;
 use crate::resources::tables::{Occupancy, Tables};
 use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::volume::blanking_layout_entry;
 use crate::resources::volume::Needed;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -60,6 +61,8 @@ pipeline_variant! {
         component: u32 => "ISO_COMP",
         /// MASK_BINARY: samples whose nearest point the mask holds 0 at are left out.
         mask: u32 => "MASK",
+        /// VTK's blanking: blanked samples are left out as masked ones are.
+        blanking: bool => "BLANKING",
         /// The surfaces of the cubic B-spline (Interpolation::Cubic).
         cubic: bool => "CUBIC",
     }
@@ -76,6 +79,8 @@ pipeline_variant! {
         component: u32 => "ISO_COMP",
         /// MASK_BINARY: the medium between the surfaces is empty where the mask holds 0.
         mask: u32 => "MASK",
+        /// VTK's blanking: the medium between the surfaces is empty where blanked.
+        blanking: bool => "BLANKING",
     }
 }
 
@@ -207,6 +212,7 @@ impl IsoPass {
                 gb_write(10),
                 sampler_entry(11),
                 sampled_texture_entry(12, wgpu::TextureSampleType::Uint, V::D3),
+                blanking_layout_entry(),
             ],
         });
         let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -226,6 +232,7 @@ impl IsoPass {
                 buffer_entry(14, B::Storage { read_only: true }),
                 sampled_texture_entry(15, wgpu::TextureSampleType::Uint, V::D3),
                 texture_entry(1, false, V::D2),
+                blanking_layout_entry(),
             ],
         });
         let firsthit = PipelineCache::new(
@@ -487,6 +494,7 @@ impl IsoPass {
             streaming: plan.is_some(),
             component,
             mask,
+            blanking: res.blanking.is_some(),
             cubic: params.interpolation == Interpolation::Cubic,
         };
         if fh.cubic && fh.streaming {
@@ -508,6 +516,7 @@ impl IsoPass {
             single_brick,
             component,
             mask,
+            blanking: res.blanking.is_some(),
         };
         let firsthit = self.firsthit.get(ctx, fh)?;
         let deferred = self.deferred.get(ctx, df)?;
@@ -632,6 +641,7 @@ impl IsoPass {
                         res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
                     ),
                 ),
+                res.blanking_entry(&self.no_mask),
             ],
         });
         let deferred_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -657,6 +667,7 @@ impl IsoPass {
                     ),
                 ),
                 bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+                res.blanking_entry(&self.no_mask),
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {

@@ -54,6 +54,7 @@ use crate::params::{
 };
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::volume::blanking_layout_entry;
 use crate::resources::volume::Needed;
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -163,6 +164,7 @@ impl PathTracePass {
                 ),
                 buffer_entry(16, B::Storage { read_only: false }),
                 sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
+                blanking_layout_entry(),
             ]
             .into_iter()
             .chain(IntermixBinding::layout_entries(ctx))
@@ -267,6 +269,8 @@ pipeline_variant! {
         crop: bool => "CROP",
         /// What the mask does (MASK_NONE, MASK_BINARY or MASK_LABELS).
         mask: u32 => "MASK",
+        /// VTK's blanking (lib/blanking.wgsl): the medium is empty at blanked samples.
+        blanking: bool => "BLANKING",
         /// Number of volumes intermixed with the main one.
         intermix: u32 => "INTERMIX",
         /// The intermixed volumes' atlas is read through a linear sampler.
@@ -337,10 +341,12 @@ impl PathTracePass {
             )));
         }
         let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
-        if intermix > 0 && (params.cropping.is_some() || res.mask.is_some()) {
+        if intermix > 0
+            && (params.cropping.is_some() || res.mask.is_some() || res.blanking.is_some())
+        {
             return Err(Error::Unsupported(
-                "intermixed volumes are path traced without cropping or a mask on the main \
-                 volume: clear the intermixed volumes or turn cropping and the mask off"
+                "intermixed volumes are path traced without cropping, a mask or blanking on \
+                 the main volume: clear the intermixed volumes or turn those off"
                     .into(),
             ));
         }
@@ -414,6 +420,7 @@ impl PathTracePass {
                 }
                 _ => MASK_NONE,
             },
+            blanking: res.blanking.is_some(),
             intermix,
             intermix_filtered: intermix > 0 && ctx.info.float32_filterable,
         };
@@ -514,6 +521,7 @@ impl PathTracePass {
                         res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
                     ),
                 ),
+                res.blanking_entry(&self.no_mask),
             ]
             .into_iter()
             .chain(self.intermix_binding.entries(res.intermix.as_ref()))

@@ -65,11 +65,11 @@ impl Resources {
             self.release_level();
             return Ok(());
         }
-        if self.mask.is_some() {
+        if self.mask.is_some() || self.blanking.is_some() {
             return Err(Error::Unsupported(format!(
                 "the bricks {what} needs exceed the volume's memory budget, so it would draw \
-                 a coarser level of the volume, and masks are not downsampled: raise the \
-                 budget or clear the mask"
+                 a coarser level of the volume, and masks and blanking are not downsampled: \
+                 raise the budget or clear the mask and the blanking"
             )));
         }
         // The first level tried: the finest whose occupied share of its points fits

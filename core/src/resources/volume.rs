@@ -10,7 +10,7 @@ use super::gradients::GradientPass;
 use super::residency::{self, Slots, NOT_LATER};
 use super::Resources;
 use crate::error::{Error, Result};
-use crate::gpu::binding::bind;
+use crate::gpu::binding::{bind, sampled_texture_entry};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
 use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS};
@@ -18,6 +18,18 @@ use crate::gpu::Context;
 use crate::params::{MaskKind, Residency, UploadOptions, VolumeData};
 use glam::DMat4;
 use std::sync::Arc;
+
+/// The blanking mask's binding in the passes that read it (lib/blanking.wgsl).
+const BLANKING_BINDING: u32 = 22;
+
+/// The blanking mask's layout entry (lib/blanking.wgsl).
+pub(crate) fn blanking_layout_entry() -> wgpu::BindGroupLayoutEntry {
+    sampled_texture_entry(
+        BLANKING_BINDING,
+        wgpu::TextureSampleType::Uint,
+        wgpu::TextureViewDimension::D3,
+    )
+}
 
 /// Whether an upload of `v` with `opts` stores precomputed gradients: one-component volumes,
 /// when asked for. Off by default: on lavapipe one rgba16float fetch costs more than the six
@@ -298,6 +310,14 @@ impl Resources {
         }
         self.blanking = Some(block_grid(ctx, "blanking", d, mask));
         Ok(())
+    }
+
+    /// The blanking mask's bind group entry (lib/blanking.wgsl), or `none` without one.
+    pub fn blanking_entry<'a>(&'a self, none: &'a wgpu::TextureView) -> wgpu::BindGroupEntry<'a> {
+        bind(
+            BLANKING_BINDING,
+            wgpu::BindingResource::TextureView(self.blanking.as_ref().unwrap_or(none)),
+        )
     }
 
     /// The mask of the current volume (Renderer::set_mask): one value per point of its

@@ -1,7 +1,8 @@
 //! Masks (VTK's MaskInput): binary masks leave samples out in every ray-casting blend mode,
-//! label maps classify labelled samples with their labels' functions.
+//! label maps classify labelled samples with their labels' functions; blanking leaves
+//! samples out of isosurfaces and the path tracer's medium too.
 
-use crate::common::gpu::{assert_error, renderer, set_bricked};
+use crate::common::gpu::{assert_error, renderer, set_bricked, trace};
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{image_diff, rgba};
 use crate::common::raycast::to_pixel;
@@ -103,6 +104,65 @@ fn binary_mask_leaves_out_samples() {
         assert!(max <= 1, "{blend:?}: bricking changes the masked image");
         r.set_volume(&vol).unwrap();
     }
+}
+
+/// VTK's blanking leaves samples out of isosurfaces and of the path tracer's medium as ray
+/// casting does: with the points x < 12 hidden, the samples x < 12 are blanked (a sample is
+/// when its nearest point or a point around it along an axis is hidden), so the pixels
+/// whose rays see only that side are background; blanking nothing changes nothing.
+#[test]
+fn blanking_leaves_samples_out_of_isosurfaces_and_the_medium() {
+    let mut r = renderer();
+    let view = scene(&mut r, Vec::new());
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        0.3,
+        [0.9, 0.8, 0.6],
+        1.0,
+    )]))
+    .unwrap();
+    let edge = column(&view, 12.0);
+    let traced = |r: &mut Renderer| -> Vec<f32> {
+        let p = PathTraceParams {
+            samples_per_frame: 8,
+            ..Default::default()
+        };
+        trace(r, &view, &p, 8).iter().map(|v| v[3]).collect()
+    };
+    let iso = |r: &mut Renderer| -> Vec<f32> {
+        let img = r
+            .render_image(&view, &params(BlendMode::Isosurface))
+            .unwrap();
+        (0..64 * 64)
+            .map(|i| f32::from(rgba(&img, i % 64, i / 64)[3]))
+            .collect()
+    };
+    for (name, draw) in [
+        ("isosurfaces", &iso as &dyn Fn(&mut Renderer) -> Vec<f32>),
+        ("path tracing", &traced),
+    ] {
+        r.set_blanking(None).unwrap();
+        let plain = draw(&mut r);
+        r.set_blanking(Some(&by_x(|_| 0))).unwrap();
+        assert_eq!(draw(&mut r), plain, "{name}: blanking nothing");
+        r.set_blanking(Some(&by_x(|x| u8::from(x < 12)))).unwrap();
+        let blanked = draw(&mut r);
+        let (mut left, mut right) = (0, 0);
+        for (i, (&a, &b)) in blanked.iter().zip(&plain).enumerate() {
+            let x = (i % 64) as f64;
+            if x < edge - 1.0 {
+                left += u32::from(a > 0.0);
+            } else if x > edge + 1.0 && b > 0.0 {
+                right += u32::from(a > 0.0);
+            }
+        }
+        println!("{name}: edge at column {edge:.1}; {left} pixels left of it, {right} right");
+        assert_eq!(
+            left, 0,
+            "{name}: nothing drawn where every sample is blanked"
+        );
+        assert!(right > 150, "{name}: the other side is drawn");
+    }
+    r.set_blanking(None).unwrap();
 }
 
 /// Ambient-occlusion rays leave masked samples out, as the surfaces do: a floor facing the

@@ -12,7 +12,9 @@ const W: u32 = 256;
 const H: u32 = 64;
 
 /// blob_transfer's colour and opacity as a 2D table over [0, 1], every row alike, or the
-/// opacity where the row's gradient magnitude (up to `gmax`) passes `edge` only.
+/// opacity where the row's gradient magnitude (up to `gmax`) passes `edge` only. A table's
+/// opacity is per sample (as VTK reads it): the 1D function's, corrected from its unit
+/// distance to the default step (one voxel spacing).
 fn table(gmax: Option<f64>, edge: Option<f64>) -> Table2D {
     let c = blob_transfer();
     let mut rgba = Vec::new();
@@ -21,7 +23,7 @@ fn table(gmax: Option<f64>, edge: Option<f64>) -> Table2D {
         for x in 0..W {
             let s = (x as f64 + 0.5) / W as f64;
             let [r, gr, b] = c.color.eval(s);
-            let a = c.opacity.eval(s)[0];
+            let a = 1.0 - (1.0 - c.opacity.eval(s)[0]).powf((1.0 / c.unit_distance) as f32);
             let keep = edge.is_none_or(|e| g > e);
             rgba.push([r, gr, b, if keep { a } else { 0.0 }]);
         }
