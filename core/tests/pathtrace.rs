@@ -1056,10 +1056,6 @@ fn past_the_budget_a_coarser_level_is_traced() {
     assert_error(
         r.render(&view, &pt_params(), None),
         "a mask past the budget",
-        &[
-            "memory budget",
-            "coarser level",
-            "not downsampled",
-        ],
+        &["memory budget", "coarser level", "not downsampled"],
     );
 }
