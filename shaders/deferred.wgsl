@@ -27,6 +27,7 @@
 #include "lib/envmap.wgsl"
 #include "lib/iso.wgsl"
 #include "lib/blanking.wgsl"
+#include "lib/rectilinear.wgsl"
 
 // 0: no scattering; 1: the preview; 2: traced (pipeline constant).
 override SCATTER: u32 = 0u;
@@ -131,7 +132,7 @@ fn shade_surface(color: vec3<f32>, pos: vec3<f32>, n: vec3<f32>, gmag: f32, ao: 
 // Extinction per world unit at world point x (the first component's opacity α as
 // −ln(1 − α) per unit distance, scaled).
 fn absorption_at(x: vec3<f32>) -> f32 {
-    let p = (frame.world_to_index * vec4<f32>(x, 1.0)).xyz;
+    let p = grid_point((frame.world_to_index * vec4<f32>(x, 1.0)).xyz);
     if ((MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) || blanked(p)) {
         return 0.0;
     }

@@ -10,6 +10,7 @@
 #include "lib/march.wgsl"
 #include "lib/intermix.wgsl"
 #include "lib/blanking.wgsl"
+#include "lib/rectilinear.wgsl"
 #include "lib/shading.wgsl"
 #include "lib/shadow.wgsl"
 #include "lib/output.wgsl"
@@ -88,33 +89,6 @@ fn over(color: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(color.rgb + w * c.rgb, color.a + w);
 }
 
-// A rectilinear grid (VolumeData::coordinates): rays march the uniform lattice over the
-// grid's box, and each sample's lattice point is mapped to the grid's index space per axis
-// through a lookup built on the host (Resources::set_volume): row a holds the index-space
-// coordinate at evenly spaced lattice points, column j at j·(n_a − 1)/(width − 1), read
-// linearly between columns. A uniform grid binds a placeholder and leaves it unread.
-@group(0) @binding(12) var grid_lookup: texture_3d<f32>;
-override RECTILINEAR: bool = false;
-
-// The grid's index-space point for the lattice point p, and the rate it changes with p
-// per axis in `index_slope` (world_gradient's scale). Without RECTILINEAR, p itself.
-fn grid_point(p: vec3<f32>) -> vec3<f32> {
-    if (!RECTILINEAR) {
-        return p;
-    }
-    let w = f32(textureDimensions(grid_lookup).x) - 1.0;
-    var q = p;
-    for (var a = 0; a < 3; a = a + 1) {
-        let span = max(frame.dims[a] - 1.0, 1.0);
-        let x = clamp(p[a] / span, 0.0, 1.0) * w;
-        let i = min(floor(x), w - 1.0);
-        let f0 = textureLoad(grid_lookup, vec3<i32>(i32(i), a, 0), 0).x;
-        let f1 = textureLoad(grid_lookup, vec3<i32>(i32(i) + 1, a, 0), 0).x;
-        q[a] = mix(f0, f1, x - i);
-        index_slope[a] = select(1.0, (f1 - f0) * w / span, frame.dims[a] > 1.0);
-    }
-    return q;
-}
 
 // A mask (Renderer::set_mask), one value per point of the grid: MASK_BINARY leaves out the
 // samples whose nearest point holds 0, MASK_LABELS classifies samples by their nearest

@@ -14,6 +14,7 @@
 #include "lib/envmap.wgsl"
 #include "lib/iso.wgsl"
 #include "lib/blanking.wgsl"
+#include "lib/rectilinear.wgsl"
 
 // Pipeline constants (core/src/passes/iso.rs, FirstHitVariant).
 override SKIP: bool = false;
@@ -139,12 +140,15 @@ fn surface_scalar(p: vec3<f32>) -> f32 {
     if (CUBIC) {
         return sample_scalars(p)[ISO_COMP];
     }
-    return exact_scalar(p);
+    return exact_scalar(grid_point(p));
 }
 
 fn surface_gradient(p: vec3<f32>) -> vec3<f32> {
     if (!CUBIC) {
-        return exact_gradient(p);
+        // (on a rectilinear grid: the grid's gradient by the rate its index space changes
+        // along the lattice's)
+        let q = grid_point(p);
+        return exact_gradient(q) * index_slope;
     }
     var g = vec3<f32>(0.0);
     for (var a = 0; a < 3; a = a + 1) {
@@ -166,7 +170,7 @@ fn refine(ray: Ray, t0: f32, t1: f32, v: f32, below: bool) -> f32 {
     var b = t1;
     for (var i = 0u; i < iso.counts.y; i = i + 1u) {
         let m = 0.5 * (a + b);
-        if ((sample_scalars(point_at(ray, m))[ISO_COMP] < v) == below) {
+        if ((sample_scalars(grid_point(point_at(ray, m)))[ISO_COMP] < v) == below) {
             a = m;
         } else {
             b = m;
@@ -205,10 +209,11 @@ fn ambient_access(p: vec3<f32>, n: vec3<f32>, v: f32, front_below: bool) -> f32 
             if (any(q < lo) || any(q > hi)) {
                 break;
             }
-            if ((MASK == MASK_BINARY && mask_value(mask_tex, q) == 0u) || blanked(q)) {
+            let g = grid_point(q);
+            if ((MASK == MASK_BINARY && mask_value(mask_tex, g) == 0u) || blanked(g)) {
                 continue;
             }
-            if ((sample_scalars(q)[ISO_COMP] < v) != front_below) {
+            if ((sample_scalars(g)[ISO_COMP] < v) != front_below) {
                 hit = true;
                 break;
             }
@@ -366,7 +371,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 k = k + 1.0;
                 continue;
             }
-            if ((MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u) || blanked(p)) {
+            let gp = grid_point(p);
+            if ((MASK == MASK_BINARY && mask_value(mask_tex, gp) == 0u) || blanked(gp)) {
                 // As VTK 9.2: a masked or blanked sample is skipped and the ray's state
                 // carries over it; a ray whose samples start masked starts below every
                 // iso-value.
@@ -389,7 +395,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 tail = tail || at_tail;
                 break;
             }
-            let s_q = sample_scalars(point_at(ray, t_q))[ISO_COMP];
+            let s_q = sample_scalars(grid_point(point_at(ray, t_q)))[ISO_COMP];
             if (take_prev) {
                 t_prev = t_q;
                 s_prev = s_q;

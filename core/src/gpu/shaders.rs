@@ -54,6 +54,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../../shaders/lib/blanking.wgsl"),
     ),
     (
+        "lib/rectilinear.wgsl",
+        include_str!("../../../shaders/lib/rectilinear.wgsl"),
+    ),
+    (
         "lib/intermix.wgsl",
         include_str!("../../../shaders/lib/intermix.wgsl"),
     ),

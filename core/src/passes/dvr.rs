@@ -19,8 +19,8 @@ use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
-use crate::resources::volume::blanking_layout_entry;
 use crate::resources::volume::Needed;
+use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).
@@ -96,7 +96,7 @@ impl DvrPass {
                     texture_entry(9, true, V::D2),
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(11, false, V::D2),
-                    texture_entry(12, false, V::D3),
+                    grid_lookup_layout_entry(),
                 ]
                 .into_iter()
                 .chain(IntermixBinding::layout_entries(ctx))
@@ -110,7 +110,7 @@ impl DvrPass {
             no_blanking,
             no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
             no_tables_2d: Tables::new(&ctx.device, [1, 1]),
-            no_grid_lookup: block_grid(ctx, "no grid lookup", [2, 3, 1], &[0f32; 6]),
+            no_grid_lookup: no_grid_lookup(ctx),
             intermix_binding: IntermixBinding::new(ctx),
         })
     }
@@ -380,12 +380,7 @@ impl DvrPass {
                     ),
                 ),
                 bind(11, wgpu::BindingResource::TextureView(tables_2d_view)),
-                bind(
-                    12,
-                    wgpu::BindingResource::TextureView(
-                        vol.grid_lookup.as_ref().unwrap_or(&self.no_grid_lookup),
-                    ),
-                ),
+                res.grid_lookup_entry(&self.no_grid_lookup)?,
             ]
             .into_iter()
             .chain(self.intermix_binding.entries(res.intermix.as_ref()))

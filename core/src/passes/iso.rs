@@ -44,8 +44,8 @@ use crate::resources::environment::texel_solid_angle;
 use crate::resources::levels::LevelDemand;
 use crate::resources::tables::{Occupancy, Tables};
 use crate::resources::targets::{clear_outputs, DepthSource};
-use crate::resources::volume::blanking_layout_entry;
 use crate::resources::volume::Needed;
+use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
@@ -63,6 +63,8 @@ pipeline_variant! {
         mask: u32 => "MASK",
         /// VTK's blanking: blanked samples are left out as masked ones are.
         blanking: bool => "BLANKING",
+        /// A rectilinear grid: samples mapped to its index space (lib/rectilinear.wgsl).
+        rectilinear: bool => "RECTILINEAR",
         /// The surfaces of the cubic B-spline (Interpolation::Cubic).
         cubic: bool => "CUBIC",
     }
@@ -81,6 +83,8 @@ pipeline_variant! {
         mask: u32 => "MASK",
         /// VTK's blanking: the medium between the surfaces is empty where blanked.
         blanking: bool => "BLANKING",
+        /// A rectilinear grid (lib/rectilinear.wgsl).
+        rectilinear: bool => "RECTILINEAR",
     }
 }
 
@@ -163,6 +167,8 @@ pub(crate) struct IsoPass {
     last_rect: [u32; 4],
     /// Bound in place of the mask when the volume has none.
     no_mask: wgpu::TextureView,
+    /// Bound in place of a rectilinear grid's lookup for a uniform grid.
+    no_grid_lookup: wgpu::TextureView,
 }
 
 /// `n` unit vectors uniform over the sphere from a fixed seed (PCG), as vec4s.
@@ -213,6 +219,7 @@ impl IsoPass {
                 sampler_entry(11),
                 sampled_texture_entry(12, wgpu::TextureSampleType::Uint, V::D3),
                 blanking_layout_entry(),
+                grid_lookup_layout_entry(),
             ],
         });
         let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -233,6 +240,7 @@ impl IsoPass {
                 sampled_texture_entry(15, wgpu::TextureSampleType::Uint, V::D3),
                 texture_entry(1, false, V::D2),
                 blanking_layout_entry(),
+                grid_lookup_layout_entry(),
             ],
         });
         let firsthit = PipelineCache::new(
@@ -273,6 +281,7 @@ impl IsoPass {
             occupancy: None,
             last_rect: [0; 4],
             no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
+            no_grid_lookup: no_grid_lookup(ctx),
         })
     }
 
@@ -406,10 +415,11 @@ impl IsoPass {
         })?;
         iso.validate()?;
         frame::check_light_count(view)?;
-        if res.volume()?.grid_lookup.is_some() {
+        let rectilinear = res.volume()?.grid_lookup.is_some();
+        if rectilinear && params.interpolation == Interpolation::Cubic {
             return Err(Error::Unsupported(
-                "isosurfaces are found on uniform grids, and this volume is rectilinear \
-                 (per-axis coordinates): use a ray-casting blend mode or resample the grid"
+                "cubic isosurfaces are found on uniform grids, and this volume is rectilinear \
+                 (per-axis coordinates): interpolate linearly or resample the grid"
                     .into(),
             ));
         }
@@ -487,14 +497,17 @@ impl IsoPass {
         } else {
             MASK_NONE
         };
+        // (blocks and their exits are in the grid's index space, which rays on a rectilinear
+        // grid do not march)
         let fh = FirstHitVariant {
-            skip: params.empty_space_skipping && occupied < SKIP_MAX_OCCUPANCY,
+            skip: params.empty_space_skipping && !rectilinear && occupied < SKIP_MAX_OCCUPANCY,
             crop: params.cropping.is_some(),
             single_brick,
             streaming: plan.is_some(),
             component,
             mask,
             blanking: res.blanking.is_some(),
+            rectilinear,
             cubic: params.interpolation == Interpolation::Cubic,
         };
         if fh.cubic && fh.streaming {
@@ -517,6 +530,7 @@ impl IsoPass {
             component,
             mask,
             blanking: res.blanking.is_some(),
+            rectilinear,
         };
         let firsthit = self.firsthit.get(ctx, fh)?;
         let deferred = self.deferred.get(ctx, df)?;
@@ -642,6 +656,7 @@ impl IsoPass {
                     ),
                 ),
                 res.blanking_entry(&self.no_mask),
+                res.grid_lookup_entry(&self.no_grid_lookup)?,
             ],
         });
         let deferred_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -668,6 +683,7 @@ impl IsoPass {
                 ),
                 bind(1, wgpu::BindingResource::TextureView(&tables.view)),
                 res.blanking_entry(&self.no_mask),
+                res.grid_lookup_entry(&self.no_grid_lookup)?,
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {

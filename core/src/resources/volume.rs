@@ -21,6 +21,22 @@ use std::sync::Arc;
 
 /// The blanking mask's binding in the passes that read it (lib/blanking.wgsl).
 const BLANKING_BINDING: u32 = 22;
+/// A rectilinear grid's lookup's binding (lib/rectilinear.wgsl).
+const GRID_LOOKUP_BINDING: u32 = 23;
+
+/// A rectilinear grid's lookup's layout entry (lib/rectilinear.wgsl).
+pub(crate) fn grid_lookup_layout_entry() -> wgpu::BindGroupLayoutEntry {
+    sampled_texture_entry(
+        GRID_LOOKUP_BINDING,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D3,
+    )
+}
+
+/// What a uniform grid binds in place of a rectilinear grid's lookup.
+pub(crate) fn no_grid_lookup(ctx: &Context) -> wgpu::TextureView {
+    block_grid(ctx, "no grid lookup", [2, 3, 1], &[0f32; 6])
+}
 
 /// The blanking mask's layout entry (lib/blanking.wgsl).
 pub(crate) fn blanking_layout_entry() -> wgpu::BindGroupLayoutEntry {
@@ -310,6 +326,18 @@ impl Resources {
         }
         self.blanking = Some(block_grid(ctx, "blanking", d, mask));
         Ok(())
+    }
+
+    /// The rectilinear grid's lookup's bind group entry (lib/rectilinear.wgsl), or `none`
+    /// for a uniform grid.
+    pub fn grid_lookup_entry<'a>(
+        &'a self,
+        none: &'a wgpu::TextureView,
+    ) -> Result<wgpu::BindGroupEntry<'a>> {
+        Ok(bind(
+            GRID_LOOKUP_BINDING,
+            wgpu::BindingResource::TextureView(self.volume()?.grid_lookup.as_ref().unwrap_or(none)),
+        ))
     }
 
     /// The blanking mask's bind group entry (lib/blanking.wgsl), or `none` without one.

@@ -3,7 +3,7 @@
 
 use crate::common::gpu::{assert_error, renderer};
 use crate::common::images::save_enlarged;
-use crate::common::metrics::{alpha, image_diff};
+use crate::common::metrics::{alpha, footprint, image_diff};
 use crate::common::raycast::to_pixel;
 use crate::common::scenes::{blob_transfer, blob_volume, shaded, volume, white};
 use ferrovol_core::*;
@@ -19,7 +19,7 @@ fn uniform_coordinates(v: &VolumeData) -> [Vec<f64>; 3] {
 }
 
 /// Coordinates that place the points where they already are draw the image of the uniform
-/// grid, in every ray-casting blend mode, shaded composite included.
+/// grid, in every ray-casting blend mode, shaded composite included, and isosurfaces.
 #[test]
 fn uniform_coordinates_draw_the_plain_volume() {
     let mut r = renderer();
@@ -31,6 +31,12 @@ fn uniform_coordinates_draw_the_plain_volume() {
     let rect = plain.clone().with_coordinates(coords).unwrap();
     r.set_transfer_function(&TransferFunction::single(blob_transfer()))
         .unwrap();
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        0.3,
+        [0.9, 0.8, 0.6],
+        1.0,
+    )]))
+    .unwrap();
     let mut view = View::fit(plain.bounds(), 64, 64);
     view.camera.azimuth(30.0);
     view.camera.elevation(20.0);
@@ -48,6 +54,13 @@ fn uniform_coordinates_draw_the_plain_volume() {
             "average",
             RenderParams {
                 blend: BlendMode::Average,
+                ..Default::default()
+            },
+        ),
+        (
+            "isosurface",
+            RenderParams {
+                blend: BlendMode::Isosurface,
                 ..Default::default()
             },
         ),
@@ -112,8 +125,59 @@ fn a_step_sits_at_its_physical_position() {
     assert!(checked > 70, "{checked} columns checked");
 }
 
-/// What needs a uniform grid refuses a rectilinear one, naming the reason: isosurfaces,
-/// path tracing, bricks.
+/// The isosurface of the distance to a point on a grid whose points crowd toward the
+/// origin (coordinates 40·(i/15)^1.5, 16 per axis) is the sphere the same field's
+/// isosurface on a uniform grid of the same box draws: the same silhouette, shaded alike.
+#[test]
+fn isosurfaces_sit_at_their_physical_position() {
+    let mut r = renderer();
+    let c = DVec3::new(21.0, 19.0, 20.0);
+    let coords: Vec<f64> = (0..16)
+        .map(|i| 40.0 * (i as f64 / 15.0).powf(1.5))
+        .collect();
+    let at = |i: f64| coords[i as usize];
+    let rect = volume([16, 16, 16], |i, j, k| {
+        (DVec3::new(at(i), at(j), at(k)) - c).length()
+    })
+    .with_coordinates([coords.clone(), coords.clone(), coords.clone()])
+    .unwrap();
+    let uniform = volume([41, 41, 41], |x, y, z| (DVec3::new(x, y, z) - c).length());
+    r.set_transfer_function(&white(&[(0.0, 1.0), (40.0, 1.0)], 1.0))
+        .unwrap();
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        12.0,
+        [0.9, 0.8, 0.6],
+        1.0,
+    )]))
+    .unwrap();
+    let mut view = View::fit(uniform.bounds(), 96, 96);
+    view.camera.azimuth(30.0);
+    view.camera.elevation(20.0);
+    view.camera.zoom(2.0);
+    let p = RenderParams {
+        blend: BlendMode::Isosurface,
+        shading: shaded().shading,
+        ..Default::default()
+    };
+    r.set_volume(&uniform).unwrap();
+    let a = r.render_image(&view, &p).unwrap();
+    r.set_volume(&rect).unwrap();
+    let b = r.render_image(&view, &p).unwrap();
+    save_enlarged(&b, "rectilinear_sphere");
+    let (fa, fb) = (footprint(&a), footprint(&b));
+    let (mean, max) = image_diff(&a, &b);
+    println!("sphere r = 12: footprint {fa} pixels uniform, {fb} rectilinear; mean {mean:.2}, max {max} levels");
+    // (trilinear between points up to 4 units apart: the surface bends a little)
+    assert!(fa > 2000, "the sphere is drawn ({fa} pixels)");
+    assert!(
+        (fa as f64 - fb as f64).abs() < 0.04 * fa as f64,
+        "{fa} vs {fb}"
+    );
+    assert!(mean < 3.0, "mean difference {mean}");
+}
+
+/// What needs a uniform grid refuses a rectilinear one, naming the reason: path tracing,
+/// cubic isosurfaces, bricks.
 #[test]
 fn rectilinear_grids_are_refused_where_unsupported() {
     let mut r = renderer();
@@ -134,9 +198,13 @@ fn rectilinear_grids_are_refused_where_unsupported() {
     )]))
     .unwrap();
     let view = View::fit(v.bounds(), 32, 32);
-    for blend in [BlendMode::Isosurface, BlendMode::PathTrace] {
+    for (blend, interpolation) in [
+        (BlendMode::Isosurface, Interpolation::Cubic),
+        (BlendMode::PathTrace, Interpolation::Linear),
+    ] {
         let p = RenderParams {
             blend,
+            interpolation,
             ..Default::default()
         };
         assert_error(
