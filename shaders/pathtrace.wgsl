@@ -36,6 +36,7 @@
 #include "lib/march.wgsl"
 #include "lib/intermix.wgsl"
 #include "lib/blanking.wgsl"
+#include "lib/rectilinear.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/phase.wgsl"
 #include "lib/bsdf.wgsl"
@@ -319,9 +320,12 @@ fn intermixed_share() -> f32 {
 
 // The main volume's part of extinction_at.
 fn main_extinction(r: Ray, t: f32) -> f32 {
-    let p = r.index_origin + t * r.index_dir;
-    if (!in_main(p) || (CROP && !in_crop(p)) || blanked(p)
-        || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
+    let lp = r.index_origin + t * r.index_dir;
+    if (!in_main(lp) || (CROP && !in_crop(lp))) {
+        return 0.0;
+    }
+    let p = grid_point(lp);
+    if (blanked(p) || (MASK == MASK_BINARY && mask_value(mask_tex, p) == 0u)) {
         return 0.0;
     }
     let s = sample_scalars(p);
@@ -368,7 +372,14 @@ fn scatter_sample(sc: Scatterer, d: vec3<f32>, rng: ptr<function, Rng>) -> vec3<
 // boundary sees the block ahead) and the distance where it leaves that block (at least a
 // little past t, so that every step advances). Intermixed volumes add their summed
 // majorant everywhere; outside the main volume's grid the span ends where the ray enters it.
+// On a rectilinear grid (RECTILINEAR: the rays march the box's uniform lattice and each
+// sample is mapped to the grid's index space) the span is the whole ray.
 fn block_span(r: Ray, t: f32) -> vec2<f32> {
+    if (RECTILINEAR) {
+        // (the blocks are the grid's, whose index space the rays do not march: the largest
+        // majorant everywhere)
+        return vec2<f32>(pt.medium.x, 3.0e38);
+    }
     let p = r.index_origin + (t + 1e-4) * r.index_dir;
     if (!in_main(p)) {
         let b = box_interval(r, vec3<f32>(0.0), frame.dims.xyz - 1.0);
@@ -473,7 +484,8 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
                 let p0 = r.index_origin + t * r.index_dir;
                 var g0 = vec3<f32>(0.0);
                 if (in_main(p0)) {
-                    g0 = world_gradient(gradient_at(p0, sample_scalars(p0)), 0u);
+                    let q0 = grid_point(p0);
+                    g0 = world_gradient(gradient_at(q0, sample_scalars(q0)), 0u);
                 }
                 var n0 = -r.dir;
                 if (dot(g0, g0) > 1e-20) {
@@ -487,7 +499,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
             break;   // the path has scattered as often as it may
         }
         let x = r.origin + t * r.dir;
-        let p = r.index_origin + t * r.index_dir;
+        let p = grid_point(r.index_origin + t * r.index_dir);
         var sc: Scatterer;
         var share = 0.0;
         var grad = vec3<f32>(0.0);

@@ -54,8 +54,8 @@ use crate::params::{
 };
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::targets::{clear_outputs, DepthSource};
-use crate::resources::volume::blanking_layout_entry;
 use crate::resources::volume::Needed;
+use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
@@ -128,6 +128,8 @@ pub(crate) struct PathTracePass {
     majorants: Option<(MajorantKey, wgpu::TextureView, f32)>,
     /// Bound in place of the mask when the volume has none.
     no_mask: wgpu::TextureView,
+    /// Bound in place of a rectilinear grid's lookup for a uniform grid.
+    no_grid_lookup: wgpu::TextureView,
     /// The intermixed volumes' bindings.
     intermix_binding: IntermixBinding,
     /// What the accumulated paths were traced with; a different key starts over.
@@ -165,6 +167,7 @@ impl PathTracePass {
                 buffer_entry(16, B::Storage { read_only: false }),
                 sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
                 blanking_layout_entry(),
+                grid_lookup_layout_entry(),
             ]
             .into_iter()
             .chain(IntermixBinding::layout_entries(ctx))
@@ -202,6 +205,7 @@ impl PathTracePass {
             env_dist: None,
             majorants: None,
             no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
+            no_grid_lookup: no_grid_lookup(ctx),
             intermix_binding: IntermixBinding::new(ctx),
             key: String::new(),
             units: 0,
@@ -271,6 +275,8 @@ pipeline_variant! {
         mask: u32 => "MASK",
         /// VTK's blanking (lib/blanking.wgsl): the medium is empty at blanked samples.
         blanking: bool => "BLANKING",
+        /// A rectilinear grid (lib/rectilinear.wgsl).
+        rectilinear: bool => "RECTILINEAR",
         /// Number of volumes intermixed with the main one.
         intermix: u32 => "INTERMIX",
         /// The intermixed volumes' atlas is read through a linear sampler.
@@ -321,13 +327,6 @@ impl PathTracePass {
                     .into(),
             ));
         }
-        if vol.grid_lookup.is_some() {
-            return Err(Error::Unsupported(
-                "path tracing traces uniform grids, and this volume is rectilinear (per-axis \
-                 coordinates): use a ray-casting blend mode or resample the grid"
-                    .into(),
-            ));
-        }
         if res.tf.as_ref().is_some_and(TransferFunction::has_2d) {
             return Err(Error::Unsupported(
                 "path tracing reads 1D transfer functions: this one has a 2D table (TF_2D)".into(),
@@ -341,12 +340,16 @@ impl PathTracePass {
             )));
         }
         let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
+        let rectilinear = vol.grid_lookup.is_some();
         if intermix > 0
-            && (params.cropping.is_some() || res.mask.is_some() || res.blanking.is_some())
+            && (params.cropping.is_some()
+                || res.mask.is_some()
+                || res.blanking.is_some()
+                || rectilinear)
         {
             return Err(Error::Unsupported(
-                "intermixed volumes are path traced without cropping, a mask or blanking on \
-                 the main volume: clear the intermixed volumes or turn those off"
+                "intermixed volumes are path traced with a uniform main volume without \
+                 cropping, a mask or blanking: clear the intermixed volumes or turn those off"
                     .into(),
             ));
         }
@@ -421,6 +424,7 @@ impl PathTracePass {
                 _ => MASK_NONE,
             },
             blanking: res.blanking.is_some(),
+            rectilinear,
             intermix,
             intermix_filtered: intermix > 0 && ctx.info.float32_filterable,
         };
@@ -522,6 +526,7 @@ impl PathTracePass {
                     ),
                 ),
                 res.blanking_entry(&self.no_mask),
+                res.grid_lookup_entry(&self.no_grid_lookup)?,
             ]
             .into_iter()
             .chain(self.intermix_binding.entries(res.intermix.as_ref()))
