@@ -37,6 +37,7 @@
 #include "lib/intermix.wgsl"
 #include "lib/blanking.wgsl"
 #include "lib/rectilinear.wgsl"
+#include "lib/table2d.wgsl"
 #include "lib/envmap.wgsl"
 #include "lib/phase.wgsl"
 #include "lib/bsdf.wgsl"
@@ -220,14 +221,20 @@ fn alpha_extinction(alpha: f32) -> f32 {
 override MASK: u32 = MASK_NONE;
 
 // The medium's colour (rgb) and opacity (a, not step-corrected) at index-space point p,
-// whose scalar is s.
-fn medium(p: vec3<f32>, s: f32) -> vec4<f32> {
-    let own = vec4<f32>(classify(0u, s).rgb, raw_alpha(0u, s));
+// whose scalars are s: the transfer function's, or its 2D table's at s and the gradient
+// magnitude there (TF2D).
+fn medium(p: vec3<f32>, s: vec4<f32>) -> vec4<f32> {
+    var own: vec4<f32>;
+    if (has_2d(0u)) {
+        own = table_2d(0u, s.x, length(world_gradient(gradient_at(p, s), 0u)));
+    } else {
+        own = vec4<f32>(classify(0u, s.x).rgb, raw_alpha(0u, s.x));
+    }
     if (MASK == MASK_LABELS) {
         let l = mask_value(mask_tex, p);
         if (labelled(l)) {
             let row = label_row(1u, l);
-            let u = label_coord(s);
+            let u = label_coord(s.x);
             let e = vec4<f32>(table_lookup(row, 0u, u).rgb, table_lookup(row, 1u, u).x);
             return mix(own, e, frame.mask.x);
         }
@@ -330,8 +337,8 @@ fn main_extinction(r: Ray, t: f32) -> f32 {
     }
     let s = sample_scalars(p);
     var sigma: f32;
-    if (MASK == MASK_LABELS) {
-        sigma = alpha_extinction(medium(p, s.x).a);
+    if (MASK == MASK_LABELS || TF2D != 0u) {
+        sigma = alpha_extinction(medium(p, s).a);
     } else {
         sigma = extinction(s.x);
     }
@@ -512,7 +519,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
             sc.b.color = intermixed_entry(which, 0u, intermixed_value(which, intermixed_point(which, x))).rgb;
         } else {
             let s = sample_scalars(p);
-            sc.b.color = medium(p, s.x).rgb;
+            sc.b.color = medium(p, s).rgb;
             if (uses_gradient()) {
                 grad = world_gradient(gradient_at(p, s), 0u);
                 share = bsdf_share(length(grad));

@@ -341,12 +341,13 @@ pub unsafe extern "C" fn fv_transfer_function_set_label_gradient_opacity(
 
 /// One component's 2D transfer function (vtkVolumeProperty::SetTransferFunction2D, TF_2D):
 /// `width × height` RGBA floats at `rgba`, x (scalar) fastest, rows of increasing gradient
-/// magnitude, opacity per sample (not corrected for the sample distance or the unit
-/// distance, as VTK 9.2 reads it); the columns span the scalars `scalar_lo` to
+/// magnitude, opacity per sample in ray casting (not corrected for the sample distance or
+/// the unit distance, as VTK 9.2 reads it) and per unit distance in path tracing; the
+/// columns span the scalars `scalar_lo` to
 /// `scalar_hi` (VTK: the component's data range), the rows gradient magnitudes 0 to
 /// `gradient_max` (scalar units per world unit; 0: every sample reads the first row, as VTK
-/// without gradient opacity). It classifies composite ray casting instead of the colour and
-/// opacity functions; NULL `rgba` removes it.
+/// without gradient opacity). It classifies composite ray casting and path tracing instead
+/// of the colour and opacity functions; NULL `rgba` removes it.
 #[no_mangle]
 pub unsafe extern "C" fn fv_transfer_function_set_table_2d(
     tf: *mut FvTransferFunction,

@@ -9,6 +9,8 @@
 // volume itself is read through the brick's nearest sampler; on lavapipe a sampler fetch
 // measured faster than textureLoad).
 override NEAREST: bool = false;
+// Components of the volume a pass reads (one unless it says otherwise).
+override NCOMP: u32 = 1u;
 
 struct Light {
     // xyz: world position (positional) or unit vector toward the light (directional);

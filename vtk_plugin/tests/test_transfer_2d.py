@@ -96,6 +96,24 @@ class Transfer2D(unittest.TestCase):
         coarse.Modified()
         self.pair("tf2d-coarse", self.image, lambda: property_2d(coarse), (0.98, 35.0))
 
+    def test_path_traced(self):
+        """The path tracer reads the 2D table as its medium (the opacity per unit distance,
+        as it reads the 1D functions'): it draws, and the gradient axis matters."""
+        import ferrovol
+        images = []
+        for table in (self.table, table_2d((0.9, 0.5, 0.1), (0.2, 0.4, 1.0), top=0.0)):
+            mapper = ferrovol.vtkFerroVolumeMapper()
+            mapper.SetRenderModeToPathTrace()
+            mapper.SetSamplesPerPixel(8)
+            errors = Errors(mapper)
+            images.append(fvtest.Scene(mapper, self.image, property_2d(table),
+                                       camera=view).render())
+            self.assertEqual(errors.messages, [])
+        fvtest.log("  path-traced 2D table: coverage %.3f; a transparent table %.3f"
+                    % (coverage(images[0]), coverage(images[1])))
+        self.assertGreater(coverage(images[0]), 0.05)
+        self.assertEqual(coverage(images[1]), 0.0)
+
     def test_opacity_is_per_sample(self):
         """VTK 9.2 uploads the 2D table as it is (no correction by the unit distance or the
         sample distance): its opacity is per sample."""

@@ -58,6 +58,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../../shaders/lib/rectilinear.wgsl"),
     ),
     (
+        "lib/table2d.wgsl",
+        include_str!("../../../shaders/lib/table2d.wgsl"),
+    ),
+    (
         "lib/intermix.wgsl",
         include_str!("../../../shaders/lib/intermix.wgsl"),
     ),

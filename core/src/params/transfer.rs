@@ -94,7 +94,7 @@ pub struct ComponentTransfer {
     pub material: Option<[f32; 4]>,
     /// A 2D transfer function (vtkVolumeProperty's TF_2D mode) that classifies this
     /// component instead of `color`, `opacity` and `gradient_opacity` in composite ray
-    /// casting.
+    /// casting and path tracing.
     pub table_2d: Option<Table2D>,
 }
 
@@ -105,8 +105,10 @@ pub struct Table2D {
     pub width: u32,
     pub height: u32,
     /// `width × height` RGBA values, x (scalar) fastest, rows of increasing gradient
-    /// magnitude; the opacity of one sample, whatever the sample distance and the
-    /// component's `unit_distance` (VTK 9.2 uploads its 2D table as it is).
+    /// magnitude. Ray casting reads the opacity as one sample's, whatever the sample
+    /// distance and the component's `unit_distance` (VTK 9.2 uploads its 2D table as it
+    /// is); the path tracer, which takes no samples, as the opacity per `unit_distance`,
+    /// as it reads `opacity`.
     pub rgba: Vec<[f32; 4]>,
     /// The scalars the first and the last column's edges are at (VTK: the component's data
     /// range): a scalar s reads the table at (s − lo) / (hi − lo) · width texels.

@@ -17,7 +17,7 @@ use crate::gpu::uniforms::{MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
 use crate::resources::intermix::IntermixBinding;
-use crate::resources::tables::{Tables, PREINTEGRATION_FORMAT};
+use crate::resources::tables::{tables_2d_layout_entry, Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
@@ -95,7 +95,7 @@ impl DvrPass {
                     blanking_layout_entry(),
                     texture_entry(9, true, V::D2),
                     sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
-                    texture_entry(11, false, V::D2),
+                    tables_2d_layout_entry(),
                     grid_lookup_layout_entry(),
                 ]
                 .into_iter()
@@ -349,10 +349,6 @@ impl DvrPass {
             Some((_, t)) if preintegration => t,
             _ => &self.no_preintegration,
         };
-        let tables_2d_view = match &res.tables_2d {
-            Some((_, t)) if tables_2d != 0 => &t.view,
-            _ => &self.no_tables_2d.view,
-        };
         let q = &ctx.queue;
         let d = &ctx.device;
         q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
@@ -379,7 +375,7 @@ impl DvrPass {
                         res.mask.as_ref().map_or(&self.no_blanking, |(m, _)| m),
                     ),
                 ),
-                bind(11, wgpu::BindingResource::TextureView(tables_2d_view)),
+                res.tables_2d_entry(tables_2d != 0, &self.no_tables_2d),
                 res.grid_lookup_entry(&self.no_grid_lookup)?,
             ]
             .into_iter()

@@ -82,25 +82,47 @@ pub(super) fn environment_distribution(
 /// The medium's majorant per min–max block: the largest extinction (per world unit) the
 /// first component's transfer function gives on the table entries the block's scalar
 /// range touches (the table is linear between entries, so its maximum over the range is
-/// at one of them).
+/// at one of them); with a 2D table, the largest over its rows of the columns the range
+/// touches.
 pub(super) fn block_majorants(res: &Resources) -> Result<Vec<f32>> {
     let tf = res.transfer_function()?;
     let vol = res.volume()?;
     let c = tf.component(0);
+    let sigma = |alpha: f64| -(1.0 - alpha.clamp(0.0, PT_MAX_OPACITY)).ln() / c.unit_distance;
     let last = (TABLE_SIZE - 1) as f64;
-    // Per table: its range and the extinction at each entry; a label map's labels'
-    // tables too (a labelled point's medium mixes its label's with the component's).
-    let table = |t: &ComponentTransfer, [lo, hi]: [f64; 2]| -> ([f64; 2], Vec<f64>) {
-        let sigma = (0..TABLE_SIZE)
-            .map(|i| {
-                let x = lo + (hi - lo) * i as f64 / last;
-                let a = (t.opacity.eval(x)[0].clamp(0.0, 1.0) as f64).min(PT_MAX_OPACITY);
-                -(1.0 - a).ln() / c.unit_distance
-            })
-            .collect();
-        ([lo, hi], sigma)
+    // Per table: the entry a scalar v reads, (v − lo) / (hi − lo) · scale + offset, and the
+    // extinction at each entry; a label map's labels' tables too (a labelled point's medium
+    // mixes its label's with the component's).
+    struct Entries {
+        range: [f64; 2],
+        scale: f64,
+        offset: f64,
+        sigma: Vec<f64>,
+    }
+    let table = |t: &ComponentTransfer, [lo, hi]: [f64; 2]| Entries {
+        range: [lo, hi],
+        scale: last,
+        offset: 0.0,
+        sigma: (0..TABLE_SIZE)
+            .map(|i| sigma(t.opacity.eval(lo + (hi - lo) * i as f64 / last)[0] as f64))
+            .collect(),
     };
-    let mut tables = vec![table(c, c.table_range())];
+    let mut tables = vec![match &c.table_2d {
+        // (texel centres at (i + ½) / width of the range; every row's opacity counts)
+        Some(t) => Entries {
+            range: t.scalar_range,
+            scale: t.width as f64,
+            offset: -0.5,
+            sigma: (0..t.width as usize)
+                .map(|x| {
+                    (0..t.height as usize)
+                        .map(|y| sigma(t.rgba[y * t.width as usize + x][3] as f64))
+                        .fold(0.0, f64::max)
+                })
+                .collect(),
+        },
+        None => table(c, c.table_range()),
+    }];
     if res.mask_kind() == Some(MaskKind::LabelMap) {
         let (range, _) = tf.label_ranges();
         for label in 1..=tf.max_label() {
@@ -118,11 +140,13 @@ pub(super) fn block_majorants(res: &Resources) -> Result<Vec<f32>> {
                 return 0.0;
             }
             let mut m = 0.0f64;
-            for ([lo, hi], sigma) in &tables {
-                let at = |v: f32| (v as f64 - lo) / (hi - lo) * last;
-                let i0 = at(mn).floor().clamp(0.0, last) as usize;
-                let i1 = at(mx).ceil().clamp(0.0, last) as usize;
-                m = sigma[i0..=i1].iter().copied().fold(m, f64::max);
+            for e in &tables {
+                let [lo, hi] = e.range;
+                let end = (e.sigma.len() - 1) as f64;
+                let at = |v: f32| (v as f64 - lo) / (hi - lo) * e.scale + e.offset;
+                let i0 = at(mn).floor().clamp(0.0, end) as usize;
+                let i1 = at(mx).ceil().clamp(0.0, end) as usize;
+                m = e.sigma[i0..=i1].iter().copied().fold(m, f64::max);
             }
             m as f32
         })

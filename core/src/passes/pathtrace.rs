@@ -53,6 +53,7 @@ use crate::params::{
     ScatterRegions, Shading, TransferFunction,
 };
 use crate::resources::intermix::IntermixBinding;
+use crate::resources::tables::{tables_2d_layout_entry, Tables};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
@@ -130,6 +131,8 @@ pub(crate) struct PathTracePass {
     no_mask: wgpu::TextureView,
     /// Bound in place of a rectilinear grid's lookup for a uniform grid.
     no_grid_lookup: wgpu::TextureView,
+    /// Bound in place of the 2D tables without any.
+    no_tables_2d: Tables,
     /// The intermixed volumes' bindings.
     intermix_binding: IntermixBinding,
     /// What the accumulated paths were traced with; a different key starts over.
@@ -168,6 +171,7 @@ impl PathTracePass {
                 sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
                 blanking_layout_entry(),
                 grid_lookup_layout_entry(),
+                tables_2d_layout_entry(),
             ]
             .into_iter()
             .chain(IntermixBinding::layout_entries(ctx))
@@ -206,6 +210,7 @@ impl PathTracePass {
             majorants: None,
             no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
             no_grid_lookup: no_grid_lookup(ctx),
+            no_tables_2d: Tables::new(&ctx.device, [1, 1]),
             intermix_binding: IntermixBinding::new(ctx),
             key: String::new(),
             units: 0,
@@ -277,6 +282,8 @@ pipeline_variant! {
         blanking: bool => "BLANKING",
         /// A rectilinear grid (lib/rectilinear.wgsl).
         rectilinear: bool => "RECTILINEAR",
+        /// 1: the medium's colour and opacity from the 2D table (lib/table2d.wgsl).
+        tables_2d: u32 => "TF2D",
         /// Number of volumes intermixed with the main one.
         intermix: u32 => "INTERMIX",
         /// The intermixed volumes' atlas is read through a linear sampler.
@@ -327,11 +334,6 @@ impl PathTracePass {
                     .into(),
             ));
         }
-        if res.tf.as_ref().is_some_and(TransferFunction::has_2d) {
-            return Err(Error::Unsupported(
-                "path tracing reads 1D transfer functions: this one has a 2D table (TF_2D)".into(),
-            ));
-        }
         if vol.components != 1 {
             return Err(Error::Unsupported(format!(
                 "path tracing renders one-component volumes (this one has {} components): \
@@ -361,6 +363,10 @@ impl PathTracePass {
             .map_or(1.0, |tf| tf.component(0).unit_distance);
         let step = res.sample_distance(params)?;
         res.ensure_tables(ctx, step)?;
+        let table_2d = res.tf.as_ref().is_some_and(TransferFunction::has_2d);
+        if table_2d {
+            res.ensure_tables_2d(ctx)?;
+        }
         res.ensure_occupancy(ctx, step)?;
         res.ensure_resident(ctx, Needed::Occupied)?;
         res.ensure_environment(ctx)?;
@@ -425,6 +431,7 @@ impl PathTracePass {
             },
             blanking: res.blanking.is_some(),
             rectilinear,
+            tables_2d: u32::from(table_2d),
             intermix,
             intermix_filtered: intermix > 0 && ctx.info.float32_filterable,
         };
@@ -527,6 +534,7 @@ impl PathTracePass {
                 ),
                 res.blanking_entry(&self.no_mask),
                 res.grid_lookup_entry(&self.no_grid_lookup)?,
+                res.tables_2d_entry(table_2d, &self.no_tables_2d),
             ]
             .into_iter()
             .chain(self.intermix_binding.entries(res.intermix.as_ref()))

@@ -2,6 +2,7 @@
 
 use super::Resources;
 use crate::error::{Error, Result};
+use crate::gpu::binding::{bind, texture_entry};
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
@@ -156,7 +157,25 @@ fn table_2d_rows(tf: &TransferFunction, comps: usize) -> (Vec<[f32; 4]>, [u32; 2
     (data, [w, h * comps as u32])
 }
 
+/// The 2D tables' binding in the passes that read them (lib/table2d.wgsl).
+const TABLES_2D_BINDING: u32 = 24;
+
+/// The 2D tables' layout entry (lib/table2d.wgsl).
+pub(crate) fn tables_2d_layout_entry() -> wgpu::BindGroupLayoutEntry {
+    texture_entry(TABLES_2D_BINDING, false, wgpu::TextureViewDimension::D2)
+}
+
 impl Resources {
+    /// The 2D tables' bind group entry: the tables [`Resources::ensure_tables_2d`] built
+    /// when `used`, else `none`.
+    pub fn tables_2d_entry<'a>(&'a self, used: bool, none: &'a Tables) -> wgpu::BindGroupEntry<'a> {
+        let view = match &self.tables_2d {
+            Some((_, t)) if used => &t.view,
+            _ => &none.view,
+        };
+        bind(TABLES_2D_BINDING, wgpu::BindingResource::TextureView(view))
+    }
+
     /// Builds the 2D tables for the transfer function, unless they are current (a transfer
     /// function without 2D tables needs none). Their opacities are per sample, whatever the
     /// sample distance, as VTK 9.2 uploads its 2D table.
