@@ -169,14 +169,7 @@ fn medium_box(r: Ray) -> vec2<f32> {
 // The part of a camera ray in the medium, before the near plane, the far plane and the
 // host's opaque depth, on the kept side of the clipping planes.
 fn camera_segment(r: Ray, px: vec2<u32>) -> vec2<f32> {
-    var seg = medium_box(r);
-    seg.x = max(seg.x, 0.0);
-    seg.y = min(seg.y, r.far);
-    if (has_flag(FLAG_DEPTH_INPUT)) {
-        let d = textureLoad(depth_in, vec2<i32>(px), 0).x;
-        seg.y = min(seg.y, depth_to_distance(r, px, d));
-    }
-    return clip_interval(r, seg);
+    return segment_within(r, px, medium_box(r));
 }
 
 // The part of a secondary ray inside the medium and on the kept side of the clipping planes.

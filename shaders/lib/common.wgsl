@@ -95,15 +95,20 @@ fn has_flag(f: u32) -> bool {
 // Linear lookup into table `which` (0: colour + corrected alpha, 1: alpha & gradient opacity)
 // of component `c` at normalised coordinate u in [0, 1] (clamped, like VTK's tables).
 fn table_lookup(c: u32, which: u32, u: f32) -> vec4<f32> {
+    return row_lookup(tables, i32(2u * c + which), u, NEAREST);
+}
+
+// Row `row` of a table texture of TABLE_N entries per row at normalised coordinate u
+// (clamped): its nearest entry, or linear between the two around it.
+fn row_lookup(t: texture_2d<f32>, row: i32, u: f32, nearest: bool) -> vec4<f32> {
     let x = clamp(u, 0.0, 1.0) * f32(TABLE_N - 1u);
-    let row = i32(2u * c + which);
-    if (NEAREST) {
-        return textureLoad(tables, vec2<i32>(i32(x + 0.5), row), 0);
+    if (nearest) {
+        return textureLoad(t, vec2<i32>(i32(x + 0.5), row), 0);
     }
     let i0 = u32(x);
     let i1 = min(i0 + 1u, TABLE_N - 1u);
-    let t0 = textureLoad(tables, vec2<i32>(i32(i0), row), 0);
-    let t1 = textureLoad(tables, vec2<i32>(i32(i1), row), 0);
+    let t0 = textureLoad(t, vec2<i32>(i32(i0), row), 0);
+    let t1 = textureLoad(t, vec2<i32>(i32(i1), row), 0);
     return mix(t0, t1, x - f32(i0));
 }
 

@@ -72,14 +72,6 @@ fn intermixed_value(j: u32, p: vec3<f32>) -> f32 {
 // as given in x) at scalar s: the nearest entry or between the two around it.
 fn intermixed_entry(j: u32, row: u32, s: f32) -> vec4<f32> {
     let v = intermix.volumes[j];
-    let x = clamp((s - v.range.x) * v.range.y, 0.0, 1.0) * f32(TABLE_N - 1u);
-    let y = i32(2u * j + row);
-    if (v.range.z > 0.0) {
-        return textureLoad(intermix_tables, vec2<i32>(i32(x + 0.5), y), 0);
-    }
-    let i0 = u32(x);
-    let i1 = min(i0 + 1u, TABLE_N - 1u);
-    let t0 = textureLoad(intermix_tables, vec2<i32>(i32(i0), y), 0);
-    let t1 = textureLoad(intermix_tables, vec2<i32>(i32(i1), y), 0);
-    return mix(t0, t1, x - f32(i0));
+    let u = (s - v.range.x) * v.range.y;
+    return row_lookup(intermix_tables, i32(2u * j + row), u, v.range.z > 0.0);
 }

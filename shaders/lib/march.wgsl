@@ -13,7 +13,13 @@
 // The part of the ray inside the volume, in front of the far plane and the host's opaque
 // geometry and on the kept side of every clipping plane.
 fn ray_segment(ray: Ray, px: vec2<u32>) -> vec2<f32> {
-    var seg = box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0);
+    return segment_within(ray, px, box_interval(ray, vec3<f32>(0.0), frame.dims.xyz - 1.0));
+}
+
+// The part `box` of the ray (its interval in a box) past the camera, in front of the far
+// plane and the host's opaque geometry and on the kept side of every clipping plane.
+fn segment_within(ray: Ray, px: vec2<u32>, box: vec2<f32>) -> vec2<f32> {
+    var seg = box;
     seg.x = max(seg.x, 0.0);
     seg.y = min(seg.y, ray.far);
     if (has_flag(FLAG_DEPTH_INPUT)) {

@@ -28,6 +28,16 @@ fn scene(r: &mut Renderer, labels: Vec<LabelTransfer>) -> View {
     View::fit(vol.bounds(), 64, 64)
 }
 
+/// One opaque isosurface of the blob at 0.3.
+fn set_isosurface(r: &mut Renderer) {
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        0.3,
+        [0.9, 0.8, 0.6],
+        1.0,
+    )]))
+    .unwrap();
+}
+
 /// Pixel column where the world plane x = `x` projects on the volume's centre line.
 fn column(view: &View, x: f64) -> f64 {
     let c = view.camera.focal_point;
@@ -48,12 +58,7 @@ fn params(blend: BlendMode) -> RenderParams {
 fn binary_mask_leaves_out_samples() {
     let mut r = renderer();
     let view = scene(&mut r, Vec::new());
-    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
-        0.3,
-        [0.9, 0.8, 0.6],
-        1.0,
-    )]))
-    .unwrap();
+    set_isosurface(&mut r);
     let ones = by_x(|_| 1);
     let half = by_x(|x| u8::from(x >= 12));
     // samples with x < 11.5 (index = world here) are left out
@@ -114,12 +119,7 @@ fn binary_mask_leaves_out_samples() {
 fn blanking_leaves_samples_out_of_isosurfaces_and_the_medium() {
     let mut r = renderer();
     let view = scene(&mut r, Vec::new());
-    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
-        0.3,
-        [0.9, 0.8, 0.6],
-        1.0,
-    )]))
-    .unwrap();
+    set_isosurface(&mut r);
     let edge = column(&view, 12.0);
     let traced = |r: &mut Renderer| -> Vec<f32> {
         let p = PathTraceParams {
