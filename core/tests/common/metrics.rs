@@ -19,6 +19,17 @@ pub fn alpha(img: &Image, x: u32, y: u32) -> u8 {
 }
 
 /// Pixels with any opacity.
+/// Per channel (r, g, b, coverage), the sum over the pixels of an accumulation
+/// (Renderer::read_accumulation).
+pub fn channel_sums(img: &[[f32; 4]]) -> [f64; 4] {
+    img.iter().fold([0.0; 4], |mut s, px| {
+        for c in 0..4 {
+            s[c] += px[c] as f64;
+        }
+        s
+    })
+}
+
 pub fn footprint(img: &Image) -> usize {
     img.rgba.chunks(4).filter(|p| p[3] > 0).count()
 }

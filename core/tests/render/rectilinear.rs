@@ -3,7 +3,7 @@
 
 use crate::common::gpu::{assert_error, renderer, trace};
 use crate::common::images::save_enlarged;
-use crate::common::metrics::{alpha, footprint, image_diff};
+use crate::common::metrics::{alpha, channel_sums, footprint, image_diff};
 use crate::common::raycast::to_pixel;
 use crate::common::scenes::{blob_transfer, blob_volume, shaded, volume, white};
 use ferrovol_core::*;
@@ -219,12 +219,7 @@ fn path_tracing_traces_the_grid() {
     for v in [&plain, &rect] {
         r.set_volume(v).unwrap();
         let img = trace(&mut r, &view, &p, 1024);
-        sums.push(img.iter().fold([0.0f64; 4], |mut s, px| {
-            for c in 0..4 {
-                s[c] += px[c] as f64;
-            }
-            s
-        }));
+        sums.push(channel_sums(&img));
     }
     let rel: Vec<f64> = (0..4).map(|c| sums[1][c] / sums[0][c] - 1.0).collect();
     println!(

@@ -4,7 +4,7 @@
 
 use crate::common::gpu::{assert_error, renderer, trace};
 use crate::common::images::save_enlarged;
-use crate::common::metrics::{footprint, image_diff};
+use crate::common::metrics::{channel_sums, footprint, image_diff};
 use crate::common::scenes::{blob_transfer, blob_volume, shaded};
 use ferrovol_core::*;
 
@@ -161,12 +161,7 @@ fn path_tracing_reads_the_table() {
     ] {
         r.set_transfer_function(&tf).unwrap();
         let img = trace(&mut r, &view, &p, 1024);
-        sums.push(img.iter().fold([0.0f64; 4], |mut s, px| {
-            for k in 0..4 {
-                s[k] += px[k] as f64;
-            }
-            s
-        }));
+        sums.push(channel_sums(&img));
     }
     let rel: Vec<f64> = (0..4).map(|k| sums[1][k] / sums[0][k] - 1.0).collect();
     println!(
