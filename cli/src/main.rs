@@ -176,9 +176,11 @@ struct RenderArgs {
     /// and scattering, whose rays go anywhere, draw the finest coarser level that fits.
     #[arg(long, value_name = "MIB")]
     gpu_memory: Option<u64>,
-    /// With --gpu-memory: a frame whose bricks exceed it draws the finest coarser level
-    /// that fits in one pass, as an interactive frame would, instead of streaming the volume
-    /// itself (the still image)
+    /// With --gpu-memory: a frame whose bricks exceed it draws in one pass, as an interactive
+    /// frame would, instead of streaming the volume itself (the still image): ray casting
+    /// draws the fine bricks resident and a coarser level's where they are missing, and
+    /// brings those its rays read for the next frames (see --repeat); isosurfaces draw the
+    /// finest coarser level that fits
     #[arg(long)]
     preview_level: bool,
     /// Render this many frames and print the mean time per frame (the first, which builds
@@ -188,7 +190,8 @@ struct RenderArgs {
     repeat: u32,
     /// With --repeat: turn the camera by this many degrees about the view up vector
     /// (azimuth) before each frame after the first, an interactive camera path; the summary
-    /// adds the bricks uploaded per frame.
+    /// adds the bricks uploaded per frame and, with --preview-level, the frames that drew
+    /// coarser bricks where fine ones were missing.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     orbit: f64,
     #[command(flatten)]
@@ -810,6 +813,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     }
     let mut timing = None;
     let mut uploads = None;
+    let mut stand_ins = vec![r.residency().stand_ins];
     if a.repeat > 1 {
         let before = r.stats().brick_uploads;
         let t0 = std::time::Instant::now();
@@ -824,6 +828,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
                 r.render(&view, &params, None)?;
             }
             r.finish()?;
+            stand_ins.push(r.residency().stand_ins);
         }
         timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);
         uploads = Some((r.stats().brick_uploads - before) as f64 / (a.repeat - 1) as f64);
@@ -865,6 +870,18 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             "ferrovol: the visible bricks exceed --gpu-memory: {passes} streamed pass(es) over \
              {} frame(s)",
             r.stats().frames
+        );
+    }
+    if a.preview_level && stand_ins.iter().any(|&n| n > 0) {
+        let drew = stand_ins.iter().filter(|&&n| n > 0).count();
+        let complete = match stand_ins.iter().rposition(|&n| n > 0) {
+            Some(k) if k + 1 < stand_ins.len() => format!("complete from frame {} on", k + 2),
+            _ => "not complete by the last frame".into(),
+        };
+        println!(
+            "ferrovol: {drew} of {} frame(s) drew a coarser level's bricks where fine ones \
+             were missing (bricks read from them per frame: {stand_ins:?}); {complete}",
+            stand_ins.len()
         );
     }
     if let (Some(ms), Some(uploads)) = (timing, uploads) {

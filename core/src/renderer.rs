@@ -33,21 +33,19 @@ pub struct Renderer {
     pt_params: PathTraceParams,
 }
 
-/// The bricks a preview frame ([`RenderParams::preview_level`]) of a mode that streams
-/// needs at whatever level it draws; none for the slice mode.
+/// The bricks a preview frame ([`RenderParams::preview_level`]) of isosurfaces needs at
+/// whatever level it draws; none for the other modes (ray casting draws coarser bricks
+/// where fine ones are missing, resources/lod.rs).
 fn preview_demand(
     res: &Resources,
     params: &RenderParams,
     iso: Option<&IsoParams>,
 ) -> Result<Option<LevelDemand>> {
-    Ok(match params.blend {
-        BlendMode::Composite => Some(LevelDemand::Visible),
-        BlendMode::Isosurface => match iso {
-            Some(iso) if res.volume.is_some() => Some(iso::surfaces_demand(iso, res, false)?),
-            _ => None,
-        },
-        BlendMode::Slice | BlendMode::PathTrace => None,
-        _ => Some(LevelDemand::All),
+    Ok(match (params.blend, iso) {
+        (BlendMode::Isosurface, Some(iso)) if res.volume.is_some() => {
+            Some(iso::surfaces_demand(iso, res, false)?)
+        }
+        _ => None,
     })
 }
 

@@ -549,10 +549,13 @@ typedef struct FvRenderParams {
    */
   float mask_blend_factor;
   /**
-   * An interactive frame: when the bricks it needs exceed the memory budget, draw the
-   * finest coarser level of the volume whose needed bricks fit, in one pass, rather than
-   * stream the volume itself in several (false, the default: the frame streams and
-   * equals the in-core image). fv_renderer_residency says which level was drawn.
+   * An interactive frame: when the bricks it needs exceed the memory budget, draw in one
+   * pass rather than stream the volume itself in several (false, the default: the frame
+   * streams and equals the in-core image). Ray casting draws the fine bricks resident and
+   * a coarser level's bricks where they are missing, and brings some of those its rays
+   * read for the next preview frame (FvResidency.stand_ins: 0 once complete);
+   * isosurfaces draw the finest coarser level whose needed bricks fit
+   * (FvResidency.level).
    */
   bool preview_level;
 } FvRenderParams;
@@ -843,6 +846,14 @@ typedef struct FvResidency {
    * That level's points per axis.
    */
   uint32_t level_dims[3];
+  /**
+   * Bricks the last frame's rays read from a coarser level standing in for them: a
+   * preview frame (FvRenderParams.preview_level) of ray casting past the budget draws
+   * the fine bricks resident and a coarser level's where they are missing, and brings
+   * some of those for the next preview frame; 0 when every sample came from the volume
+   * itself (the frame is complete).
+   */
+  uint32_t stand_ins;
 } FvResidency;
 
 /**

@@ -534,6 +534,7 @@ pub unsafe extern "C" fn fv_renderer_residency(
             dense_bytes: s.dense_bytes,
             level: s.level,
             level_dims: s.level_dims,
+            stand_ins: s.stand_ins,
         };
         Ok(())
     })

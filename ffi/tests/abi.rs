@@ -1163,7 +1163,8 @@ fn streamed_frames_report_progress() {
 
 /// Path tracing past the memory budget traces a coarser level, and fv_renderer_residency
 /// says which: 2 fine points per point for a budget of a quarter of the volume; a ray-cast
-/// frame after it draws the volume itself again.
+/// frame after it draws the volume itself again; a preview frame of ray casting reports the
+/// bricks it read from a coarser level's stand-ins, and a still frame none.
 #[test]
 fn path_tracing_past_the_budget_reports_its_level() {
     let lib = Lib::open();
@@ -1205,6 +1206,14 @@ fn path_tracing_past_the_budget_reports_its_level() {
     s.frame(24, 24);
     let res = read(&s);
     assert_eq!((res.level, res.level_dims), (1, [32; 3]), "{res:?}");
+    assert_eq!(res.stand_ins, 0, "{res:?}");
+    p.preview_level = true;
+    s.set_params(&p);
+    let preview = s.frame(24, 24).to_vec();
+    let res = read(&s);
+    println!("a preview past the budget: {res:?}");
+    assert!(preview.chunks(4).any(|p| p[3] > 20), "drawn");
+    assert!(res.stand_ins > 0 && res.level == 1, "{res:?}");
 }
 
 /// The context's device memory counters: a renderer's frames allocate once (repeated

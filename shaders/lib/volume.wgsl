@@ -7,7 +7,8 @@
 // (SINGLE_BRICK) is its own texture and is sampled directly.
 
 struct Pool {
-    brick: vec4<f32>,     // x: cells per brick edge, y: apron points around a brick's core
+    brick: vec4<f32>,     // x: cells per brick edge, y: apron points around a brick's core,
+                          // z: 1 when rays report the bricks they read (a preview frame)
     grid: vec4<u32>,      // bricks per axis
     slot: vec4<f32>,      // points per slot, per axis
     inv_size: vec4<f32>,  // 1 / the pool texture's size in points, per axis
@@ -21,12 +22,17 @@ var<private> pool: Pool;
 // The first component's central differences per texel of the pool (shaders/gradient.wgsl),
 // where the upload made them (PRECOMPUTED_GRADIENT); otherwise the pool again, unused.
 @group(1) @binding(3) var gradient_tex: texture_3d<f32>;
-// Per brick: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest), or
-// PAGE_EMPTY when it is not resident, or PAGE_MISSING when a later pass of a streamed
-// frame brings it.
+// Per brick, x: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest),
+// or PAGE_EMPTY when it is not resident, or PAGE_MISSING when a later pass of a streamed
+// frame brings it; y: 0, or, in a preview frame where the brick is not resident, the
+// log2 of the factor of the coarser level whose brick in that slot stands in for it.
 @group(1) @binding(4) var page_table: texture_3d<u32>;
 // Per brick: the texel value a non-resident brick reads as (each component's lowest value).
 @group(1) @binding(5) var brick_constants: texture_3d<f32>;
+// Per brick, in a preview frame: READ_STAND_IN when a ray sampled it from a coarser level's
+// stand-in, READ_FINE when from the brick itself (what the next preview frame brings and
+// keeps, resources/lod.rs).
+@group(1) @binding(6) var<storage, read_write> brick_requests: array<u32>;
 
 // The volume is one brick, its texture the pool: no page-table lookups (a pipeline
 // constant each pass sets from the volume).
@@ -42,12 +48,14 @@ struct Brick {
     empty: bool,          // not resident: every sample reads `constant`
     constant: vec4<f32>,
     missing: bool,        // needed, resident in a later pass of a streamed frame
+    inv_scale: f32,       // 1, or 1 / the factor of the coarser level standing in for it
 }
 
 var<private> brick: Brick;
 
 fn enter_brick(cell: vec3<u32>) {
-    let e = textureLoad(page_table, vec3<i32>(cell), 0).x;
+    let page = textureLoad(page_table, vec3<i32>(cell), 0).xy;
+    let e = page.x;
     brick.empty = (e & PAGE_EMPTY) != 0u;
     brick.missing = (e & PAGE_MISSING) != 0u;
     brick.constant = textureLoad(brick_constants, vec3<i32>(cell), 0);
@@ -56,7 +64,13 @@ fn enter_brick(cell: vec3<u32>) {
     let slot = vec3<f32>(s) * pool.slot.xyz;
     brick.core_lo = vec3<f32>(cell) * pool.brick.x;
     brick.core_hi = min(brick.core_lo + pool.brick.x, frame.dims.xyz - 1.0);
-    brick.tex_lo = brick.core_lo - pool.brick.y - slot;
+    // A stand-in is the brick of the coarser level holding this one, sampled at p / factor.
+    brick.inv_scale = 1.0 / f32(1u << page.y);
+    brick.tex_lo = vec3<f32>(cell >> vec3<u32>(page.y)) * pool.brick.x - pool.brick.y - slot;
+    if (pool.brick.z != 0.0) {
+        brick_requests[cell.x + pool.grid.x * (cell.y + pool.grid.y * cell.z)] =
+            select(READ_FINE, READ_STAND_IN, page.y != 0u);
+    }
     brick.slot_lo = slot;
     brick.slot_hi = slot + pool.slot.xyz - 1.0;
 }
@@ -119,7 +133,7 @@ override CLIPPED_VOXEL: bool = false;
 
 // Pool texture coordinate of index-space point p (in the brick that holds it).
 fn pool_coord(p: vec3<f32>) -> vec3<f32> {
-    return (locate(p) - brick.tex_lo + 0.5) * pool.inv_size.xyz;
+    return (locate(p) * brick.inv_scale - brick.tex_lo + 0.5) * pool.inv_size.xyz;
 }
 
 // The cubic B-spline of the points instead of trilinear interpolation (Interpolation::Cubic;
@@ -215,7 +229,7 @@ fn neighbour(tc: vec3<f32>, q: vec3<f32>) -> vec4<f32> {
 // coordinates.
 fn gradient_tc(tc: vec3<f32>, p: vec3<f32>, s: vec4<f32>) -> Gradient {
     if (PRECOMPUTED_GRADIENT && !FORWARD_DIFF && !CLIPPED_VOXEL) {
-        let d = textureSampleLevel(gradient_tex, volume_sampler, tc, 0.0).xyz;
+        let d = textureSampleLevel(gradient_tex, volume_sampler, tc, 0.0).xyz * brick.inv_scale;
         var g: Gradient;
         g.x = vec4<f32>(d.x, 0.0, 0.0, 0.0);
         g.y = vec4<f32>(d.y, 0.0, 0.0, 0.0);
@@ -238,6 +252,10 @@ fn gradient_tc(tc: vec3<f32>, p: vec3<f32>, s: vec4<f32>) -> Gradient {
         g.y = 0.5 * (neighbour(tc + dy, p + ey) - neighbour(tc - dy, p - ey));
         g.z = 0.5 * (neighbour(tc + dz, p + ez) - neighbour(tc - dz, p - ez));
     }
+    // (per pool texel: a coarser level's texel spans 1 / inv_scale index units)
+    g.x = g.x * brick.inv_scale;
+    g.y = g.y * brick.inv_scale;
+    g.z = g.z * brick.inv_scale;
     return g;
 }
 

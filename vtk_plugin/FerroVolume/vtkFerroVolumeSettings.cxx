@@ -487,9 +487,10 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   params.empty_space_skipping = self->GetEmptySpaceSkipping() != 0;
   params.extremum_depth = self->GetExtremumDepth() != 0;
   params.preintegration = self->GetPreIntegration() != 0;
-  // An interactive render of a volume whose bricks exceed MaxMemoryInBytes draws a coarser
-  // level in one pass; a still render streams the volume itself. (Path tracing's
-  // accumulation must not restart between the two.)
+  // An interactive render of a volume whose bricks exceed MaxMemoryInBytes draws in one
+  // pass, a coarser level's bricks where fine ones are missing (those its rays read come in
+  // the next interactive renders); a still render streams the volume itself. (Path
+  // tracing's accumulation must not restart between the two.)
   vtkRenderWindow* window = ren->GetRenderWindow();
   params.preview_level = this->Blend != FV_BLEND_MODE_PATH_TRACE && window &&
     window->GetDesiredUpdateRate() > 1.0;

@@ -404,9 +404,9 @@ class Settings(unittest.TestCase):
 
     def test_interactive_render_over_the_budget_draws_a_coarser_level(self):
         # A quarter budget, the window rendering interactively (DesiredUpdateRate above 1 s⁻¹,
-        # as an interactor sets it while the camera moves): one pass of a coarser level, no
-        # pass reported between 0 and 1 (the pipeline's own update reports those two); the
-        # still render after it streams the volume itself.
+        # as an interactor sets it while the camera moves): one pass, a coarser level's bricks
+        # where fine ones are missing, no pass reported between 0 and 1 (the pipeline's own
+        # update reports those two); the still render after it streams the volume itself.
         full, _ = self.render()
         progress = []
 

@@ -119,6 +119,10 @@ impl GridValue for u32 {
     const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 }
 
+impl GridValue for [u32; 2] {
+    const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+}
+
 impl GridValue for u8 {
     const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
 }

@@ -217,6 +217,11 @@ pub const PAGE_EMPTY: u32 = 1 << 31;
 /// a streamed frame (the ray stops there and resumes then; shaders/dvr.wgsl).
 pub const PAGE_MISSING: u32 = 1 << 30;
 
+/// What the request buffer holds for a brick a preview frame's rays sampled from a coarser
+/// level's stand-in, and from the brick itself (lib/volume.wgsl, resources/lod.rs).
+pub const READ_STAND_IN: u32 = 1;
+pub const READ_FINE: u32 = 2;
+
 /// What the DVR pass's mask does (its MASK pipeline constant): nothing, leave out the
 /// samples at points holding 0, classify labelled samples with their labels' tables.
 pub const MASK_NONE: u32 = 0;
@@ -293,6 +298,8 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("PAGE_SLOT_BITS", Wgsl::U32(PAGE_SLOT_BITS)),
     ("PAGE_EMPTY", Wgsl::U32(PAGE_EMPTY)),
     ("PAGE_MISSING", Wgsl::U32(PAGE_MISSING)),
+    ("READ_STAND_IN", Wgsl::U32(READ_STAND_IN)),
+    ("READ_FINE", Wgsl::U32(READ_FINE)),
     ("MAX_CLIP", Wgsl::U32(MAX_CLIP_PLANES as u32)),
     ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
     ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),

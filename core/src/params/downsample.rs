@@ -41,6 +41,28 @@ fn tent_weights(n: u32, m: u32) -> Vec<Vec<(usize, f64)>> {
         .collect()
 }
 
+/// [`tent_weights`] for coarse point i at fine point i·`factor`: the axis extended to
+/// (m − 1)·factor + 1 points, those past the last reading the last (as a clamping sampler).
+fn lattice_weights(n: u32, m: u32, factor: u32) -> Vec<Vec<(usize, f64)>> {
+    if m == 1 {
+        return tent_weights(n, m);
+    }
+    let last = n as usize - 1;
+    tent_weights((m - 1) * factor + 1, m)
+        .into_iter()
+        .map(|w| {
+            let mut out: Vec<(usize, f64)> = Vec::with_capacity(w.len());
+            for (j, x) in w {
+                match out.last_mut() {
+                    Some((k, y)) if *k == j.min(last) => *y += x,
+                    _ => out.push((j.min(last), x)),
+                }
+            }
+            out
+        })
+        .collect()
+}
+
 /// Per fine point, the coarse points it contributes to with their weights.
 fn by_fine(weights: &[Vec<(usize, f64)>], n: u32) -> Vec<Vec<(usize, f64)>> {
     let mut out = vec![Vec::new(); n as usize];
@@ -62,11 +84,18 @@ impl VolumeData {
     /// and holds three coarse planes at most besides the result. A rectilinear grid is
     /// refused.
     pub fn downsampled(&self, factor: u32) -> Result<VolumeData> {
-        downsample(self, factor)
+        downsample(self, factor, false)
+    }
+
+    /// [`VolumeData::downsampled`] with coarse point i at fine point i·`factor` (spacing ×
+    /// factor; past the last fine point the tent reads the last): a coarse brick then holds
+    /// the same box as `factor`³ fine ones (resources/lod.rs).
+    pub(crate) fn downsampled_on_lattice(&self, factor: u32) -> Result<VolumeData> {
+        downsample(self, factor, true)
     }
 }
 
-fn downsample(v: &VolumeData, factor: u32) -> Result<VolumeData> {
+fn downsample(v: &VolumeData, factor: u32, lattice: bool) -> Result<VolumeData> {
     if factor == 0 {
         return Err(Error::InvalidParameter(
             "a downsampling factor of 0: give 1 or more fine points per coarse point".into(),
@@ -80,9 +109,16 @@ fn downsample(v: &VolumeData, factor: u32) -> Result<VolumeData> {
     let [nx, ny, nz] = v.dims;
     let [mx, my, mz] = v.dims.map(|n| coarse_points(n, factor));
     let c = v.components as usize;
-    let wx = tent_weights(nx, mx);
-    let to_y = by_fine(&tent_weights(ny, my), ny);
-    let wz = tent_weights(nz, mz);
+    let weights = |n, m| {
+        if lattice {
+            lattice_weights(n, m, factor)
+        } else {
+            tent_weights(n, m)
+        }
+    };
+    let wx = weights(nx, mx);
+    let to_y = by_fine(&weights(ny, my), ny);
+    let wz = weights(nz, mz);
     let to_z = by_fine(&wz, nz);
     let last_z: Vec<usize> = wz.iter().map(|w| w.last().expect("a weight").0).collect();
     let plane_len = mx as usize * my as usize * c;
@@ -126,7 +162,9 @@ fn downsample(v: &VolumeData, factor: u32) -> Result<VolumeData> {
         }
     }
     let r = |a: usize, n: u32, m: u32| {
-        if m > 1 {
+        if lattice && n > 1 {
+            v.spacing[a] * factor as f64
+        } else if m > 1 {
             v.spacing[a] * (n - 1) as f64 / (m - 1) as f64
         } else {
             v.spacing[a]
@@ -191,6 +229,32 @@ mod tests {
             }
             // every fine point is read by some coarse point
             assert!(by_fine(&w, n).iter().all(|t| !t.is_empty()));
+        }
+    }
+
+    #[test]
+    fn lattice_levels_put_coarse_point_i_on_fine_point_i_times_the_factor() {
+        // f = x along 6 points (5 cells), factor 2: coarse points on fine 0, 2, 4 and 6 (past
+        // the end, reading the last point); inside, the tent reproduces the field exactly
+        let v = VolumeData::new(
+            [6, 1, 1],
+            1,
+            Scalars::F32((0..6).map(|x| x as f32).collect()),
+        )
+        .unwrap()
+        .with_spacing([0.5, 1.0, 1.0])
+        .unwrap();
+        let c = v.downsampled_on_lattice(2).unwrap();
+        assert_eq!(c.dims, [4, 1, 1]);
+        assert_eq!(c.spacing, [1.0, 1.0, 1.0]);
+        let values: Vec<f64> = (0..4).map(|i| c.scalars.get(i)).collect();
+        assert!((values[1] - 2.0).abs() < 1e-6 && (values[2] - 4.0).abs() < 1e-6);
+        assert!(
+            (values[3] - 5.0).abs() < 1e-6,
+            "the edge, clamped: {values:?}"
+        );
+        for w in lattice_weights(6, 4, 2) {
+            assert!((w.iter().map(|&(_, x)| x).sum::<f64>() - 1.0).abs() < 1e-12);
         }
     }
 

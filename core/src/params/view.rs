@@ -96,6 +96,11 @@ pub struct Residency {
     pub level: u32,
     /// That level's points per axis.
     pub level_dims: [u32; 3],
+    /// Bricks the last frame's rays read from a coarser level standing in for them: a
+    /// preview frame ([`super::RenderParams::preview_level`]) of ray casting past the budget
+    /// draws the fine bricks it has and a coarser level's where they are missing, and brings
+    /// some of those for the next; 0 when every sample came from the volume itself.
+    pub stand_ins: u32,
 }
 
 /// A finished frame read back to the CPU.

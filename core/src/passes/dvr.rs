@@ -138,7 +138,24 @@ impl DvrPass {
             Some(bricks_in_view(res, view, params)?)
         };
         let front = visibility_order(res, view, params)?;
-        let plan = res.plan_streaming(ctx, needed, &front, in_view.as_deref())?;
+        // A preview past the budget draws coarser bricks where fine ones are missing (masks,
+        // blanking and intermixed volumes have no coarser levels: such a preview streams).
+        let lod = match in_view.as_deref() {
+            Some(in_view)
+                if params.preview_level
+                    && params.blend != BlendMode::Slice
+                    && res.mask.is_none()
+                    && res.blanking.is_none()
+                    && res.intermix.is_none() =>
+            {
+                res.enter_lod(ctx, needed, &front, in_view)?
+            }
+            _ => false,
+        };
+        let plan = match lod {
+            true => None,
+            false => res.plan_streaming(ctx, needed, &front, in_view.as_deref())?,
+        };
         let occupied = res.occupancy.as_ref().map_or(1.0, |o| o.fraction);
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
@@ -419,6 +436,9 @@ impl DvrPass {
                     res.streamed_pass(&plan, g);
                 }
             }
+        }
+        if lod {
+            res.read_lod_requests(ctx)?;
         }
         res.stats.frames += 1;
         Ok(())

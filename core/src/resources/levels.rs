@@ -29,8 +29,6 @@ pub(crate) struct Level {
 /// The bricks a frame that draws a coarser level past the budget needs resident, at
 /// whatever level it draws.
 pub(crate) enum LevelDemand {
-    /// Every brick (a preview of MIP, MinIP, average or additive).
-    All,
     /// Those the transfer function makes visible (path tracing, volumetric shadows).
     Visible,
     /// Those where component `component` takes one of `values` (ambient occlusion around
@@ -154,7 +152,6 @@ impl Resources {
         in_view: InView<'_>,
     ) -> Result<(u32, u32)> {
         let visible = match demand {
-            LevelDemand::All => false,
             LevelDemand::Visible => true,
             LevelDemand::Surfaces { visible, .. } => *visible,
         };
@@ -165,7 +162,6 @@ impl Resources {
         let vol = self.volume()?;
         let occupied = self.occupancy.as_ref().map(|o| &o.flags[..]);
         let flags = match demand {
-            LevelDemand::All => None,
             LevelDemand::Visible => occupied.map(<[u32]>::to_vec),
             LevelDemand::Surfaces {
                 values, component, ..

@@ -7,6 +7,7 @@ pub(crate) mod environment;
 pub(crate) mod gradients;
 pub(crate) mod intermix;
 pub(crate) mod levels;
+pub(crate) mod lod;
 pub(crate) mod residency;
 pub(crate) mod tables;
 pub(crate) mod targets;
@@ -29,7 +30,8 @@ use volume::GpuVolume;
 /// or rebuilt on demand by its `ensure_*` function when what decides its contents changed.
 pub(crate) struct Resources {
     /// Layout of the volume's bind group (group 1 of every pass that samples the volume):
-    /// pool uniforms, pool texture, sampler, gradient pool, page table, empty bricks' values.
+    /// pool uniforms, pool texture, sampler, gradient pool, page table, empty bricks' values,
+    /// the bricks a preview frame read from a coarser level (lod.rs).
     pub brick_bgl: wgpu::BindGroupLayout,
     pub nearest: wgpu::Sampler,
     linear: wgpu::Sampler,
@@ -90,6 +92,7 @@ impl Resources {
                     wgpu::TextureViewDimension::D3,
                 ),
                 texture_entry(5, false, wgpu::TextureViewDimension::D3),
+                buffer_entry(6, wgpu::BufferBindingType::Storage { read_only: false }),
             ],
         });
         let sampler = |f: wgpu::FilterMode| {

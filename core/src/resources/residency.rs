@@ -36,9 +36,16 @@ impl Slots {
         self.brick_in.len() as u32
     }
 
-    /// Bricks resident.
-    pub fn resident(&self) -> u32 {
-        self.brick_in.iter().filter(|b| b.is_some()).count() as u32
+    /// Ids from 0 to `bricks` (more than before: new ids, not resident; fewer: those past
+    /// it are evicted, their slots free).
+    pub fn set_bricks(&mut self, bricks: usize) {
+        for b in self.brick_in.iter_mut() {
+            if b.is_some_and(|b| b >= bricks) {
+                *b = None;
+            }
+        }
+        self.slot_of.resize(bricks, None);
+        self.last_used.resize(bricks, 0);
     }
 
     /// Starts a frame or a streamed pass: bricks used from now on are the current ones.
@@ -247,7 +254,7 @@ mod tests {
         );
         // the pool grows only when the bricks asked for exceed it
         assert_eq!(s.allocated(), 4);
-        assert_eq!(s.resident(), 4);
+        assert_eq!((0..6).filter(|&b| s.slot_of(b).is_some()).count(), 4);
         // shrinking keeps the needed bricks, then the most recently used
         let moves = s.shrink(2, &[false, false, true, false, false, false]);
         assert_eq!(moves, [(2, 0), (3, 1)]);

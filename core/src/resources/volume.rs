@@ -11,9 +11,9 @@ use super::residency::{self, Slots, NOT_LATER};
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, sampled_texture_entry};
-use crate::gpu::buffers::uniform_buffer;
+use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
-use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS};
+use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS, READ_STAND_IN};
 use crate::gpu::Context;
 use crate::params::{MaskKind, Residency, UploadOptions, VolumeData};
 use glam::DMat4;
@@ -83,6 +83,7 @@ impl HostVolume<'_> {
 }
 
 /// Which bricks a frame needs resident.
+#[derive(Clone, Copy)]
 pub(crate) enum Needed<'a> {
     /// All of them (the projection modes read every value).
     All,
@@ -114,19 +115,62 @@ pub(crate) struct GpuVolume {
     /// The memory budget: most bytes of the pool (with precomputed gradients).
     pub(super) max_bytes: u64,
     /// Which brick is in which slot, and when each was last used.
-    slots: Slots,
+    pub(super) slots: Slots,
     /// Layers of slots the pool texture has.
-    layers: u32,
+    pub(super) layers: u32,
     pool: Option<wgpu::Texture>,
     gradient: Option<wgpu::Texture>,
-    page: Vec<u32>,
+    /// Per brick, the page table's entry: x the slot (or PAGE_EMPTY / PAGE_MISSING), y the
+    /// log2 factor of a coarser level's brick standing in for it (lod.rs), else 0.
+    pub(super) page: Vec<[u32; 2]>,
     page_table: wgpu::Texture,
+    /// Per brick, set by rays that read it from a coarser level's stand-in (binding 6).
+    pub(super) requests: wgpu::Buffer,
+    /// The coarser level whose bricks stand in for missing ones in preview frames.
+    pub(super) lod: Option<Lod>,
     constants: wgpu::Texture,
     uniform: wgpu::Buffer,
     /// Bind groups through the linear and the nearest sampler, once the pool exists.
-    groups: Option<[wgpu::BindGroup; 2]>,
+    pub(super) groups: Option<[wgpu::BindGroup; 2]>,
     /// What the volume was uploaded with (its coarser levels are uploaded alike).
     pub opts: UploadOptions,
+}
+
+/// A coarser level of the volume whose bricks stand in for fine ones in preview frames
+/// (lod.rs).
+pub(crate) struct Lod {
+    /// log2 of the level's factor (fine points per coarse point along each axis).
+    pub shift: u32,
+    /// The level's bricks: the volume's brick size, a coarse brick over the box of
+    /// factor³ fine ones.
+    pub grid: BrickGrid,
+    /// The level's points (coarse point i at fine point i·factor).
+    pub host: Arc<VolumeData>,
+    /// The level's bricks are in the slots, by ids after the volume's bricks.
+    pub active: bool,
+    /// Per fine brick, what the last preview frame's rays read there (0: nothing).
+    pub reads: Vec<u32>,
+}
+
+impl Lod {
+    /// The level's bricks are in the slots (a preview frame is being drawn).
+    pub fn active(&self) -> bool {
+        self.active
+    }
+
+    /// The level's bricks are no longer in the slots.
+    pub fn deactivate(&mut self) {
+        self.active = false;
+    }
+
+    /// Fine bricks the last preview frame read from a stand-in (0: it drew the volume).
+    pub fn stand_ins_read(&self) -> u32 {
+        if self.active {
+            self.reads.iter().filter(|&&r| r == READ_STAND_IN).count() as u32
+        } else {
+            0
+        }
+    }
 }
 
 impl GpuVolume {
@@ -152,7 +196,9 @@ impl GpuVolume {
         let bytes = |n: [u32; 3]| n.iter().map(|&d| d as u64).product::<u64>() * point;
         Residency {
             bricks: self.grid.len() as u32,
-            resident: self.slots.resident(),
+            resident: (0..self.grid.len())
+                .filter(|&b| self.slots.slot_of(b).is_some())
+                .count() as u32,
             pool_bytes: self.pool.as_ref().map_or(0, |t| {
                 let s = t.size();
                 bytes([s.width, s.height, s.depth_or_array_layers])
@@ -160,6 +206,7 @@ impl GpuVolume {
             dense_bytes: bytes(self.data_dims),
             level: 1,
             level_dims: self.data_dims,
+            stand_ins: self.lod.as_ref().map_or(0, |l| l.stand_ins_read()),
         }
     }
 }
@@ -249,9 +296,15 @@ pub(super) fn new_volume(
             c[comp] = (lo[comp] - layout.shift[comp]) / layout.scale[comp];
         }
     }
-    let page = vec![PAGE_EMPTY; grid.len()];
+    let page = vec![[PAGE_EMPTY, 0]; grid.len()];
     let page_table = block_grid_texture(ctx, "page table", grid.counts, &page);
     let constants = block_grid_texture(ctx, "empty bricks' values", grid.counts, &constants);
+    let requests = buffer(
+        ctx,
+        "brick requests",
+        4 * grid.len() as u64,
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    );
     let uniform = uniform_buffer(
         ctx,
         "pool uniforms",
@@ -286,6 +339,8 @@ pub(super) fn new_volume(
         gradient: None,
         page,
         page_table,
+        requests,
+        lod: None,
         constants,
         uniform,
         groups: None,
@@ -377,7 +432,7 @@ impl Resources {
         upload_texture(&ctx.queue, &pool, texels, vol.layout.texel_bytes);
         vol.pool = Some(pool);
         vol.slots.place(&[0], |_| NOT_LATER, 1, 1);
-        vol.page[0] = 0;
+        vol.page[0] = [0, 0];
         vol.layers = 1;
         self.finish_residency(ctx)
     }
@@ -446,7 +501,7 @@ impl Resources {
     }
 
     /// Runs `f` with the block flags `needed` stands for (`None`: every brick).
-    fn with_flags<T>(
+    pub(super) fn with_flags<T>(
         &mut self,
         needed: Needed<'_>,
         f: impl FnOnce(&mut Resources, Option<&[u32]>) -> Result<T>,
@@ -472,6 +527,7 @@ impl Resources {
         flags: Option<&[u32]>,
         stream: Option<(&FrontToBack, Option<&[bool]>)>,
     ) -> Result<Option<StreamPlan>> {
+        self.leave_lod();
         let vol = self
             .volume
             .as_mut()
@@ -538,13 +594,13 @@ impl Resources {
 
     /// After the pool changed: the page table, the pool's gradients, uniforms and bind
     /// groups.
-    fn finish_residency(&mut self, ctx: &Context) -> Result<()> {
+    pub(super) fn finish_residency(&mut self, ctx: &Context) -> Result<()> {
         let vol = self.volume.as_mut().expect("a volume");
         upload_texture(
             &ctx.queue,
             &vol.page_table,
             bytemuck::cast_slice(&vol.page),
-            4,
+            8,
         );
         let pool = vol.pool.as_ref().expect("a pool");
         let view = pool.create_view(&Default::default());
@@ -559,7 +615,12 @@ impl Resources {
         let s = pool.size();
         let g = &vol.grid;
         let pu = PoolUniforms {
-            brick: [g.brick_cells as f32, g.apron as f32, 0.0, 0.0],
+            brick: [
+                g.brick_cells as f32,
+                g.apron as f32,
+                vol.lod.as_ref().is_some_and(|l| l.active()) as u32 as f32,
+                0.0,
+            ],
             grid: [g.counts[0], g.counts[1], g.counts[2], 0],
             slot: [g.slot[0] as f32, g.slot[1] as f32, g.slot[2] as f32, 0.0],
             inv_size: [
@@ -591,6 +652,7 @@ impl Resources {
                     ),
                     bind(4, wgpu::BindingResource::TextureView(&page_view)),
                     bind(5, wgpu::BindingResource::TextureView(&constants_view)),
+                    bind(6, vol.requests.as_entire_binding()),
                 ],
             })
         };
@@ -635,7 +697,7 @@ pub(crate) struct StreamPlan {
 }
 
 /// Per brick: whether it overlaps a block flagged in `flags` (all bricks without).
-fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
+pub(super) fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
     let grid = vol.grid;
     let bd = vol.minmax.dims;
     (0..grid.len())
@@ -668,7 +730,7 @@ pub(super) fn slot_bytes(vol: &GpuVolume) -> u64 {
 }
 
 /// Slots the memory budget holds: whole layers, at most the 3D texture limit's.
-fn capacity(vol: &GpuVolume) -> u32 {
+pub(super) fn capacity(vol: &GpuVolume) -> u32 {
     let layer = vol.grid.layer_slots() as u64 * slot_bytes(vol);
     let layers = (vol.max_bytes / layer).min(vol.grid.slots[2] as u64) as u32;
     layers * vol.grid.layer_slots()
@@ -699,10 +761,19 @@ pub(super) fn size_text(bytes: u64) -> String {
 /// No brick resident and no pool (after a failed upload: the next frame starts again).
 pub(super) fn forget(vol: &mut GpuVolume) {
     vol.slots = Slots::new(vol.grid.len());
-    vol.page.fill(PAGE_EMPTY);
+    vol.page.fill([PAGE_EMPTY, 0]);
+    if let Some(lod) = vol.lod.as_mut() {
+        lod.deactivate();
+    }
     vol.pool = None;
     vol.layers = 0;
     vol.groups = None;
+}
+
+/// The page-table entry of a brick in slot `s`.
+pub(super) fn slot_entry(grid: &BrickGrid, s: u32) -> u32 {
+    let [sx, sy, sz] = slot_position(grid, s);
+    sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS)
 }
 
 /// Where slot `s` lies in the pool, in slots per axis.
@@ -760,7 +831,7 @@ fn shrink(ctx: &Context, vol: &mut GpuVolume, layers: u32, needed: &[bool]) {
 /// Applies a placement: the pool grown to the slots allocated (the old pool copied), the
 /// bricks `moves` names read from `host` into their slots, and the page table: resident
 /// bricks at their slots, bricks `missing` marks PAGE_MISSING, the rest empty.
-fn apply_moves(
+pub(super) fn apply_moves(
     ctx: &Context,
     vol: &mut GpuVolume,
     host: &VolumeData,
@@ -782,12 +853,13 @@ fn apply_moves(
     }
     let pool = vol.pool.as_ref().expect("allocated above");
     for &(i, slot) in moves {
-        let texels = bricks::brick_texels(
-            host,
-            &vol.layout,
-            grid.slot_origin_point(grid.cell(i)),
-            grid.slot,
-        )?;
+        // (ids past the volume's bricks are a coarser level's, lod.rs)
+        let (data, g, j) = match vol.lod.as_ref() {
+            Some(l) if i >= grid.len() => (&*l.host, &l.grid, i - grid.len()),
+            _ => (host, &grid, i),
+        };
+        let texels =
+            bricks::brick_texels(data, &vol.layout, g.slot_origin_point(g.cell(j)), g.slot)?;
         let p = slot_position(&grid, slot);
         let origin = [
             p[0] * grid.slot[0],
@@ -805,12 +877,9 @@ fn apply_moves(
     }
     for (i, page) in vol.page.iter_mut().enumerate() {
         *page = match vol.slots.slot_of(i) {
-            Some(s) => {
-                let [sx, sy, sz] = slot_position(&grid, s);
-                sx | sy << PAGE_SLOT_BITS | sz << (2 * PAGE_SLOT_BITS)
-            }
-            None if missing(i) => PAGE_MISSING,
-            None => PAGE_EMPTY,
+            Some(s) => [slot_entry(&grid, s), 0],
+            None if missing(i) => [PAGE_MISSING, 0],
+            None => [PAGE_EMPTY, 0],
         };
     }
     Ok(())

@@ -794,12 +794,13 @@ fn streamed_frames_equal_in_core_ones() {
     }
 }
 
-/// Interactive frames ([`RenderParams::preview_level`]) of a volume whose needed bricks
+/// Interactive frames ([`RenderParams::preview_level`]) of isosurfaces whose needed bricks
 /// exceed the budget draw the finest coarser level that fits, in one pass, exactly as that
 /// level uploaded as the volume draws; the still frame after them streams and equals the
-/// in-core image; a volume that fits draws itself, and so does a masked one (streamed).
+/// in-core image; a volume that fits draws itself, and a masked one streams (ray casting's
+/// previews: render/lod.rs).
 #[test]
-fn preview_frames_draw_a_coarser_level_in_one_pass() {
+fn isosurface_previews_draw_a_coarser_level_in_one_pass() {
     let mut r = renderer();
     let vol = blob_volume(40);
     r.set_transfer_function(&TransferFunction::single(blob_transfer()))
@@ -816,11 +817,8 @@ fn preview_frames_draw_a_coarser_level_in_one_pass() {
         memory_budget: Some(dense / 4),
         ..Default::default()
     };
-    for blend in [
-        BlendMode::Composite,
-        BlendMode::Maximum,
-        BlendMode::Isosurface,
-    ] {
+    {
+        let blend = BlendMode::Isosurface;
         let still = RenderParams {
             blend,
             sample_distance: Some(1.0),

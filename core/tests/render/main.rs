@@ -16,6 +16,7 @@ mod bricks;
 mod common;
 mod compositing;
 mod intermix;
+mod lod;
 mod masks;
 mod preintegration;
 mod rectilinear;

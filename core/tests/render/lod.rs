@@ -1,0 +1,169 @@
+//! Level of detail per brick in interactive frames ([`RenderParams::preview_level`]) of ray
+//! casting past the memory budget: one pass, fine bricks where resident and a coarser
+//! level's bricks standing in elsewhere; the bricks the rays read from a stand-in come in
+//! the next frames, so frames of a still camera converge to the in-core image, and bricks no
+//! ray reaches are never brought.
+
+use crate::common::gpu::renderer;
+use crate::common::images::save_enlarged;
+use crate::common::metrics::{footprint, image_diff};
+use crate::common::scenes::{blob_transfer, blob_volume, component_transfer, volume};
+use ferrovol_core::*;
+
+fn psnr(a: &Image, b: &Image) -> f64 {
+    let mse = a
+        .rgba
+        .iter()
+        .zip(&b.rgba)
+        .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
+        .sum::<f64>()
+        / a.rgba.len() as f64;
+    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
+}
+
+/// The first preview frame past the budget draws in one pass, from the stand-ins where fine
+/// bricks are missing, close to the in-core image; the still frame streams and equals it.
+#[test]
+fn previews_draw_coarser_bricks_where_fine_ones_are_missing() {
+    let mut r = renderer();
+    let vol = blob_volume(40);
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let view = View::fit(vol.bounds(), 64, 64);
+    let dense = 40u64.pow(3) * 4;
+    let budget = UploadOptions {
+        max_brick_points: Some(12),
+        memory_budget: Some(dense / 4),
+        ..Default::default()
+    };
+    for blend in [BlendMode::Composite, BlendMode::Maximum] {
+        let still = RenderParams {
+            blend,
+            sample_distance: Some(1.0),
+            ..Default::default()
+        };
+        let preview = RenderParams {
+            preview_level: true,
+            ..still.clone()
+        };
+        r.set_volume(&vol).unwrap();
+        let in_core = r.render_image(&view, &still).unwrap();
+        let fits = r.render_image(&view, &preview).unwrap();
+        assert_eq!(image_diff(&in_core, &fits).1, 0, "{blend:?}: fits");
+        assert_eq!(r.residency().stand_ins, 0);
+        r.set_volume_with(&vol, budget).unwrap();
+        let passes = r.stats().streamed_passes;
+        let first = r.render_image(&view, &preview).unwrap();
+        let res = r.residency();
+        assert_eq!(r.stats().streamed_passes, passes, "{blend:?}: one pass");
+        save_enlarged(&first, &format!("lod_first_{blend:?}"));
+        let (mean, max) = image_diff(&first, &in_core);
+        println!(
+            "{blend:?}: first preview {:.1} dB from in core (mean {mean:.3}/255, max \
+             {max}/255), {} bricks read from stand-ins, {} of {} fine bricks resident, pool \
+             {} of {} bytes",
+            psnr(&first, &in_core),
+            res.stand_ins,
+            res.resident,
+            res.bricks,
+            res.pool_bytes,
+            dense / 4
+        );
+        assert!(footprint(&first) * 2 > footprint(&in_core));
+        assert!(res.stand_ins > 0 && res.pool_bytes <= dense / 4, "{res:?}");
+        assert!(psnr(&first, &in_core) > 20.0, "{blend:?}: close to in core");
+        let streamed = r.render_image(&view, &still).unwrap();
+        assert!(
+            r.stats().streamed_passes >= passes + 2,
+            "the still frame streams"
+        );
+        assert!(
+            image_diff(&streamed, &in_core).1 <= 2,
+            "{blend:?}: and equals in core"
+        );
+        assert_eq!(
+            r.residency().stand_ins,
+            0,
+            "no stand-in after a still frame"
+        );
+    }
+}
+
+/// A box whose top slab (toward the camera) is opaque over a translucent inside: every brick
+/// is visible and in view, too many for the budget, but the rays stop in the top layer of
+/// bricks. Preview frames of a still camera bring the bricks the rays read, a share of the
+/// pool per frame, until none is read from a stand-in: then the frame equals the in-core
+/// image, and the bricks below the slab were never brought.
+#[test]
+fn previews_converge_to_the_fine_image_and_bring_only_what_rays_read() {
+    let mut r = renderer();
+    let n = 96u32;
+    // (a pattern in the slab, finer than the stand-ins' points)
+    let vol = volume([n; 3], |x, y, z| match z >= (n - 7) as f64 {
+        true => 0.8 + 0.2 * (x / 1.5).sin() * (y / 2.0).sin(),
+        false => 0.3,
+    });
+    r.set_transfer_function(&TransferFunction::single(component_transfer(
+        &[
+            (0.0, [0.2, 0.3, 0.9]),
+            (0.6, [0.2, 0.3, 0.9]),
+            (1.0, [1.0, 0.8, 0.3]),
+        ],
+        &[(0.0, 0.0), (0.3, 0.05), (0.55, 1.0), (1.0, 1.0)],
+        1.0,
+    )))
+    .unwrap();
+    let view = View::fit(vol.bounds(), 64, 64);
+    let still = RenderParams {
+        sample_distance: Some(1.0),
+        ..Default::default()
+    };
+    let preview = RenderParams {
+        preview_level: true,
+        ..still.clone()
+    };
+    r.set_volume(&vol).unwrap();
+    let in_core = r.render_image(&view, &still).unwrap();
+    let dense = (n as u64).pow(3) * 4;
+    // 50 slots: stand-ins from the level twice as coarse; 36: four times, so that the bricks
+    // the rays read fit beside them
+    for budget in [dense * 4 / 5, dense * 9 / 16] {
+        r.set_volume_with(
+            &vol,
+            UploadOptions {
+                max_brick_points: Some(24),
+                memory_budget: Some(budget),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let uploads = r.stats().brick_uploads;
+        let mut frames = Vec::new();
+        let complete = loop {
+            let img = r.render_image(&view, &preview).unwrap();
+            let res = r.residency();
+            frames.push((res.stand_ins, res.resident, psnr(&img, &in_core)));
+            if res.stand_ins == 0 || frames.len() == 12 {
+                break (res.stand_ins == 0).then_some((img, res));
+            }
+        };
+        let Some((img, res)) = complete else {
+            panic!("never complete: (stand-ins read, resident, PSNR) per frame {frames:?}");
+        };
+        let (mean, max) = image_diff(&img, &in_core);
+        println!(
+            "budget {budget}: complete after {} frames {frames:?}: {mean:.4}/255 mean, \
+             {max}/255 max from in core; {} of {} bricks resident, {} uploads",
+            frames.len(),
+            res.resident,
+            res.bricks,
+            r.stats().brick_uploads - uploads
+        );
+        assert!(max <= 2, "the complete preview equals in core");
+        assert!(
+            res.resident * 3 < res.bricks,
+            "the bricks under the slab never came: {res:?}"
+        );
+        assert!(frames[0].0 > 0 && frames[0].2 < frames[frames.len() - 1].2);
+    }
+}
