@@ -72,7 +72,7 @@ fn cell_at(p: vec3<f32>) -> Cell {
     let q = locate(p);
     c.lo = vec3<i32>(brick.slot_lo);
     c.hi = vec3<i32>(brick.slot_hi);
-    let t = clamp(q - brick.tex_lo, brick.slot_lo, brick.slot_hi);
+    let t = clamp(q * brick.inv_scale - brick.tex_lo, brick.slot_lo, brick.slot_hi);
     c.i0 = clamp(vec3<i32>(floor(t)), c.lo, max(c.hi - 1, c.lo));
     c.f = t - vec3<f32>(c.i0);
     return c;
@@ -130,7 +130,8 @@ fn exact_gradient(p: vec3<f32>) -> vec3<f32> {
     if (!SINGLE_BRICK && brick.empty) {
         g = vec3<f32>(0.0);
     }
-    return 0.5 * frame.scalar_scale[ISO_COMP] * g;
+    // (per pool texel: a coarser level's stand-in spans 1 / inv_scale index units)
+    return 0.5 * frame.scalar_scale[ISO_COMP] * brick.inv_scale * g;
 }
 
 // The field the surfaces are of at p, and its index-space gradient: the exact trilinear

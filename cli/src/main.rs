@@ -178,9 +178,8 @@ struct RenderArgs {
     gpu_memory: Option<u64>,
     /// With --gpu-memory: a frame whose bricks exceed it draws in one pass, as an interactive
     /// frame would, instead of streaming the volume itself (the still image): ray casting
-    /// draws the fine bricks resident and a coarser level's where they are missing, and
-    /// brings those its rays read for the next frames (see --repeat); isosurfaces draw the
-    /// finest coarser level that fits
+    /// and isosurfaces draw the fine bricks resident and a coarser level's where they are
+    /// missing, and bring those their rays read for the next frames (see --repeat)
     #[arg(long)]
     preview_level: bool,
     /// Render this many frames and print the mean time per frame (the first, which builds

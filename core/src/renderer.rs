@@ -33,22 +33,6 @@ pub struct Renderer {
     pt_params: PathTraceParams,
 }
 
-/// The bricks a preview frame ([`RenderParams::preview_level`]) of isosurfaces needs at
-/// whatever level it draws; none for the other modes (ray casting draws coarser bricks
-/// where fine ones are missing, resources/lod.rs).
-fn preview_demand(
-    res: &Resources,
-    params: &RenderParams,
-    iso: Option<&IsoParams>,
-) -> Result<Option<LevelDemand>> {
-    Ok(match (params.blend, iso) {
-        (BlendMode::Isosurface, Some(iso)) if res.volume.is_some() => {
-            Some(iso::surfaces_demand(iso, res, false)?)
-        }
-        _ => None,
-    })
-}
-
 /// The pass in `slot`, created by `new` on first use.
 fn ensure<T>(slot: &mut Option<T>, new: impl FnOnce() -> Result<T>) -> Result<&mut T> {
     if slot.is_none() {
@@ -379,24 +363,11 @@ impl Renderer {
             }
             _ => None,
         };
-        let in_view = |res: &Resources| frame::bricks_in_view(res, view, params);
-        let level = match anywhere {
-            Some((demand, what)) => Some((demand, None, what)),
-            // (masks and blanking are not downsampled: such a preview streams)
-            None if params.preview_level && res.mask.is_none() && res.blanking.is_none() => {
-                preview_demand(res, params, self.iso_params.as_ref())?.map(|d| {
-                    (
-                        d,
-                        Some(&in_view as &dyn Fn(&Resources) -> Result<Vec<bool>>),
-                        "a preview frame",
-                    )
-                })
-            }
-            None => None,
-        };
-        match &level {
-            Some((demand, in_view, what)) if res.intermix.is_none() => {
-                res.enter_level(ctx, params, (demand, *in_view), what)?
+        // (preview frames past the budget draw coarser bricks where fine ones are missing,
+        // resources/lod.rs)
+        match &anywhere {
+            Some((demand, what)) if res.intermix.is_none() => {
+                res.enter_level(ctx, params, demand, what)?
             }
             _ => res.release_level(),
         }

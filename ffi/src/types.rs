@@ -301,11 +301,10 @@ pub struct FvRenderParams {
     pub mask_blend_factor: f32,
     /// An interactive frame: when the bricks it needs exceed the memory budget, draw in one
     /// pass rather than stream the volume itself in several (false, the default: the frame
-    /// streams and equals the in-core image). Ray casting draws the fine bricks resident and
-    /// a coarser level's bricks where they are missing, and brings some of those its rays
-    /// read for the next preview frame (FvResidency.stand_ins: 0 once complete);
-    /// isosurfaces draw the finest coarser level whose needed bricks fit
-    /// (FvResidency.level).
+    /// streams and equals the in-core image). Ray casting and isosurfaces (without ambient
+    /// occlusion or scattering) draw the fine bricks resident and a coarser level's bricks
+    /// where they are missing, and bring some of those their rays read for the next
+    /// preview frame (FvResidency.stand_ins: 0 once complete).
     pub preview_level: bool,
 }
 

@@ -213,10 +213,12 @@ pub struct RenderParams {
     /// rather than the transfer function's components (0: the mask is not read).
     pub mask_blend: f32,
     /// An interactive frame of a volume whose needed bricks exceed the memory budget: draw
-    /// the finest coarser level whose needed bricks fit, in one pass, rather than stream the
-    /// volume itself through the pool in several (a still frame streams, and equals the
-    /// in-core image). Ray casting (not the slice mode) and isosurfaces, without a mask
-    /// (masks are not downsampled: a masked frame streams); the frames whose rays go
+    /// in one pass, the fine bricks resident and a coarser level's bricks standing in where
+    /// they are missing, rather than stream the volume itself through the pool in several
+    /// (a still frame streams, and equals the in-core image); the bricks the rays read from
+    /// stand-ins come in the next preview frames ([`crate::Residency::stand_ins`]: 0 once
+    /// complete). Ray casting (not the slice mode) and the isosurfaces' first hit, without a
+    /// mask or blanking (not downsampled: such a frame streams); the frames whose rays go
     /// anywhere draw a coarser level past the budget anyway.
     pub preview_level: bool,
 }

@@ -443,6 +443,7 @@ impl IsoPass {
         let component = iso_component(res.tf.as_ref(), res.volume()?.components);
         self.ensure_occupancy(ctx, res, &values, component)?;
         let surfaces = &self.occupancy.as_ref().expect("built above").flags;
+        let mut lod = false;
         let plan = if iso.scattering.is_some() {
             // the scattering also reads the transfer function's opacity between the surfaces
             res.ensure_occupancy(ctx, step)?;
@@ -459,7 +460,22 @@ impl IsoPass {
                 Some(bricks_in_view(res, view, params)?)
             };
             let front = visibility_order(res, view, params)?;
-            res.plan_streaming(ctx, Needed::Blocks(surfaces), &front, in_view.as_deref())?
+            // A preview past the budget draws coarser bricks where fine ones are missing
+            // (masks and blanking have no coarser levels: such a preview streams).
+            lod = match in_view.as_deref() {
+                Some(in_view)
+                    if params.preview_level && res.mask.is_none() && res.blanking.is_none() =>
+                {
+                    res.enter_lod(ctx, Needed::Blocks(surfaces), &front, in_view)?
+                }
+                _ => false,
+            };
+            match lod {
+                true => None,
+                false => {
+                    res.plan_streaming(ctx, Needed::Blocks(surfaces), &front, in_view.as_deref())?
+                }
+            }
         };
         if plan.is_some() {
             check_streamable(res, params, iso, step)?;
@@ -736,6 +752,9 @@ impl IsoPass {
         ctx.checked("rendering the isosurface frame", || {
             q.submit([enc.finish()]);
         })?;
+        if lod {
+            res.read_lod_requests(ctx)?;
+        }
         res.stats.frames += 1;
         Ok(())
     }

@@ -41,25 +41,21 @@ pub(crate) enum LevelDemand {
     },
 }
 
-/// Of a level's bricks, those some pixel's ray can reach (a frame whose rays stay on their
-/// pixels' lines: a preview); none for rays that go anywhere.
-pub(crate) type InView<'a> = Option<&'a dyn Fn(&Resources) -> Result<Vec<bool>>>;
-
 impl Resources {
-    /// Before a frame that cannot stream, or should not (`what` names it in errors): leaves
-    /// the volume as it is when the bricks `demand` names (within the view where `in_view`
-    /// says) fit the memory budget, dropping any coarser level's pool; otherwise swaps in
+    /// Before a frame that cannot stream (`what` names it in errors): leaves the volume as
+    /// it is when the bricks `demand` names fit the memory budget, dropping any coarser
+    /// level's pool; otherwise swaps in
     /// the finest coarser level whose needed bricks fit, building it if needed, and drops
     /// the fine level's pool. [`Resources::leave_level`] swaps back after the frame.
     pub fn enter_level(
         &mut self,
         ctx: &Context,
         params: &RenderParams,
-        (demand, in_view): (&LevelDemand, InView<'_>),
+        demand: &LevelDemand,
         what: &str,
     ) -> Result<()> {
         self.drawn_level = 1;
-        if self.fits(ctx, params, demand, in_view)? {
+        if self.fits(ctx, params, demand)? {
             self.release_level();
             return Ok(());
         }
@@ -72,7 +68,7 @@ impl Resources {
         }
         // The first level tried: the finest whose occupied share of its points fits
         // (without the bricks' aprons, so it may not; the next is tried then).
-        let (needed, _) = self.demand(ctx, params, demand, in_view)?;
+        let (needed, _) = self.demand(ctx, params, demand)?;
         let fine = self.volume()?;
         let share = needed as f64 / fine.grid.len() as f64;
         let point = fine.layout.texel_bytes as f64 + if fine.gradients { 8.0 } else { 0.0 };
@@ -96,7 +92,7 @@ impl Resources {
                 self.build_level(ctx, factor)?;
             }
             self.swap_level();
-            if self.fits(ctx, params, demand, in_view)? {
+            if self.fits(ctx, params, demand)? {
                 self.drawn_level = self.level.as_ref().expect("swapped in").factor;
                 return Ok(());
             }
@@ -131,25 +127,17 @@ impl Resources {
     }
 
     /// Whether the bricks `demand` names at the current level fit the memory budget.
-    fn fits(
-        &mut self,
-        ctx: &Context,
-        params: &RenderParams,
-        demand: &LevelDemand,
-        in_view: InView<'_>,
-    ) -> Result<bool> {
-        let (needed, capacity) = self.demand(ctx, params, demand, in_view)?;
+    fn fits(&mut self, ctx: &Context, params: &RenderParams, demand: &LevelDemand) -> Result<bool> {
+        let (needed, capacity) = self.demand(ctx, params, demand)?;
         Ok(self.volume()?.host.is_none() || needed <= capacity)
     }
 
-    /// The bricks `demand` names at the current level (in view where `in_view` says), and
-    /// the slots the budget holds.
+    /// The bricks `demand` names at the current level, and the slots the budget holds.
     fn demand(
         &mut self,
         ctx: &Context,
         params: &RenderParams,
         demand: &LevelDemand,
-        in_view: InView<'_>,
     ) -> Result<(u32, u32)> {
         let visible = match demand {
             LevelDemand::Visible => true,
@@ -176,8 +164,7 @@ impl Resources {
                 Some(flags)
             }
         };
-        let in_view = in_view.map(|f| f(self)).transpose()?;
-        Ok(volume::demand(vol, flags.as_deref(), in_view.as_deref()))
+        Ok(volume::demand(vol, flags.as_deref()))
     }
 
     /// Builds the level `factor` times coarser than the (fine, swapped-out) volume.

@@ -708,18 +708,10 @@ pub(super) fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool>
         .collect()
 }
 
-/// The bricks overlapping a block `flags` marks (all bricks without), of those `in_view`
-/// marks where given, and the slots the memory budget holds.
-pub(super) fn demand(
-    vol: &GpuVolume,
-    flags: Option<&[u32]>,
-    in_view: Option<&[bool]>,
-) -> (u32, u32) {
-    let needed = needed_bricks(vol, flags);
-    let count = match in_view {
-        Some(v) => needed.iter().zip(v).filter(|&(&n, &v)| n && v).count(),
-        None => needed.iter().filter(|&&n| n).count(),
-    } as u32;
+/// The bricks overlapping a block `flags` marks (all bricks without), and the slots the
+/// memory budget holds.
+pub(super) fn demand(vol: &GpuVolume, flags: Option<&[u32]>) -> (u32, u32) {
+    let count = needed_bricks(vol, flags).iter().filter(|&&n| n).count() as u32;
     (count, capacity(vol))
 }
 

@@ -21,14 +21,21 @@ fn psnr(a: &Image, b: &Image) -> f64 {
     10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
 }
 
-/// The first preview frame past the budget draws in one pass, from the stand-ins where fine
-/// bricks are missing, close to the in-core image; the still frame streams and equals it.
+/// The first preview frame past the budget draws in one pass (ray casting and the
+/// isosurfaces' first hit), from the stand-ins where fine bricks are missing, close to the
+/// in-core image; the still frame streams and equals it. A masked preview streams (masks
+/// have no coarser levels).
 #[test]
 fn previews_draw_coarser_bricks_where_fine_ones_are_missing() {
     let mut r = renderer();
     let vol = blob_volume(40);
     r.set_transfer_function(&TransferFunction::single(blob_transfer()))
         .unwrap();
+    r.set_isosurface(&IsoParams {
+        shininess: Shininess::Constant(32.0),
+        ..IsoParams::with_values(vec![IsoValue::new(0.3, [0.4, 0.6, 1.0], 1.0)])
+    })
+    .unwrap();
     let view = View::fit(vol.bounds(), 64, 64);
     let dense = 40u64.pow(3) * 4;
     let budget = UploadOptions {
@@ -36,7 +43,11 @@ fn previews_draw_coarser_bricks_where_fine_ones_are_missing() {
         memory_budget: Some(dense / 4),
         ..Default::default()
     };
-    for blend in [BlendMode::Composite, BlendMode::Maximum] {
+    for blend in [
+        BlendMode::Composite,
+        BlendMode::Maximum,
+        BlendMode::Isosurface,
+    ] {
         let still = RenderParams {
             blend,
             sample_distance: Some(1.0),
@@ -87,6 +98,21 @@ fn previews_draw_coarser_bricks_where_fine_ones_are_missing() {
             "no stand-in after a still frame"
         );
     }
+    r.set_volume_with(&vol, budget).unwrap();
+    r.set_mask(Some((&vec![1u8; 40 * 40 * 40], MaskKind::Binary)))
+        .unwrap();
+    let passes = r.stats().streamed_passes;
+    let preview = RenderParams {
+        preview_level: true,
+        ..Default::default()
+    };
+    let masked = r.render_image(&view, &preview).unwrap();
+    assert!(footprint(&masked) > 0, "masked preview drawn");
+    assert!(
+        r.stats().streamed_passes > passes,
+        "a masked preview streams"
+    );
+    assert_eq!(r.residency().stand_ins, 0);
 }
 
 /// A box whose top slab (toward the camera) is opaque over a translucent inside: every brick
