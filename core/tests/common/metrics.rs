@@ -3,6 +3,18 @@
 
 use ferrovol_core::Image;
 
+/// PSNR (dB) of an 8-bit image against another over every channel.
+pub fn psnr(img: &Image, reference: &Image) -> f64 {
+    let mse = img
+        .rgba
+        .iter()
+        .zip(&reference.rgba)
+        .map(|(a, b)| (*a as f64 - *b as f64).powi(2))
+        .sum::<f64>()
+        / img.rgba.len() as f64;
+    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
+}
+
 /// Pixel (x, y) as premultiplied RGBA bytes.
 pub fn rgba(img: &Image, x: u32, y: u32) -> [u8; 4] {
     let i = 4 * (y * img.width + x) as usize;

@@ -6,19 +6,30 @@
 
 use crate::common::gpu::renderer;
 use crate::common::images::save_enlarged;
-use crate::common::metrics::{footprint, image_diff};
+use crate::common::metrics::{footprint, image_diff, psnr};
 use crate::common::scenes::{blob_transfer, blob_volume, component_transfer, volume};
 use ferrovol_core::*;
 
-fn psnr(a: &Image, b: &Image) -> f64 {
-    let mse = a
-        .rgba
-        .iter()
-        .zip(&b.rgba)
-        .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
-        .sum::<f64>()
-        / a.rgba.len() as f64;
-    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
+/// The still and the preview parameters of `blend`, and the in-core image of `vol` (set
+/// without a budget) at `view`.
+fn in_core(
+    r: &mut Renderer,
+    vol: &VolumeData,
+    view: &View,
+    blend: BlendMode,
+) -> (RenderParams, RenderParams, Image) {
+    let still = RenderParams {
+        blend,
+        sample_distance: Some(1.0),
+        ..Default::default()
+    };
+    let preview = RenderParams {
+        preview_level: true,
+        ..still.clone()
+    };
+    r.set_volume(vol).unwrap();
+    let image = r.render_image(view, &still).unwrap();
+    (still, preview, image)
 }
 
 /// The first preview frame past the budget draws in one pass (ray casting and the
@@ -48,17 +59,7 @@ fn previews_draw_coarser_bricks_where_fine_ones_are_missing() {
         BlendMode::Maximum,
         BlendMode::Isosurface,
     ] {
-        let still = RenderParams {
-            blend,
-            sample_distance: Some(1.0),
-            ..Default::default()
-        };
-        let preview = RenderParams {
-            preview_level: true,
-            ..still.clone()
-        };
-        r.set_volume(&vol).unwrap();
-        let in_core = r.render_image(&view, &still).unwrap();
+        let (still, preview, in_core) = in_core(&mut r, &vol, &view, blend);
         let fits = r.render_image(&view, &preview).unwrap();
         assert_eq!(image_diff(&in_core, &fits).1, 0, "{blend:?}: fits");
         assert_eq!(r.residency().stand_ins, 0);
@@ -140,16 +141,7 @@ fn previews_converge_to_the_fine_image_and_bring_only_what_rays_read() {
     )))
     .unwrap();
     let view = View::fit(vol.bounds(), 64, 64);
-    let still = RenderParams {
-        sample_distance: Some(1.0),
-        ..Default::default()
-    };
-    let preview = RenderParams {
-        preview_level: true,
-        ..still.clone()
-    };
-    r.set_volume(&vol).unwrap();
-    let in_core = r.render_image(&view, &still).unwrap();
+    let (_, preview, in_core) = in_core(&mut r, &vol, &view, BlendMode::Composite);
     let dense = (n as u64).pow(3) * 4;
     // 50 slots: stand-ins from the level twice as coarse; 36: four times, so that the bricks
     // the rays read fit beside them

@@ -4,22 +4,11 @@
 
 use crate::common::gpu::{renderer, set_bricked};
 use crate::common::images::save_enlarged;
-use crate::common::metrics::{footprint, frame_diff, image_diff};
+use crate::common::metrics::{footprint, frame_diff, image_diff, psnr};
 use crate::common::scenes::{component_transfer, oblique, radial};
 use ferrovol_core::*;
 
 /// PSNR (dB) of `img` against `reference` over the RGBA bytes.
-fn psnr(img: &Image, reference: &Image) -> f64 {
-    let mse = img
-        .rgba
-        .iter()
-        .zip(&reference.rgba)
-        .map(|(a, b)| (*a as f64 - *b as f64).powi(2))
-        .sum::<f64>()
-        / img.rgba.len() as f64;
-    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
-}
-
 fn shell_volume() -> VolumeData {
     radial(48, |d| 4.0 * d)
 }
