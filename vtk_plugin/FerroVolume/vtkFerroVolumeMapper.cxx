@@ -28,8 +28,11 @@
 #include "vtkFerroVolumeRefinement.h"
 #include "vtkFerroVolumeRenderToImage.h"
 #include "vtkFerroVolumeSettings.h"
+#include "vtkCamera.h"
 #include "vtkCommand.h"
+#include "vtkDataObject.h"
 #include "vtkDualDepthPeelingPass.h"
+#include "vtkHardwareSelector.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseVectorKey.h"
 #include "vtkImageData.h"
@@ -500,6 +503,55 @@ bool InsideDualDepthPeeling(vtkVolume* vol)
   }
   return false;
 }
+
+// A hardware-selection pass of `selector` over `image` (placed by `vol`): what
+// vtkGPUVolumeRayCastMapper writes, where the frame shows the volume (vtkFerroVolumeSelection).
+bool DrawSelection(vtkFerroVolumeOutput& output, vtkRenderer* ren, vtkVolume* vol,
+  vtkImageData* image, vtkHardwareSelector* selector, const vtkFerroVolumeFrameRequest& req,
+  const int rect[4], std::string& error)
+{
+  vtkFerroVolumeSelection select;
+  switch (selector->GetCurrentPass())
+  {
+    case vtkHardwareSelector::CELL_ID_LOW24:
+      select.What = vtkFerroVolumeSelection::Write::PointLow24;
+      break;
+    case vtkHardwareSelector::CELL_ID_HIGH24:
+      select.What = vtkFerroVolumeSelection::Write::PointHigh24;
+      break;
+    default:
+      select.What = vtkFerroVolumeSelection::Write::Prop;
+      break;
+  }
+  // device coordinates → world → the point index relative to the extent's first point
+  vtkNew<vtkMatrix4x4> deviceToWorld;
+  deviceToWorld->DeepCopy(ren->GetActiveCamera()->GetCompositeProjectionTransformMatrix(
+    static_cast<double>(req.ViewportW) / req.ViewportH, -1, 1));
+  deviceToWorld->Invert();
+  const int* extent = image->GetExtent();
+  vtkNew<vtkMatrix4x4> fromExtent;
+  for (int k = 0; k < 3; ++k)
+  {
+    fromExtent->SetElement(k, 3, extent[2 * k]);
+  }
+  vtkNew<vtkMatrix4x4> indexToWorld;
+  vtkMatrix4x4::Multiply4x4(vol->GetMatrix(), image->GetIndexToPhysicalMatrix(), indexToWorld);
+  vtkMatrix4x4::Multiply4x4(indexToWorld, fromExtent, indexToWorld);
+  indexToWorld->Invert();
+  vtkNew<vtkMatrix4x4> deviceToIndex;
+  vtkMatrix4x4::Multiply4x4(indexToWorld, deviceToWorld, deviceToIndex);
+  select.DeviceToIndex = deviceToIndex;
+  image->GetDimensions(select.Dims);
+  selector->BeginRenderProp();
+  selector->GetPropColorValue(select.PropColor);
+  const bool drawn = output.Select(req, rect, select, error) != vtkFerroVolumeOutput::Composited::Failed;
+  const vtkIdType points =
+    static_cast<vtkIdType>(select.Dims[0]) * select.Dims[1] * select.Dims[2];
+  selector->UpdateMaximumPointId(points);
+  selector->UpdateMaximumCellId(points);
+  selector->EndRenderProp();
+  return drawn;
+}
 }
 
 //------------------------------------------------------------------------------------------
@@ -513,13 +565,11 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     return;
   }
-  if (ren->GetSelector())
+  // Hardware selection: cell selections, as vtkGPUVolumeRayCastMapper (other associations
+  // leave the volume out).
+  vtkHardwareSelector* selector = ren->GetSelector();
+  if (selector && selector->GetFieldAssociation() != vtkDataObject::FIELD_ASSOCIATION_CELLS)
   {
-    if (in->FirstTime("selection"))
-    {
-      vtkWarningMacro(<< "hardware selection (picking) of volumes is not supported by "
-                         "ferrovol: the volume is not drawn into selection passes");
-    }
     return;
   }
   if (InsideDualDepthPeeling(vol))
@@ -651,6 +701,25 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   this->LastRenderSize[0] = req.RenderW;
   this->LastRenderSize[1] = req.RenderH;
 
+  // The part of the viewport the volume can cover (where the frame is composited).
+  int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
+  if (!in->Settings.CoversViewport())
+  {
+    const double* spacing = image->GetSpacing();
+    const double pad = vtkFerroVolumeLookupTables::MatrixScale(vol) *
+      std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
+    vtkFerroVolumeOutput::ProjectedRect(ren, vol, pad, req.ViewportW, req.ViewportH, rect);
+  }
+  if (selector)
+  {
+    if (!DrawSelection(in->Output, ren, main, image, selector, req, rect, error))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+    this->LastRenderDrew = 1;
+    return;
+  }
   if (this->RenderToImage)
   {
     // The frame goes into the images, not the window.
@@ -676,15 +745,6 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   }
   else
   {
-    // Composite over the part of the viewport the volume can cover.
-    int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
-    if (!in->Settings.CoversViewport())
-    {
-      const double* spacing = image->GetSpacing();
-      const double pad = vtkFerroVolumeLookupTables::MatrixScale(vol) *
-        std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
-      vtkFerroVolumeOutput::ProjectedRect(ren, vol, pad, req.ViewportW, req.ViewportH, rect);
-    }
     switch (in->Output.Composite(req, rect, error))
     {
       case vtkFerroVolumeOutput::Composited::Failed:

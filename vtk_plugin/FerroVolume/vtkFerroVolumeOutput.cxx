@@ -185,6 +185,47 @@ void main()
   gl_FragDepth = depth;
 }
 )";
+
+// A hardware-selection pass: the prop's id colour, or the index + 1 of the point at the
+// frame's depth (low or high 24 bits), where the accumulated opacity exceeds 3/255.
+const char* SelectFragmentShader = R"(//VTK::System::Dec
+in vec2 texCoord;
+uniform sampler2D fvColor;
+uniform sampler2D fvDepth;
+uniform int fvWrite;
+uniform vec3 fvPropColor;
+uniform vec4 fvToIndex[4];
+uniform vec3 fvDims;
+//VTK::Output::Dec
+void main()
+{
+  vec2 tc = vec2(texCoord.x, 1.0 - texCoord.y);
+  float alpha = texture(fvColor, tc).a;
+  float depth = texture(fvDepth, tc).r;
+  if (alpha <= 3.0 / 255.0)
+  {
+    discard;
+  }
+  gl_FragDepth = depth;
+  if (fvWrite == 0)
+  {
+    gl_FragData[0] = vec4(fvPropColor, 1.0);
+    return;
+  }
+  vec4 d = vec4(2.0 * texCoord - 1.0, 2.0 * depth - 1.0, 1.0);
+  vec4 p = vec4(dot(fvToIndex[0], d), dot(fvToIndex[1], d), dot(fvToIndex[2], d),
+    dot(fvToIndex[3], d));
+  ivec3 n = ivec3(fvDims);
+  ivec3 v = clamp(ivec3(floor(p.xyz / p.w + 0.5)), ivec3(0), n - 1);
+  uint id = uint(v.x) + uint(n.x) * (uint(v.y) + uint(n.y) * uint(v.z)) + 1u;
+  if (fvWrite == 2)
+  {
+    id = id >> 24;
+  }
+  gl_FragData[0] =
+    vec4(float(id & 255u), float((id >> 8) & 255u), float((id >> 16) & 255u), 255.0) / 255.0;
+}
+)";
 } // namespace
 
 //------------------------------------------------------------------------------------------
@@ -316,19 +357,62 @@ bool vtkFerroVolumeOutput::Render(vtkObject* self, int preference, ferrovol::Ren
 vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Composite(
   const vtkFerroVolumeFrameRequest& req, const int rect[4], std::string& error)
 {
+  return this->DrawQuad(this->Quad, CompositeFragmentShader, req, rect, true, error,
+    [&](vtkShaderProgram* program)
+    {
+      program->SetUniformf("fvColorScale", req.ColorScale);
+      program->SetUniformf("fvColorBias", req.ColorBias);
+    });
+}
+
+vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Select(
+  const vtkFerroVolumeFrameRequest& req, const int rect[4], const vtkFerroVolumeSelection& select,
+  std::string& error)
+{
+  return this->DrawQuad(this->SelectQuad, SelectFragmentShader, req, rect, false, error,
+    [&](vtkShaderProgram* program)
+    {
+      program->SetUniformi("fvWrite", static_cast<int>(select.What));
+      program->SetUniform3f("fvPropColor", select.PropColor);
+      float rows[4][4];
+      for (int i = 0; i < 4; ++i)
+      {
+        for (int j = 0; j < 4; ++j)
+        {
+          rows[i][j] = static_cast<float>(select.DeviceToIndex->GetElement(i, j));
+        }
+      }
+      program->SetUniform4fv("fvToIndex", 4, rows);
+      const float dims[3] = { static_cast<float>(select.Dims[0]),
+        static_cast<float>(select.Dims[1]), static_cast<float>(select.Dims[2]) };
+      program->SetUniform3f("fvDims", dims);
+    });
+}
+
+template <typename Uniforms>
+vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::DrawQuad(
+  std::unique_ptr<vtkOpenGLQuadHelper>& quad, const char* shader,
+  const vtkFerroVolumeFrameRequest& req, const int rect[4], bool blend, std::string& error,
+  Uniforms uniforms)
+{
   vtkOpenGLRenderWindow* win = req.Window;
-  if (!this->Quad || this->QuadWindow != win)
+  if (this->QuadWindow != win)
   {
-    this->Quad.reset(new vtkOpenGLQuadHelper(win, nullptr, CompositeFragmentShader, ""));
+    this->Quad.reset();
+    this->SelectQuad.reset();
     this->QuadWindow = win;
   }
-  if (!this->Quad->Program)
+  if (!quad)
+  {
+    quad.reset(new vtkOpenGLQuadHelper(win, nullptr, shader, ""));
+  }
+  if (!quad->Program)
   {
     error = "could not compile the shader that composites the volume into OpenGL";
-    this->Quad.reset();
+    quad.reset();
     return Composited::Failed;
   }
-  win->GetShaderCache()->ReadyShaderProgram(this->Quad->Program);
+  win->GetShaderCache()->ReadyShaderProgram(quad->Program);
   if (rect[2] < 1 || rect[3] < 1)
   {
     return Composited::OffScreen;
@@ -347,8 +431,15 @@ vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Composite(
   ostate->vtkglViewport(req.ViewportX, req.ViewportY, req.ViewportW, req.ViewportH);
   ostate->vtkglEnable(GL_SCISSOR_TEST);
   ostate->vtkglScissor(req.ViewportX + rect[0], req.ViewportY + rect[1], rect[2], rect[3]);
-  ostate->vtkglEnable(GL_BLEND);
-  ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (blend)
+  {
+    ostate->vtkglEnable(GL_BLEND);
+    ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  }
+  else
+  {
+    ostate->vtkglDisable(GL_BLEND);
+  }
   // Rays already stopped at the opaque geometry: the volume's depth is written as is.
   ostate->vtkglEnable(GL_DEPTH_TEST);
   ostate->vtkglDepthFunc(GL_ALWAYS);
@@ -357,11 +448,10 @@ vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Composite(
   vtkTextureObject* depth = this->Path->DepthTexture();
   color->Activate();
   depth->Activate();
-  this->Quad->Program->SetUniformi("fvColor", color->GetTextureUnit());
-  this->Quad->Program->SetUniformi("fvDepth", depth->GetTextureUnit());
-  this->Quad->Program->SetUniformf("fvColorScale", req.ColorScale);
-  this->Quad->Program->SetUniformf("fvColorBias", req.ColorBias);
-  this->Quad->Render();
+  quad->Program->SetUniformi("fvColor", color->GetTextureUnit());
+  quad->Program->SetUniformi("fvDepth", depth->GetTextureUnit());
+  uniforms(quad->Program);
+  quad->Render();
   depth->Deactivate();
   color->Deactivate();
   vtkOpenGLCheckErrorMacro("after compositing the ferrovol frame");
@@ -416,7 +506,7 @@ void vtkFerroVolumeOutput::ProjectedRect(
 void vtkFerroVolumeOutput::ReleaseGraphicsResources(vtkWindow* window)
 {
   vtkOpenGLRenderWindow* glwin = vtkOpenGLRenderWindow::SafeDownCast(window);
-  if ((this->Path || this->Quad) && glwin && glwin == this->PathWindow)
+  if ((this->Path || this->Quad || this->SelectQuad) && glwin && glwin == this->PathWindow)
   {
     // the GL names below belong to this window's context
     glwin->MakeCurrent();
@@ -437,5 +527,6 @@ void vtkFerroVolumeOutput::ReleaseGraphicsResources(vtkWindow* window)
   this->PathReason.clear();
   // The quad helper releases itself through the callback it registered with its window.
   this->Quad.reset();
+  this->SelectQuad.reset();
   this->QuadWindow = nullptr;
 }

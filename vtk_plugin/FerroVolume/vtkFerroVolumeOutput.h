@@ -20,6 +20,7 @@
 #include <set>
 #include <string>
 
+class vtkMatrix4x4;
 class vtkObject;
 class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
@@ -45,6 +46,26 @@ struct vtkFerroVolumeFrameRequest
 };
 
 // Linear (colour) or nearest (depth) filtering, clamped to the edges.
+// What a hardware-selection pass (vtkHardwareSelector, cell association) writes where the
+// last frame shows the volume (accumulated opacity above 3/255, as vtkGPUVolumeRayCastMapper):
+// the prop's colour id, or the index + 1 of the volume's point nearest the frame's depth
+// there, its low or its high 24 bits.
+struct vtkFerroVolumeSelection
+{
+  enum class Write
+  {
+    Prop,
+    PointLow24,
+    PointHigh24
+  };
+  Write What = Write::Prop;
+  float PropColor[3] = { 0.0f, 0.0f, 0.0f };
+  // Normalised device coordinates (x, y, window depth all in [-1, 1]) → the volume's point
+  // index (relative to its extent), homogeneous.
+  vtkMatrix4x4* DeviceToIndex = nullptr;
+  int Dims[3] = { 1, 1, 1 };
+};
+
 void vtkFerroVolumeSetSampling(vtkTextureObject* texture, bool linear);
 
 // A way for frames to travel from ferrovol to OpenGL.
@@ -87,6 +108,10 @@ public:
   // viewport), its colour scaled by req's ColorScale and ColorBias.
   Composited Composite(
     const vtkFerroVolumeFrameRequest& req, const int rect[4], std::string& error);
+  // Draws the last frame's selection ids (`select`) over the viewport instead, scissored
+  // to `rect`, where the volume shows; elsewhere what is there stays.
+  Composited Select(const vtkFerroVolumeFrameRequest& req, const int rect[4],
+    const vtkFerroVolumeSelection& select, std::string& error);
 
   // The viewport pixels (x, y, w, h relative to the viewport) the volume's world bounding
   // box, grown by `pad` world units on every side, can cover (a volume one point thick
@@ -124,7 +149,15 @@ private:
   vtkWeakPointer<vtkOpenGLRenderWindow> PathWindow;
   std::string PathReason;
   std::set<std::string> Warned;
+  // Draws `quad` (made from `shader` for `req`'s window when missing) over the viewport,
+  // scissored to `rect`, after `uniforms` set its own uniforms beside fvColor and fvDepth.
+  template <typename Uniforms>
+  Composited DrawQuad(std::unique_ptr<vtkOpenGLQuadHelper>& quad, const char* shader,
+    const vtkFerroVolumeFrameRequest& req, const int rect[4], bool blend, std::string& error,
+    Uniforms uniforms);
+
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  std::unique_ptr<vtkOpenGLQuadHelper> SelectQuad;
   vtkWeakPointer<vtkOpenGLRenderWindow> QuadWindow;
 };
 
