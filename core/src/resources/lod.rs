@@ -124,24 +124,31 @@ impl Resources {
             shift += 1;
         };
         if vol.lod.as_ref().is_none_or(|l| l.shift != shift) {
-            let reads = match vol.lod.take() {
-                Some(l) => {
-                    if l.active {
-                        vol.slots.set_bricks(fine);
-                    }
-                    l.reads
-                }
-                None => vec![0; fine],
+            // (the last level's stand-ins leave first, and with them the page entries)
+            self.leave_lod();
+            let vol = self.volume.as_mut().expect("a volume");
+            let (reads, mut built) = match vol.lod.take() {
+                Some(l) => (l.reads, l.built),
+                None => (vec![0; fine], Vec::new()),
             };
-            let data = host.downsampled_on_lattice(1 << shift)?;
+            let data = match built.iter().find(|(s, _)| *s == shift) {
+                Some((_, data)) => data.clone(),
+                None => {
+                    let data = Arc::new(host.downsampled_on_lattice(1 << shift)?);
+                    built.push((shift, data.clone()));
+                    data
+                }
+            };
             vol.lod = Some(Lod {
                 shift,
                 grid: coarse,
-                host: Arc::new(data),
+                host: data,
                 active: false,
                 reads,
+                built,
             });
         }
+        let vol = self.volume.as_mut().expect("a volume");
         let lod = vol.lod.as_mut().expect("set above");
         if !lod.active {
             vol.slots.set_bricks(fine + coarse.len());

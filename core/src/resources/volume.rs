@@ -150,6 +150,9 @@ pub(crate) struct Lod {
     pub active: bool,
     /// Per fine brick, what the last preview frame's rays read there (0: nothing).
     pub reads: Vec<u32>,
+    /// The levels built so far, by shift (kept: the level a preview takes follows what its
+    /// rays read, and building one reads the whole volume).
+    pub built: Vec<(u32, Arc<VolumeData>)>,
 }
 
 impl Lod {
