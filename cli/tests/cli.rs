@@ -111,6 +111,37 @@ fn demo_render_writes_a_picture_of_the_volume() {
     assert_eq!(corner, [0, 0, 0]);
 }
 
+/// Interactive frames past the memory budget: `--preview-level --repeat` says how many of
+/// them drew a coarser level's bricks where fine ones were missing, and never streams.
+#[test]
+fn preview_frames_over_the_budget_report_their_stand_ins() {
+    let args = [
+        "--demo-size",
+        "64",
+        "--size",
+        "64x64",
+        "--gpu-memory",
+        "1",
+        "--brick",
+        "24",
+        "--preview-level",
+        "--repeat",
+        "3",
+    ];
+    let (out, stdout, _) = render_ok("preview", &args);
+    println!("{stdout}");
+    assert!(
+        stdout.contains("3 of 3 frame(s) drew a coarser level's bricks"),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains("streamed pass"),
+        "a preview does not stream"
+    );
+    let img = image::open(&out).expect("a PNG").to_rgb8();
+    assert!(img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count() > 64 * 64 / 10);
+}
+
 #[test]
 fn iso_render_of_nested_surfaces_with_ao() {
     let iso = ["--demo", "marschner-lobb", "--mode", "iso", "--iso", "0.7"];
