@@ -12,7 +12,7 @@ use super::bricks::{BrickGrid, FrontToBack};
 use super::residency::NOT_LATER;
 use super::volume::{self, Lod, Needed};
 use super::Resources;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::readback::read_buffer;
 use crate::gpu::uniforms::PAGE_EMPTY;
 use crate::gpu::Context;
@@ -68,17 +68,11 @@ impl Resources {
         front: &FrontToBack,
         in_view: &[bool],
     ) -> Result<bool> {
-        let vol = self
-            .volume
-            .as_mut()
-            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
+        let vol = self.volume.as_mut().ok_or_else(super::no_volume)?;
         let Some(host) = vol.host.clone() else {
             return Ok(false);
         };
-        let mut needed = volume::needed_bricks(vol, flags);
-        for (n, &v) in needed.iter_mut().zip(in_view) {
-            *n &= v;
-        }
+        let needed = volume::needed_bricks(vol, flags, Some(in_view));
         let count = needed.iter().filter(|&&n| n).count() as u32;
         let capacity = volume::capacity(vol);
         if count <= capacity || capacity < 2 {
@@ -225,7 +219,7 @@ impl Resources {
         let Some(lod) = vol.lod.as_mut().filter(|l| l.active) else {
             return;
         };
-        lod.deactivate();
+        lod.active = false;
         vol.slots.set_bricks(vol.grid.len());
         for p in vol.page.iter_mut().filter(|p| p[1] != 0) {
             *p = [PAGE_EMPTY, 0];

@@ -73,6 +73,11 @@ pub(crate) struct Resources {
     pub intermix_generation: u64,
 }
 
+/// The error of a frame without a volume.
+pub(super) fn no_volume() -> Error {
+    Error::InvalidParameter("no volume has been set".into())
+}
+
 impl Resources {
     pub fn new(ctx: &Context) -> Resources {
         let d = &ctx.device;
@@ -141,9 +146,7 @@ impl Resources {
 
     /// The volume, or the error every pass gives without one.
     pub fn volume(&self) -> Result<&GpuVolume> {
-        self.volume
-            .as_ref()
-            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))
+        self.volume.as_ref().ok_or_else(no_volume)
     }
 
     /// The transfer function, or the error every pass that classifies gives without one.

@@ -156,16 +156,6 @@ pub(crate) struct Lod {
 }
 
 impl Lod {
-    /// The level's bricks are in the slots (a preview frame is being drawn).
-    pub fn active(&self) -> bool {
-        self.active
-    }
-
-    /// The level's bricks are no longer in the slots.
-    pub fn deactivate(&mut self) {
-        self.active = false;
-    }
-
     /// Fine bricks the last preview frame read from a stand-in (0: it drew the volume).
     pub fn stand_ins_read(&self) -> u32 {
         if self.active {
@@ -531,19 +521,11 @@ impl Resources {
         stream: Option<(&FrontToBack, Option<&[bool]>)>,
     ) -> Result<Option<StreamPlan>> {
         self.leave_lod();
-        let vol = self
-            .volume
-            .as_mut()
-            .ok_or_else(|| Error::InvalidParameter("no volume has been set".into()))?;
+        let vol = self.volume.as_mut().ok_or_else(super::no_volume)?;
         let Some(host) = vol.host.clone() else {
             return Ok(None);
         };
-        let mut needed = needed_bricks(vol, flags);
-        if let Some((_, Some(in_view))) = stream {
-            for (n, &v) in needed.iter_mut().zip(in_view) {
-                *n &= v;
-            }
-        }
+        let needed = needed_bricks(vol, flags, stream.and_then(|(_, in_view)| in_view));
         let count = needed.iter().filter(|&&n| n).count() as u32;
         let capacity = capacity(vol);
         if capacity == 0 {
@@ -621,7 +603,7 @@ impl Resources {
             brick: [
                 g.brick_cells as f32,
                 g.apron as f32,
-                vol.lod.as_ref().is_some_and(|l| l.active()) as u32 as f32,
+                vol.lod.as_ref().is_some_and(|l| l.active) as u32 as f32,
                 0.0,
             ],
             grid: [g.counts[0], g.counts[1], g.counts[2], 0],
@@ -699,14 +681,22 @@ pub(crate) struct StreamPlan {
     rank: Vec<u32>,
 }
 
-/// Per brick: whether it overlaps a block flagged in `flags` (all bricks without).
-pub(super) fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool> {
+/// Per brick: whether it overlaps a block flagged in `flags` (all bricks without) and,
+/// where `in_view` is given, is marked there.
+pub(super) fn needed_bricks(
+    vol: &GpuVolume,
+    flags: Option<&[u32]>,
+    in_view: Option<&[bool]>,
+) -> Vec<bool> {
     let grid = vol.grid;
     let bd = vol.minmax.dims;
     (0..grid.len())
-        .map(|i| match flags {
-            None => true,
-            Some(flags) => grid.blocks_of(i, bd).any(|b| flags[b] != 0),
+        .map(|i| {
+            in_view.is_none_or(|v| v[i])
+                && match flags {
+                    None => true,
+                    Some(flags) => grid.blocks_of(i, bd).any(|b| flags[b] != 0),
+                }
         })
         .collect()
 }
@@ -714,7 +704,10 @@ pub(super) fn needed_bricks(vol: &GpuVolume, flags: Option<&[u32]>) -> Vec<bool>
 /// The bricks overlapping a block `flags` marks (all bricks without), and the slots the
 /// memory budget holds.
 pub(super) fn demand(vol: &GpuVolume, flags: Option<&[u32]>) -> (u32, u32) {
-    let count = needed_bricks(vol, flags).iter().filter(|&&n| n).count() as u32;
+    let count = needed_bricks(vol, flags, None)
+        .iter()
+        .filter(|&&n| n)
+        .count() as u32;
     (count, capacity(vol))
 }
 
@@ -758,7 +751,7 @@ pub(super) fn forget(vol: &mut GpuVolume) {
     vol.slots = Slots::new(vol.grid.len());
     vol.page.fill([PAGE_EMPTY, 0]);
     if let Some(lod) = vol.lod.as_mut() {
-        lod.deactivate();
+        lod.active = false;
     }
     vol.pool = None;
     vol.layers = 0;
