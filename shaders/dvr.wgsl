@@ -47,6 +47,8 @@ override STREAMING: bool = false;
 override PREINT: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
+// FLAG_DEPTH_RANGE: the window depth where each pixel's ray starts (depth_in: where it ends).
+@group(0) @binding(25) var depth_near: texture_2d<f32>;
 
 // The intermixed volumes (lib/intermix.wgsl): the rays march the world box holding every
 // volume; each sample composites the main volume where its grid holds the sample, then each
@@ -534,6 +536,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             seg.x = tg + max(ceil((seg.x - tg) / dt - jit), 0.0) * dt;
         }
     }
+    // A depth range (Renderer::render_between): the lattice's samples in [near, far) only,
+    // counted alike at both ends so that ranges which meet share no sample.
+    var range_samples = 1.0e7;
+    if (has_flag(FLAG_DEPTH_RANGE) && seg.x < seg.y) {
+        let near = depth_to_distance(ray, px, textureLoad(depth_near, vec2<i32>(px), 0).x);
+        let far = depth_to_distance(ray, px, textureLoad(depth_in, vec2<i32>(px), 0).x);
+        let first = max(ceil((near - seg.x) / dt - jit), 0.0);
+        range_samples = ceil((far - seg.x) / dt - jit) - first;
+        seg.x = seg.x + first * dt;
+        first_forced = false;
+        if (range_samples <= 0.0) {
+            seg = vec2<f32>(1.0, 0.0);
+        }
+    }
     // (written so that NaN from a degenerate ray also leaves)
     if (!(seg.x < seg.y)) {
         if (STREAMING) {
@@ -555,6 +571,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (first_forced) {
         k_end = max(k_end, 1.0);
     }
+    k_end = min(k_end, range_samples);
     var color = st.color;
     var value = st.value;
     var misc = st.misc;

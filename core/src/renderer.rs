@@ -341,6 +341,35 @@ impl Renderer {
         self.render_from(view, params, DepthSource::Shared)
     }
 
+    /// Like [`Renderer::render`], but each pixel's ray samples only between two window depths
+    /// (`near` and `far`, 0 near … 1 far, rows top to bottom, half-open: nothing where
+    /// near ≥ far), on the lattice the whole ray would use, so that segments which meet
+    /// share no sample. A host peeling translucent geometry (VTK's dual depth peeling)
+    /// renders the volume between its layers this way. Ray casting only: the isosurface,
+    /// slice and path-tracing blend modes and volumetric shadows are refused.
+    pub fn render_between(
+        &mut self,
+        view: &View,
+        params: &RenderParams,
+        near: &[f32],
+        far: &[f32],
+    ) -> Result<()> {
+        let refused = match params.blend {
+            BlendMode::Isosurface | BlendMode::Slice | BlendMode::PathTrace => {
+                Some(format!("the {:?} blend mode", params.blend))
+            }
+            _ if frame::casts_shadows(view, params) => Some("volumetric shadows".to_string()),
+            _ => None,
+        };
+        if let Some(what) = refused {
+            return Err(Error::Unsupported(format!(
+                "rays limited to a depth range are ray cast: {what} draws whole rays (render \
+                 without a depth range, or use a ray-casting blend mode)"
+            )));
+        }
+        self.render_from(view, params, DepthSource::Range(near, far))
+    }
+
     fn render_from(
         &mut self,
         view: &View,

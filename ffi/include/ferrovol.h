@@ -1164,6 +1164,21 @@ enum FvStatus fv_renderer_render(struct FvRenderer *renderer,
                                  size_t depth_count);
 
 /**
+ * Renders like fv_renderer_render, each pixel's ray sampling only between two window depths:
+ * `near` and `far` hold `count` = width·height depths each (0 near … 1 far, rows top to
+ * bottom), the interval half-open and empty where near ≥ far, the samples on the lattice of
+ * the whole ray (segments that meet share none). For hosts that peel translucent geometry.
+ * Ray casting only: FV_STATUS_UNSUPPORTED in the isosurface, slice and path-tracing blend
+ * modes and with volumetric shadows.
+ */
+enum FvStatus fv_renderer_render_between(struct FvRenderer *renderer,
+                                         uint32_t width,
+                                         uint32_t height,
+                                         const float *near,
+                                         const float *far,
+                                         size_t count);
+
+/**
  * Chooses where frames go (an FvOutputPath). FV_OUTPUT_PATH_SHARED is refused with
  * FV_STATUS_UNSUPPORTED and the reason (backend, missing Vulkan extension) where the
  * device cannot export memory; the path is then unchanged.

@@ -322,6 +322,16 @@ public:
   void render(uint32_t width, uint32_t height, const std::vector<float> &depth = {}) {
     check(fv_renderer_render(h_.get(), width, height, detail::data_or_null(depth), depth.size()));
   }
+  /// Renders with each pixel's ray between two window depths (fv_renderer_render_between).
+  void render_between(uint32_t width, uint32_t height, const std::vector<float> &near,
+                      const std::vector<float> &far) {
+    if (near.size() != far.size())
+      throw Error(FV_STATUS_INVALID_ARGUMENT,
+                  "render_between: " + std::to_string(near.size()) + " near depths but " +
+                      std::to_string(far.size()) + " far ones");
+    check(fv_renderer_render_between(h_.get(), width, height, near.data(), far.data(),
+                                     near.size()));
+  }
   /// Paths per pixel the last path-traced frame shows.
   uint32_t accumulated_samples() const {
     uint32_t n = 0;

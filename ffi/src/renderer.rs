@@ -380,6 +380,39 @@ pub unsafe extern "C" fn fv_renderer_render(
     })
 }
 
+/// Renders like fv_renderer_render, each pixel's ray sampling only between two window depths:
+/// `near` and `far` hold `count` = width·height depths each (0 near … 1 far, rows top to
+/// bottom), the interval half-open and empty where near ≥ far, the samples on the lattice of
+/// the whole ray (segments that meet share none). For hosts that peel translucent geometry.
+/// Ray casting only: FV_STATUS_UNSUPPORTED in the isosurface, slice and path-tracing blend
+/// modes and with volumetric shadows.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_render_between(
+    renderer: *mut FvRenderer,
+    width: u32,
+    height: u32,
+    near: *const f32,
+    far: *const f32,
+    count: usize,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        if near.is_null() || far.is_null() {
+            return Err(FfiError::invalid("near and far must not be NULL"));
+        }
+        r.view.width = width;
+        r.view.height = height;
+        // SAFETY: the caller guarantees `count` floats at `near` and at `far`.
+        let (near, far) = unsafe {
+            (
+                std::slice::from_raw_parts(near, count),
+                std::slice::from_raw_parts(far, count),
+            )
+        };
+        r.r.render_between(&r.view, &r.params, near, far)?;
+        Ok(())
+    })
+}
+
 /// Chooses where frames go (an FvOutputPath). FV_OUTPUT_PATH_SHARED is refused with
 /// FV_STATUS_UNSUPPORTED and the reason (backend, missing Vulkan extension) where the
 /// device cannot export memory; the path is then unchanged.

@@ -13,7 +13,7 @@ use crate::gpu::binding::{
 };
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
-use crate::gpu::uniforms::{MASK_BINARY, MASK_LABELS, MASK_NONE};
+use crate::gpu::uniforms::{FLAG_DEPTH_RANGE, MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
 use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
 use crate::resources::intermix::IntermixBinding;
@@ -89,6 +89,7 @@ impl DvrPass {
                     texture_entry(2, false, V::D3),
                     sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
                     texture_entry(4, false, V::D2),
+                    texture_entry(25, false, V::D2),
                     storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
                     storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
                     buffer_entry(7, B::Storage { read_only: false }),
@@ -160,7 +161,10 @@ impl DvrPass {
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
-        let f = frame::frame(res, view, params, step, depth_input)?;
+        let mut f = frame::frame(res, view, params, step, depth_input)?;
+        if matches!(depth, DepthSource::Range(..)) {
+            f.uniforms.mode[1] |= FLAG_DEPTH_RANGE;
+        }
         if plan.is_some() && f.volumetric {
             return Err(Error::Unsupported(
                 "volumetric shadows need every visible brick resident, and the visible bricks \
@@ -370,6 +374,7 @@ impl DvrPass {
         let d = &ctx.device;
         q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
         let depth_in_view = t.depth_in.create_view(&Default::default());
+        let depth_near_view = t.depth_near.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
         let depth_view = t.depth.create_view(&Default::default());
         let dvr_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -381,6 +386,7 @@ impl DvrPass {
                 bind(2, wgpu::BindingResource::TextureView(&vol.ranges)),
                 bind(3, wgpu::BindingResource::TextureView(occupancy)),
                 bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
+                bind(25, wgpu::BindingResource::TextureView(&depth_near_view)),
                 bind(5, wgpu::BindingResource::TextureView(&color_view)),
                 bind(6, wgpu::BindingResource::TextureView(&depth_view)),
                 bind(7, t.state.as_entire_binding()),

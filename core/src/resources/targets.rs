@@ -17,6 +17,8 @@ pub(crate) struct Targets {
     pub(crate) color: wgpu::Texture,
     pub(crate) depth: wgpu::Texture,
     pub(crate) depth_in: wgpu::Texture,
+    /// Where rays start, for [`DepthSource::Range`] (window depth; never shared).
+    pub(crate) depth_near: wgpu::Texture,
     /// The exportable memory of `color`, `depth` and `depth_in` (owned by those textures)
     /// when they were allocated for [`OutputPath::Shared`].
     exported: Option<[ExportableMemory; 3]>,
@@ -43,6 +45,9 @@ pub(crate) enum DepthSource<'a> {
     Cpu(&'a [f32]),
     /// Already in the shared depth-input image, written by the host.
     Shared,
+    /// Uploaded from the CPU: each pixel's ray samples only between a near and a far window
+    /// depth (half-open, nothing where near ≥ far).
+    Range(&'a [f32], &'a [f32]),
 }
 
 /// Clears the frame's colour (transparent) and depth (far) images; the passes that cover only
@@ -118,6 +123,12 @@ impl Resources {
                 wgpu::TextureFormat::R32Float,
                 wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             )?;
+            let depth_near = d.create_texture(&texture_2d(
+                "depth near",
+                [width, height],
+                wgpu::TextureFormat::R32Float,
+                wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            ));
             let exported = match (color_mem, depth_mem, depth_in_mem) {
                 (Some(a), Some(b), Some(c)) => Some([a, b, c]),
                 _ => None,
@@ -159,6 +170,7 @@ impl Resources {
                 color,
                 depth,
                 depth_in,
+                depth_near,
                 exported,
                 generation: self.generation + 1,
             })
@@ -202,31 +214,41 @@ impl Resources {
     }
 
     /// Checks a CPU depth input (window depth per pixel) against the frame's size and copies
-    /// it into the depth-input image; nothing to do for the other sources. The output images
-    /// must be allocated for the frame.
+    /// it into the depth-input image (a range's near depths into the near image); nothing to
+    /// do for the other sources. The output images must be allocated for the frame.
     pub fn write_depth_input(
         &self,
         ctx: &Context,
         view: &View,
         depth: DepthSource<'_>,
     ) -> Result<()> {
-        let DepthSource::Cpu(d) = depth else {
-            return Ok(());
+        let (far, near) = match depth {
+            DepthSource::Cpu(d) => (d, None),
+            DepthSource::Range(near, far) => (far, Some(near)),
+            DepthSource::None | DepthSource::Shared => return Ok(()),
         };
         let n = (view.width * view.height) as usize;
-        if d.len() != n {
-            return Err(Error::InvalidParameter(format!(
-                "depth image has {} values for a {}x{} frame ({n} expected)",
-                d.len(),
-                view.width,
-                view.height
-            )));
+        for (what, d) in [("depth image", Some(far)), ("near depth image", near)] {
+            match d {
+                Some(d) if d.len() != n => {
+                    return Err(Error::InvalidParameter(format!(
+                        "{what} has {} values for a {}x{} frame ({n} expected)",
+                        d.len(),
+                        view.width,
+                        view.height
+                    )))
+                }
+                _ => {}
+            }
         }
         let t = self
             .targets
             .as_ref()
             .expect("output images allocated for the frame");
-        upload_texture(&ctx.queue, &t.depth_in, bytemuck::cast_slice(d), 4);
+        upload_texture(&ctx.queue, &t.depth_in, bytemuck::cast_slice(far), 4);
+        if let Some(near) = near {
+            upload_texture(&ctx.queue, &t.depth_near, bytemuck::cast_slice(near), 4);
+        }
         Ok(())
     }
 

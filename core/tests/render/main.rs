@@ -21,6 +21,7 @@ mod masks;
 mod preintegration;
 mod rectilinear;
 mod reference;
+mod segments;
 mod silhouettes;
 mod sources;
 mod state;
