@@ -396,8 +396,11 @@ pub unsafe extern "C" fn fv_renderer_render_between(
     count: usize,
 ) -> FvStatus {
     with_renderer(renderer, |r| {
-        if near.is_null() || far.is_null() {
-            return Err(FfiError::invalid("near and far must not be NULL"));
+        if near.is_null() {
+            return Err(FfiError::null("near"));
+        }
+        if far.is_null() {
+            return Err(FfiError::null("far"));
         }
         r.view.width = width;
         r.view.height = height;

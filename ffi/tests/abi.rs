@@ -532,6 +532,52 @@ fn renderer_errors() {
             centre > 100,
             "the uniform volume must be opaque at the centre"
         );
+
+        // Rays between two depths: nothing where near = far, the whole ray from 0 to 1.
+        type Between = unsafe extern "C" fn(H, u32, u32, *const f32, *const f32, usize) -> FvStatus;
+        let between = lib.f::<Between>("fv_renderer_render_between");
+        let (zeros, ones) = ([0.0f32; 256], [1.0f32; 256]);
+        lib.expect(
+            between(s.r, 16, 16, null(), ones.as_ptr(), 256),
+            Null,
+            "near",
+        );
+        lib.expect(
+            between(s.r, 16, 16, zeros.as_ptr(), null(), 256),
+            Null,
+            "far",
+        );
+        lib.expect(
+            between(s.r, 16, 16, zeros.as_ptr(), ones.as_ptr(), 10),
+            Invalid,
+            "10 values",
+        );
+        let read = lib.f::<unsafe extern "C" fn(H, *mut H) -> FvStatus>("fv_renderer_read_frame");
+        let rgba = lib.f::<unsafe extern "C" fn(H) -> *const u8>("fv_frame_rgba");
+        let free = lib.f::<Free>("fv_frame_free");
+        for (near, expect_drawn) in [(&ones, false), (&zeros, true)] {
+            lib.ok(between(s.r, 16, 16, near.as_ptr(), ones.as_ptr(), 256));
+            let mut f: H = null_mut();
+            lib.ok(read(s.r, &mut f));
+            let a = *rgba(f).add(4 * (8 * 16 + 8) + 3);
+            free(f);
+            assert_eq!(
+                a == centre,
+                expect_drawn,
+                "near {}: centre alpha {a}",
+                near[0]
+            );
+            assert_eq!(a == 0, !expect_drawn, "near {}: centre alpha {a}", near[0]);
+        }
+        let mut iso = p;
+        iso.blend_mode = FvBlendMode::Isosurface as u32;
+        s.set_params(&iso);
+        lib.expect(
+            between(s.r, 16, 16, zeros.as_ptr(), ones.as_ptr(), 256),
+            FvStatus::Unsupported,
+            "depth range",
+        );
+        s.set_params(&p);
         let png = lib.f::<unsafe extern "C" fn(H, *const c_char, *const [f32; 3]) -> FvStatus>(
             "fv_frame_write_png",
         );

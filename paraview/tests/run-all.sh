@@ -61,6 +61,7 @@ step cranium       pvbatch $T/test_cranium.py
 step properties    pvbatch $T/test_properties.py
 step volume-properties pvbatch $T/test_volume_properties.py
 step screenshot    pvbatch $T/test_screenshot.py
+step translucent   pvbatch $T/test_translucent.py
 step progressive-pvpython pvpython $T/test_progressive.py
 step progressive-pvbatch  pvbatch $T/test_progressive.py
 step mpi-serial    pvbatch $T/test_mpi.py serial

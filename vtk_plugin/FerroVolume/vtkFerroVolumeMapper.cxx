@@ -12,6 +12,8 @@
 //                               vtkFerroVolumeSharedOutput: zero copy) and one full-screen
 //                               quad composites it (premultiplied blending, gl_FragDepth from
 //                               ferrovol's depth)
+//   vtkFerroVolumeDepthPeeling  inside vtkDualDepthPeelingPass: the volume between its
+//                               translucent layers, into the pass's targets
 //   vtkFerroVolumeRenderToImage RenderToImage: the frame into the mapper's own colour and
 //                               depth textures instead of the window
 //   vtkFerroVolumeRefinement    progressive path tracing: whether a render is, its time
@@ -20,6 +22,7 @@
 #include "vtkFerroVolumeMapper.h"
 
 #include "vtkFerroVolumeContext.h"
+#include "vtkFerroVolumeDepthPeeling.h"
 #include "vtkFerroVolumeDepthReader.h"
 #include "vtkFerroVolumeInputHelper.h"
 #include "vtkFerroVolumeIntermix.h"
@@ -31,7 +34,6 @@
 #include "vtkCamera.h"
 #include "vtkCommand.h"
 #include "vtkDataObject.h"
-#include "vtkDualDepthPeelingPass.h"
 #include "vtkHardwareSelector.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseVectorKey.h"
@@ -40,7 +42,6 @@
 #include "vtkMultiVolume.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
-#include "vtkOpenGLRenderPass.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
@@ -69,6 +70,7 @@ public:
   vtkFerroVolumeIntermix Intermix;
   vtkFerroVolumeSettings Settings;
   vtkFerroVolumeOutput Output;
+  vtkFerroVolumeDepthPeeling Peeling;
   vtkFerroVolumeRenderToImage Image;
   vtkFerroVolumeRefinement Refinement;
   // warnings said once per mapper
@@ -166,6 +168,7 @@ public:
   void ReleaseDeviceResources(vtkWindow* window)
   {
     this->Output.ReleaseGraphicsResources(window);
+    this->Peeling.ReleaseGraphicsResources(window);
     this->Image.ReleaseGraphicsResources();
     this->FreeRenderer();
   }
@@ -483,27 +486,6 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
 namespace
 {
-// Whether vtkDualDepthPeelingPass is drawing the volume inside its peeling loop (its
-// volumetric peels mark the prop with vtkOpenGLRenderPass::RenderPasses), where it expects
-// vtkOpenGLGPUVolumeRayCastMapper's shader to read its depth textures and write its targets.
-bool InsideDualDepthPeeling(vtkVolume* vol)
-{
-  vtkInformation* keys = vol->GetPropertyKeys();
-  if (!keys || !keys->Has(vtkOpenGLRenderPass::RenderPasses()))
-  {
-    return false;
-  }
-  const int n = keys->Length(vtkOpenGLRenderPass::RenderPasses());
-  for (int i = 0; i < n; ++i)
-  {
-    if (vtkDualDepthPeelingPass::SafeDownCast(keys->Get(vtkOpenGLRenderPass::RenderPasses(), i)))
-    {
-      return true;
-    }
-  }
-  return false;
-}
-
 // A hardware-selection pass of `selector` over `image` (placed by `vol`): what
 // vtkGPUVolumeRayCastMapper writes, where the frame shows the volume (vtkFerroVolumeSelection).
 bool DrawSelection(vtkFerroVolumeOutput& output, vtkRenderer* ren, vtkVolume* vol,
@@ -572,13 +554,18 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     return;
   }
-  if (InsideDualDepthPeeling(vol))
+  // Inside vtkDualDepthPeelingPass's volumetric peels: the volume between its layers.
+  vtkRenderPass* peeling = vtkFerroVolumeDepthPeeling::PeelingPass(vol);
+  if (peeling &&
+    (this->RenderMode == RENDER_MODE_PATH_TRACE || this->BlendMode == ISOSURFACE_BLEND ||
+      this->BlendMode == SLICE_BLEND))
   {
     if (in->FirstTime("depth-peeling"))
     {
       vtkWarningMacro(<< "depth peeling for volumes (vtkRenderer UseDepthPeelingForVolumes "
-                         "with translucent geometry) is not supported by ferrovol: the "
-                         "volume is not drawn; turn UseDepthPeelingForVolumes off to have it "
+                         "with translucent geometry) draws ray-cast volumes between the "
+                         "translucent layers; path tracing, isosurfaces and slices are not "
+                         "drawn there: turn UseDepthPeelingForVolumes off to have this volume "
                          "composited over the translucent geometry (in ParaView: the render "
                          "view's DepthPeelingForVolumes, on by default)");
     }
@@ -688,6 +675,18 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   req.UseDepth = vtkFerroVolumeDepthReader::SceneHasOpaqueGeometry(ren, vol);
   req.ColorScale = 1.0f / this->FinalColorWindow;
   req.ColorBias = 0.5f - this->FinalColorLevel / this->FinalColorWindow;
+  if (peeling && !selector && !this->RenderToImage)
+  {
+    if (!in->Peeling.Draw(peeling, this, vol, *in->Renderer, req, error))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+    this->LastRenderSize[0] = req.RenderW;
+    this->LastRenderSize[1] = req.RenderH;
+    this->LastRenderDrew = 1;
+    return;
+  }
   std::string warning;
   if (!in->Output.Render(this, this->OutputPath, *in->Renderer, req, error, warning))
   {
