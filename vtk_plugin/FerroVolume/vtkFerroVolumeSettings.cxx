@@ -1,6 +1,7 @@
 #include "vtkFerroVolumeSettings.h"
 
 #include "vtkCamera.h"
+#include "vtkCommand.h"
 #include "vtkContourValues.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
@@ -19,6 +20,8 @@
 #include "vtkPlaneCollection.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
+#include "vtkShaderProperty.h"
+#include "vtkUniforms.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
@@ -395,7 +398,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   const bool isosurface = this->Blend == FV_BLEND_MODE_ISOSURFACE;
   params.shade = prop->GetShade(0) != 0 &&
     (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface || this->Blend == FV_BLEND_MODE_SLICE);
-  this->WarnUnsupported(self, warned);
+  this->WarnUnsupported(self, vol, warned);
   if (self->GetMaskInput() &&
     self->GetMaskType() == vtkGPUVolumeRayCastMapper::LabelMapMaskType &&
     this->Blend == FV_BLEND_MODE_COMPOSITE && input.GetComponents() > 1 &&
@@ -561,8 +564,30 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
 }
 
 void vtkFerroVolumeSettings::WarnUnsupported(
-  vtkFerroVolumeMapper* self, std::set<std::string>& warned) const
+  vtkFerroVolumeMapper* self, vtkVolume* vol, std::set<std::string>& warned) const
 {
+  // vtkOpenGLGPUVolumeRayCastMapper applies the volume's shader property to its GLSL ray
+  // caster and fires UpdateShaderEvent with the program; ferrovol runs no GLSL ray caster.
+  vtkShaderProperty* shader = vol->GetShaderProperty();
+  const auto customUniforms = [](vtkUniforms* u) { return u && u->GetNumberOfUniforms() > 0; };
+  if (shader &&
+    (shader->HasVertexShaderCode() || shader->HasFragmentShaderCode() ||
+      shader->HasGeometryShaderCode() || shader->GetNumberOfShaderReplacements() > 0 ||
+      customUniforms(shader->GetVertexCustomUniforms()) ||
+      customUniforms(shader->GetFragmentCustomUniforms()) ||
+      customUniforms(shader->GetGeometryCustomUniforms())) &&
+    warned.insert("shader-property").second)
+  {
+    vtkWarningWithObjectMacro(self, << "the volume's ShaderProperty (custom shader code, "
+                                       "replacements or uniforms) is not applied: ferrovol "
+                                       "ray casts in its own shaders, not VTK's GLSL");
+  }
+  if (self->HasObserver(vtkCommand::UpdateShaderEvent) &&
+    warned.insert("update-shader-event").second)
+  {
+    vtkWarningWithObjectMacro(self, << "UpdateShaderEvent is never fired: ferrovol ray casts "
+                                       "in its own shaders, there is no GLSL program to update");
+  }
   if (self->GetUseDepthPass() && this->Blend == FV_BLEND_MODE_COMPOSITE &&
     warned.insert("depth-pass").second)
   {

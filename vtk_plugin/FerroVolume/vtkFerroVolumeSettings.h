@@ -62,8 +62,9 @@ public:
 private:
   bool Intermixing = false;
   // Warns, once per mapper and setting, about each vtkGPUVolumeRayCastMapper setting in
-  // effect that ferrovol does not honour.
-  void WarnUnsupported(vtkFerroVolumeMapper* self, std::set<std::string>& warned) const;
+  // effect that ferrovol does not honour (`vol`: its shader property).
+  void WarnUnsupported(
+    vtkFerroVolumeMapper* self, vtkVolume* vol, std::set<std::string>& warned) const;
   bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
   // AutoAdjustSampleDistances: the factor (1, 1/2, 1/5 or 1/10) the smallest world spacing
   // is divided by to make the step, from the time the last render took against the time

@@ -826,6 +826,28 @@ class Behaviour(unittest.TestCase):
         self.assertEqual(events, ["start", "end", "start", "end"])
         self.assertGreater(m.GetTimeToDraw(), 0.0)
 
+    def test_shader_property_and_update_shader_event_are_warned(self):
+        """The volume's ShaderProperty (custom GLSL, replacements, uniforms) and
+        UpdateShaderEvent observers belong to VTK's GLSL ray caster: each is warned once,
+        and the image stays ferrovol's."""
+        m = ferrovol.vtkFerroVolumeMapper()
+        errors = Errors(m)
+        scene = reference_scene(m)
+        plain = scene.render()
+        self.assertEqual(errors.warnings, [])
+        shader = scene.volume.GetShaderProperty()
+        shader.AddFragmentShaderReplacement("//VTK::Shading::Impl", True,
+                                            "//VTK::Shading::Impl\n", False)
+        shader.GetFragmentCustomUniforms().SetUniformf("fvUnused", 1.0)
+        m.AddObserver("UpdateShaderEvent", lambda o, e: None)
+        changed = scene.render()
+        scene.render()
+        self.assertEqual(errors.messages, [])
+        self.assertEqual(len(errors.warnings), 2, errors.warnings)
+        self.assertIn("ShaderProperty", errors.warnings[0])
+        self.assertIn("UpdateShaderEvent", errors.warnings[1])
+        np.testing.assert_array_equal(plain, changed)
+
     def test_support_ratio_preload(self):
         m = ferrovol.vtkFerroVolumeMapper()
         self.assertEqual(m.IsRenderSupported(None, None), 1)

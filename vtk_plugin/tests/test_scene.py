@@ -94,9 +94,8 @@ class SceneTests(unittest.TestCase):
         starts move to the layers' depths: 23-37 dB from its unpeeled image here), which
         bounds how close the two can be. Isosurfaces are not peeled: one warning, the volume
         left out."""
-        floors = {"Composite": (0.98, 33.0), "MaximumIntensity": (0.98, 42.0),
-                  "Additive": (0.98, 32.0)}
-        for blend, (ssim_floor, psnr_floor) in floors.items():
+        for blend in ("Composite", "MaximumIntensity", "MinimumIntensity", "AverageIntensity",
+                      "Additive"):
             mapper = ferrovol.vtkFerroVolumeMapper()
             errors = Errors(mapper)
             ours = self.peeled(mapper, blend)
@@ -104,19 +103,23 @@ class SceneTests(unittest.TestCase):
             theirs = self.peeled(vtk.vtkGPUVolumeRayCastMapper(), blend)
             unpeeled = self.peeled(ferrovol.vtkFerroVolumeMapper(), blend, volumes_peeled=0)
             s, p = compare("scene-depth-peeling-" + blend, ours, theirs)
-            # Where VTK's peeled image differs much from ferrovol's unpeeled one (the
-            # spheres seen through the volume), ferrovol's peeled one is close to VTK's.
-            changed = np.abs(unpeeled - theirs).max(axis=2) > 24
-            near = np.abs(ours - theirs).max(axis=2)[changed]
-            far = np.abs(unpeeled - theirs).max(axis=2)[changed]
-            fvtest.log("  %s: %d pixels show the peeling (>24/255 from unpeeled, mean %.1f); "
-                       "there ferrovol is within %.1f of VTK (mean), %.1f at the 95th "
-                       "percentile" % (blend, changed.sum(), far.mean(), near.mean(),
-                                       np.percentile(near, 95)))
             self.assertEqual(errors.messages + errors.warnings, [])
             np.testing.assert_array_equal(ours, again)
-            self.assertGreaterEqual(s, ssim_floor, blend)
-            self.assertGreaterEqual(p, psnr_floor, blend)
+            self.assertGreaterEqual(s, 0.98, blend)
+            self.assertGreaterEqual(p, 35.0, blend)
+            # Where VTK's peeled image differs much from ferrovol's unpeeled one (the
+            # spheres seen through the volume), ferrovol's peeled one is close to VTK's. (In
+            # average intensity VTK's peeled image stays within 24/255 of it everywhere.)
+            changed = np.abs(unpeeled - theirs).max(axis=2) > 24
+            fvtest.log("  %s: %d pixels show the peeling (>24/255 from unpeeled)"
+                       % (blend, changed.sum()))
+            if blend == "AverageIntensity":
+                continue
+            near = np.abs(ours - theirs).max(axis=2)[changed]
+            far = np.abs(unpeeled - theirs).max(axis=2)[changed]
+            fvtest.log("    there unpeeled is %.1f from VTK (mean), peeled %.1f (mean), %.1f "
+                       "at the 95th percentile" % (far.mean(), near.mean(),
+                                                   np.percentile(near, 95)))
             self.assertGreater(changed.sum(), 80, blend)
             self.assertLess(near.mean(), 0.25 * far.mean(), blend)
 
@@ -127,7 +130,7 @@ class SceneTests(unittest.TestCase):
         s, p = compare("scene-depth-peeling-viewports", ours, theirs)
         self.assertEqual(errors.messages + errors.warnings, [])
         self.assertGreaterEqual(s, 0.98)
-        self.assertGreaterEqual(p, 33.0)
+        self.assertGreaterEqual(p, 35.0)
 
         mapper = ferrovol.vtkFerroVolumeMapper()
         errors = Errors(mapper)

@@ -8,6 +8,7 @@
 //! texel back into a scalar with a per-component `scale · texel + shift`.
 
 use crate::error::{Error, Result};
+use crate::gpu::uniforms::PAGE_SLOT_BITS;
 use crate::gpu::DeviceInfo;
 use crate::params::{ScalarType, VolumeData};
 
@@ -318,7 +319,8 @@ pub fn plan_bricks(
     let b = edge - (2 * BRICK_OVERLAP + 1);
     let counts = cells.map(|c| c.div_ceil(b));
     let n: u64 = counts.iter().map(|&c| c as u64).product();
-    let per_axis = (max_pool / edge) as u64;
+    // (the page table addresses PAGE_SLOT_BITS bits of slot per axis)
+    let per_axis = ((max_pool / edge) as u64).min(1 << PAGE_SLOT_BITS);
     let per_layer = n.div_ceil(per_axis.max(1));
     let sx = per_layer.min(per_axis);
     let sy = per_layer.div_ceil(sx.max(1));
@@ -327,13 +329,15 @@ pub fn plan_bricks(
     if per_axis == 0 || sy > per_axis {
         return Err(Error::Unsupported(format!(
             "the volume ({} × {} × {} points, {} bytes per point) needs {n} bricks of {edge}³ \
-             points, {:.2} GiB of texture; the device takes at most {max_pool} points per \
-             axis in one 3D texture",
+             points, {:.2} GiB of texture; a pool holds at most {per_axis} slots per axis \
+             (the device takes at most {max_pool} points per axis in one 3D texture, the page \
+             table addresses {} slots per axis)",
             dims[0],
             dims[1],
             dims[2],
             texel_bytes,
             (n * slot_bytes) as f64 / (1u64 << 30) as f64,
+            1u32 << PAGE_SLOT_BITS,
         )));
     }
     Ok(BrickGrid {
@@ -569,6 +573,16 @@ mod tests {
         assert_eq!((blocks[0], blocks[11]), (1, 35 + 7 + 3));
         assert_eq!(g.brick_cells + 1 + 2 * g.apron, 20);
         assert_eq!(g.slot_origin_point([1, 0, 0]), [13, -2, -2]);
+    }
+
+    #[test]
+    fn slots_per_axis_stay_within_the_page_tables_bits() {
+        // 15996 one-cell bricks in 6³ slots on a device taking 16384 points per axis: 2730
+        // slots would fit the texture along an axis, the page table addresses 1024.
+        let g = plan_bricks([4000, 3, 3], 1, 6, 16384, u64::MAX, 6).unwrap();
+        assert_eq!(g.len(), 15996);
+        assert!(g.slots.iter().all(|&s| s <= 1 << PAGE_SLOT_BITS), "{:?}", g.slots);
+        assert!(g.slots.iter().map(|&s| s as usize).product::<usize>() >= g.len());
     }
 
     #[test]
