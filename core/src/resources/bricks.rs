@@ -581,7 +581,11 @@ mod tests {
         // slots would fit the texture along an axis, the page table addresses 1024.
         let g = plan_bricks([4000, 3, 3], 1, 6, 16384, u64::MAX, 6).unwrap();
         assert_eq!(g.len(), 15996);
-        assert!(g.slots.iter().all(|&s| s <= 1 << PAGE_SLOT_BITS), "{:?}", g.slots);
+        assert!(
+            g.slots.iter().all(|&s| s <= 1 << PAGE_SLOT_BITS),
+            "{:?}",
+            g.slots
+        );
         assert!(g.slots.iter().map(|&s| s as usize).product::<usize>() >= g.len());
     }
 
