@@ -502,17 +502,23 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         jit = hash01(pix ^ frame.viewport.w);
         shadow_jitter = jit;
     }
+    // Quadrature::Midpoint: samples in the middle of their steps, the ray ending exactly
+    // where it leaves the volume (its last part sampled after the loop).
+    let midpoint = has_flag(FLAG_MIDPOINT);
+    if (midpoint) {
+        jit = 0.5;
+    }
     if (!(max(seg.x, cl.x) < min(seg.y, cl.y))) {
         seg = vec2<f32>(1.0, 0.0);
     } else {
         seg.x = cl.x;
-        seg.y = min(seg.y, cl.y + dt);
+        seg.y = min(seg.y, cl.y + select(dt, 0.0, midpoint));
         if (frame.counts.x > 0u) {
             // VTK discards a clipped ray whose first sample lies outside the box
             if (seg.x + jit * dt > box.y) {
                 seg = vec2<f32>(1.0, 0.0);
             }
-        } else if (seg.x + jit * dt >= seg.y && !has_flag(FLAG_PIECE)) {
+        } else if (seg.x + jit * dt >= seg.y && !has_flag(FLAG_PIECE) && !midpoint) {
             // VTK always takes its first sample (clamped to the edge) even past the exit
             first_forced = true;
         }
@@ -570,6 +576,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var k_end = min(select(floor(k_last) + 1.0, ceil(k_last), half_open), 1.0e7);
     if (first_forced) {
         k_end = max(k_end, 1.0);
+    }
+    if (midpoint) {
+        // whole steps only: the rest of the ray is one shorter step
+        k_end = min(floor((seg.y - seg.x) / dt), 1.0e7);
     }
     k_end = min(k_end, range_samples);
     var color = st.color;
@@ -699,6 +709,32 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             misc.x = misc.x + 1.0;
         }
         k = k + 1.0;
+    }
+    // Quadrature::Midpoint: the part of the ray past the last whole step, sampled at its
+    // middle, its opacity corrected from a whole step's to its length.
+    if (midpoint && blend == BLEND_COMPOSITE && !suspended && k >= k_end && color.a < ert) {
+        let rest = seg.y - seg.x - k_end * dt;
+        let t = seg.x + (k_end + 0.5 * rest / dt) * dt;
+        let lp = ray.index_origin + t * ray.index_dir;
+        let p = grid_point(lp);
+        var shown = rest > 1.0e-4 * dt && !((CROP && !in_crop(lp)) || left_out(p));
+        if (SKIP && shown) {
+            shown = block_occupied(p);
+        }
+        if (shown && STREAMING && waits(p, ray.index_dir)) {
+            suspended = true; // (resumes here: k stays k_end)
+        } else if (shown) {
+            let s = sample_scalars(p);
+            var c = classify_sample(s, s, p, ray.origin + t * ray.dir, ray.dir);
+            c.a = 1.0 - pow(max(1.0 - c.a, 0.0), rest / dt);
+            if (c.a > 0.0) {
+                color = over(color, c);
+                if (misc.z == 0.0 && color.a > frame.misc.z) {
+                    depth_t = t;
+                    misc.z = 1.0;
+                }
+            }
+        }
     }
     if (depth_t >= 0.0) {
         misc.y = distance_to_depth(ray, depth_t);

@@ -7,8 +7,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 use ferrovol_core::{
     synth, AmbientOcclusion, BlendMode, BsdfParams, ClipPlane, Context, Environment,
     GradientMethod, Interpolation, IsoParams, IsoScatterMode, IsoScattering, IsoValue,
-    PathTraceParams, RenderParams, Renderer, ScalarType, ScatterRegions, Shininess, SpecularMode,
-    UploadOptions, View, VolumeData,
+    PathTraceParams, Quadrature, RenderParams, Renderer, ScalarType, ScatterRegions, Shininess,
+    SpecularMode, UploadOptions, View, VolumeData,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -164,6 +164,10 @@ struct RenderArgs {
     /// consecutive samples (thin opacity peaks without slicing at the default step).
     #[arg(long)]
     preintegration: bool,
+    /// Midpoint quadrature: samples in the middle of their steps and the path through the
+    /// volume exact (VTK's lattice by default: first order in the step, off at silhouettes).
+    #[arg(long)]
+    midpoint: bool,
     /// Background colour r,g,b in [0, 1].
     #[arg(long, default_value = "0,0,0", value_parser = parse_rgb)]
     background: [f32; 3],
@@ -767,6 +771,11 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         empty_space_skipping: !a.no_skip,
         preintegration: a.preintegration,
         preview_level: a.preview_level,
+        quadrature: if a.midpoint {
+            Quadrature::Midpoint
+        } else {
+            Quadrature::Vtk
+        },
         slice_plane: (a.mode == Mode::Slice).then(|| {
             let b = vol.bounds();
             let p = a.slice_plane.unwrap_or([

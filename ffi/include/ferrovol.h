@@ -131,6 +131,23 @@ typedef enum FvInterpolation {
 } FvInterpolation;
 
 /**
+ * How ray casting places its samples along a ray (FvRenderParams.quadrature).
+ */
+typedef enum FvQuadrature {
+  /**
+   * VTK 9.2's lattice: the first sample one step in, each standing for a whole step.
+   */
+  FV_QUADRATURE_VTK = 0,
+  /**
+   * Samples in the middle of their steps and the path through the volume exact (the
+   * last, shorter step sampled at its middle): second order in the step. Not with
+   * jittering or whole_box_enabled (FV_STATUS_INVALID_ARGUMENT), nor with intermixed
+   * volumes (FV_STATUS_UNSUPPORTED).
+   */
+  FV_QUADRATURE_MIDPOINT = 1,
+} FvQuadrature;
+
+/**
  * Gradient estimator for shading and gradient opacity.
  */
 typedef enum FvGradientMethod {
@@ -557,6 +574,10 @@ typedef struct FvRenderParams {
    * preview frame (FvResidency.stand_ins: 0 once complete).
    */
   bool preview_level;
+  /**
+   * One of FvQuadrature (default FV_QUADRATURE_VTK).
+   */
+  uint32_t quadrature;
 } FvRenderParams;
 
 /**

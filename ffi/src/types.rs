@@ -5,7 +5,7 @@
 use crate::status::{FfiError, FfiResult};
 use ferrovol_core::{
     BlendMode, Camera, ClipPlane, Cropping, GradientMethod, Interpolation, Light, LightSpace,
-    MaskKind, RenderParams, Shading,
+    MaskKind, Quadrature, RenderParams, Shading,
 };
 use glam::{DMat4, DVec3};
 
@@ -118,6 +118,19 @@ pub enum FvInterpolation {
     /// The cubic B-spline of the points (not prefiltered: smooths at the scale of a voxel),
     /// in ray casting and isosurfaces; path tracing answers FV_STATUS_UNSUPPORTED.
     Cubic = 2,
+}
+
+/// How ray casting places its samples along a ray (FvRenderParams.quadrature).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FvQuadrature {
+    /// VTK 9.2's lattice: the first sample one step in, each standing for a whole step.
+    Vtk = 0,
+    /// Samples in the middle of their steps and the path through the volume exact (the
+    /// last, shorter step sampled at its middle): second order in the step. Not with
+    /// jittering or whole_box_enabled (FV_STATUS_INVALID_ARGUMENT), nor with intermixed
+    /// volumes (FV_STATUS_UNSUPPORTED).
+    Midpoint = 1,
 }
 
 /// Gradient estimator for shading and gradient opacity.
@@ -306,6 +319,8 @@ pub struct FvRenderParams {
     /// where they are missing, and bring some of those their rays read for the next
     /// preview frame (FvResidency.stand_ins: 0 once complete).
     pub preview_level: bool,
+    /// One of FvQuadrature (default FV_QUADRATURE_VTK).
+    pub quadrature: u32,
 }
 
 /// Counters that show what the renderer re-uploaded. Thread use: plain data.
@@ -442,6 +457,7 @@ impl FvRenderParams {
             },
             mask_blend_factor: d.mask_blend,
             preview_level: d.preview_level,
+            quadrature: FvQuadrature::Vtk as u32,
         }
     }
 }
@@ -539,6 +555,11 @@ impl ToCore for FvRenderParams {
             }),
             mask_blend: self.mask_blend_factor,
             preview_level: self.preview_level,
+            quadrature: enum_value(
+                "quadrature",
+                self.quadrature,
+                &[Quadrature::Vtk, Quadrature::Midpoint],
+            )?,
         };
         p.validate()?;
         Ok(p)

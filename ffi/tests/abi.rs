@@ -5,7 +5,7 @@
 use ferrovol::FvStatus::{self, InvalidArgument as Invalid, NullArgument as Null};
 use ferrovol::{
     FvBlendMode, FvCamera, FvIntermixedVolume, FvIsoParams, FvLight, FvPathTraceParams,
-    FvRenderParams, FvScalarType, FvSharedImage, FvVolumeDesc,
+    FvQuadrature, FvRenderParams, FvScalarType, FvSharedImage, FvVolumeDesc,
 };
 use libloading::{Library, Symbol};
 use std::ffi::{c_char, c_void, CStr};
@@ -451,8 +451,16 @@ fn renderer_errors() {
         lib.expect(render(s.r, 8, 8, depth.as_ptr(), 10), Invalid, "10 values");
 
         type Edit = fn(&mut FvRenderParams);
-        let cases: [(Edit, &str); 12] = [
+        let cases: [(Edit, &str); 14] = [
             (|p| p.blend_mode = 42, "blend_mode 42"),
+            (|p| p.quadrature = 5, "quadrature 5"),
+            (
+                |p| {
+                    p.quadrature = FvQuadrature::Midpoint as u32;
+                    p.jitter = true;
+                },
+                "midpoint quadrature",
+            ),
             (
                 |p| {
                     p.blend_mode = FvBlendMode::Slice as u32;

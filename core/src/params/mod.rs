@@ -25,8 +25,8 @@ pub use iso::{
 pub use light::{Light, LightSpace};
 pub use pathtrace::{BsdfParams, Convergence, PathTraceParams, ScatterRegions};
 pub use render::{
-    BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, RenderParams, Shading,
-    MAX_CLIP_PLANES, MAX_LIGHTS,
+    BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, Quadrature, RenderParams,
+    Shading, MAX_CLIP_PLANES, MAX_LIGHTS,
 };
 pub(crate) use transfer::{build_preintegration, build_tables, build_tables_over};
 pub use transfer::{

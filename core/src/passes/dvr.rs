@@ -15,7 +15,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{FLAG_DEPTH_RANGE, MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
-use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind};
+use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind, Quadrature};
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{tables_2d_layout_entry, Tables, PREINTEGRATION_FORMAT};
 use crate::resources::targets::{clear_outputs, DepthSource};
@@ -186,6 +186,13 @@ impl DvrPass {
             return Err(Error::Unsupported(
                 "the slice blend mode needs every brick in view resident, and they exceed \
                  the volume's memory budget: raise the budget"
+                    .into(),
+            ));
+        }
+        if params.quadrature == Quadrature::Midpoint && res.intermix.is_some() {
+            return Err(Error::Unsupported(
+                "the midpoint quadrature draws one volume: clear the intermixed volumes or use \
+                 Quadrature::Vtk"
                     .into(),
             ));
         }

@@ -19,6 +19,7 @@ mod intermix;
 mod lod;
 mod masks;
 mod preintegration;
+mod quadrature;
 mod rectilinear;
 mod reference;
 mod segments;
