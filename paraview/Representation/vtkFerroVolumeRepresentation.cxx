@@ -175,6 +175,11 @@ void vtkFerroVolumeRepresentation::SetPreIntegration(int value)
   this->GetFerroVolumeMapper()->SetPreIntegration(value != 0);
 }
 
+void vtkFerroVolumeRepresentation::SetMidpointQuadrature(int value)
+{
+  this->GetFerroVolumeMapper()->SetMidpointQuadrature(value != 0);
+}
+
 void vtkFerroVolumeRepresentation::SetCubicInterpolation(int value)
 {
   this->GetFerroVolumeMapper()->SetCubicInterpolation(value != 0);

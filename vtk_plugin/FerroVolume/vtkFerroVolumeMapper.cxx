@@ -262,6 +262,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , LastRenderProgressive(0)
   , LastRenderSize{ 0, 0 }
   , PreIntegration(0)
+  , MidpointQuadrature(0)
   , CubicInterpolation(0)
   , Internals(new vtkInternals)
 {
@@ -821,6 +822,7 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
   os << indent << "ExtremumDepth: " << this->ExtremumDepth << "\n";
   os << indent << "PreIntegration: " << this->PreIntegration << "\n";
+  os << indent << "MidpointQuadrature: " << this->MidpointQuadrature << "\n";
   os << indent << "CubicInterpolation: " << this->CubicInterpolation << "\n";
   os << indent << "WholeExtent: " << this->WholeExtent[0] << " " << this->WholeExtent[1] << " "
      << this->WholeExtent[2] << " " << this->WholeExtent[3] << " " << this->WholeExtent[4] << " "
