@@ -544,8 +544,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // A depth range (Renderer::render_between): the lattice's samples in [near, far) only,
     // counted alike at both ends so that ranges which meet share no sample.
+    // With midpoints the range is the path itself: its steps end exactly at both ends.
     var range_samples = 1.0e7;
-    if (has_flag(FLAG_DEPTH_RANGE) && seg.x < seg.y) {
+    if (has_flag(FLAG_DEPTH_RANGE) && seg.x < seg.y && midpoint) {
+        let near = depth_to_distance(ray, px, textureLoad(depth_near, vec2<i32>(px), 0).x);
+        let far = depth_to_distance(ray, px, textureLoad(depth_in, vec2<i32>(px), 0).x);
+        seg = vec2<f32>(max(seg.x, near), min(seg.y, far));
+    } else if (has_flag(FLAG_DEPTH_RANGE) && seg.x < seg.y) {
         let near = depth_to_distance(ray, px, textureLoad(depth_near, vec2<i32>(px), 0).x);
         let far = depth_to_distance(ray, px, textureLoad(depth_in, vec2<i32>(px), 0).x);
         let first = max(ceil((near - seg.x) / dt - jit), 0.0);

@@ -345,8 +345,9 @@ impl Renderer {
     /// (`near` and `far`, 0 near … 1 far, rows top to bottom, half-open: nothing where
     /// near ≥ far), on the lattice the whole ray would use, so that segments which meet
     /// share no sample. A host peeling translucent geometry (VTK's dual depth peeling)
-    /// renders the volume between its layers this way. Ray casting only: the isosurface,
-    /// slice and path-tracing blend modes and volumetric shadows are refused.
+    /// renders the volume between its layers this way ([`crate::Quadrature::Midpoint`]: the range
+    /// is the path itself, its steps ending exactly at both ends). Ray casting only: the
+    /// isosurface, slice and path-tracing blend modes and volumetric shadows are refused.
     pub fn render_between(
         &mut self,
         view: &View,

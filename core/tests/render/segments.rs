@@ -1,7 +1,8 @@
 //! Rays limited to a per-pixel depth range ([`Renderer::render_between`]), as a host peeling
 //! translucent geometry draws the volume between its layers: two ranges that meet, composited
 //! front over back, give the whole ray's image, since they take the whole ray's samples and
-//! share none.
+//! share none (with the midpoint quadrature the ranges' steps end exactly at both ends: the
+//! same integral, split there).
 
 use crate::common::gpu::{assert_error, renderer};
 use crate::common::images::save_enlarged;
@@ -34,7 +35,15 @@ fn ranges_that_meet_compose_the_whole_ray() {
         .unwrap();
     let view = View::fit(vol.bounds(), 64, 64);
     let n = 64 * 64;
-    for (name, params) in [("unshaded", RenderParams::default()), ("shaded", shaded())] {
+    let midpoints = RenderParams {
+        quadrature: Quadrature::Midpoint,
+        ..shaded()
+    };
+    for (name, params) in [
+        ("unshaded", RenderParams::default()),
+        ("shaded", shaded()),
+        ("midpoints", midpoints),
+    ] {
         let whole = r.render_image(&view, &params).unwrap();
         // Split each ray where its opacity passes 0.3 (the far plane where it never does).
         let split = r
@@ -63,7 +72,8 @@ fn ranges_that_meet_compose_the_whole_ray() {
             footprint(&back)
         );
         assert!(footprint(&whole) > 500 && footprint(&front) > 500 && footprint(&back) > 500);
-        // Two RGBA8 roundings (each segment's), one in the compositing above.
+        // Two RGBA8 roundings (each segment's), one in the compositing above (midpoints:
+        // the split also ends a step there).
         assert!(
             max <= 3,
             "{name}: front over back differs from the whole ray by {max}"
