@@ -114,3 +114,20 @@ pub fn oblique(vol: &VolumeData, size: u32) -> View {
     view.camera.reset_clipping_range(b);
     view
 }
+
+/// A homogeneous white slab set on `r`: 9 × 9 points across, 33 along z (L = 32 units
+/// thick), opacity α = 1 − 0.25^(1/4) per u = 8 units, so that Beer–Lambert gives 0.75
+/// through it; viewed along z with a parallel camera, 33 × 33 pixels. Returns the view,
+/// α and u.
+pub fn slab(r: &mut Renderer) -> (View, f64, f64) {
+    let vol = volume([9, 9, 33], |_, _, _| 0.5);
+    let u = 8.0;
+    let a = 1.0 - 0.25f64.powf(u / 32.0);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&white(&[(0.0, a as f32), (1.0, a as f32)], u))
+        .unwrap();
+    let mut view = View::fit(vol.bounds(), 33, 33);
+    view.camera.parallel = true;
+    view.camera.reset_clipping_range(vol.bounds());
+    (view, a, u)
+}

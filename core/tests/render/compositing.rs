@@ -7,7 +7,7 @@ use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, footprint, image_diff, rgba};
 use crate::common::raycast::to_pixel;
 use crate::common::scenes::{
-    blob_transfer, blob_volume, component_transfer, shaded, volume, white, with_clip_plane,
+    blob_transfer, blob_volume, component_transfer, shaded, slab, volume, white, with_clip_plane,
 };
 use crate::{box_corners, mask_extents, projected_extents};
 use ferrovol_core::*;
@@ -20,18 +20,10 @@ use glam::DVec3;
 #[test]
 fn slab_opacity_matches_beer_lambert() {
     let mut r = renderer();
-    // 9 × 9 points across, 33 along z: a slab L = 32 thick (points sit at index · spacing).
-    let vol = volume([9, 9, 33], |_, _, _| 0.5);
+    // A slab L = 32 thick (points sit at index · spacing); expected opacity 0.75 =
+    // 1 − (1 − α)^(L/u) with u = 8: α = 1 − 0.25^(1/4) ≈ 0.293.
+    let (view, a, u) = slab(&mut r);
     let l = 32.0;
-    // Expected opacity 0.75 = 1 − (1 − α)^(L/u) with u = 8: α = 1 − 0.25^(1/4) ≈ 0.293.
-    let u = 8.0;
-    let a = 1.0 - 0.25f64.powf(u / l);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&white(&[(0.0, a as f32), (1.0, a as f32)], u))
-        .unwrap();
-    let mut view = View::fit(vol.bounds(), 33, 33);
-    view.camera.parallel = true;
-    view.camera.reset_clipping_range(vol.bounds());
     let sigma = -(1.0 - a).ln() / u;
     let expected = 1.0 - (-sigma * l).exp();
     // dt = 1 (the default, the spacing) and 0.5 divide L (32 and 64 samples); 0.3 does not

@@ -8,9 +8,7 @@
 use crate::common::gpu::{assert_error, renderer, set_bricked};
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{image_diff, psnr, rgba};
-use crate::common::scenes::{
-    blob_transfer, blob_volume, component_transfer, shaded, volume, white,
-};
+use crate::common::scenes::{blob_transfer, blob_volume, component_transfer, shaded, slab};
 use ferrovol_core::*;
 
 fn midpoint(base: RenderParams, dt: f64) -> RenderParams {
@@ -24,16 +22,8 @@ fn midpoint(base: RenderParams, dt: f64) -> RenderParams {
 #[test]
 fn midpoints_give_a_slabs_exact_opacity_at_any_step() {
     let mut r = renderer();
-    // As compositing.rs's slab: 32 units thick along z, alpha 0.293 per 8 units.
-    let vol = volume([9, 9, 33], |_, _, _| 0.5);
-    let (l, u) = (32.0, 8.0);
-    let a = 1.0 - 0.25f64.powf(u / l);
-    r.set_volume(&vol).unwrap();
-    r.set_transfer_function(&white(&[(0.0, a as f32), (1.0, a as f32)], u))
-        .unwrap();
-    let mut view = View::fit(vol.bounds(), 33, 33);
-    view.camera.parallel = true;
-    view.camera.reset_clipping_range(vol.bounds());
+    // 32 units thick along z, Beer–Lambert's opacity through it 0.75.
+    let (view, _, _) = slab(&mut r);
     let expected = 0.75;
     // Steps that do not divide the slab (3 leaves 2 units, 7 leaves 4, 40 exceeds it).
     for dt in [0.3, 3.0, 7.0, 40.0] {
