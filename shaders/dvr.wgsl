@@ -45,6 +45,10 @@ override STREAMING: bool = false;
 // scalar taken to run linearly between them, from the pre-integration tables; shading and
 // gradient opacity stay the sample's own (the back of the segment).
 override PREINT: bool = false;
+// Quadrature::Midpoint: samples in the middle of their steps, the ray ending exactly where
+// it leaves the volume, opaque depth or a clipping plane (its last part, shorter than a
+// step, sampled after the loop at its middle).
+override MIDPOINT: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 // FLAG_DEPTH_RANGE: the window depth where each pixel's ray starts (depth_in: where it ends).
@@ -502,23 +506,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         jit = hash01(pix ^ frame.viewport.w);
         shadow_jitter = jit;
     }
-    // Quadrature::Midpoint: samples in the middle of their steps, the ray ending exactly
-    // where it leaves the volume (its last part sampled after the loop).
-    let midpoint = has_flag(FLAG_MIDPOINT);
-    if (midpoint) {
+    if (MIDPOINT) {
         jit = 0.5;
     }
     if (!(max(seg.x, cl.x) < min(seg.y, cl.y))) {
         seg = vec2<f32>(1.0, 0.0);
     } else {
         seg.x = cl.x;
-        seg.y = min(seg.y, cl.y + select(dt, 0.0, midpoint));
+        seg.y = min(seg.y, cl.y + select(dt, 0.0, MIDPOINT));
         if (frame.counts.x > 0u) {
             // VTK discards a clipped ray whose first sample lies outside the box
             if (seg.x + jit * dt > box.y) {
                 seg = vec2<f32>(1.0, 0.0);
             }
-        } else if (seg.x + jit * dt >= seg.y && !has_flag(FLAG_PIECE) && !midpoint) {
+        } else if (seg.x + jit * dt >= seg.y && !has_flag(FLAG_PIECE) && !MIDPOINT) {
             // VTK always takes its first sample (clamped to the edge) even past the exit
             first_forced = true;
         }
@@ -546,7 +547,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // counted alike at both ends so that ranges which meet share no sample.
     // With midpoints the range is the path itself: its steps end exactly at both ends.
     var range_samples = 1.0e7;
-    if (has_flag(FLAG_DEPTH_RANGE) && seg.x < seg.y && midpoint) {
+    if (has_flag(FLAG_DEPTH_RANGE) && seg.x < seg.y && MIDPOINT) {
         let near = depth_to_distance(ray, px, textureLoad(depth_near, vec2<i32>(px), 0).x);
         let far = depth_to_distance(ray, px, textureLoad(depth_in, vec2<i32>(px), 0).x);
         seg = vec2<f32>(max(seg.x, near), min(seg.y, far));
@@ -582,7 +583,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (first_forced) {
         k_end = max(k_end, 1.0);
     }
-    if (midpoint) {
+    if (MIDPOINT) {
         // whole steps only: the rest of the ray is one shorter step
         k_end = min(floor((seg.y - seg.x) / dt), 1.0e7);
     }
@@ -717,7 +718,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // Quadrature::Midpoint: the part of the ray past the last whole step, sampled at its
     // middle, its opacity corrected from a whole step's to its length.
-    if (midpoint && blend == BLEND_COMPOSITE && !suspended && k >= k_end && color.a < ert) {
+    if (MIDPOINT && blend == BLEND_COMPOSITE && !suspended && k >= k_end && color.a < ert) {
         let rest = seg.y - seg.x - k_end * dt;
         let t = seg.x + (k_end + 0.5 * rest / dt) * dt;
         let lp = ray.index_origin + t * ray.index_dir;

@@ -208,7 +208,6 @@ pub const FLAG_AVERAGE_RANGE: u32 = 1024;
 pub const FLAG_EXTREMUM_DEPTH: u32 = 2048;
 pub const FLAG_PIECE: u32 = 4096;
 pub const FLAG_DEPTH_RANGE: u32 = 8192;
-pub const FLAG_MIDPOINT: u32 = 16384;
 
 /// Bits per axis of a page-table entry's slot position (lib/volume.wgsl).
 pub const PAGE_SLOT_BITS: u32 = 10;
@@ -293,7 +292,6 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("FLAG_EXTREMUM_DEPTH", Wgsl::U32(FLAG_EXTREMUM_DEPTH)),
     ("FLAG_PIECE", Wgsl::U32(FLAG_PIECE)),
     ("FLAG_DEPTH_RANGE", Wgsl::U32(FLAG_DEPTH_RANGE)),
-    ("FLAG_MIDPOINT", Wgsl::U32(FLAG_MIDPOINT)),
     ("MASK_NONE", Wgsl::U32(MASK_NONE)),
     ("MASK_BINARY", Wgsl::U32(MASK_BINARY)),
     ("MASK_LABELS", Wgsl::U32(MASK_LABELS)),

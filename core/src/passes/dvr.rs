@@ -49,6 +49,7 @@ pipeline_variant! {
         forward_diff: bool => "FORWARD_DIFF",
         streaming: bool => "STREAMING",
         preintegration: bool => "PREINT",
+        midpoint: bool => "MIDPOINT",
         rectilinear: bool => "RECTILINEAR",
         /// Number of volumes intermixed with the main one.
         intermix: u32 => "INTERMIX",
@@ -356,6 +357,7 @@ impl DvrPass {
             forward_diff: params.gradient == GradientMethod::Forward,
             streaming,
             preintegration,
+            midpoint: params.quadrature == Quadrature::Midpoint,
             rectilinear,
             intermix,
             intermix_filtered: intermix > 0 && ctx.info.float32_filterable,

@@ -5,12 +5,11 @@
 use crate::error::{Error, Result};
 use crate::gpu::uniforms::{
     flag_bits, mat, FrameUniforms, FLAG_AVERAGE_RANGE, FLAG_DEPTH_INPUT, FLAG_EXTREMUM_DEPTH,
-    FLAG_INDEPENDENT, FLAG_JITTER, FLAG_MIDPOINT, FLAG_PIECE, FLAG_TWO_SIDED,
+    FLAG_INDEPENDENT, FLAG_JITTER, FLAG_PIECE, FLAG_TWO_SIDED,
 };
 use crate::gpu::Context;
 use crate::params::{
-    BlendMode, ClipPlane, LightSpace, MaskKind, Quadrature, RenderParams, TransferFunction, View,
-    MAX_LIGHTS,
+    BlendMode, ClipPlane, LightSpace, MaskKind, RenderParams, TransferFunction, View, MAX_LIGHTS,
 };
 use crate::resources::bricks::{FrontToBack, BLOCK_SIZE};
 use crate::resources::intermix::world_box;
@@ -375,7 +374,6 @@ pub(crate) fn frame(
         (depth_input, FLAG_DEPTH_INPUT),
         (params.extremum_depth, FLAG_EXTREMUM_DEPTH),
         (params.whole_box.is_some(), FLAG_PIECE),
-        (params.quadrature == Quadrature::Midpoint, FLAG_MIDPOINT),
     ]);
     // VTK's volumetric shadows: one component.
     let volumetric = casts_shadows(view, params);
