@@ -717,29 +717,48 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         k = k + 1.0;
     }
     // Quadrature::Midpoint: the part of the ray past the last whole step, sampled at its
-    // middle, its opacity corrected from a whole step's to its length.
-    if (MIDPOINT && blend == BLEND_COMPOSITE && !suspended && k >= k_end && color.a < ert) {
-        let rest = seg.y - seg.x - k_end * dt;
-        let t = seg.x + (k_end + 0.5 * rest / dt) * dt;
+    // middle, weighted by its length in steps: composite corrects the opacity for it,
+    // average and additive weigh their terms (and average its count), MIP and MinIP take
+    // the sample as it is.
+    if (MIDPOINT && !suspended && k >= k_end && !(blend == BLEND_COMPOSITE && color.a >= ert)) {
+        let w = (seg.y - seg.x) / dt - k_end;
+        let t = seg.x + (k_end + 0.5 * w) * dt;
         let lp = ray.index_origin + t * ray.index_dir;
         let p = grid_point(lp);
-        var shown = rest > 1.0e-4 * dt && !((CROP && !in_crop(lp)) || left_out(p));
-        if (SKIP && shown) {
-            shown = block_occupied(p);
+        let inside = w > 1.0e-4 && !((CROP && !in_crop(lp)) || left_out(p));
+        var occupied = inside;
+        if (SKIP && inside) {
+            occupied = block_occupied(p);
         }
-        if (shown && STREAMING && waits(p, ray.index_dir)) {
+        if (occupied && STREAMING && waits(p, ray.index_dir)) {
             suspended = true; // (resumes here: k stays k_end)
-        } else if (shown) {
+        } else if (occupied) {
             let s = sample_scalars(p);
-            var c = classify_sample(s, s, p, ray.origin + t * ray.dir, ray.dir);
-            c.a = 1.0 - pow(max(1.0 - c.a, 0.0), rest / dt);
-            if (c.a > 0.0) {
-                color = over(color, c);
-                if (misc.z == 0.0 && color.a > frame.misc.z) {
-                    depth_t = t;
-                    misc.z = 1.0;
+            if (blend == BLEND_COMPOSITE) {
+                var c = classify_sample(s, s, p, ray.origin + t * ray.dir, ray.dir);
+                c.a = 1.0 - pow(max(1.0 - c.a, 0.0), w);
+                if (c.a > 0.0) {
+                    color = over(color, c);
+                    if (misc.z == 0.0 && color.a > frame.misc.z) {
+                        depth_t = t;
+                        misc.z = 1.0;
+                    }
                 }
+            } else if (blend == BLEND_MAXIMUM || blend == BLEND_MINIMUM) {
+                value = extremum(value, s, misc.x == 0.0);
+                misc.x = misc.x + 1.0;
+            } else if (blend == BLEND_AVERAGE) {
+                let r = frame.average_range;
+                if (!has_flag(FLAG_AVERAGE_RANGE) || (s.x >= r.x && s.x <= r.y)) {
+                    value = value + w * projection_term(s, vec4<f32>(1.0));
+                    misc.x = misc.x + w;
+                }
+            } else {
+                value = value + w * projection_term(s, frame.additive_scale);
+                misc.x = misc.x + 1.0;
             }
+        } else if (inside && blend == BLEND_AVERAGE) {
+            misc.x = misc.x + w; // (an empty block's samples count, their terms are 0)
         }
     }
     if (depth_t >= 0.0) {

@@ -238,9 +238,9 @@ pub enum Quadrature {
     /// Midpoints: each sample in the middle of its step, and the part of the ray past the
     /// last whole step (up to the exit, opaque depth or a clipping plane, exactly) one more
     /// sample at its middle, its opacity corrected for its length: the path length through
-    /// the volume is exact, and the rule second order in the step. Composite ray casting
-    /// (the other blend modes sample the midpoints of whole steps); not with jittering or
-    /// for pieces of a whole volume (`whole_box`).
+    /// the volume is exact, and the rule second order in the step. Average and additive
+    /// weigh that last sample by its length, MIP and MinIP take it as any other; not with
+    /// jittering or for pieces of a whole volume (`whole_box`).
     Midpoint,
 }
 
