@@ -3,7 +3,8 @@
 //! each standing for a whole step): the exact opacity of a slab whatever the step, the
 //! wavelet closer to its converged image than VTK's lattice at the same step (unshaded at
 //! twice the step),
-//! the same image bricked, and the settings it refuses.
+//! the same image bricked and streamed past the memory budget, and the settings it
+//! refuses.
 
 use crate::common::gpu::{assert_error, renderer, set_bricked};
 use crate::common::images::save_enlarged;
@@ -120,6 +121,32 @@ fn midpoints_are_the_same_bricked() {
     let (mean, max) = image_diff(&bricked, &whole);
     println!("midpoints bricked vs one brick: mean {mean:.4}, max {max}");
     assert!(max <= 1, "{max}");
+    // streamed through a quarter of the volume's memory, several passes a frame
+    let budget = UploadOptions {
+        max_brick_points: Some(12),
+        memory_budget: Some(40u64.pow(3) * 4 / 4),
+        ..Default::default()
+    };
+    r.set_volume_with(&vol, budget).unwrap();
+    for blend in [
+        BlendMode::Composite,
+        BlendMode::Average,
+        BlendMode::Additive,
+    ] {
+        let p = RenderParams {
+            blend,
+            ..params.clone()
+        };
+        let streamed = r.render_image(&view, &p).unwrap();
+        let res = r.residency();
+        assert!(res.pool_bytes < res.dense_bytes / 2, "{res:?}");
+        r.set_volume(&vol).unwrap();
+        let in_core = r.render_image(&view, &p).unwrap();
+        let (mean, max) = image_diff(&streamed, &in_core);
+        println!("midpoints streamed vs in core, {blend:?}: mean {mean:.4}, max {max}");
+        assert!(max <= 1, "{blend:?}: {max}");
+        r.set_volume_with(&vol, budget).unwrap();
+    }
     r.set_volume(&vol).unwrap();
     for (p, words) in [
         (
