@@ -506,7 +506,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         jit = hash01(pix ^ frame.viewport.w);
         shadow_jitter = jit;
     }
-    if (MIDPOINT) {
+    // (pre-integrated, the samples stay on the steps' ends, each classifying its step)
+    if (MIDPOINT && !PREINT) {
         jit = 0.5;
     }
     if (!(max(seg.x, cl.x) < min(seg.y, cl.y))) {
@@ -722,7 +723,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // the sample as it is.
     if (MIDPOINT && !suspended && k >= k_end && !(blend == BLEND_COMPOSITE && color.a >= ert)) {
         let w = (seg.y - seg.x) / dt - k_end;
-        let t = seg.x + (k_end + 0.5 * w) * dt;
+        // (pre-integrated: the last step's end, classifying the step from its start)
+        let t = select(seg.x + (k_end + 0.5 * w) * dt, seg.y, PREINT);
         let lp = ray.index_origin + t * ray.index_dir;
         let p = grid_point(lp);
         let inside = w > 1.0e-4 && !((CROP && !in_crop(lp)) || left_out(p));
@@ -735,7 +737,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         } else if (occupied) {
             let s = sample_scalars(p);
             if (blend == BLEND_COMPOSITE) {
-                var c = classify_sample(s, s, p, ray.origin + t * ray.dir, ray.dir);
+                var sf = s;
+                if (PREINT) {
+                    sf = front;
+                    if (front_k != k_end - 1.0) {
+                        let start = ray.index_origin + (seg.x + k_end * dt) * ray.index_dir;
+                        sf = front_scalars(grid_point(start), s);
+                        _ = grid_point(lp);
+                    }
+                }
+                var c = classify_sample(sf, s, p, ray.origin + t * ray.dir, ray.dir);
                 c.a = 1.0 - pow(max(1.0 - c.a, 0.0), w);
                 if (c.a > 0.0) {
                     color = over(color, c);

@@ -239,7 +239,9 @@ pub enum Quadrature {
     /// last whole step (up to the exit, opaque depth or a clipping plane, exactly) one more
     /// sample at its middle, its opacity corrected for its length: the path length through
     /// the volume is exact, and the rule second order in the step. Average and additive
-    /// weigh that last sample by its length, MIP and MinIP take it as any other; not with
+    /// weigh that last sample by its length, MIP and MinIP take it as any other. With
+    /// `preintegration` the samples stay on the steps' ends (each classifying its step, as
+    /// on VTK's lattice) and the last, shorter step is classified likewise. Not with
     /// jittering or for pieces of a whole volume (`whole_box`).
     Midpoint,
 }
