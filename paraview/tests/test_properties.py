@@ -87,6 +87,7 @@ CHANGES = [
     ("RGBPoints", [37.35, 0.0, 0.6, 0.2, 276.8, 1.0, 1.0, 0.0], True),
     (("UseCropping", "CroppingOrigin", "CroppingScale"), [1, [0, 0, 0], [0.5, 1, 1]], True),
     (("Position", "Orientation"), [[4, 0, 0], [0, 0, 30]], True),
+    ("FerrovolMidpointQuadrature", 1, True),
     ("FerrovolEmptySpaceSkipping", 0, False),
     # any vtkVolumeMapper blend mode on the shared property: maximum intensity here
     ("BlendMode(shared)", 1, True),
