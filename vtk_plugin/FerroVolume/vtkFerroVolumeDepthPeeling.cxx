@@ -228,8 +228,13 @@ bool vtkFerroVolumeDepthPeeling::ReadPassTexture(vtkOpenGLRenderWindow* win,
     return false;
   }
   out.resize(static_cast<size_t>(width) * height * components);
+  // (into client memory: a pixel-pack buffer left bound would take the texels instead)
+  GLint pack = 0;
+  glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pack);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
   glGetTexImage(GL_TEXTURE_2D, 0, components == 2 ? GL_RG : GL_DEPTH_COMPONENT, GL_FLOAT,
     out.data());
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pack));
   vtkOpenGLCheckErrorMacro("after reading a depth peeling texture");
   return true;
 }
