@@ -178,8 +178,8 @@ public:
    * path through the volume is then exact and the rule second order in the step, where
    * vtkGPUVolumeRayCastMapper's lattice (the first sample one step in, each standing for a
    * whole step) is first order and most wrong along silhouettes: on VTK's wavelet benchmark,
-   * twice the sample distance with midpoints is closer to the converged image than VTK's
-   * lattice at its own (docs/PERFORMANCE.md). UseJittering is not applied with it (a
+   * unshaded, twice the sample distance with midpoints is closer to the converged image than
+   * VTK's lattice at its own (docs/PERFORMANCE.md). UseJittering is not applied with it (a
    * warning), nor is it under MPI (pieces of a whole extent) or for a vtkMultiVolume, which
    * keep VTK's lattice. Default off: VTK's images.
    */
