@@ -727,7 +727,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let t = select(seg.x + (k_end + 0.5 * w) * dt, seg.y, PREINT);
         let lp = ray.index_origin + t * ray.index_dir;
         let p = grid_point(lp);
-        let inside = w > 1.0e-4 && !((CROP && !in_crop(lp)) || left_out(p));
+        let inside = w > 0.0 && !((CROP && !in_crop(lp)) || left_out(p));
         var occupied = inside;
         if (SKIP && inside) {
             occupied = block_occupied(p);
