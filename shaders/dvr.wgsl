@@ -393,6 +393,27 @@ fn extremum(value: vec4<f32>, s: vec4<f32>, first: bool) -> vec4<f32> {
     return min(value, s);
 }
 
+// The projections (MIP, MinIP, average, additive): the running value and misc.x, the
+// samples counted, after a sample of scalars `s` standing for `w` steps (1, or less for a
+// midpoint ray's last, shorter step). VTK: the average takes the opacity-weighted
+// normalised scalars of the samples inside its range; additive sums the same terms, the
+// opacity scaled linearly by step / unit distance.
+fn project(value: ptr<function, vec4<f32>>, misc: ptr<function, vec4<f32>>, s: vec4<f32>, w: f32) {
+    if (BLEND == BLEND_MAXIMUM || BLEND == BLEND_MINIMUM) {
+        *value = extremum(*value, s, (*misc).x == 0.0);
+        (*misc).x = (*misc).x + 1.0;
+    } else if (BLEND == BLEND_AVERAGE) {
+        let r = frame.average_range;
+        if (!has_flag(FLAG_AVERAGE_RANGE) || (s.x >= r.x && s.x <= r.y)) {
+            *value = *value + w * projection_term(s, vec4<f32>(1.0));
+            (*misc).x = (*misc).x + w;
+        }
+    } else {
+        *value = *value + w * projection_term(s, frame.additive_scale);
+        (*misc).x = (*misc).x + 1.0;
+    }
+}
+
 // Opacity × normalised scalar per component (average and additive blend modes), the
 // opacity scaled by `scale` per component.
 fn projection_term(s: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
@@ -700,20 +721,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                     break;
                 }
             }
-        } else if (blend == BLEND_MAXIMUM || blend == BLEND_MINIMUM) {
-            value = extremum(value, s, misc.x == 0.0);
-            misc.x = misc.x + 1.0;
-        } else if (blend == BLEND_AVERAGE) {
-            // VTK: opacity-weighted normalised scalars of the samples inside the range
-            let r = frame.average_range;
-            if (!has_flag(FLAG_AVERAGE_RANGE) || (s.x >= r.x && s.x <= r.y)) {
-                value = value + projection_term(s, vec4<f32>(1.0));
-                misc.x = misc.x + 1.0;
-            }
         } else {
-            // VTK: additive sums the same terms, opacity scaled linearly by step / unit distance
-            value = value + projection_term(s, frame.additive_scale);
-            misc.x = misc.x + 1.0;
+            project(&value, &misc, s, 1.0);
         }
         k = k + 1.0;
     }
@@ -755,18 +764,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                         misc.z = 1.0;
                     }
                 }
-            } else if (blend == BLEND_MAXIMUM || blend == BLEND_MINIMUM) {
-                value = extremum(value, s, misc.x == 0.0);
-                misc.x = misc.x + 1.0;
-            } else if (blend == BLEND_AVERAGE) {
-                let r = frame.average_range;
-                if (!has_flag(FLAG_AVERAGE_RANGE) || (s.x >= r.x && s.x <= r.y)) {
-                    value = value + w * projection_term(s, vec4<f32>(1.0));
-                    misc.x = misc.x + w;
-                }
             } else {
-                value = value + w * projection_term(s, frame.additive_scale);
-                misc.x = misc.x + 1.0;
+                project(&value, &misc, s, w);
             }
         } else if (inside && blend == BLEND_AVERAGE) {
             misc.x = misc.x + w; // (an empty block's samples count, their terms are 0)
