@@ -153,10 +153,10 @@ vtkRenderPass* vtkFerroVolumeDepthPeeling::PeelingPass(vtkVolume* vol)
   const int n = keys->Length(vtkOpenGLRenderPass::RenderPasses());
   for (int i = 0; i < n; ++i)
   {
-    vtkObjectBase* pass = keys->Get(vtkOpenGLRenderPass::RenderPasses(), i);
-    if (vtkDualDepthPeelingPass::SafeDownCast(pass))
+    if (auto* pass =
+          vtkDualDepthPeelingPass::SafeDownCast(keys->Get(vtkOpenGLRenderPass::RenderPasses(), i)))
     {
-      return vtkDualDepthPeelingPass::SafeDownCast(pass);
+      return pass;
     }
   }
   return nullptr;
