@@ -16,6 +16,7 @@ each frame waited for with WaitForCompletion). The configurations:
   pre-int fast       ferrovol fast with PreIntegration on
   midpoint default   the default with MidpointQuadrature on
   midpoint fast      ferrovol fast with MidpointQuadrature on
+  adaptive default   the default with AdaptiveSampling on (midpoints, a step per block)
   vtk default        vtkGPUVolumeRayCastMapper as a script gets it
 
 (ferrovol's reference is drawn without pre-integration and on VTK's lattice: every rule
@@ -41,6 +42,7 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "regression"))
 sys.path.insert(0, os.path.join(ROOT, "tests"))
 
 WARMUP = 2
+LATTICE, MIDPOINT, ADAPTIVE = range(3)
 REFERENCE_DIVISOR = 16
 
 
@@ -98,12 +100,13 @@ class Bench:
         self.start.DeepCopy(self.renderer.GetActiveCamera())
         self.spacing = min(data.GetSpacing())
 
-    def configure(self, sample_distance=None, preintegration=False, midpoint=False):
+    def configure(self, sample_distance=None, preintegration=False, quadrature=LATTICE):
         """Sample distance as a multiple of the smallest spacing; None: the defaults."""
         m = self.mapper
         if hasattr(m, "SetPreIntegration"):
             m.SetPreIntegration(preintegration)
-            m.SetMidpointQuadrature(midpoint)
+            m.SetMidpointQuadrature(quadrature == MIDPOINT)
+            m.SetAdaptiveSampling(quadrature == ADAPTIVE)
         if sample_distance is None:
             m.AutoAdjustSampleDistancesOn()
             m.SetSampleDistance(1.0)
@@ -175,14 +178,15 @@ def main(argv):
             refs[kind] = b.image()
         rows = []
         for label, kind, distance, pre, mid in (
-                ("ferrovol default", "ferrovol", None, False, False),
-                ("ferrovol fast", "ferrovol", 2.0, False, False),
-                ("ferrovol half", "ferrovol", 0.5, False, False),
-                ("pre-int default", "ferrovol", None, True, False),
-                ("pre-int fast", "ferrovol", 2.0, True, False),
-                ("midpoint default", "ferrovol", None, False, True),
-                ("midpoint fast", "ferrovol", 2.0, False, True),
-                ("vtk default", "vtk", None, False, False)):
+                ("ferrovol default", "ferrovol", None, False, LATTICE),
+                ("ferrovol fast", "ferrovol", 2.0, False, LATTICE),
+                ("ferrovol half", "ferrovol", 0.5, False, LATTICE),
+                ("pre-int default", "ferrovol", None, True, LATTICE),
+                ("pre-int fast", "ferrovol", 2.0, True, LATTICE),
+                ("midpoint default", "ferrovol", None, False, MIDPOINT),
+                ("midpoint fast", "ferrovol", 2.0, False, MIDPOINT),
+                ("adaptive default", "ferrovol", None, False, ADAPTIVE),
+                ("vtk default", "vtk", None, False, LATTICE)):
             b = benches[kind]
             b.configure(distance, pre, mid)
             img = b.image()

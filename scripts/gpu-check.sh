@@ -75,9 +75,9 @@ run() {
     done
     step "in core $big³ uint16" render --demo-size "$big" --demo-type uint16 --size "$render" \
         --zoom 1.5 --repeat "$repeat" --orbit 2 -o "$out/in-core.png"
-    for pre in "" --preintegration; do
-        step "wavelet 256³ composite ${pre:-sampled}" render --demo-size 256 $pre \
-            --size "$render" --repeat "$repeat" -o "$out/composite${pre:+-preintegrated}.png"
+    for rule in "" --preintegration --midpoint --adaptive; do
+        step "wavelet 256³ composite ${rule:-sampled}" render --demo-size 256 $rule \
+            --size "$render" --repeat "$repeat" -o "$out/composite${rule:+-${rule#--}}.png"
     done
     step isosurfaces render --demo-size 256 --mode iso --iso 180 --size "$render" \
         --repeat "$repeat" -o "$out/iso.png"

@@ -49,6 +49,9 @@ override PREINT: bool = false;
 // it leaves the volume, opaque depth or a clipping plane (its last part, shorter than a
 // step, sampled after the loop at its middle).
 override MIDPOINT: bool = false;
+// Quadrature::Adaptive, unshaded composite (with MIDPOINT): a step per block (its occupancy
+// value).
+override ADAPTIVE: bool = false;
 
 @group(0) @binding(7) var<storage, read_write> state: array<PixelState>;
 // FLAG_DEPTH_RANGE: the window depth where each pixel's ray starts (depth_in: where it ends).
@@ -606,8 +609,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         k_end = max(k_end, 1.0);
     }
     if (MIDPOINT) {
-        // whole steps only: the rest of the ray is one shorter step
-        k_end = min(floor((seg.y - seg.x) / dt), 1.0e7);
+        // whole steps only: the rest of the ray is one shorter step (adaptive: k counts
+        // the sample distances walked, and the last step ends at the path's end)
+        k_end = min(select(floor((seg.y - seg.x) / dt), (seg.y - seg.x) / dt, ADAPTIVE), 1.0e7);
     }
     k_end = min(k_end, range_samples);
     var color = st.color;
@@ -658,8 +662,65 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
+    if (ADAPTIVE) {
+        // Quadrature::Adaptive: steps of as many sample distances as the block holding the
+        // middle of the step's first sample distance allows, a coarse one ending at the
+        // block's exit (never shorter than one), each sampled at its middle, its opacity
+        // corrected for its length. One loop, one sample an iteration, the block's exit
+        // computed only for coarse steps and skips (nested loops, or work some lanes do
+        // and others not, leave lanes idle on lavapipe). The general loop below and the
+        // midpoint tail take no sample after it.
+        loop {
+            if (k >= k_end) {
+                break;
+            }
+            let probe = ray.index_origin + (seg.x + (k + 0.5) * dt) * ray.index_dir;
+            let m = block_value(probe);
+            if (SKIP && m == 0u) {
+                k = max((block_exit(ray, probe) - seg.x) / dt, k + 0.5);
+                continue;
+            }
+            var k1 = min(k + 1.0, k_end);
+            var whole = k1 == k + 1.0;
+            var w = 1.0;
+            if (m > 1u) {
+                let h = f32(m);
+                let exit = (block_exit(ray, probe) - seg.x) / dt;
+                k1 = min(min(k + h, max(exit, k + 1.0)), k_end);
+                whole = k1 == k + h;
+                w = h;
+            }
+            // (a whole step's length exact: its opacity needs no pow)
+            w = select(k1 - k, w, whole);
+            let t = seg.x + 0.5 * (k + k1) * dt;
+            let p = grid_point(ray.index_origin + t * ray.index_dir);
+            if (STREAMING && waits(p, ray.index_dir)) {
+                suspended = true;
+                break;
+            }
+            let s = sample_scalars(p);
+            var c = classify_sample(s, s, p, ray.origin + t * ray.dir, ray.dir);
+            if (!whole) {
+                c.a = 1.0 - pow(max(1.0 - c.a, 0.0), w);
+            } else if (m >= 2u) {
+                let q = (1.0 - c.a) * (1.0 - c.a);
+                c.a = 1.0 - select(q, q * q, m >= 4u);
+            }
+            k = k1;
+            if (c.a > 0.0) {
+                color = over(color, c);
+                if (misc.z == 0.0 && color.a > frame.misc.z) {
+                    depth_t = t;
+                    misc.z = 1.0;
+                }
+                if (color.a >= ert) {
+                    break;
+                }
+            }
+        }
+    }
     loop {
-        if (k >= k_end) {
+        if (k >= k_end || ADAPTIVE) {
             break;
         }
         let t = seg.x + (k + jit) * dt;
@@ -730,7 +791,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // middle, weighted by its length in steps: composite corrects the opacity for it,
     // average and additive weigh their terms (and average its count), MIP and MinIP take
     // the sample as it is.
-    if (MIDPOINT && !suspended && k >= k_end && !(blend == BLEND_COMPOSITE && color.a >= ert)) {
+    if (MIDPOINT && !ADAPTIVE && !suspended && k >= k_end && !(blend == BLEND_COMPOSITE && color.a >= ert)) {
         let w = (seg.y - seg.x) / dt - k_end;
         // (pre-integrated: the last step's end, classifying the step from its start)
         let t = select(seg.x + (k_end + 0.5 * w) * dt, seg.y, PREINT);

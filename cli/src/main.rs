@@ -168,6 +168,10 @@ struct RenderArgs {
     /// volume exact (VTK's lattice by default: first order in the step, off at silhouettes).
     #[arg(long)]
     midpoint: bool,
+    /// Adaptive midpoint quadrature: unshaded composite rays take 1, 2 or 4 sample distances
+    /// per step by how much the transfer function changes per step in each block.
+    #[arg(long, conflicts_with = "midpoint")]
+    adaptive: bool,
     /// Background colour r,g,b in [0, 1].
     #[arg(long, default_value = "0,0,0", value_parser = parse_rgb)]
     background: [f32; 3],
@@ -771,7 +775,9 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         empty_space_skipping: !a.no_skip,
         preintegration: a.preintegration,
         preview_level: a.preview_level,
-        quadrature: if a.midpoint {
+        quadrature: if a.adaptive {
+            Quadrature::Adaptive
+        } else if a.midpoint {
             Quadrature::Midpoint
         } else {
             Quadrature::Vtk

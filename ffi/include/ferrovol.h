@@ -145,6 +145,13 @@ typedef enum FvQuadrature {
    * volumes (FV_STATUS_UNSUPPORTED).
    */
   FV_QUADRATURE_MIDPOINT = 1,
+  /**
+   * Midpoints with a step per min–max block: composite rays take 1, 2 or 4 sample
+   * distances per step where the transfer function barely varies over the block's
+   * values (ferrovol's Quadrature::Adaptive); the other blend modes as
+   * FV_QUADRATURE_MIDPOINT. The same refusals.
+   */
+  FV_QUADRATURE_ADAPTIVE = 2,
 } FvQuadrature;
 
 /**

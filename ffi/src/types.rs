@@ -131,6 +131,11 @@ pub enum FvQuadrature {
     /// jittering or whole_box_enabled (FV_STATUS_INVALID_ARGUMENT), nor with intermixed
     /// volumes (FV_STATUS_UNSUPPORTED).
     Midpoint = 1,
+    /// Midpoints with a step per min–max block: composite rays take 1, 2 or 4 sample
+    /// distances per step where the transfer function barely varies over the block's
+    /// values (ferrovol's Quadrature::Adaptive); the other blend modes as
+    /// FV_QUADRATURE_MIDPOINT. The same refusals.
+    Adaptive = 2,
 }
 
 /// Gradient estimator for shading and gradient opacity.
@@ -558,7 +563,7 @@ impl ToCore for FvRenderParams {
             quadrature: enum_value(
                 "quadrature",
                 self.quadrature,
-                &[Quadrature::Vtk, Quadrature::Midpoint],
+                &[Quadrature::Vtk, Quadrature::Midpoint, Quadrature::Adaptive],
             )?,
         };
         p.validate()?;

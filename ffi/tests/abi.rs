@@ -451,7 +451,7 @@ fn renderer_errors() {
         lib.expect(render(s.r, 8, 8, depth.as_ptr(), 10), Invalid, "10 values");
 
         type Edit = fn(&mut FvRenderParams);
-        let cases: [(Edit, &str); 14] = [
+        let cases: [(Edit, &str); 15] = [
             (|p| p.blend_mode = 42, "blend_mode 42"),
             (|p| p.quadrature = 5, "quadrature 5"),
             (
@@ -460,6 +460,13 @@ fn renderer_errors() {
                     p.jitter = true;
                 },
                 "midpoint quadrature",
+            ),
+            (
+                |p| {
+                    p.quadrature = FvQuadrature::Adaptive as u32;
+                    p.jitter = true;
+                },
+                "adaptive quadrature",
             ),
             (
                 |p| {

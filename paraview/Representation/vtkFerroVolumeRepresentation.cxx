@@ -180,6 +180,11 @@ void vtkFerroVolumeRepresentation::SetMidpointQuadrature(int value)
   this->GetFerroVolumeMapper()->SetMidpointQuadrature(value != 0);
 }
 
+void vtkFerroVolumeRepresentation::SetAdaptiveSampling(int value)
+{
+  this->GetFerroVolumeMapper()->SetAdaptiveSampling(value != 0);
+}
+
 void vtkFerroVolumeRepresentation::SetCubicInterpolation(int value)
 {
   this->GetFerroVolumeMapper()->SetCubicInterpolation(value != 0);

@@ -27,7 +27,7 @@
  * - the sampling settings of vtkGPUVolumeRayCastMapper with the same meaning:
  *   AutoAdjustSampleDistances, SampleDistance, ImageSampleDistance, UseJittering,
  *   EmptySpaceSkipping, MaxMemoryInBytes and MaxMemoryFraction; and vtkFerroVolumeMapper's
- *   PreIntegration, MidpointQuadrature and CubicInterpolation.
+ *   PreIntegration, MidpointQuadrature, AdaptiveSampling and CubicInterpolation.
  *
  * Inputs: vtkImageData only (what vtkFerroVolumeMapper renders). Rectilinear grids and
  * composite datasets, which "Volume" accepts, are not drawn; a warning says so.
@@ -107,6 +107,7 @@ public:
   void SetEmptySpaceSkipping(int value);
   void SetPreIntegration(int value);
   void SetMidpointQuadrature(int value);
+  void SetAdaptiveSampling(int value);
   void SetCubicInterpolation(int value);
   void SetMaxMemoryInBytes(vtkIdType value);
   void SetMaxMemoryFraction(double value);

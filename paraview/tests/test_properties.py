@@ -88,6 +88,7 @@ CHANGES = [
     (("UseCropping", "CroppingOrigin", "CroppingScale"), [1, [0, 0, 0], [0.5, 1, 1]], True),
     (("Position", "Orientation"), [[4, 0, 0], [0, 0, 30]], True),
     ("FerrovolMidpointQuadrature", 1, True),
+    ("FerrovolAdaptiveSampling", 1, True),
     ("FerrovolEmptySpaceSkipping", 0, False),
     # any vtkVolumeMapper blend mode on the shared property: maximum intensity here
     ("BlendMode(shared)", 1, True),

@@ -3,9 +3,10 @@
 // planes), VTK's cropping regions and the occupancy grid for empty-space skipping.
 
 // Per block of the occupancy grid (a texture: lavapipe reads storage buffers at per-lane
-// indices one lane at a time): 1 when the block may hold something the pass looks for
-// (dvr: some voxel with non-zero opacity; firsthit: some iso-value within the block's
-// range), 0 when the pass can skip it.
+// indices one lane at a time): non-zero when the block may hold something the pass looks
+// for (dvr: some voxel with non-zero opacity, the value then the step multiplier adaptive
+// rays take there, 1, 2 or 4; firsthit: some iso-value within the block's range), 0 when
+// the pass can skip it.
 @group(0) @binding(3) var occupancy: texture_3d<u32>;
 // The host's opaque depth (window depth per pixel), read when FLAG_DEPTH_INPUT is set.
 @group(0) @binding(4) var depth_in: texture_2d<f32>;
@@ -46,7 +47,11 @@ fn block_coord(p: vec3<f32>) -> vec3<i32> {
 }
 
 fn block_occupied(p: vec3<f32>) -> bool {
-    return textureLoad(occupancy, block_coord(p), 0).x != 0u;
+    return block_value(p) != 0u;
+}
+
+fn block_value(p: vec3<f32>) -> u32 {
+    return textureLoad(occupancy, block_coord(p), 0).x;
 }
 
 // Distance at which the ray leaves the occupancy block holding p.

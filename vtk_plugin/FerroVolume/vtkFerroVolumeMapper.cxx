@@ -263,6 +263,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , LastRenderSize{ 0, 0 }
   , PreIntegration(0)
   , MidpointQuadrature(0)
+  , AdaptiveSampling(0)
   , CubicInterpolation(0)
   , Internals(new vtkInternals)
 {
@@ -823,6 +824,7 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ExtremumDepth: " << this->ExtremumDepth << "\n";
   os << indent << "PreIntegration: " << this->PreIntegration << "\n";
   os << indent << "MidpointQuadrature: " << this->MidpointQuadrature << "\n";
+  os << indent << "AdaptiveSampling: " << this->AdaptiveSampling << "\n";
   os << indent << "CubicInterpolation: " << this->CubicInterpolation << "\n";
   os << indent << "WholeExtent: " << this->WholeExtent[0] << " " << this->WholeExtent[1] << " "
      << this->WholeExtent[2] << " " << this->WholeExtent[3] << " " << this->WholeExtent[4] << " "

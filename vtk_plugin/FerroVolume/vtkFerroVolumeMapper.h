@@ -190,6 +190,23 @@ public:
 
   ///@{
   /**
+   * Adaptive sampling: the midpoint quadrature (it implies MidpointQuadrature) with a step per
+   * 8-cell block of the volume: unshaded composite rays take 1, 2 or 4 sample distances per
+   * step where the transfer function's opacity and colour barely change per step over the
+   * block's values (their spread over the block's range times the share of it one voxel
+   * crosses, from the data's largest jump between neighbours), a coarse step ending at its
+   * block's exit; only where that saves half the samples of the occupied blocks (reading the
+   * blocks costs the rest). Shaded rays, other blend modes, gradient opacity, 2D transfer
+   * functions, cropping, masks and blanking take every step, as MidpointQuadrature does.
+   * Default off: VTK's images (docs/PERFORMANCE.md has what it measures).
+   */
+  vtkSetClampMacro(AdaptiveSampling, vtkTypeBool, 0, 1);
+  vtkGetMacro(AdaptiveSampling, vtkTypeBool);
+  vtkBooleanMacro(AdaptiveSampling, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Cubic interpolation: where the property's InterpolationType is linear, ray casting
    * reconstructs the volume with the cubic B-spline of its points (not prefiltered: it
    * smooths at the scale of a voxel and keeps linear fields as they are; Sigg and Hadwiger's
@@ -769,6 +786,7 @@ protected:
   int LastRenderSize[2];
   vtkTypeBool PreIntegration;
   vtkTypeBool MidpointQuadrature;
+  vtkTypeBool AdaptiveSampling;
   vtkTypeBool CubicInterpolation;
 
 private:

@@ -511,22 +511,26 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       params.whole_box[3 + a] = std::max(whole[2 * a], whole[2 * a + 1] - cells) - extent[2 * a];
     }
   }
-  // MidpointQuadrature: samples placed mid-step (not jittered), on one whole volume.
-  if (self->GetMidpointQuadrature() && (params.whole_box_enabled || this->Intermixing) &&
+  // MidpointQuadrature and AdaptiveSampling: samples placed mid-step (not jittered), on one
+  // whole volume.
+  const bool midpoints = self->GetMidpointQuadrature() || self->GetAdaptiveSampling();
+  const char* quadrature = self->GetAdaptiveSampling() ? "AdaptiveSampling" : "MidpointQuadrature";
+  if (midpoints && (params.whole_box_enabled || this->Intermixing) &&
     warned.insert("midpoint-pieces").second)
   {
-    vtkWarningWithObjectMacro(self, << "MidpointQuadrature is not applied to "
+    vtkWarningWithObjectMacro(self, << quadrature << " is not applied to "
                                     << (this->Intermixing ? "a vtkMultiVolume"
                                                           : "a piece of a whole extent (MPI)")
                                     << ": its rays sample on VTK's lattice");
   }
-  if (self->GetMidpointQuadrature() && !params.whole_box_enabled && !this->Intermixing)
+  if (midpoints && !params.whole_box_enabled && !this->Intermixing)
   {
-    params.quadrature = FV_QUADRATURE_MIDPOINT;
+    params.quadrature =
+      self->GetAdaptiveSampling() ? FV_QUADRATURE_ADAPTIVE : FV_QUADRATURE_MIDPOINT;
     if (params.jitter && warned.insert("midpoint-jitter").second)
     {
-      vtkWarningWithObjectMacro(self, << "UseJittering is not applied with MidpointQuadrature: "
-                                         "its samples sit in the middle of their steps");
+      vtkWarningWithObjectMacro(self, << "UseJittering is not applied with " << quadrature
+                                      << ": its samples sit in the middle of their steps");
     }
     params.jitter = false;
   }

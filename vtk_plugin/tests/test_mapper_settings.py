@@ -341,29 +341,35 @@ class Settings(unittest.TestCase):
     def test_midpoint_quadrature_is_closer_at_twice_the_step(self):
         """MidpointQuadrature against VTK's lattice on the wavelet, each against its own
         converged image (1/16 voxel): at twice the sample distance midpoints are closer than
-        the lattice at the default one. UseJittering is not applied with it (one warning).
-        One mapper throughout (its pipelines are built once)."""
+        the lattice at the default one; AdaptiveSampling (a step per block) at the default
+        one too. UseJittering is not applied with it (one warning). One mapper throughout
+        (its pipelines are built once)."""
         scene, errors = fvtest.ferrovol_scene(self.src, tf_property(), None, size=(120, 120),
                                               camera=view)
         m = scene.mapper
         m.AutoAdjustSampleDistancesOff()
 
-        def render(d, midpoint, jitter=False):
+        def render(d, midpoint, jitter=False, adaptive=False):
             m.SetSampleDistance(d)
             m.SetMidpointQuadrature(midpoint)
+            m.SetAdaptiveSampling(adaptive)
             m.SetUseJittering(jitter)
             return scene.render()
 
         self.assertEqual(m.GetMidpointQuadrature(), 0)
+        self.assertEqual(m.GetAdaptiveSampling(), 0)
         lattice_ref, midpoint_ref = render(1.0 / 16, 0), render(1.0 / 16, 1)
         lattice, midpoints = render(1.0, 0), render(2.0, 1)
-        save("settings-midpoint-quadrature", lattice_ref, lattice, midpoints)
+        adaptive = render(1.0, 0, adaptive=True)
+        save("settings-midpoint-quadrature", lattice_ref, lattice, midpoints, adaptive)
         p_lattice, p_mid = fvtest.psnr(lattice, lattice_ref), fvtest.psnr(midpoints, midpoint_ref)
+        p_adaptive = fvtest.psnr(adaptive, midpoint_ref)
         print("against converged images: VTK's lattice at step 1 %.1f dB, midpoints at step 2 "
-              "%.1f dB (the converged images %.1f dB apart)"
-              % (p_lattice, p_mid, fvtest.psnr(midpoint_ref, lattice_ref)))
+              "%.1f dB, adaptive at step 1 %.1f dB (the converged images %.1f dB apart)"
+              % (p_lattice, p_mid, p_adaptive, fvtest.psnr(midpoint_ref, lattice_ref)))
         self.assertGreater(coverage(midpoints), 0.2)
         self.assertGreater(p_mid, p_lattice + 2.0)
+        self.assertGreater(p_adaptive, p_lattice + 2.0)
         self.assertEqual(errors.warnings, [])
         plain, jittered = render(1.0, 1), render(1.0, 1, True)
         self.assertEqual(errors.messages, [])

@@ -26,7 +26,7 @@ pub use light::{Light, LightSpace};
 pub use pathtrace::{BsdfParams, Convergence, PathTraceParams, ScatterRegions};
 pub use render::{
     BlendMode, ClipPlane, Cropping, GradientMethod, Interpolation, Quadrature, RenderParams,
-    Shading, MAX_CLIP_PLANES, MAX_LIGHTS,
+    Shading, ADAPTIVE_STEP_TOLERANCE, MAX_CLIP_PLANES, MAX_LIGHTS,
 };
 pub(crate) use transfer::{build_preintegration, build_tables, build_tables_over};
 pub use transfer::{

@@ -7,6 +7,11 @@
 use super::frame::{
     self, bricks_in_view, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY,
 };
+
+/// The least share of the occupied blocks' samples an adaptive frame must save for its rays
+/// to read their blocks' step multipliers; below it they take every step (the midpoint
+/// rule). On lavapipe the reads cost about what half the samples do (docs/PERFORMANCE.md).
+const ADAPTIVE_MIN_SAVING: f64 = 0.5;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
@@ -50,6 +55,7 @@ pipeline_variant! {
         streaming: bool => "STREAMING",
         preintegration: bool => "PREINT",
         midpoint: bool => "MIDPOINT",
+        adaptive: bool => "ADAPTIVE",
         rectilinear: bool => "RECTILINEAR",
         /// Number of volumes intermixed with the main one.
         intermix: u32 => "INTERMIX",
@@ -190,12 +196,12 @@ impl DvrPass {
                     .into(),
             ));
         }
-        if params.quadrature == Quadrature::Midpoint && res.intermix.is_some() {
-            return Err(Error::Unsupported(
-                "the midpoint quadrature draws one volume: clear the intermixed volumes or use \
-                 Quadrature::Vtk"
-                    .into(),
-            ));
+        if params.quadrature.midpoints() && res.intermix.is_some() {
+            return Err(Error::Unsupported(format!(
+                "the {} quadrature draws one volume: clear the intermixed volumes or use \
+                 Quadrature::Vtk",
+                params.quadrature.name()
+            )));
         }
         let vol = res.volume()?;
         let rectilinear = vol.grid_lookup.is_some();
@@ -300,6 +306,25 @@ impl DvrPass {
             && !f.volumetric
             && mask != MASK_LABELS
             && tables_2d == 0;
+        // Adaptive steps: composite and unshaded (lighting turns with the gradient's
+        // direction, which a block's values do not bound), classified by the 1D tables the
+        // occupancy grid's step multipliers come from, on a uniform grid whose blocks rays
+        // march, with nothing that cuts samples out inside a block (cropping, blanking,
+        // masks); and only where the coarse steps save enough samples to pay for reading
+        // the blocks.
+        let saving = res.occupancy.as_ref().map_or(0.0, |o| o.saving);
+        let adaptive = params.quadrature == Quadrature::Adaptive
+            && !params.shading.enabled
+            && saving >= ADAPTIVE_MIN_SAVING
+            && params.blend == BlendMode::Composite
+            && !preintegration
+            && !f.gradient_opacity
+            && tables_2d == 0
+            && mask == MASK_NONE
+            && (vol.components == 1 || f.independent)
+            && !rectilinear
+            && params.cropping.is_none()
+            && res.blanking.is_none();
         let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
         if intermix > 0 {
             let refused = [
@@ -357,7 +382,8 @@ impl DvrPass {
             forward_diff: params.gradient == GradientMethod::Forward,
             streaming,
             preintegration,
-            midpoint: params.quadrature == Quadrature::Midpoint,
+            midpoint: params.quadrature.midpoints(),
+            adaptive,
             rectilinear,
             intermix,
             intermix_filtered: intermix > 0 && ctx.info.float32_filterable,

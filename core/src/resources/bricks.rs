@@ -411,11 +411,15 @@ pub fn brick_texels(
 }
 
 /// Min–max of each component over occupancy blocks of [`BLOCK_SIZE`] cells: block b holds
-/// the points b·S … b·S + S (inclusive), all a sample inside the block interpolates from.
+/// the points b·S … b·S + S (inclusive), all a sample inside the block interpolates from;
+/// and how far apart neighbouring points are there.
 pub struct MinMaxGrid {
     pub dims: [u32; 3],
     /// Per block, per component: (min, max).
     pub ranges: Vec<[f32; 2]>,
+    /// Per block, per component: the largest change between neighbouring points (along
+    /// x, y or z), how rough the data is at the voxel scale, which its range does not tell.
+    pub jumps: Vec<f32>,
 }
 
 impl MinMaxGrid {
@@ -429,10 +433,22 @@ impl MinMaxGrid {
         let nc = v.components;
         let nblocks = dims.iter().map(|&d| d as usize).product::<usize>();
         let mut ranges = vec![[f32::INFINITY, f32::NEG_INFINITY]; nblocks * nc as usize];
+        let mut jumps = vec![0.0f32; nblocks * nc as usize];
         // Reduce along x into per-(row, block) ranges first, then spread over y and z.
         let (nx, ny, nz) = (v.dims[0], v.dims[1], v.dims[2]);
         let source = v.scalars.source().is_some();
         let mut row_vals = vec![0.0; if source { (nx * nc) as usize } else { 0 }];
+        // A source's rows of the slice before (those not yet read of this one): the jumps
+        // to a point's neighbours before it along y and z.
+        let mut before = vec![
+            0.0;
+            if source {
+                row_vals.len() * ny as usize
+            } else {
+                0
+            }
+        ];
+        let apart = |a: f64, b: f64| (a - b).abs() as f32;
         for k in 0..nz {
             let bz_lo = (k.saturating_sub(1) / s).min(dims[2] - 1);
             let bz_hi = (k / s).min(dims[2] - 1);
@@ -446,6 +462,7 @@ impl MinMaxGrid {
                     bz: [bz_lo, bz_hi],
                     by: [by_lo, by_hi],
                     ranges: &mut ranges,
+                    jumps: &mut jumps,
                 };
                 if source {
                     let start = (k as usize * ny as usize + j as usize) * row_vals.len();
@@ -453,13 +470,53 @@ impl MinMaxGrid {
                     if let Some(i) = row_vals.iter().position(|x| !x.is_finite()) {
                         return Err(v.non_finite(start + i, row_vals[i]));
                     }
-                    row.reduce(|i, c| row_vals[(i * nc + c) as usize] as f32);
+                    let n = row_vals.len();
+                    let (done, rest) = before.split_at_mut(j as usize * n);
+                    let above = &mut rest[..n];
+                    row.reduce(
+                        |i, c| row_vals[(i * nc + c) as usize] as f32,
+                        |i, c| {
+                            let x = (i * nc + c) as usize;
+                            let y = if j > 0 {
+                                apart(row_vals[x], done[done.len() - n + x])
+                            } else {
+                                0.0
+                            };
+                            let z = if k > 0 {
+                                apart(row_vals[x], above[x])
+                            } else {
+                                0.0
+                            };
+                            y.max(z)
+                        },
+                    );
+                    above.copy_from_slice(&row_vals);
                 } else {
-                    row.reduce(|i, c| v.value(i, j, k, c) as f32);
+                    row.reduce(
+                        |i, c| v.value(i, j, k, c) as f32,
+                        |i, c| {
+                            let val = v.value(i, j, k, c);
+                            let y = if j > 0 {
+                                apart(val, v.value(i, j - 1, k, c))
+                            } else {
+                                0.0
+                            };
+                            let z = if k > 0 {
+                                apart(val, v.value(i, j, k - 1, c))
+                            } else {
+                                0.0
+                            };
+                            y.max(z)
+                        },
+                    );
                 }
             }
         }
-        Ok(MinMaxGrid { dims, ranges })
+        Ok(MinMaxGrid {
+            dims,
+            ranges,
+            jumps,
+        })
     }
 
     /// Per block, 1 where component `c` (of `nc`) takes one of `values` (an isosurface of it
@@ -506,12 +563,15 @@ struct RowRanges<'a> {
     bz: [u32; 2],
     by: [u32; 2],
     ranges: &'a mut [[f32; 2]],
+    jumps: &'a mut [f32],
 }
 
 impl RowRanges<'_> {
-    /// Folds the row's values (`value(i, c)`) into the ranges of the blocks holding them.
+    /// Folds the row's values (`value(i, c)`) into the ranges of the blocks holding them, and
+    /// their jumps to their neighbours along x and (`across(i, c)`) along y and z into the
+    /// blocks' jumps.
     #[inline]
-    fn reduce(&mut self, value: impl Fn(u32, u32) -> f32) {
+    fn reduce(&mut self, value: impl Fn(u32, u32) -> f32, across: impl Fn(u32, u32) -> f32) {
         let (s, dims, nc) = (BLOCK_SIZE, self.dims, self.nc);
         for bx in 0..dims[0] {
             let i0 = bx * s;
@@ -519,10 +579,14 @@ impl RowRanges<'_> {
             for c in 0..nc {
                 let mut lo = f32::INFINITY;
                 let mut hi = f32::NEG_INFINITY;
+                let mut jump = 0.0f32;
+                let mut prev = value(i0, c);
                 for i in i0..=i1 {
                     let val = value(i, c);
                     lo = lo.min(val);
                     hi = hi.max(val);
+                    jump = jump.max((val - prev).abs()).max(across(i, c));
+                    prev = val;
                 }
                 for bz in self.bz[0]..=self.bz[1] {
                     for by in self.by[0]..=self.by[1] {
@@ -530,6 +594,8 @@ impl RowRanges<'_> {
                         let r = &mut self.ranges[b * nc as usize + c as usize];
                         r[0] = r[0].min(lo);
                         r[1] = r[1].max(hi);
+                        let j = &mut self.jumps[b * nc as usize + c as usize];
+                        *j = j.max(jump);
                     }
                 }
             }

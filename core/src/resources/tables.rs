@@ -1,12 +1,16 @@
 //! The transfer-function tables and the occupancy of the min–max blocks they give.
 
+use super::bricks::BLOCK_SIZE;
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, texture_entry};
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
-use crate::params::{build_preintegration, build_tables, build_tables_over, TransferFunction};
+use crate::params::{
+    build_preintegration, build_tables, build_tables_over, TransferFunction,
+    ADAPTIVE_STEP_TOLERANCE,
+};
 
 /// The pre-integration tables' texel format.
 pub(crate) const PREINTEGRATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -64,6 +68,9 @@ pub(crate) struct Occupancy<K> {
     pub flags: Vec<u32>,
     /// The fraction of blocks occupied.
     pub fraction: f64,
+    /// The share of an occupied block's samples adaptive rays save on average (from the
+    /// step multipliers the ray-casting occupancy holds).
+    pub saving: f64,
 }
 
 impl<K: PartialEq> Occupancy<K> {
@@ -74,12 +81,20 @@ impl<K: PartialEq> Occupancy<K> {
 
     pub fn new(ctx: &Context, label: &str, key: K, dims: [u32; 3], occ: &[u32]) -> Self {
         let grid = block_grid(ctx, label, dims, occ);
-        let fraction = occ.iter().filter(|&&o| o != 0).count() as f64 / occ.len().max(1) as f64;
+        let occupied = occ.iter().filter(|&&o| o != 0).count();
+        let fraction = occupied as f64 / occ.len().max(1) as f64;
+        let saved: f64 = occ
+            .iter()
+            .filter(|&&m| m > 1)
+            .map(|&m| 1.0 - 1.0 / m as f64)
+            .sum();
+        let saving = saved / occupied.max(1) as f64;
         Occupancy {
             key,
             grid,
             flags: occ.to_vec(),
             fraction,
+            saving,
         }
     }
 }
@@ -228,8 +243,10 @@ impl Resources {
         Ok(())
     }
 
-    /// Classifies the min–max grid against the transfer function: 1 for blocks where some
-    /// value in the block's range has non-zero opacity.
+    /// Classifies the min–max grid against the transfer function: 0 for blocks where no
+    /// value in the block's range has non-zero opacity, else the step multiplier an
+    /// adaptive ray may take there: 1, 2 or 4 sample distances, as many as keep the change
+    /// of the classified function per step within [`crate::ADAPTIVE_STEP_TOLERANCE`].
     pub fn ensure_occupancy(&mut self, ctx: &Context, step: f64) -> Result<()> {
         let (Some(tf), Some(vol)) = (self.tf.as_ref(), self.volume.as_ref()) else {
             return Err(Error::InvalidParameter(
@@ -247,19 +264,28 @@ impl Resources {
         } else {
             vec![nc - 1]
         };
-        let counts = |tables: Vec<[f32; 4]>, visible: bool| {
+        let counts = |tables: &[[f32; 4]], visible: bool| {
             let mut p = vec![0u32; TABLE_SIZE + 1];
             for i in 0..TABLE_SIZE {
                 p[i + 1] = p[i] + (tables[i][3] > 0.0 && visible) as u32;
             }
             p
         };
-        let mut prefix: Vec<(usize, [f64; 2], Vec<u32>)> = opacity_comps
+        // Dependent components take their colour from the others, a label map classifies
+        // labelled samples with other functions: their rays take every step.
+        let adaptive = (nc == 1 || tf.independent) && (nc > 1 || tf.max_label() == 0);
+        let mut functions: Vec<Classified> = opacity_comps
             .iter()
             .map(|&c| {
                 let ct = tf.component(if tf.independent { c } else { 0 });
                 let visible = !tf.independent || ct.weight > 0.0;
-                (c, ct.table_range(), counts(build_tables(ct, step), visible))
+                let tables = build_tables(ct, step);
+                Classified {
+                    component: c,
+                    range: ct.table_range(),
+                    prefix: counts(&tables, visible),
+                    spread: (adaptive && visible).then(|| Spread::new(&tables[..TABLE_SIZE])),
+                }
             })
             .collect();
         // A label map classifies a one-component volume's labelled samples with their
@@ -269,29 +295,113 @@ impl Resources {
             for label in 1..=tf.max_label() {
                 let t = tf.label_transfer(label);
                 let tables = build_tables_over(&t, step, range, gradient_range);
-                prefix.push((0, range, counts(tables, true)));
+                functions.push(Classified {
+                    component: 0,
+                    range,
+                    prefix: counts(&tables, true),
+                    spread: None,
+                });
             }
         }
+        // A sample distance in voxels (along the shortest edge): a block's spread of the
+        // classified function times the fraction of its range one voxel can cross (its
+        // largest jump between neighbours, at least the range over the block's width: data
+        // smooth at the block's scale) bounds how much it changes per sample distance.
+        let m = vol.index_to_data;
+        let edge = [m.x_axis, m.y_axis, m.z_axis]
+            .map(|a| a.truncate().length())
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        let voxels = (step / edge) as f32;
         let nblocks = vol.minmax.ranges.len() / nc;
         let mut occ = vec![0u32; nblocks];
         let last = (TABLE_SIZE - 1) as f64;
         for (b, o) in occ.iter_mut().enumerate() {
-            for (c, [lo, hi], p) in &prefix {
-                let [mn, mx] = vol.minmax.ranges[b * nc + c];
+            let mut change = if adaptive { 0.0 } else { f32::INFINITY };
+            for f in &functions {
+                let [lo, hi] = f.range;
+                let [mn, mx] = vol.minmax.ranges[b * nc + f.component];
+                let jump = vol.minmax.jumps[b * nc + f.component];
+                let crossed = (jump / (mx - mn)).max(1.0 / BLOCK_SIZE as f32).min(1.0);
                 let x0 = ((mn as f64 - lo) / (hi - lo) * last)
                     .floor()
                     .clamp(0.0, last) as usize;
                 let x1 = ((mx as f64 - lo) / (hi - lo) * last)
                     .ceil()
                     .clamp(0.0, last) as usize;
-                if p[x1 + 1] > p[x0] {
+                if f.prefix[x1 + 1] > f.prefix[x0] {
                     *o = 1;
-                    break;
                 }
+                if let Some(s) = &f.spread {
+                    change = change.max(s.over(x0, x1) * crossed * voxels);
+                }
+            }
+            if *o != 0 {
+                *o = match change {
+                    c if 4.0 * c <= ADAPTIVE_STEP_TOLERANCE => 4,
+                    c if 2.0 * c <= ADAPTIVE_STEP_TOLERANCE => 2,
+                    _ => 1,
+                };
             }
         }
         self.occupancy = Some(Occupancy::new(ctx, "occupancy", key, vol.minmax.dims, &occ));
         self.stats.occupancy_updates += 1;
         Ok(())
+    }
+}
+
+/// One function that classifies a component's samples, as the occupancy reads it.
+struct Classified {
+    component: usize,
+    /// The scalar range its table spans.
+    range: [f64; 2],
+    /// Prefix counts of its table's entries with non-zero opacity.
+    prefix: Vec<u32>,
+    /// How much it varies over runs of entries (`None`: not for adaptive steps).
+    spread: Option<Spread>,
+}
+
+/// Range queries of how much a table varies: the largest spread (max − min) of its
+/// opacity and its opacity-weighted colour over a run of entries, from a sparse table of
+/// their minima and maxima over runs of 2^l entries.
+struct Spread {
+    levels: Vec<Vec<[[f32; 4]; 2]>>,
+}
+
+impl Spread {
+    fn new(entries: &[[f32; 4]]) -> Spread {
+        let merge = |a: [[f32; 4]; 2], b: [[f32; 4]; 2]| {
+            [
+                std::array::from_fn(|i| a[0][i].min(b[0][i])),
+                std::array::from_fn(|i| a[1][i].max(b[1][i])),
+            ]
+        };
+        let first: Vec<[[f32; 4]; 2]> = entries
+            .iter()
+            .map(|e| {
+                let q = [e[0] * e[3], e[1] * e[3], e[2] * e[3], e[3]];
+                [q, q]
+            })
+            .collect();
+        let mut levels = vec![first];
+        let mut w = 1;
+        while 2 * w <= entries.len() {
+            let prev = &levels[levels.len() - 1];
+            let next = (0..=entries.len() - 2 * w)
+                .map(|i| merge(prev[i], prev[i + w]))
+                .collect();
+            levels.push(next);
+            w *= 2;
+        }
+        Spread { levels }
+    }
+
+    /// The largest spread of one quantity over entries `x0..=x1`.
+    fn over(&self, x0: usize, x1: usize) -> f32 {
+        let l = (x1 - x0 + 1).ilog2() as usize;
+        let (a, b) = (self.levels[l][x0], self.levels[l][x1 + 1 - (1 << l)]);
+        (0..4)
+            .map(|i| a[1][i].max(b[1][i]) - a[0][i].min(b[0][i]))
+            .fold(0.0, f32::max)
     }
 }

@@ -11,6 +11,7 @@
 use ferrovol_core::*;
 use glam::DVec3;
 
+mod adaptive;
 mod bricks;
 #[path = "../common/mod.rs"]
 mod common;
