@@ -484,6 +484,23 @@ fn slice_state(ray: Ray, box: vec2<f32>, term: f32) -> PixelState {
     return st;
 }
 
+// Composites c (not premultiplied) over the ray's colour, and notes the distance t where
+// its opacity first passes the depth threshold (misc.z: passed; turned into a depth after
+// the loop).
+fn composite_over(
+    color: ptr<function, vec4<f32>>,
+    misc: ptr<function, vec4<f32>>,
+    depth_t: ptr<function, f32>,
+    c: vec4<f32>,
+    t: f32,
+) {
+    *color = over(*color, c);
+    if ((*misc).z == 0.0 && (*color).a > frame.misc.z) {
+        *depth_t = t;
+        (*misc).z = 1.0;
+    }
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
@@ -708,11 +725,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             k = k1;
             if (c.a > 0.0) {
-                color = over(color, c);
-                if (misc.z == 0.0 && color.a > frame.misc.z) {
-                    depth_t = t;
-                    misc.z = 1.0;
-                }
+                composite_over(&color, &misc, &depth_t, c, t);
                 if (color.a >= ert) {
                     break;
                 }
@@ -773,11 +786,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 c = intermixed_sample(j, pos, ray.dir);
             }
             if (c.a > 0.0 || INTERMIX > 0u) {
-                color = over(color, c);
-                if (misc.z == 0.0 && color.a > frame.misc.z) {
-                    depth_t = t;
-                    misc.z = 1.0;
-                }
+                composite_over(&color, &misc, &depth_t, c, t);
                 if (color.a >= ert) {
                     break;
                 }
@@ -819,11 +828,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 var c = classify_sample(sf, s, p, ray.origin + t * ray.dir, ray.dir);
                 c.a = 1.0 - pow(max(1.0 - c.a, 0.0), w);
                 if (c.a > 0.0) {
-                    color = over(color, c);
-                    if (misc.z == 0.0 && color.a > frame.misc.z) {
-                        depth_t = t;
-                        misc.z = 1.0;
-                    }
+                    composite_over(&color, &misc, &depth_t, c, t);
                 }
             } else {
                 project(&value, &misc, s, w);

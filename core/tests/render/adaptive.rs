@@ -82,31 +82,28 @@ fn rough_data_takes_every_step_and_flat_functions_any() {
     });
     r.set_volume(&vol).unwrap();
     let view = View::fit(vol.bounds(), 96, 96);
-    let base = RenderParams::default();
+    // the adaptive image's largest difference from the midpoint one
+    let from_midpoints = |r: &mut Renderer, what: &str| {
+        let base = RenderParams::default();
+        let mut img = |q| r.render_image(&view, &at(q, 1.0, &base)).unwrap();
+        let (mid, adaptive) = (img(Quadrature::Midpoint), img(Quadrature::Adaptive));
+        let (mean, max) = image_diff(&adaptive, &mid);
+        println!("{what}: adaptive vs midpoints mean {mean:.4}, max {max}");
+        max
+    };
     r.set_transfer_function(&ramp(0.0, 1.0, 1.0)).unwrap();
-    let mid = r
-        .render_image(&view, &at(Quadrature::Midpoint, 1.0, &base))
-        .unwrap();
-    let adaptive = r
-        .render_image(&view, &at(Quadrature::Adaptive, 1.0, &base))
-        .unwrap();
-    let (mean, max) = image_diff(&adaptive, &mid);
-    println!("noise: adaptive vs midpoints mean {mean:.4}, max {max}");
-    assert_eq!(max, 0, "rough data took a coarse step");
+    assert_eq!(
+        from_midpoints(&mut r, "noise"),
+        0,
+        "rough data took a coarse step"
+    );
     r.set_transfer_function(&TransferFunction::single(component_transfer(
         &[(0.0, [0.9, 0.6, 0.3]), (1.0, [0.9, 0.6, 0.3])],
         &[(0.0, 0.02), (1.0, 0.02)],
         1.0,
     )))
     .unwrap();
-    let mid = r
-        .render_image(&view, &at(Quadrature::Midpoint, 1.0, &base))
-        .unwrap();
-    let adaptive = r
-        .render_image(&view, &at(Quadrature::Adaptive, 1.0, &base))
-        .unwrap();
-    let (mean, max) = image_diff(&adaptive, &mid);
-    println!("flat function: adaptive vs midpoints mean {mean:.4}, max {max}");
+    let max = from_midpoints(&mut r, "flat function");
     assert!(max <= 1, "{max}");
 }
 
