@@ -146,10 +146,10 @@ typedef enum FvQuadrature {
    */
   FV_QUADRATURE_MIDPOINT = 1,
   /**
-   * Midpoints with a step per min–max block: composite rays take 1, 2 or 4 sample
-   * distances per step where the transfer function barely varies over the block's
-   * values (ferrovol's Quadrature::Adaptive); the other blend modes as
-   * FV_QUADRATURE_MIDPOINT. The same refusals.
+   * Midpoints with a step per min–max block: unshaded composite rays take 1, 2 or 4
+   * sample distances per step where the transfer function barely changes per step in
+   * the block (ferrovol's Quadrature::Adaptive); shaded rays and the other blend modes
+   * as FV_QUADRATURE_MIDPOINT. The same refusals.
    */
   FV_QUADRATURE_ADAPTIVE = 2,
 } FvQuadrature;

@@ -8,10 +8,6 @@ use super::frame::{
     self, bricks_in_view, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY,
 };
 
-/// The least share of the occupied blocks' samples an adaptive frame must save for its rays
-/// to read their blocks' step multipliers; below it they take every step (the midpoint
-/// rule). On lavapipe the reads cost about what half the samples do (docs/PERFORMANCE.md).
-const ADAPTIVE_MIN_SAVING: f64 = 0.5;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
@@ -26,6 +22,11 @@ use crate::resources::tables::{tables_2d_layout_entry, Tables, PREINTEGRATION_FO
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
+
+/// The least share of the occupied blocks' samples an adaptive frame must save for its rays
+/// to read their blocks' step multipliers; below it they take every step (the midpoint
+/// rule). On lavapipe the reads cost about what half the samples do (docs/PERFORMANCE.md).
+const ADAPTIVE_MIN_SAVING: f64 = 0.5;
 
 pipeline_variant! {
     /// The pipeline constants of one specialisation of the DVR pass (overrides in dvr.wgsl).

@@ -448,7 +448,7 @@ impl MinMaxGrid {
                 0
             }
         ];
-        let apart = |a: f64, b: f64| (a - b).abs() as f32;
+        let apart = |a: f32, b: f64| (a as f64 - b).abs() as f32;
         for k in 0..nz {
             let bz_lo = (k.saturating_sub(1) / s).min(dims[2] - 1);
             let bz_hi = (k / s).min(dims[2] - 1);
@@ -475,18 +475,14 @@ impl MinMaxGrid {
                     let above = &mut rest[..n];
                     row.reduce(
                         |i, c| row_vals[(i * nc + c) as usize] as f32,
-                        |i, c| {
+                        |i, c, val| {
                             let x = (i * nc + c) as usize;
                             let y = if j > 0 {
-                                apart(row_vals[x], done[done.len() - n + x])
+                                apart(val, done[done.len() - n + x])
                             } else {
                                 0.0
                             };
-                            let z = if k > 0 {
-                                apart(row_vals[x], above[x])
-                            } else {
-                                0.0
-                            };
+                            let z = if k > 0 { apart(val, above[x]) } else { 0.0 };
                             y.max(z)
                         },
                     );
@@ -494,8 +490,7 @@ impl MinMaxGrid {
                 } else {
                     row.reduce(
                         |i, c| v.value(i, j, k, c) as f32,
-                        |i, c| {
-                            let val = v.value(i, j, k, c);
+                        |i, c, val| {
                             let y = if j > 0 {
                                 apart(val, v.value(i, j - 1, k, c))
                             } else {
@@ -568,10 +563,10 @@ struct RowRanges<'a> {
 
 impl RowRanges<'_> {
     /// Folds the row's values (`value(i, c)`) into the ranges of the blocks holding them, and
-    /// their jumps to their neighbours along x and (`across(i, c)`) along y and z into the
-    /// blocks' jumps.
+    /// their jumps to their neighbours along x and (`across(i, c, value)`) along y and z
+    /// into the blocks' jumps.
     #[inline]
-    fn reduce(&mut self, value: impl Fn(u32, u32) -> f32, across: impl Fn(u32, u32) -> f32) {
+    fn reduce(&mut self, value: impl Fn(u32, u32) -> f32, across: impl Fn(u32, u32, f32) -> f32) {
         let (s, dims, nc) = (BLOCK_SIZE, self.dims, self.nc);
         for bx in 0..dims[0] {
             let i0 = bx * s;
@@ -585,7 +580,7 @@ impl RowRanges<'_> {
                     let val = value(i, c);
                     lo = lo.min(val);
                     hi = hi.max(val);
-                    jump = jump.max((val - prev).abs()).max(across(i, c));
+                    jump = jump.max((val - prev).abs()).max(across(i, c, val));
                     prev = val;
                 }
                 for bz in self.bz[0]..=self.bz[1] {

@@ -331,6 +331,9 @@ impl Resources {
                     .clamp(0.0, last) as usize;
                 if f.prefix[x1 + 1] > f.prefix[x0] {
                     *o = 1;
+                    if !adaptive {
+                        break;
+                    }
                 }
                 if let Some(s) = &f.spread {
                     change = change.max(s.over(x0, x1) * crossed * voxels);
