@@ -3,6 +3,7 @@
 #include "vtkCellData.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkDataArray.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
 #include "vtkFerroVolumeMapper.h"
 #include "vtkFloatArray.h"
@@ -10,6 +11,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
+#include "vtkMultiProcessStream.h"
 #include "vtkObjectFactory.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPVLODVolume.h"
@@ -24,6 +26,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -430,6 +433,7 @@ int vtkFerroVolumeRepresentation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   const int result = this->Superclass::RequestData(request, inputVector, outputVector);
+  this->GatherWholeRanges();
 
   // Without input (a client or render server in client/server mode) only the outline shows.
   const bool hasInput = inputVector[0]->GetNumberOfInformationObjects() == 1;
@@ -458,10 +462,11 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
     // Under MPI each rank draws its own piece, on the whole volume's sample lattice (the
     // mapper's WholeExtent). vtkImageVolumeRepresentation asks for ordered compositing (IceT
     // blends the ranks' frames back to front with "over"), which is right for composite
-    // rays and for the nearly transparent sums the mapper draws for additive and average,
-    // but not for the extremum of MIP and MinIP: for those the ranks' frames are composited
-    // by depth instead, and each rank writes its extremum's place in the colour range as
-    // the depth, so the largest maximum (smallest minimum) wins.
+    // rays and for the nearly transparent shares of the average, but not for the extremum
+    // of MIP and MinIP: for those the ranks' frames are composited by depth instead, and
+    // each rank writes its extremum's place in the colour range as the depth, so the
+    // largest maximum (smallest minimum) wins. Nor for additive sums, which "over" cannot
+    // add in 8 bits: the mapper sums the ranks' frames itself, and one rank draws the sum.
     vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
     const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
     vtkFerroVolumeMapper* mapper = this->GetFerroVolumeMapper();
@@ -475,6 +480,7 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
       (drawn == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND ||
         drawn == vtkVolumeMapper::MINIMUM_INTENSITY_BLEND);
     mapper->SetExtremumDepth(extremum);
+    mapper->SetDistributedSum(parallel && drawn == vtkVolumeMapper::ADDITIVE_BLEND);
     if (extremum)
     {
       outInfo->Set(vtkPVRenderView::NEED_ORDERED_COMPOSITING(), 0);
@@ -483,6 +489,7 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
   if (request_type == vtkPVView::REQUEST_RENDER())
   {
     this->ApplyVectorMode();
+    this->ApplyWholeRanges();
     // A screenshot is a converged image: its render traces the whole budget. ParaView
     // renders a capture with the window's buffer swapping off (vtkSMViewProxy::
     // CaptureWindowInternal), in the GUI, pvpython and pvbatch alike.
@@ -496,8 +503,167 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
 }
 
 //------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::GatherWholeRanges()
+{
+  this->WholeRanges.clear();
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (!controller || controller->GetNumberOfProcesses() < 2)
+  {
+    return;
+  }
+  // this rank's arrays: count, then (cell data, name, components, ranges…, magnitude's)
+  vtkMultiProcessStream mine;
+  auto* image = vtkImageData::SafeDownCast(this->Cache);
+  std::vector<vtkDataArray*> arrays;
+  std::vector<bool> cells;
+  vtkDataSetAttributes* attributes[2] = { image ? image->GetPointData() : nullptr,
+    image ? image->GetCellData() : nullptr };
+  for (vtkDataSetAttributes* data : attributes)
+  {
+    for (int i = 0; data && i < data->GetNumberOfArrays(); ++i)
+    {
+      vtkDataArray* array = data->GetArray(i);
+      if (array && array->GetName() && array->GetNumberOfTuples() > 0)
+      {
+        arrays.push_back(array);
+        cells.push_back(data == image->GetCellData());
+      }
+    }
+  }
+  mine << static_cast<int>(arrays.size());
+  for (size_t i = 0; i < arrays.size(); ++i)
+  {
+    vtkDataArray* array = arrays[i];
+    const int comps = array->GetNumberOfComponents();
+    mine << static_cast<int>(cells[i]) << std::string(array->GetName()) << comps;
+    for (int c = 0; c <= comps; ++c)
+    {
+      double range[2];
+      array->GetFiniteRange(range, c < comps ? c : -1); // (-1: the magnitude, last)
+      mine << range[0] << range[1];
+    }
+  }
+  std::vector<vtkMultiProcessStream> all;
+  controller->Gather(mine, all, 0);
+  vtkMultiProcessStream merged;
+  if (controller->GetLocalProcessId() == 0)
+  {
+    for (auto& stream : all)
+    {
+      int count = 0;
+      stream >> count;
+      for (int i = 0; i < count; ++i)
+      {
+        int cell = 0, comps = 0;
+        std::string name;
+        stream >> cell >> name >> comps;
+        auto& ranges = this->WholeRanges[{ cell != 0, name }];
+        if (ranges.size() != static_cast<size_t>(comps) + 1)
+        {
+          ranges.assign(static_cast<size_t>(comps) + 1,
+            { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() });
+        }
+        for (auto& range : ranges)
+        {
+          double lo = 0.0, hi = 0.0;
+          stream >> lo >> hi;
+          if (lo <= hi)
+          {
+            range = { std::min(range[0], lo), std::max(range[1], hi) };
+          }
+        }
+      }
+    }
+    merged << static_cast<int>(this->WholeRanges.size());
+    for (const auto& entry : this->WholeRanges)
+    {
+      merged << static_cast<int>(entry.first.first) << entry.first.second
+             << static_cast<int>(entry.second.size());
+      for (const auto& range : entry.second)
+      {
+        merged << range[0] << range[1];
+      }
+    }
+  }
+  controller->Broadcast(merged, 0);
+  if (controller->GetLocalProcessId() != 0)
+  {
+    int count = 0;
+    merged >> count;
+    for (int i = 0; i < count; ++i)
+    {
+      int cell = 0, size = 0;
+      std::string name;
+      merged >> cell >> name >> size;
+      auto& ranges = this->WholeRanges[{ cell != 0, name }];
+      ranges.resize(static_cast<size_t>(size));
+      for (auto& range : ranges)
+      {
+        merged >> range[0] >> range[1];
+      }
+    }
+  }
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::ApplyWholeRanges()
+{
+  vtkFerroVolumeMapper* mapper = this->GetFerroVolumeMapper();
+  mapper->RemoveAllWholeScalarRanges();
+  if (this->WholeRanges.empty())
+  {
+    return;
+  }
+  // the array the mapper draws, or the one ApplyVectorMode() derived it from
+  bool cell = std::get<0>(this->VectorModeSource);
+  std::string name = std::get<1>(this->VectorModeSource);
+  if (name.empty())
+  {
+    auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
+    int cellFlag = 0;
+    vtkDataArray* array = image
+      ? vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
+          this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
+          this->VolumeMapper->GetArrayName(), cellFlag)
+      : nullptr;
+    if (!array || !array->GetName())
+    {
+      return;
+    }
+    cell = cellFlag == 1;
+    name = array->GetName();
+  }
+  const auto found = this->WholeRanges.find({ cell, name });
+  if (found == this->WholeRanges.end() || found->second.size() < 2)
+  {
+    return;
+  }
+  const auto& ranges = found->second;
+  const int comps = static_cast<int>(ranges.size()) - 1;
+  if (!std::get<1>(this->VectorModeSource).empty())
+  {
+    // one derived component: the magnitude (-1, the last range) or a component's
+    const int c = std::get<2>(this->VectorModeSource);
+    const auto& range = ranges[c < 0 || c >= comps ? comps : c];
+    if (range[0] <= range[1])
+    {
+      mapper->SetWholeScalarRange(0, range[0], range[1]);
+    }
+    return;
+  }
+  for (int c = 0; c < std::min(comps, 4); ++c)
+  {
+    if (ranges[c][0] <= ranges[c][1])
+    {
+      mapper->SetWholeScalarRange(c, ranges[c][0], ranges[c][1]);
+    }
+  }
+}
+
+//------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::ApplyVectorMode()
 {
+  this->VectorModeSource = { false, "", 0 };
   auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
   vtkVolumeProperty* prop = this->Property;
   vtkColorTransferFunction* ctf = prop ? prop->GetRGBTransferFunction(0) : nullptr;
@@ -584,6 +750,8 @@ void vtkFerroVolumeRepresentation::ApplyVectorMode()
   }
   this->VolumeMapper->SetInputConnection(this->VectorModeProducer->GetOutputPort());
   this->VolumeMapper->SelectScalarArray(name.c_str());
+  this->VectorModeSource = { cellFlag == 1, array->GetName() ? array->GetName() : "",
+    mode == vtkScalarsToColors::MAGNITUDE ? -1 : component };
 }
 
 //------------------------------------------------------------------------------------------

@@ -47,7 +47,10 @@
 #include "vtkSmartPointer.h" // for ivar
 
 #include <array>  // for ivar
+#include <map>    // for ivar
 #include <string> // for ivar
+#include <tuple>  // for ivar
+#include <utility> // for ivar
 #include <vector> // for ivar
 
 class vtkFerroVolumeMapper;
@@ -313,6 +316,22 @@ protected:
   vtkSmartPointer<vtkImageData> VectorModeImage;
   vtkSmartPointer<vtkTrivialProducer> VectorModeProducer;
   std::string VectorModeKey;
+  // What ApplyVectorMode() derived the mapper's array from: (cell data, array name,
+  // component, or -1 for the magnitude); empty name: the mapper draws the data's own array.
+  std::tuple<bool, std::string, int> VectorModeSource{ false, "", 0 };
+
+  /**
+   * Under MPI: every point and cell array's finite range over all ranks, per component
+   * and of the magnitude (a collective operation, in RequestData, which every rank runs).
+   */
+  void GatherWholeRanges();
+  /**
+   * Gives the mapper the whole dataset's ranges of the array it draws (GatherWholeRanges),
+   * so that every rank's piece classifies its values as the whole would.
+   */
+  void ApplyWholeRanges();
+  // (cell data, array name) → each component's range, then the magnitude's
+  std::map<std::pair<bool, std::string>, std::vector<std::array<double, 2>>> WholeRanges;
 
 private:
   vtkFerroVolumeRepresentation(const vtkFerroVolumeRepresentation&) = delete;

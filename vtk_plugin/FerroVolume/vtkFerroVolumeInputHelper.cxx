@@ -574,12 +574,27 @@ bool vtkFerroVolumeInputHelper::Upload(
     }
     this->ComponentRanges[c] = { range[0], range[1] };
   }
+  this->SetWholeRanges(this->Whole);
   this->MeanSpacing = pv.MeanSpacing;
   std::copy(pv.Desc.dims, pv.Desc.dims + 3, this->UploadedDims);
   this->BlankingStale = true;
   this->MaskKey.reset();
   this->Uploaded = key;
   return true;
+}
+
+void vtkFerroVolumeInputHelper::SetWholeRanges(const WholeRanges& whole)
+{
+  this->Whole = whole;
+  this->Effective = this->ComponentRanges;
+  for (int c = 0; c < this->Components && c < 4; ++c)
+  {
+    if (whole[c])
+    {
+      this->Effective[c] = { std::min(this->Effective[c][0], (*whole[c])[0]),
+        std::max(this->Effective[c][1], (*whole[c])[1]) };
+    }
+  }
 }
 
 // vtkGPUVolumeRayCastMapper's blanking texture, on ferrovol's grid: a point is hidden where

@@ -53,8 +53,12 @@ public:
   int GetComponents() const { return this->Components; }
   // The selected scalars' VTK type (VTK_VOID before Select).
   int GetDataType() const;
-  // Each component's finite data range.
-  const Ranges& GetRanges() const { return this->ComponentRanges; }
+  // Each component's finite data range, widened to the whole dataset's (SetWholeRanges).
+  const Ranges& GetRanges() const { return this->Effective; }
+  // The whole dataset's range of each component the input is a piece of (none: the
+  // input's own), which GetRanges() spans besides the input's.
+  using WholeRanges = std::array<std::optional<std::array<double, 2>>, 4>;
+  void SetWholeRanges(const WholeRanges& whole);
   // The mean voxel spacing, VTK's unit of gradient magnitude.
   double GetMeanSpacing() const { return this->MeanSpacing; }
 
@@ -122,6 +126,8 @@ private:
   uint32_t UploadedDims[3] = { 0, 0, 0 };
   int Components = 0;
   Ranges ComponentRanges{};
+  WholeRanges Whole{};
+  Ranges Effective{};
   double MeanSpacing = 1.0;
 };
 

@@ -28,9 +28,11 @@
 #include "vtkFerroVolumeIntermix.h"
 #include "vtkFerroVolumeLookupTables.h"
 #include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumePieceSum.h"
 #include "vtkFerroVolumeRefinement.h"
 #include "vtkFerroVolumeRenderToImage.h"
 #include "vtkFerroVolumeSettings.h"
+#include "vtkBoundingBox.h"
 #include "vtkCamera.h"
 #include "vtkCommand.h"
 #include "vtkDataObject.h"
@@ -73,6 +75,8 @@ public:
   vtkFerroVolumeDepthPeeling Peeling;
   vtkFerroVolumeRenderToImage Image;
   vtkFerroVolumeRefinement Refinement;
+  vtkFerroVolumePieceSum PieceSum;
+  vtkFerroVolumeInputHelper::WholeRanges WholeRanges{};
   // warnings said once per mapper
   std::set<std::string> Warned;
   // the convergence read back for the frame counted `ConvergenceFrame` (stats().frames)
@@ -129,6 +133,7 @@ public:
     types.Color = self->GetColorRangeType();
     types.ScalarOpacity = self->GetScalarOpacityRangeType();
     types.GradientOpacity = self->GetGradientOpacityRangeType();
+    this->Input.SetWholeRanges(this->WholeRanges);
     if (!(this->Input.Select(self, error) && this->MakeRenderer(self, error) &&
           this->Input.Upload(*this->Renderer, budget, error)))
     {
@@ -221,6 +226,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   : EmptySpaceSkipping(1)
   , ExtremumDepth(0)
   , WholeExtent{ 0, -1, 0, -1, 0, -1 }
+  , DistributedSum(0)
   , OutputPath(OUTPUT_PATH_AUTOMATIC)
   , EnvironmentLighting(0.0)
   , EnvironmentMap(nullptr)
@@ -468,6 +474,66 @@ void vtkFerroVolumeMapper::PostRender(
 }
 
 //------------------------------------------------------------------------------------------
+void vtkFerroVolumeMapper::SetWholeScalarRange(int component, double low, double high)
+{
+  if (component < 0 || component > 3 || !(low <= high) || !std::isfinite(low) ||
+    !std::isfinite(high))
+  {
+    vtkErrorMacro(<< "SetWholeScalarRange(" << component << ", " << low << ", " << high
+                  << "): wants a component from 0 to 3 and a finite range, low <= high");
+    return;
+  }
+  auto& range = this->Internals->WholeRanges[component];
+  if (!range || (*range)[0] != low || (*range)[1] != high)
+  {
+    range = std::array<double, 2>{ low, high };
+    this->Modified();
+  }
+}
+
+void vtkFerroVolumeMapper::RemoveAllWholeScalarRanges()
+{
+  auto& ranges = this->Internals->WholeRanges;
+  if (std::any_of(ranges.begin(), ranges.end(), [](const auto& r) { return r.has_value(); }))
+  {
+    ranges = {};
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------------------
+bool vtkFerroVolumeMapper::SumsPieces() const
+{
+  const int* whole = this->WholeExtent;
+  return this->DistributedSum && this->BlendMode == ADDITIVE_BLEND &&
+    this->RenderMode != RENDER_MODE_PATH_TRACE && whole[0] <= whole[1] &&
+    whole[2] <= whole[3] && whole[4] <= whole[5];
+}
+
+//------------------------------------------------------------------------------------------
+double* vtkFerroVolumeMapper::GetBounds()
+{
+  double* bounds = this->Superclass::GetBounds();
+  vtkImageData* image = vtkImageData::SafeDownCast(this->GetDataSetInput());
+  if (!this->SumsPieces() || !image)
+  {
+    return bounds;
+  }
+  // the whole extent's corners, placed as the piece's points are
+  vtkBoundingBox box;
+  const int* whole = this->WholeExtent;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double point[3];
+    image->TransformIndexToPhysicalPoint(whole[corner & 1 ? 1 : 0],
+      whole[corner & 2 ? 3 : 2], whole[corner & 4 ? 5 : 4], point);
+    box.AddPoint(point);
+  }
+  box.GetBounds(this->Bounds);
+  return this->Bounds;
+}
+
+//------------------------------------------------------------------------------------------
 void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   if (this->GeneratingCanonicalView)
@@ -478,7 +544,11 @@ void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->InvokeEvent(vtkCommand::VolumeMapperRenderStartEvent, nullptr);
   vtkNew<vtkTimerLog> timer;
   timer->StartTimer();
+  // (the same on every process of a parallel render: the sum is a collective operation)
+  this->Internals->PieceSum.Begin(this->SumsPieces() && ren && vol && !ren->GetSelector() &&
+    !this->RenderToImage && !vtkFerroVolumeDepthPeeling::PeelingPass(vol));
   this->GPURender(ren, vol);
+  this->Internals->PieceSum.Finish();
   timer->StopTimer();
   this->TimeToDraw = timer->GetElapsedTime();
   (vol->GetAllocatedRenderTime() < 1.0 ? this->SmallTimeToDraw : this->BigTimeToDraw) =
@@ -690,7 +760,9 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   std::string warning;
-  if (!in->Output.Render(this, this->OutputPath, *in->Renderer, req, error, warning))
+  // (a frame summed across processes is read back, and the sum written into its texture)
+  const int outputPath = in->PieceSum.Pending() ? OUTPUT_PATH_READBACK : this->OutputPath;
+  if (!in->Output.Render(this, outputPath, *in->Renderer, req, error, warning))
   {
     vtkErrorMacro(<< error);
     return;
@@ -699,8 +771,25 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     vtkWarningMacro(<< warning);
   }
+  bool draw = true;
+  std::string sumMessage;
+  if (!in->PieceSum.Add(
+        in->Output.ColorTexture(), req.RenderW, req.RenderH, draw, sumMessage))
+  {
+    vtkErrorMacro(<< sumMessage);
+    return;
+  }
+  if (!sumMessage.empty() && in->Warned.insert(sumMessage).second)
+  {
+    vtkWarningMacro(<< sumMessage);
+  }
   this->LastRenderSize[0] = req.RenderW;
   this->LastRenderSize[1] = req.RenderH;
+  if (!draw)
+  {
+    this->LastRenderDrew = 1; // another process draws the sum this frame joined
+    return;
+  }
 
   // The part of the viewport the volume can cover (where the frame is composited).
   int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
@@ -822,6 +911,15 @@ void vtkFerroVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << (this->Transfer2DYAxisArray ? this->Transfer2DYAxisArray : "(none)") << "\n";
   os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
   os << indent << "ExtremumDepth: " << this->ExtremumDepth << "\n";
+  os << indent << "DistributedSum: " << this->DistributedSum << "\n";
+  for (int c = 0; c < 4; ++c)
+  {
+    if (const auto& range = this->Internals->WholeRanges[c])
+    {
+      os << indent << "WholeScalarRange " << c << ": " << (*range)[0] << " " << (*range)[1]
+         << "\n";
+    }
+  }
   os << indent << "PreIntegration: " << this->PreIntegration << "\n";
   os << indent << "MidpointQuadrature: " << this->MidpointQuadrature << "\n";
   os << indent << "AdaptiveSampling: " << this->AdaptiveSampling << "\n";

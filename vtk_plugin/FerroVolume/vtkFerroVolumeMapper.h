@@ -236,6 +236,44 @@ public:
 
   ///@{
   /**
+   * The data range of a component (0-3) over the whole dataset the input is a piece of
+   * (ParaView sets them under MPI, with WholeExtent), so that every piece classifies its
+   * values as the whole would: the span of the transfer functions' tables, the scalar axis
+   * of 2D transfer functions, and the scalars the additive and average blend modes
+   * normalise are taken over this range instead of the piece's own (widened to the piece's
+   * own where its values go beyond). Default: none (the input's own ranges).
+   */
+  void SetWholeScalarRange(int component, double low, double high);
+  void RemoveAllWholeScalarRanges();
+  ///@}
+
+  ///@{
+  /**
+   * The additive blend mode in a parallel run whose processes each draw a piece of one
+   * volume (with WholeExtent; ParaView sets it under MPI): the processes' frames are added
+   * exactly, across the global controller's processes (vtkMultiProcessController), and the
+   * lowest process that drew a frame draws min(1, the sum) while the others draw nothing,
+   * so that compositing the processes' frames shows the whole volume's sum (IceT's 8-bit
+   * "over" cannot add two sums). Summing is a collective operation: every process must
+   * render the mapper in each frame, as ParaView's parallel renders do; the mapper then
+   * reports the whole extent's bounds, so that every process culls the volume alike.
+   * Frames go through the readback path. Default off; ignored with one process, in other
+   * blend modes, in path tracing, RenderToImage, hardware selection and depth peeling.
+   */
+  vtkSetClampMacro(DistributedSum, vtkTypeBool, 0, 1);
+  vtkGetMacro(DistributedSum, vtkTypeBool);
+  vtkBooleanMacro(DistributedSum, vtkTypeBool);
+  ///@}
+
+  /**
+   * The input's bounds; the whole extent's while the additive frames of the pieces are
+   * summed across processes (DistributedSum).
+   */
+  double* GetBounds() VTK_SIZEHINT(6) override;
+  using Superclass::GetBounds;
+
+  ///@{
+  /**
    * Isosurface blend mode: how much of the environment's light falls on the surfaces,
    * diffuse (irradiance) and specular (the Phong lobe sampled on the environment map),
    * added to the renderer's lights. 0 (the default) lights the surfaces as
@@ -730,6 +768,10 @@ protected:
   vtkFerroVolumeMapper();
   ~vtkFerroVolumeMapper() override;
 
+  // Whether additive frames are summed across processes (DistributedSum and its conditions
+  // that are the same on every process and in every render).
+  bool SumsPieces() const;
+
   ///@{
   /**
    * vtkGPUVolumeRayCastMapper's pure virtual hooks for AMR rendering, which nothing in
@@ -744,6 +786,7 @@ protected:
   vtkTypeBool EmptySpaceSkipping;
   vtkTypeBool ExtremumDepth;
   int WholeExtent[6];
+  vtkTypeBool DistributedSum;
   int OutputPath;
   double EnvironmentLighting;
   char* EnvironmentMap;

@@ -333,6 +333,56 @@ class Settings(unittest.TestCase):
         self.assertGreater(d, 0.2)
         self.assertGreater(s, 0.8)
 
+    def test_a_piece_classifies_as_the_whole(self):
+        # A piece of the wavelet away from its centre (z >= 8, a smaller data range than the
+        # whole's) with the whole's range (WholeScalarRange), in the additive blend mode,
+        # against the whole wavelet cropped to the same box (the rays enter both at z = 24,
+        # so they sample alike): the additive sums normalise the scalars by the whole's
+        # range, which the piece alone does not have.
+        whole = self.src.GetOutput()
+        ext = whole.GetExtent()
+        lo, hi = whole.GetPointData().GetScalars().GetRange()
+        voi = vtk.vtkExtractVOI()
+        voi.SetInputData(whole)
+        voi.SetVOI(ext[0], ext[1], ext[2], ext[3], 8, ext[5])
+        voi.Update()
+        piece = voi.GetOutput()
+        self.assertLess(piece.GetPointData().GetScalars().GetRange()[1], hi - 10.0)
+        prop = lambda: tf_property(opacity=[(37.3531, 0.0), (276.829, 0.1)])  # noqa: E731
+        camera = parallel_camera((0.0, 0.0, 0.0), 100.0, 26.0, (1.0, 200.0))
+
+        def cropped(m):
+            m.SetBlendModeToAdditive()
+            m.CroppingOn()
+            m.SetCroppingRegionPlanes(ext[0], ext[1], ext[2], ext[3], 8, ext[5])
+            m.SetCroppingRegionFlagsToSubVolume()
+
+        def as_piece(whole_range):
+            def conf(m):
+                m.SetBlendModeToAdditive()
+                if whole_range:
+                    m.SetWholeScalarRange(0, lo, hi)
+            return conf
+
+        ref, _ = self.render(cropped, prop(), camera=camera)
+        alone, _ = self.render(as_piece(False), prop(), data=piece, camera=camera)
+        piece_img, mapper = self.render(as_piece(True), prop(), data=piece, camera=camera)
+        save("settings-piece-whole-range", ref, piece_img, alone)
+        s_piece, s_alone = ssim(piece_img, ref), ssim(alone, ref)
+        d_piece, d_alone = mean_diff(piece_img, ref), mean_diff(alone, ref)
+        fvtest.log("  piece against the cropped whole: with the whole's range SSIM %.4f, mean "
+                   "|diff| %.2f; with its own SSIM %.4f, %.2f" % (s_piece, d_piece, s_alone,
+                                                                  d_alone))
+        self.assertGreater(coverage(ref), 0.1)
+        self.assertGreater(d_alone, 2.0)
+        self.assertLess(d_piece, 0.2)
+        mapper.RemoveAllWholeScalarRanges()
+        self.assertLess(mean_diff(self._keep.render(), alone), 0.1 * d_alone)
+        errors = Errors(mapper)
+        mapper.SetWholeScalarRange(4, 0.0, 1.0)
+        self.assertTrue(any("component from 0 to 3" in m for m in errors.messages),
+                        errors.messages)
+
     def test_empty_space_skipping_changes_nothing(self):
         on, _ = self.render()
         off, _ = self.render(lambda m: m.EmptySpaceSkippingOff())
