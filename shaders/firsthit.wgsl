@@ -284,9 +284,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (has_flag(FLAG_JITTER)) {
         jit = hash01(pix ^ frame.viewport.w);
     }
+    // Lattice sample k lies at lattice + (k + jit) dt: from the segment's start, or for a
+    // piece of a whole volume (FLAG_PIECE) on the whole's lattice, so that a piece samples
+    // where the whole ray would (the segment's ends, the faces pieces share, are sampled
+    // besides).
+    var lattice = seg.x;
+    if (has_flag(FLAG_PIECE)) {
+        let tg = max(box_interval(ray, frame.whole_lo.xyz, frame.whole_hi.xyz).x, 0.0);
+        lattice = tg + max(ceil((seg.x - tg) / dt - jit), 0.0) * dt;
+    }
     var k = 0.0;
     // Bounded below 2^24 so that k + 1 is always exact and the loop always ends.
-    let k_end = min(ceil((seg.y - seg.x) / dt - jit), 1.0e7);
+    let k_end = min(ceil((seg.y - lattice) / dt - jit), 1.0e7);
     // The segment's end is sampled too, so a crossing between the last lattice sample and
     // the end is found.
     var tail = true;
@@ -337,7 +346,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 s_prev = s;
                 if (skip_after) {
                     have_prev = false;
-                    k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+                    k = max(k + 1.0, ceil((block_exit(ray, p) - lattice) / dt - jit));
                 } else {
                     k = k + 1.0;
                 }
@@ -345,7 +354,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             var k_here = k;
             var at_tail = false;
             if (k < k_end) {
-                t = seg.x + (k + jit) * dt;
+                t = lattice + (k + jit) * dt;
             } else if (tail) {
                 tail = false;
                 at_tail = true;
@@ -361,7 +370,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             skip_after = false;
             if (SKIP && k_here < k_end && !block_occupied(p)) {
                 if (!have_prev) {
-                    k = max(k + 1.0, ceil((block_exit(ray, p) - seg.x) / dt - jit));
+                    k = max(k + 1.0, ceil((block_exit(ray, p) - lattice) / dt - jit));
                     continue;
                 }
                 // The interval from the last sample into this empty block is still checked.
@@ -388,7 +397,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             // One fetch per pass: without a previous sample, this pass takes it (one
             // lattice step back) and the next pass comes back to t.
-            let t_back = max(seg.x, seg.x + (k_here - 1.0 + jit) * dt);
+            let t_back = max(seg.x, lattice + (k_here - 1.0 + jit) * dt);
             let take_prev = !have_prev;
             let t_q = select(t, t_back, take_prev);
             if (STREAMING && waits(point_at(ray, t_q), ray.index_dir)) {
