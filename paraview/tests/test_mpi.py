@@ -113,15 +113,21 @@ LABEL_CAMERA = "oblique"
 
 # A 2D transfer function set through the representation's properties (Use 2D Transfer
 # Function, Transfer Function 2D with two boxes of ParaView's editor), drawn by "Ferrovol
-# Volume" and by ParaView's "Volume". Serial, against Volume: 0.9886 / 34.96 dB measured (the
+# Volume" and by ParaView's "Volume". Serial, against Volume: 0.9869 / 31.67 dB measured (the
 # volume box), where the mappers' samples differ along the box's faces and the wavelet's
-# slabs, which the table's per-sample opacity shows more than the 1D functions do. Under MPI
-# each rank's mapper, VTK's as ferrovol's, spreads the table's scalar axis over its own
-# piece's data range (VTK's meaning: the component's data range), so neither composited
-# image is the serial one (both measured at 0.93 / 19 dB from their serial images); ferrovol
-# against Volume there 0.959 / 25.7 dB. The floors sit under what was measured.
-TF2D_SERIAL = (0.975, 33.0)
-TF2D_DISTRIBUTED = (0.94, 23.5)
+# slabs, which the table's per-sample opacity shows more than the 1D functions do, and where
+# ferrovol clamps the table to [0, 1]: both mappers resize ParaView's 10x10 table with
+# vtkImageResize, whose windowed sinc rings past 1 at the boxes' edges; VTK keeps the
+# overshoot (colour above opacity), which IceT's 8-bit "over" wraps under MPI into dark
+# blotches in Volume's composited image (0.92 / 19 dB from its serial image). Ferrovol's
+# composited image is its serial one (the whole's ranges, a clamped table): measured 0.9995
+# / 51.7 dB (box), held to the other modes' bar; Volume's is reported. The floors sit under
+# what was measured.
+TF2D_SERIAL = (0.975, 30.0)
+# The range the 2D transfer function's image spans: RTData's over the whole Wavelet (x) by
+# the boxes' gradient axis (y). ParaView rescales a 2D transfer function to the data range
+# it knows, which under pvbatch --symmetric is each rank's own piece's.
+TF2D_RANGE = [37.35310363769531, 276.8288269042969, 0.0, 1.0]
 TF2D_BOXES = [150.0, 0.0, 60.0, 0.6, 1.0, 0.2, 0.1, 0.6, 70.0, 0.3, 70.0, 0.7, 0.1, 0.4, 1.0, 0.5]
 TF2D_CAMERA = "oblique"
 
@@ -159,6 +165,8 @@ def show_tf2d(view, disp):
     """disp drawn through a 2D transfer function; returns Volume's and ferrovol's images."""
     tf2d = GetTransferFunction2D("RTData")
     tf2d.Boxes = TF2D_BOXES
+    # (the whole Wavelet's range: under --symmetric each rank would span its own piece's)
+    tf2d.RescaleTransferFunction(*TF2D_RANGE)
     tf2d.Build()
     disp.TransferFunction2D = tf2d
     disp.UseTransfer2D = 1
@@ -343,15 +351,11 @@ def distributed():
     T.set_camera(view, bounds, direction=CAMERAS[TF2D_CAMERA])
     imgs = show_tf2d(view, disp)
     tf2d_ref = os.path.join(T.OUT_DIR, "mpi-serial-tf2d-ferrovol.png")
-    if T.rank() == 0:
-        T.compare("mpi -n %d 2D transfer function vs Volume" % T.nranks(),
-                  imgs["Ferrovol Volume"], imgs["Volume"], *TF2D_DISTRIBUTED, failures)
-        if os.path.exists(tf2d_ref):
-            T.compare("mpi -n %d 2D transfer function vs serial (measured)" % T.nranks(),
-                      imgs["Ferrovol Volume"], T.read_png(tf2d_ref))
-            T.compare("mpi -n %d Volume's 2D transfer function vs serial (measured)"
-                      % T.nranks(), imgs["Volume"],
-                      T.read_png(tf2d_ref.replace("ferrovol", "vtk")))
+    if T.rank() == 0 and os.path.exists(tf2d_ref):
+        T.compare("mpi -n %d 2D transfer function vs serial" % T.nranks(),
+                  imgs["Ferrovol Volume"], T.read_png(tf2d_ref), MIN_SSIM, MIN_PSNR, failures)
+        T.compare("mpi -n %d Volume's 2D transfer function vs serial (measured)"
+                  % T.nranks(), imgs["Volume"], T.read_png(tf2d_ref.replace("ferrovol", "vtk")))
     Hide(src, view)
     show_labels(view, src)
     T.set_camera(view, bounds, direction=CAMERAS[LABEL_CAMERA])

@@ -459,7 +459,10 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
   {
     for (int k = 0; k < 4; ++k)
     {
-      rgba[4 * i + k] = static_cast<float>(scalars->GetComponent(i, k));
+      // (vtkImageResize's windowed sinc rings past [0, 1] at a box's edges: a colour above
+      // 1 composites to more colour than opacity, which IceT's 8-bit "over" wraps under MPI)
+      const double v = scalars->GetComponent(i, k);
+      rgba[4 * i + k] = static_cast<float>(v > 0.0 ? std::min(v, 1.0) : 0.0);
     }
   }
   const double span = range[1] - range[0];
