@@ -502,6 +502,56 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
   return 1;
 }
 
+namespace
+{
+using RangeMap = std::map<std::pair<bool, std::string>, std::vector<std::array<double, 2>>>;
+
+// A map of ranges as a stream: the count, then each (cell data, name, count of ranges,
+// the ranges).
+void WriteRanges(const RangeMap& ranges, vtkMultiProcessStream& stream)
+{
+  stream << static_cast<int>(ranges.size());
+  for (const auto& entry : ranges)
+  {
+    stream << static_cast<int>(entry.first.first) << entry.first.second
+           << static_cast<int>(entry.second.size());
+    for (const auto& range : entry.second)
+    {
+      stream << range[0] << range[1];
+    }
+  }
+}
+
+// Widens `ranges` by the ranges WriteRanges put in `stream` (an array whose number of
+// ranges differs starts again from the stream's).
+void MergeRanges(vtkMultiProcessStream& stream, RangeMap& ranges)
+{
+  int count = 0;
+  stream >> count;
+  for (int i = 0; i < count; ++i)
+  {
+    int cell = 0, size = 0;
+    std::string name;
+    stream >> cell >> name >> size;
+    auto& merged = ranges[{ cell != 0, name }];
+    if (merged.size() != static_cast<size_t>(size))
+    {
+      merged.assign(static_cast<size_t>(size),
+        { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() });
+    }
+    for (auto& range : merged)
+    {
+      double lo = 0.0, hi = 0.0;
+      stream >> lo >> hi;
+      if (lo <= hi)
+      {
+        range = { std::min(range[0], lo), std::max(range[1], hi) };
+      }
+    }
+  }
+}
+}
+
 //------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::GatherWholeRanges()
 {
@@ -511,98 +561,45 @@ void vtkFerroVolumeRepresentation::GatherWholeRanges()
   {
     return;
   }
-  // this rank's arrays: count, then (cell data, name, components, ranges…, magnitude's)
-  vtkMultiProcessStream mine;
+  // this rank's point and cell arrays: each component's range, then the magnitude's
+  RangeMap local;
   auto* image = vtkImageData::SafeDownCast(this->Cache);
-  std::vector<vtkDataArray*> arrays;
-  std::vector<bool> cells;
   vtkDataSetAttributes* attributes[2] = { image ? image->GetPointData() : nullptr,
     image ? image->GetCellData() : nullptr };
-  for (vtkDataSetAttributes* data : attributes)
+  for (int a = 0; a < 2; ++a)
   {
-    for (int i = 0; data && i < data->GetNumberOfArrays(); ++i)
+    for (int i = 0; attributes[a] && i < attributes[a]->GetNumberOfArrays(); ++i)
     {
-      vtkDataArray* array = data->GetArray(i);
-      if (array && array->GetName() && array->GetNumberOfTuples() > 0)
+      vtkDataArray* array = attributes[a]->GetArray(i);
+      if (!array || !array->GetName() || array->GetNumberOfTuples() == 0)
       {
-        arrays.push_back(array);
-        cells.push_back(data == image->GetCellData());
+        continue;
+      }
+      const int comps = array->GetNumberOfComponents();
+      auto& ranges = local[{ a == 1, array->GetName() }];
+      ranges.resize(static_cast<size_t>(comps) + 1);
+      for (int c = 0; c <= comps; ++c)
+      {
+        array->GetFiniteRange(ranges[c].data(), c < comps ? c : -1); // (-1: the magnitude)
       }
     }
   }
-  mine << static_cast<int>(arrays.size());
-  for (size_t i = 0; i < arrays.size(); ++i)
-  {
-    vtkDataArray* array = arrays[i];
-    const int comps = array->GetNumberOfComponents();
-    mine << static_cast<int>(cells[i]) << std::string(array->GetName()) << comps;
-    for (int c = 0; c <= comps; ++c)
-    {
-      double range[2];
-      array->GetFiniteRange(range, c < comps ? c : -1); // (-1: the magnitude, last)
-      mine << range[0] << range[1];
-    }
-  }
+  vtkMultiProcessStream mine;
+  WriteRanges(local, mine);
   std::vector<vtkMultiProcessStream> all;
   controller->Gather(mine, all, 0);
   vtkMultiProcessStream merged;
   if (controller->GetLocalProcessId() == 0)
   {
+    RangeMap whole;
     for (auto& stream : all)
     {
-      int count = 0;
-      stream >> count;
-      for (int i = 0; i < count; ++i)
-      {
-        int cell = 0, comps = 0;
-        std::string name;
-        stream >> cell >> name >> comps;
-        auto& ranges = this->WholeRanges[{ cell != 0, name }];
-        if (ranges.size() != static_cast<size_t>(comps) + 1)
-        {
-          ranges.assign(static_cast<size_t>(comps) + 1,
-            { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() });
-        }
-        for (auto& range : ranges)
-        {
-          double lo = 0.0, hi = 0.0;
-          stream >> lo >> hi;
-          if (lo <= hi)
-          {
-            range = { std::min(range[0], lo), std::max(range[1], hi) };
-          }
-        }
-      }
+      MergeRanges(stream, whole);
     }
-    merged << static_cast<int>(this->WholeRanges.size());
-    for (const auto& entry : this->WholeRanges)
-    {
-      merged << static_cast<int>(entry.first.first) << entry.first.second
-             << static_cast<int>(entry.second.size());
-      for (const auto& range : entry.second)
-      {
-        merged << range[0] << range[1];
-      }
-    }
+    WriteRanges(whole, merged);
   }
   controller->Broadcast(merged, 0);
-  if (controller->GetLocalProcessId() != 0)
-  {
-    int count = 0;
-    merged >> count;
-    for (int i = 0; i < count; ++i)
-    {
-      int cell = 0, size = 0;
-      std::string name;
-      merged >> cell >> name >> size;
-      auto& ranges = this->WholeRanges[{ cell != 0, name }];
-      ranges.resize(static_cast<size_t>(size));
-      for (auto& range : ranges)
-      {
-        merged >> range[0] >> range[1];
-      }
-    }
-  }
+  MergeRanges(merged, this->WholeRanges);
 }
 
 //------------------------------------------------------------------------------------------
