@@ -2,6 +2,7 @@
 
 #include "vtkCellData.h"
 #include "vtkColorTransferFunction.h"
+#include "vtkCommunicator.h"
 #include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
@@ -480,7 +481,6 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
       (drawn == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND ||
         drawn == vtkVolumeMapper::MINIMUM_INTENSITY_BLEND);
     mapper->SetExtremumDepth(extremum);
-    mapper->SetDistributedSum(parallel && drawn == vtkVolumeMapper::ADDITIVE_BLEND);
     if (extremum)
     {
       outInfo->Set(vtkPVRenderView::NEED_ORDERED_COMPOSITING(), 0);
@@ -490,6 +490,7 @@ int vtkFerroVolumeRepresentation::ProcessViewRequest(
   {
     this->ApplyVectorMode();
     this->ApplyWholeRanges();
+    this->UpdateDistributedSum();
     // A screenshot is a converged image: its render traces the whole budget. ParaView
     // renders a capture with the window's buffer swapping off (vtkSMViewProxy::
     // CaptureWindowInternal), in the GUI, pvpython and pvbatch alike.
@@ -600,6 +601,31 @@ void vtkFerroVolumeRepresentation::GatherWholeRanges()
   }
   controller->Broadcast(merged, 0);
   MergeRanges(merged, this->WholeRanges);
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeRepresentation::UpdateDistributedSum()
+{
+  vtkFerroVolumeMapper* mapper = this->GetFerroVolumeMapper();
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  bool sum = controller && controller->GetNumberOfProcesses() > 1 &&
+    this->DrawnBlendMode() == vtkVolumeMapper::ADDITIVE_BLEND;
+  if (sum)
+  {
+    // (the same on every rank, and so is this collective operation)
+    auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
+    int cellFlag = 0;
+    vtkDataArray* scalars = image
+      ? vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
+          this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
+          this->VolumeMapper->GetArrayName(), cellFlag)
+      : nullptr;
+    const int mine = scalars && scalars->GetNumberOfTuples() > 0 ? 1 : 0;
+    int all = 0;
+    controller->AllReduce(&mine, &all, 1, vtkCommunicator::MIN_OP);
+    sum = all == 1;
+  }
+  mapper->SetDistributedSum(sum);
 }
 
 //------------------------------------------------------------------------------------------

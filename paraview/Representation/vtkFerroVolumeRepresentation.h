@@ -330,6 +330,13 @@ protected:
    * so that every rank's piece classifies its values as the whole would.
    */
   void ApplyWholeRanges();
+  /**
+   * Under MPI, in the additive blend mode: the mapper's DistributedSum, when every rank's
+   * mapper has scalars to draw (ParaView's vtkPVLODVolume skips the mapper of a rank
+   * without, which the sum, a collective operation in the mapper's render, would wait for).
+   * A collective operation itself, at REQUEST_RENDER, which every rank runs.
+   */
+  void UpdateDistributedSum();
   // (cell data, array name) → each component's range, then the magnitude's
   std::map<std::pair<bool, std::string>, std::vector<std::array<double, 2>>> WholeRanges;
 

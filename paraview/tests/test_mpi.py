@@ -201,6 +201,29 @@ def ref_path(cam, blend=None):
     return os.path.join(T.OUT_DIR, "mpi-serial%s-%s.png" % (tag, cam))
 
 
+def empty_pieces(view, failures):
+    """Additive on a Wavelet of one cell, which leaves every rank but one an empty piece:
+    ParaView then skips those ranks' mappers (no scalars), so the ranks must not start the
+    additive sum (a collective operation) that they would never join: the render ends and
+    the rank with the cell draws it."""
+    tiny = Wavelet()
+    tiny.WholeExtent = [0, 1, 0, 1, 0, 1]
+    disp = setup(view, tiny)
+    disp.FerrovolBlendMode = "Additive"
+    T.set_camera(view, [0.0, 1.0, 0.0, 1.0, 0.0, 1.0], direction=CAMERAS["oblique"])
+    Render(view)
+    img, _, _ = T.screenshot(view, "mpi-n%d-additive-empty-pieces" % T.nranks())
+    points = tiny.GetClientSideObject().GetOutputDataObject(0).GetNumberOfPoints()
+    T.print_in_rank_order("  rank %d/%d: %d points of the one-cell Wavelet"
+                          % (T.rank(), T.nranks(), points))
+    Hide(tiny, view)
+    if T.rank() == 0:
+        drawn = T.coverage(img)
+        T.log("  additive with empty pieces: the render ends, %.3f of the frame drawn" % drawn)
+        if drawn < 0.05:
+            failures.append("additive with empty pieces: %.3f of the frame drawn" % drawn)
+
+
 def make_view():
     """The view, without FXAA: ParaView smooths the composited image under MPI (not the
     serial one), which these comparisons of the compositing itself would count."""
@@ -391,6 +414,7 @@ def distributed():
     if T.rank() == 0 and os.path.exists(labels_ref):
         T.compare("mpi -n %d label map vs serial" % T.nranks(), img, T.read_png(labels_ref),
                   MIN_SSIM, MIN_PSNR, failures)
+    empty_pieces(view, failures)
     # Rank-local failures are printed by their ranks; rank 0 decides the exit status.
     if failures and T.rank() != 0:
         print("FAIL rank %d: %s" % (T.rank(), "; ".join(failures)), flush=True)
