@@ -604,6 +604,17 @@ void vtkFerroVolumeRepresentation::GatherWholeRanges()
 }
 
 //------------------------------------------------------------------------------------------
+vtkDataArray* vtkFerroVolumeRepresentation::MapperScalars(int& cellFlag)
+{
+  auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
+  cellFlag = 0;
+  return image ? vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
+                   this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
+                   this->VolumeMapper->GetArrayName(), cellFlag)
+               : nullptr;
+}
+
+//------------------------------------------------------------------------------------------
 void vtkFerroVolumeRepresentation::UpdateDistributedSum()
 {
   vtkFerroVolumeMapper* mapper = this->GetFerroVolumeMapper();
@@ -613,13 +624,8 @@ void vtkFerroVolumeRepresentation::UpdateDistributedSum()
   if (sum)
   {
     // (the same on every rank, and so is this collective operation)
-    auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
     int cellFlag = 0;
-    vtkDataArray* scalars = image
-      ? vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
-          this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
-          this->VolumeMapper->GetArrayName(), cellFlag)
-      : nullptr;
+    vtkDataArray* scalars = this->MapperScalars(cellFlag);
     const int mine = scalars && scalars->GetNumberOfTuples() > 0 ? 1 : 0;
     int all = 0;
     controller->AllReduce(&mine, &all, 1, vtkCommunicator::MIN_OP);
@@ -642,13 +648,8 @@ void vtkFerroVolumeRepresentation::ApplyWholeRanges()
   std::string name = std::get<1>(this->VectorModeSource);
   if (name.empty())
   {
-    auto* image = vtkImageData::SafeDownCast(this->VolumeMapper->GetInputDataObject(0, 0));
     int cellFlag = 0;
-    vtkDataArray* array = image
-      ? vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
-          this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
-          this->VolumeMapper->GetArrayName(), cellFlag)
-      : nullptr;
+    vtkDataArray* array = this->MapperScalars(cellFlag);
     if (!array || !array->GetName())
     {
       return;
@@ -700,9 +701,7 @@ void vtkFerroVolumeRepresentation::ApplyVectorMode()
     return;
   }
   int cellFlag = 0;
-  vtkDataArray* array = vtkAbstractMapper::GetScalars(image, this->VolumeMapper->GetScalarMode(),
-    this->VolumeMapper->GetArrayAccessMode(), this->VolumeMapper->GetArrayId(),
-    this->VolumeMapper->GetArrayName(), cellFlag);
+  vtkDataArray* array = this->MapperScalars(cellFlag);
   const int comps = array ? array->GetNumberOfComponents() : 0;
   if (comps < 2)
   {

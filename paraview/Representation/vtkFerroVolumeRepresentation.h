@@ -53,6 +53,7 @@
 #include <utility> // for ivar
 #include <vector> // for ivar
 
+class vtkDataArray;
 class vtkFerroVolumeMapper;
 class vtkImageData;
 class vtkTrivialProducer;
@@ -337,6 +338,9 @@ protected:
    * A collective operation itself, at REQUEST_RENDER, which every rank runs.
    */
   void UpdateDistributedSum();
+  // The scalars the mapper draws (its input image's, by its scalar mode and array), or
+  // nullptr; `cellFlag` 1 for cell data.
+  vtkDataArray* MapperScalars(int& cellFlag);
   // (cell data, array name) → each component's range, then the magnitude's
   std::map<std::pair<bool, std::string>, std::vector<std::array<double, 2>>> WholeRanges;
 
