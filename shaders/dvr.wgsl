@@ -571,9 +571,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // unless the ray leaves the whole volume here.
     var half_open = false;
     if (has_flag(FLAG_PIECE)) {
-        let whole = box_interval(ray, frame.whole_lo.xyz, frame.whole_hi.xyz);
-        let tg = max(whole.x, 0.0);
-        let tge = min(whole.y, ray.far);
+        let whole = whole_interval(ray);
+        let tg = whole.x;
+        let tge = whole.y;
         // (the whole ray's first sample forced past its exit, as above, falls to the piece
         // where the ray enters the whole)
         let forced = frame.counts.x == 0u && tg < tge && tg + jit * dt >= tge;
@@ -582,7 +582,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         half_open = !piece_last;
         if (seg.x < seg.y) {
             first_forced = forced && seg.x <= tg + 1.0e-3 * dt;
-            seg.x = tg + max(ceil((seg.x - tg) / dt - jit), 0.0) * dt;
+            seg.x = whole_lattice_from(tg, seg.x, dt, jit);
         }
     }
     // A depth range (Renderer::render_between): the lattice's samples in [near, far) only,

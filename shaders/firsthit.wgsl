@@ -290,8 +290,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // besides).
     var lattice = seg.x;
     if (has_flag(FLAG_PIECE)) {
-        let tg = max(box_interval(ray, frame.whole_lo.xyz, frame.whole_hi.xyz).x, 0.0);
-        lattice = tg + max(ceil((seg.x - tg) / dt - jit), 0.0) * dt;
+        lattice = whole_lattice_from(whole_interval(ray).x, seg.x, dt, jit);
     }
     var k = 0.0;
     // Bounded below 2^24 so that k + 1 is always exact and the loop always ends.

@@ -69,6 +69,19 @@ fn box_interval(r: Ray, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
     return slab_interval(r.index_origin, r.index_dir, lo, hi);
 }
 
+// A piece of a whole volume (FLAG_PIECE): the ray's path through the whole's box, from the
+// eye to the far plane.
+fn whole_interval(r: Ray) -> vec2<f32> {
+    let whole = box_interval(r, frame.whole_lo.xyz, frame.whole_hi.xyz);
+    return vec2<f32>(max(whole.x, 0.0), min(whole.y, r.far));
+}
+
+// The whole ray's samples lie at tg + (k + jit) dt: the origin, on that lattice, of the
+// first of them at or after t (that sample is the origin + jit dt).
+fn whole_lattice_from(tg: f32, t: f32, dt: f32, jit: f32) -> f32 {
+    return tg + max(ceil((t - tg) / dt - jit), 0.0) * dt;
+}
+
 // Distance along the ray of a window depth value (0 near … 1 far).
 fn depth_to_distance(r: Ray, px: vec2<u32>, depth: f32) -> f32 {
     let p = unproject(vec3<f32>(pixel_ndc(px), depth * 2.0 - 1.0));
