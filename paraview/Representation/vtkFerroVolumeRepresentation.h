@@ -261,8 +261,8 @@ protected:
    * The superclass's work (array selection, scalar mode, cropping planes, independent
    * components, the transfer-function mode), then the blend mode ferrovol draws (see
    * DrawnBlendMode()). Hides the volume when the input is not image data, when ray casting
-   * in a value that is no vtkVolumeMapper mode, or with "Use 2D Transfer Function" on (2D
-   * transfer functions: not supported by ferrovol yet); WarnAboutSettings() says so.
+   * in a value that is no vtkVolumeMapper mode, or with a 2D transfer function whose second
+   * axis is another array than the gradient magnitude; WarnAboutSettings() says so.
    */
   void UpdateMapperParameters() override;
 
@@ -275,8 +275,9 @@ protected:
    * Warns (vtkWarningMacro) about each shared "Volume" setting this representation does not
    * draw as "Volume" would: when ray casting, the drawn blend mode Slice (and so its Slice
    * Type) or a value that is no vtkVolumeMapper blend mode, and a FerrovolBlendMode that
-   * disagrees with a Blend Mode other than Composite; always, "Use 2D Transfer Function" and
-   * a "Volume Rendering Mode" other than Smart. Called while rendering, so only a visible
+   * disagrees with a Blend Mode other than Composite; always, a 2D transfer function over
+   * another array than the gradient magnitude and a "Volume Rendering Mode" other than
+   * Smart. Called while rendering, so only a visible
    * "Ferrovol Volume" speaks; says each warning once while it applies. Returns false when the
    * volume must be hidden.
    */
