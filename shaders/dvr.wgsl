@@ -692,9 +692,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 break;
             }
             let probe = ray.index_origin + (seg.x + (k + 0.5) * dt) * ray.index_dir;
-            let m = block_value(probe);
+            let occ = block_texel(probe);
+            let m = occ & 0xffu;
             if (SKIP && m == 0u) {
-                k = max((block_exit(ray, probe) - seg.x) / dt, k + 0.5);
+                k = max((leap_exit(ray, probe, occ >> 8u) - seg.x) / dt, k + 0.5);
                 continue;
             }
             var k1 = min(k + 1.0, k_end);
@@ -740,13 +741,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let lp = ray.index_origin + t * ray.index_dir;
         let p = grid_point(lp);
         var occupied = true;
+        var occ = 0u;
         if (SKIP) {
-            occupied = block_occupied(p);
+            occ = block_texel(p);
+            occupied = (occ & 0xffu) != 0u;
         }
         // PREINT takes the sample after one taken in an occupied block even in an empty
         // block: its segment begins in the occupied one.
         if (SKIP && !occupied && !(PREINT && front_occupied && front_k == k - 1.0)) {
-            let next = max(k + 1.0, ceil((block_exit(ray, lp) - seg.x) / dt - jit));
+            let next = max(k + 1.0, ceil((leap_exit(ray, lp, occ >> 8u) - seg.x) / dt - jit));
             if (blend == BLEND_AVERAGE || blend == BLEND_ADDITIVE) {
                 // their terms there are 0, but the samples count
                 misc.x = misc.x + min(next, k_end) - k;

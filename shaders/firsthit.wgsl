@@ -324,6 +324,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = 0.0;
     var p = vec3<f32>(0.0);
     var skip_after = false;
+    // SKIP: the occupancy texel of the block holding p
+    var occ = 0u;
     var advance = false;
     // Lavapipe runs the body of every branch for all lanes whenever it runs the code around
     // it, so the surface work (bisection, exact gradient, occlusion, G-buffer writes) stays
@@ -345,7 +347,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 s_prev = s;
                 if (skip_after) {
                     have_prev = false;
-                    k = max(k + 1.0, ceil((block_exit(ray, p) - lattice) / dt - jit));
+                    k = max(k + 1.0, ceil((leap_exit(ray, p, occ >> 8u) - lattice) / dt - jit));
                 } else {
                     k = k + 1.0;
                 }
@@ -367,9 +369,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             p = point_at(ray, t);
             skip_after = false;
-            if (SKIP && k_here < k_end && !block_occupied(p)) {
+            if (SKIP && k_here < k_end) {
+                occ = block_texel(p);
+            }
+            if (SKIP && k_here < k_end && (occ & 0xffu) == 0u) {
                 if (!have_prev) {
-                    k = max(k + 1.0, ceil((block_exit(ray, p) - lattice) / dt - jit));
+                    k = max(k + 1.0, ceil((leap_exit(ray, p, occ >> 8u) - lattice) / dt - jit));
                     continue;
                 }
                 // The interval from the last sample into this empty block is still checked.

@@ -83,7 +83,9 @@ var<private> pt: PathTrace;
 // (core/src/passes/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
 @group(0) @binding(14) var<storage, read> env_cdf: array<f32>;
 // Per min–max block (march.wgsl: block_coord): the largest extinction (per world unit) its
-// scalar range can take under the transfer function.
+// scalar range can take under the transfer function, or where that is 0, minus the block's
+// Chebyshev distance to the nearest block with extinction (core/src/resources/tables.rs,
+// empty_distances): a ray leaps the cube of blocks without it (leap_exit).
 @group(0) @binding(15) var majorants: texture_3d<f32>;
 // Per pixel (PT_FLAG_GUIDE), summed over the paths: the unit normal at the camera path's
 // first collision (facing the camera; the gradient's direction) and its distance along
@@ -386,8 +388,11 @@ fn block_span(r: Ray, t: f32) -> vec2<f32> {
         let end = select(3.0e38, b.x, b.x > t + 1e-4 && b.x < b.y);
         return vec2<f32>(pt.lobe.z, end);
     }
-    let m = textureLoad(majorants, block_coord(p), 0).x + pt.lobe.z;
-    return vec2<f32>(m, max(block_exit(r, p), t + 1e-4));
+    let m = textureLoad(majorants, block_coord(p), 0).x;
+    if (m <= 0.0) {
+        return vec2<f32>(pt.lobe.z, max(leap_exit(r, p, u32(-m)), t + 1e-4));
+    }
+    return vec2<f32>(m + pt.lobe.z, max(block_exit(r, p), t + 1e-4));
 }
 
 // One step of tracking over [t, t1): the next tentative collision, drawn against the

@@ -5,8 +5,10 @@
 // Per block of the occupancy grid (a texture: lavapipe reads storage buffers at per-lane
 // indices one lane at a time): non-zero when the block may hold something the pass looks
 // for (dvr: some voxel with non-zero opacity, the value then the step multiplier adaptive
-// rays take there, 1, 2 or 4; firsthit: some iso-value within the block's range), 0 when
-// the pass can skip it.
+// rays take there, 1, 2 or 4; firsthit: some iso-value within the block's range) in the
+// low 8 bits, 0 there when the pass can skip it; an empty block's bits 8–31 hold its
+// Chebyshev distance in blocks to the nearest occupied one (core/src/resources/tables.rs,
+// leap_texels), so that a ray leaps the whole cube of empty blocks around it (leap_exit).
 @group(0) @binding(3) var occupancy: texture_3d<u32>;
 // The host's opaque depth (window depth per pixel), read when FLAG_DEPTH_INPUT is set.
 @group(0) @binding(4) var depth_in: texture_2d<f32>;
@@ -51,7 +53,22 @@ fn block_occupied(p: vec3<f32>) -> bool {
 }
 
 fn block_value(p: vec3<f32>) -> u32 {
+    return block_texel(p) & 0xffu;
+}
+
+// The occupancy texel of the block holding p, as it is (value and leap distance).
+fn block_texel(p: vec3<f32>) -> u32 {
     return textureLoad(occupancy, block_coord(p), 0).x;
+}
+
+// Distance at which the ray leaves the empty space around the empty block holding p, d
+// blocks from the nearest occupied one: the cube of the blocks less than d away along
+// every axis.
+fn leap_exit(r: Ray, p: vec3<f32>, d: u32) -> f32 {
+    let bs = f32(frame.counts.z);
+    let reach = f32(max(d, 1u) - 1u) * bs;
+    let lo = floor(p / bs) * bs;
+    return box_interval(r, lo - reach, lo + bs + reach).y;
 }
 
 // Distance at which the ray leaves the occupancy block holding p.

@@ -53,7 +53,7 @@ use crate::params::{
     ScatterRegions, Shading, TransferFunction,
 };
 use crate::resources::intermix::IntermixBinding;
-use crate::resources::tables::{tables_2d_layout_entry, Tables};
+use crate::resources::tables::{empty_distances, tables_2d_layout_entry, Tables};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::volume::Needed;
 use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, no_grid_lookup};
@@ -315,7 +315,14 @@ impl PathTracePass {
         let m = medium::block_majorants(res)?;
         let max = m.iter().copied().fold(0.0f32, f32::max);
         let dims = res.volume()?.minmax.dims;
-        let grid = block_grid(ctx, "path tracing block majorants", dims, &m);
+        // (a block without extinction holds −its leap distance: pathtrace.wgsl, block_span)
+        let medium: Vec<bool> = m.iter().map(|&x| x > 0.0).collect();
+        let texels: Vec<f32> = m
+            .iter()
+            .zip(empty_distances(dims, &medium))
+            .map(|(&x, d)| if x > 0.0 { x } else { -(d as f32) })
+            .collect();
+        let grid = block_grid(ctx, "path tracing block majorants", dims, &texels);
         self.majorants = Some((key, grid, max));
         Ok(max)
     }

@@ -59,8 +59,9 @@ impl Tables {
     }
 }
 
-/// Which min–max blocks hold something to draw (1) and which can be skipped (0), as the
-/// passes read it (lib/march.wgsl), for the contents `key` names.
+/// Which min–max blocks hold something to draw (non-zero) and which can be skipped (0), as
+/// the passes read it (lib/march.wgsl), for the contents `key` names. On the GPU an empty
+/// block also holds how far the empty space around it reaches ([`leap_texels`]).
 pub(crate) struct Occupancy<K> {
     pub key: K,
     pub grid: wgpu::TextureView,
@@ -80,7 +81,7 @@ impl<K: PartialEq> Occupancy<K> {
     }
 
     pub fn new(ctx: &Context, label: &str, key: K, dims: [u32; 3], occ: &[u32]) -> Self {
-        let grid = block_grid(ctx, label, dims, occ);
+        let grid = block_grid(ctx, label, dims, &leap_texels(dims, occ));
         let occupied = occ.iter().filter(|&&o| o != 0).count();
         let fraction = occupied as f64 / occ.len().max(1) as f64;
         let saved: f64 = occ
@@ -97,6 +98,66 @@ impl<K: PartialEq> Occupancy<K> {
             saving,
         }
     }
+}
+
+/// The farthest an empty block's leap reaches, in blocks ([`empty_distances`]' value where
+/// no block is occupied).
+pub(crate) const LEAP_MAX: u32 = (1 << 24) - 1;
+
+/// The occupancy grid's texels: an occupied block's value as it is (1 to 255), an empty
+/// block's [`empty_distances`] in bits 8–31 (lib/march.wgsl, `leap_exit`).
+fn leap_texels(dims: [u32; 3], occ: &[u32]) -> Vec<u32> {
+    let occupied: Vec<bool> = occ.iter().map(|&o| o != 0).collect();
+    occ.iter()
+        .zip(empty_distances(dims, &occupied))
+        .map(|(&o, d)| if o != 0 { o } else { d << 8 })
+        .collect()
+}
+
+/// Per block of a grid of `dims` blocks: 0 where `occupied`, else the Chebyshev distance in
+/// blocks to the nearest occupied block (at most [`LEAP_MAX`], which it is when none is),
+/// so that every block less than that distance away along each axis is empty and a ray can
+/// leap out of the whole cube of them. Two raster passes over the 26 neighbours with unit
+/// weights, exact for the Chebyshev metric.
+pub(crate) fn empty_distances(dims: [u32; 3], occupied: &[bool]) -> Vec<u32> {
+    let [nx, ny, nz] = dims.map(|d| d as i64);
+    let index = |x: i64, y: i64, z: i64| ((z * ny + y) * nx + x) as usize;
+    let mut dist: Vec<u32> = occupied
+        .iter()
+        .map(|&o| if o { 0 } else { LEAP_MAX })
+        .collect();
+    // the neighbours before a block in raster order (z, then y, then x); the passes go
+    // forwards with these offsets and backwards with their negatives
+    let before: Vec<[i64; 3]> = (-1..=1)
+        .flat_map(|z| (-1..=1).flat_map(move |y| (-1..=1).map(move |x| [x, y, z])))
+        .filter(|&[x, y, z]| z < 0 || (z == 0 && (y < 0 || (y == 0 && x < 0))))
+        .collect();
+    for sign in [1i64, -1] {
+        for zi in 0..nz {
+            for yi in 0..ny {
+                for xi in 0..nx {
+                    let [x, y, z] = if sign > 0 {
+                        [xi, yi, zi]
+                    } else {
+                        [nx - 1 - xi, ny - 1 - yi, nz - 1 - zi]
+                    };
+                    let here = index(x, y, z);
+                    if dist[here] == 0 {
+                        continue;
+                    }
+                    let mut d = dist[here];
+                    for &[ox, oy, oz] in &before {
+                        let [qx, qy, qz] = [x + sign * ox, y + sign * oy, z + sign * oz];
+                        if (0..nx).contains(&qx) && (0..ny).contains(&qy) && (0..nz).contains(&qz) {
+                            d = d.min(dist[index(qx, qy, qz)].saturating_add(1));
+                        }
+                    }
+                    dist[here] = d.min(LEAP_MAX);
+                }
+            }
+        }
+    }
+    dist
 }
 
 /// Keeps in `slot` the tables `build` makes of the transfer function of `key` (rows of
@@ -406,5 +467,69 @@ impl Spread {
         (0..4)
             .map(|i| a[1][i].max(b[1][i]) - a[0][i].min(b[0][i]))
             .fold(0.0, f32::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{leap_texels, LEAP_MAX};
+
+    /// The leap distances equal the brute-force Chebyshev distance to the nearest occupied
+    /// block, on grids of several shapes and densities; occupied blocks keep their values.
+    #[test]
+    fn leap_texels_hold_the_chebyshev_distance() {
+        let mut seed = 0x9e37_79b9u32;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed
+        };
+        for (dims, every) in [
+            ([7u32, 5, 3], 9u32),
+            ([1, 1, 12], 5),
+            ([9, 9, 9], 60),
+            ([6, 4, 8], 1_000_000),
+            ([5, 5, 5], 1),
+        ] {
+            let n = (dims[0] * dims[1] * dims[2]) as usize;
+            let occ: Vec<u32> = (0..n)
+                .map(|_| {
+                    if rand() % every == 0 {
+                        [1, 2, 4][rand() as usize % 3]
+                    } else {
+                        0
+                    }
+                })
+                .collect();
+            let texels = leap_texels(dims, &occ);
+            let at = |i: usize| {
+                let x = i % dims[0] as usize;
+                let y = i / dims[0] as usize % dims[1] as usize;
+                let z = i / (dims[0] * dims[1]) as usize;
+                [x as i64, y as i64, z as i64]
+            };
+            for i in 0..n {
+                if occ[i] != 0 {
+                    assert_eq!(texels[i], occ[i], "{dims:?}: occupied block {i}");
+                    continue;
+                }
+                let p = at(i);
+                let brute = (0..n)
+                    .filter(|&j| occ[j] != 0)
+                    .map(|j| {
+                        let q = at(j);
+                        (0..3).map(|a| (p[a] - q[a]).unsigned_abs()).max().unwrap() as u32
+                    })
+                    .min()
+                    .unwrap_or(LEAP_MAX);
+                assert_eq!(
+                    texels[i] & 0xff,
+                    0,
+                    "{dims:?}: empty block {i} reads as occupied"
+                );
+                assert_eq!(texels[i] >> 8, brute, "{dims:?}: block {i}");
+            }
+        }
     }
 }

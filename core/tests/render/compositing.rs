@@ -585,6 +585,101 @@ fn additive_average_skipping_changes_no_pixel() {
 }
 
 // ---------------------------------------------------------------------------------------
+// Composite and isosurface rays leap the empty space around them: the same image
+// ---------------------------------------------------------------------------------------
+
+/// Two small blobs in a large, mostly empty volume (rays leap cubes of many empty blocks,
+/// and a ray through nothing leaps the whole volume): composite (lattice, midpoints,
+/// adaptive, pre-integrated; unshaded and shaded) and the isosurface's first hit, with and
+/// without skipping, give the same pixels and depths, in one brick and across bricks of 16
+/// points.
+#[test]
+fn leaping_empty_space_changes_no_pixel() {
+    let mut r = renderer();
+    let n = 72u32;
+    let m = (n - 1) as f64;
+    let vol = volume([n; 3], |x, y, z| {
+        let g = |c: [f64; 3], s: f64| {
+            let r2 = (x - c[0] * m).powi(2) + (y - c[1] * m).powi(2) + (z - c[2] * m).powi(2);
+            (-r2 / (2.0 * (s * m).powi(2))).exp()
+        };
+        (0.95 * g([0.3, 0.6, 0.55], 0.1) + 0.8 * g([0.72, 0.3, 0.4], 0.08)).min(1.0)
+    });
+    let mut view = View::fit(vol.bounds(), 80, 80);
+    view.camera.azimuth(31.0);
+    view.camera.elevation(17.0);
+    view.camera.orthogonalize_view_up();
+    view.camera.reset_clipping_range(vol.bounds());
+    r.set_transfer_function(&white(&[(0.0, 0.0), (0.25, 0.0), (1.0, 0.9)], 1.0))
+        .unwrap();
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        0.5,
+        [0.9, 0.8, 0.7],
+        1.0,
+    )]))
+    .unwrap();
+    let mut compared = 0;
+    for bricked in [false, true] {
+        if bricked {
+            set_bricked(&mut r, &vol, 16);
+        } else {
+            r.set_volume(&vol).unwrap();
+        }
+        let cases = [
+            ("lattice", RenderParams::default()),
+            ("shaded", shaded()),
+            (
+                "midpoints",
+                RenderParams {
+                    quadrature: Quadrature::Midpoint,
+                    ..RenderParams::default()
+                },
+            ),
+            (
+                "adaptive",
+                RenderParams {
+                    quadrature: Quadrature::Adaptive,
+                    ..RenderParams::default()
+                },
+            ),
+            (
+                "pre-integrated",
+                RenderParams {
+                    preintegration: true,
+                    ..RenderParams::default()
+                },
+            ),
+            (
+                "isosurface",
+                RenderParams {
+                    blend: BlendMode::Isosurface,
+                    ..RenderParams::default()
+                },
+            ),
+        ];
+        for (name, base) in cases {
+            let [on, off] = [true, false].map(|empty_space_skipping| {
+                let p = RenderParams {
+                    empty_space_skipping,
+                    ..base.clone()
+                };
+                r.render_image(&view, &p).unwrap()
+            });
+            let label = format!("{name} (bricked {bricked})");
+            let differ = on.rgba.chunks(4).zip(off.rgba.chunks(4));
+            let differ = differ.filter(|(a, b)| a != b).count();
+            let lit = footprint(&off);
+            println!("{label}: {lit} pixels lit, {differ} differ with skipping on");
+            assert!(lit > 100, "{label}: only {lit} pixels lit");
+            assert_eq!(differ, 0, "{label}: skipping changed {differ} pixels");
+            assert!(on.depth == off.depth, "{label}: skipping changed the depth");
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, 12);
+}
+
+// ---------------------------------------------------------------------------------------
 // MIP / MinIP skipping by block range leaves the image as it is
 // ---------------------------------------------------------------------------------------
 
