@@ -32,13 +32,29 @@ pub fn ball(n: u32, r: f64) -> VolumeData {
 /// Two overlapping Gaussian blobs, smooth, values in [0, 1]: a volume with gradients in
 /// every direction and both soft and steep parts of the transfer function.
 pub fn blob_volume(n: u32) -> VolumeData {
+    blobs(
+        n,
+        &[
+            (0.95, [0.45, 0.5, 0.55], 0.22),
+            (0.7, [0.72, 0.35, 0.4], 0.1),
+        ],
+    )
+}
+
+/// An n³ volume of Gaussian blobs (weight, centre and width as fractions of the volume's
+/// edge), their sum clamped to 1.
+pub fn blobs(n: u32, blobs: &[(f64, [f64; 3], f64)]) -> VolumeData {
     let m = (n - 1) as f64;
     volume([n; 3], |x, y, z| {
         let g = |c: [f64; 3], s: f64| {
             let r2 = (x - c[0] * m).powi(2) + (y - c[1] * m).powi(2) + (z - c[2] * m).powi(2);
             (-r2 / (2.0 * (s * m).powi(2))).exp()
         };
-        (0.95 * g([0.45, 0.5, 0.55], 0.22) + 0.7 * g([0.72, 0.35, 0.4], 0.1)).min(1.0)
+        blobs
+            .iter()
+            .map(|&(w, c, s)| w * g(c, s))
+            .sum::<f64>()
+            .min(1.0)
     })
 }
 

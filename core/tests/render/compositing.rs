@@ -7,7 +7,8 @@ use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, footprint, image_diff, rgba};
 use crate::common::raycast::to_pixel;
 use crate::common::scenes::{
-    blob_transfer, blob_volume, component_transfer, shaded, slab, volume, white, with_clip_plane,
+    blob_transfer, blob_volume, blobs, component_transfer, oblique, shaded, slab, volume, white,
+    with_clip_plane,
 };
 use crate::{box_corners, mask_extents, projected_extents};
 use ferrovol_core::*;
@@ -596,20 +597,11 @@ fn additive_average_skipping_changes_no_pixel() {
 #[test]
 fn leaping_empty_space_changes_no_pixel() {
     let mut r = renderer();
-    let n = 72u32;
-    let m = (n - 1) as f64;
-    let vol = volume([n; 3], |x, y, z| {
-        let g = |c: [f64; 3], s: f64| {
-            let r2 = (x - c[0] * m).powi(2) + (y - c[1] * m).powi(2) + (z - c[2] * m).powi(2);
-            (-r2 / (2.0 * (s * m).powi(2))).exp()
-        };
-        (0.95 * g([0.3, 0.6, 0.55], 0.1) + 0.8 * g([0.72, 0.3, 0.4], 0.08)).min(1.0)
-    });
-    let mut view = View::fit(vol.bounds(), 80, 80);
-    view.camera.azimuth(31.0);
-    view.camera.elevation(17.0);
-    view.camera.orthogonalize_view_up();
-    view.camera.reset_clipping_range(vol.bounds());
+    let vol = blobs(
+        72,
+        &[(0.95, [0.3, 0.6, 0.55], 0.1), (0.8, [0.72, 0.3, 0.4], 0.08)],
+    );
+    let view = oblique(&vol, 80);
     r.set_transfer_function(&white(&[(0.0, 0.0), (0.25, 0.0), (1.0, 0.9)], 1.0))
         .unwrap();
     r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
