@@ -63,6 +63,36 @@ fn lattice_weights(n: u32, m: u32, factor: u32) -> Vec<Vec<(usize, f64)>> {
         .collect()
 }
 
+/// How a coarse point combines the fine points its weights reach: their weighted mean, or
+/// (the stand-ins of MIP and MinIP previews, which a mean would dim or brighten where a
+/// structure is thinner than the level's spacing) their largest or smallest value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Reduction {
+    Mean,
+    Max,
+    Min,
+}
+
+impl Reduction {
+    /// The accumulator before any fine point.
+    fn start(self) -> f64 {
+        match self {
+            Reduction::Mean => 0.0,
+            Reduction::Max => f64::NEG_INFINITY,
+            Reduction::Min => f64::INFINITY,
+        }
+    }
+
+    /// `acc` with the fine value `v` of weight `w` taken in.
+    fn take(self, acc: f64, w: f64, v: f64) -> f64 {
+        match self {
+            Reduction::Mean => acc + w * v,
+            Reduction::Max => acc.max(v),
+            Reduction::Min => acc.min(v),
+        }
+    }
+}
+
 /// Per fine point, the coarse points it contributes to with their weights.
 fn by_fine(weights: &[Vec<(usize, f64)>], n: u32) -> Vec<Vec<(usize, f64)>> {
     let mut out = vec![Vec::new(); n as usize];
@@ -84,18 +114,23 @@ impl VolumeData {
     /// and holds three coarse planes at most besides the result. A rectilinear grid is
     /// refused.
     pub fn downsampled(&self, factor: u32) -> Result<VolumeData> {
-        downsample(self, factor, false)
+        downsample(self, factor, false, Reduction::Mean)
     }
 
     /// [`VolumeData::downsampled`] with coarse point i at fine point i·`factor` (spacing ×
-    /// factor; past the last fine point the tent reads the last): a coarse brick then holds
-    /// the same box as `factor`³ fine ones (resources/lod.rs).
-    pub(crate) fn downsampled_on_lattice(&self, factor: u32) -> Result<VolumeData> {
-        downsample(self, factor, true)
+    /// factor; past the last fine point the tent reads the last), `reduction` combining the
+    /// points the tent reaches: a coarse brick then holds the same box as `factor`³ fine
+    /// ones (resources/lod.rs).
+    pub(crate) fn downsampled_on_lattice(
+        &self,
+        factor: u32,
+        reduction: Reduction,
+    ) -> Result<VolumeData> {
+        downsample(self, factor, true, reduction)
     }
 }
 
-fn downsample(v: &VolumeData, factor: u32, lattice: bool) -> Result<VolumeData> {
+fn downsample(v: &VolumeData, factor: u32, lattice: bool, op: Reduction) -> Result<VolumeData> {
     if factor == 0 {
         return Err(Error::InvalidParameter(
             "a downsampling factor of 0: give 1 or more fine points per coarse point".into(),
@@ -124,36 +159,37 @@ fn downsample(v: &VolumeData, factor: u32, lattice: bool) -> Result<VolumeData> 
     let plane_len = mx as usize * my as usize * c;
     let mut out = empty_scalars(v.scalars.scalar_type(), plane_len * mz as usize);
     let mut row = vec![0.0; nx as usize * c];
-    let mut row_sum = vec![0.0; mx as usize * c];
-    let mut slab = vec![0.0; plane_len];
+    let mut row_sum = vec![op.start(); mx as usize * c];
+    let mut slab = vec![op.start(); plane_len];
     let mut planes: VecDeque<(usize, Vec<f64>)> = VecDeque::new();
     for (z, planes_of_z) in to_z.iter().enumerate() {
-        slab.fill(0.0);
+        slab.fill(op.start());
         for (y, to) in to_y.iter().enumerate() {
             let start = (z * ny as usize + y) * nx as usize * c;
             v.scalars.read_run(start, &mut row)?;
-            row_sum.fill(0.0);
+            row_sum.fill(op.start());
             for (i, w) in wx.iter().enumerate() {
                 for &(j, x) in w {
                     for k in 0..c {
-                        row_sum[i * c + k] += x * row[j * c + k];
+                        let acc = &mut row_sum[i * c + k];
+                        *acc = op.take(*acc, x, row[j * c + k]);
                     }
                 }
             }
             for &(yy, x) in to {
                 let dst = &mut slab[yy * mx as usize * c..(yy + 1) * mx as usize * c];
                 for (d, s) in dst.iter_mut().zip(&row_sum) {
-                    *d += x * s;
+                    *d = op.take(*d, x, *s);
                 }
             }
         }
         for &(k, x) in planes_of_z {
             if planes.back().is_none_or(|(b, _)| *b < k) {
-                planes.push_back((k, vec![0.0; plane_len]));
+                planes.push_back((k, vec![op.start(); plane_len]));
             }
             let plane = &mut planes.iter_mut().find(|(b, _)| *b == k).expect("pushed").1;
             for (d, s) in plane.iter_mut().zip(&slab) {
-                *d += x * s;
+                *d = op.take(*d, x, *s);
             }
         }
         while planes.front().is_some_and(|(k, _)| last_z[*k] <= z) {
@@ -192,8 +228,8 @@ fn empty_scalars(t: ScalarType, n: usize) -> Scalars {
     }
 }
 
-/// Appends `values` to `out` in its type (integers rounded: a weighted mean of values of a
-/// type lies within its range).
+/// Appends `values` to `out` in its type (integers rounded: a weighted mean, the largest or
+/// the smallest of values of a type lies within its range).
 fn push_values(out: &mut Scalars, values: &[f64]) {
     fn put<T>(out: &mut Vec<T>, values: &[f64], f: impl Fn(f64) -> T) {
         out.extend(values.iter().map(|&x| f(x)));
@@ -232,6 +268,25 @@ mod tests {
         }
     }
 
+    /// A spike one point wide: the mean level spreads and lowers it, the largest and
+    /// smallest keep it whole in the coarse point whose tent reaches it.
+    #[test]
+    fn max_and_min_levels_keep_a_one_point_spike() {
+        let line =
+            |values: [u8; 7]| VolumeData::new([7, 1, 1], 1, Scalars::U8(values.to_vec())).unwrap();
+        let level = |v: &VolumeData, r| {
+            let c = v.downsampled_on_lattice(2, r).unwrap();
+            (0..c.dims[0] as usize)
+                .map(|i| c.scalars.get(i))
+                .collect::<Vec<f64>>()
+        };
+        let bright = line([10, 10, 10, 200, 10, 10, 10]);
+        assert_eq!(level(&bright, Reduction::Max), [10.0, 200.0, 200.0, 10.0]);
+        assert_eq!(level(&bright, Reduction::Mean), [10.0, 58.0, 58.0, 10.0]);
+        let dark = line([90, 90, 90, 3, 90, 90, 90]);
+        assert_eq!(level(&dark, Reduction::Min), [90.0, 3.0, 3.0, 90.0]);
+    }
+
     #[test]
     fn lattice_levels_put_coarse_point_i_on_fine_point_i_times_the_factor() {
         // f = x along 6 points (5 cells), factor 2: coarse points on fine 0, 2, 4 and 6 (past
@@ -244,7 +299,7 @@ mod tests {
         .unwrap()
         .with_spacing([0.5, 1.0, 1.0])
         .unwrap();
-        let c = v.downsampled_on_lattice(2).unwrap();
+        let c = v.downsampled_on_lattice(2, Reduction::Mean).unwrap();
         assert_eq!(c.dims, [4, 1, 1]);
         assert_eq!(c.spacing, [1.0, 1.0, 1.0]);
         let values: Vec<f64> = (0..4).map(|i| c.scalars.get(i)).collect();

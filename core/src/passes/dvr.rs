@@ -16,6 +16,7 @@ use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{FLAG_DEPTH_RANGE, MASK_BINARY, MASK_LABELS, MASK_NONE};
 use crate::gpu::Context;
+use crate::params::downsample::Reduction;
 use crate::params::{BlendMode, GradientMethod, Interpolation, MaskKind, Quadrature};
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{tables_2d_layout_entry, Tables, PREINTEGRATION_FORMAT};
@@ -157,7 +158,13 @@ impl DvrPass {
                     && res.blanking.is_none()
                     && res.intermix.is_none() =>
             {
-                res.enter_lod(ctx, needed, &front, in_view)?
+                // (MIP and MinIP stand-ins keep the extremes a mean would lose)
+                let reduction = match params.blend {
+                    BlendMode::Maximum => Reduction::Max,
+                    BlendMode::Minimum => Reduction::Min,
+                    _ => Reduction::Mean,
+                };
+                res.enter_lod(ctx, needed, &front, in_view, reduction)?
             }
             _ => false,
         };

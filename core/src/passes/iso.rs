@@ -35,6 +35,7 @@ use crate::gpu::readback::{read_buffer, read_texture_layer};
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND, MASK_BINARY, MASK_NONE};
 use crate::gpu::Context;
+use crate::params::downsample::Reduction;
 use crate::params::iso::MAX_SPECULAR_SAMPLES;
 use crate::params::{
     BlendMode, GBuffer, Interpolation, IsoParams, IsoScatterMode, MaskKind, RenderParams, Shading,
@@ -466,7 +467,13 @@ impl IsoPass {
                 Some(in_view)
                     if params.preview_level && res.mask.is_none() && res.blanking.is_none() =>
                 {
-                    res.enter_lod(ctx, Needed::Blocks(surfaces), &front, in_view)?
+                    res.enter_lod(
+                        ctx,
+                        Needed::Blocks(surfaces),
+                        &front,
+                        in_view,
+                        Reduction::Mean,
+                    )?
                 }
                 _ => false,
             };

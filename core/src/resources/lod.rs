@@ -16,7 +16,7 @@ use crate::error::Result;
 use crate::gpu::readback::read_buffer;
 use crate::gpu::uniforms::PAGE_EMPTY;
 use crate::gpu::Context;
-use crate::params::downsample::coarse_points;
+use crate::params::downsample::{coarse_points, Reduction};
 use std::sync::Arc;
 
 /// A preview frame brings at most 1/UPLOAD_SHARE of the pool's slots of fine bricks.
@@ -55,9 +55,10 @@ impl Resources {
         needed: Needed<'_>,
         front: &FrontToBack,
         in_view: &[bool],
+        reduction: Reduction,
     ) -> Result<bool> {
         self.with_flags(needed, |res, flags| {
-            res.place_lod(ctx, flags, front, in_view)
+            res.place_lod(ctx, flags, front, in_view, reduction)
         })
     }
 
@@ -67,6 +68,7 @@ impl Resources {
         flags: Option<&[u32]>,
         front: &FrontToBack,
         in_view: &[bool],
+        reduction: Reduction,
     ) -> Result<bool> {
         let vol = self.volume.as_mut().ok_or_else(super::no_volume)?;
         let Some(host) = vol.host.clone() else {
@@ -117,7 +119,11 @@ impl Resources {
             }
             shift += 1;
         };
-        if vol.lod.as_ref().is_none_or(|l| l.shift != shift) {
+        if vol
+            .lod
+            .as_ref()
+            .is_none_or(|l| (l.shift, l.reduction) != (shift, reduction))
+        {
             // (the last level's stand-ins leave first, and with them the page entries)
             self.leave_lod();
             let vol = self.volume.as_mut().expect("a volume");
@@ -125,16 +131,17 @@ impl Resources {
                 Some(l) => (l.reads, l.built),
                 None => (vec![0; fine], Vec::new()),
             };
-            let data = match built.iter().find(|(s, _)| *s == shift) {
+            let data = match built.iter().find(|(k, _)| *k == (shift, reduction)) {
                 Some((_, data)) => data.clone(),
                 None => {
-                    let data = Arc::new(host.downsampled_on_lattice(1 << shift)?);
-                    built.push((shift, data.clone()));
+                    let data = Arc::new(host.downsampled_on_lattice(1 << shift, reduction)?);
+                    built.push(((shift, reduction), data.clone()));
                     data
                 }
             };
             vol.lod = Some(Lod {
                 shift,
+                reduction,
                 grid: coarse,
                 host: data,
                 active: false,

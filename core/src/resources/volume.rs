@@ -15,6 +15,7 @@ use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
 use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS, READ_STAND_IN};
 use crate::gpu::Context;
+use crate::params::downsample::Reduction;
 use crate::params::{MaskKind, Residency, UploadOptions, VolumeData};
 use glam::DMat4;
 use std::sync::Arc;
@@ -141,6 +142,8 @@ pub(crate) struct GpuVolume {
 pub(crate) struct Lod {
     /// log2 of the level's factor (fine points per coarse point along each axis).
     pub shift: u32,
+    /// How its points combine the fine ones (MIP and MinIP previews keep the extremes).
+    pub reduction: Reduction,
     /// The level's bricks: the volume's brick size, a coarse brick over the box of
     /// factor³ fine ones.
     pub grid: BrickGrid,
@@ -150,9 +153,9 @@ pub(crate) struct Lod {
     pub active: bool,
     /// Per fine brick, what the last preview frame's rays read there (0: nothing).
     pub reads: Vec<u32>,
-    /// The levels built so far, by shift (kept: the level a preview takes follows what its
-    /// rays read, and building one reads the whole volume).
-    pub built: Vec<(u32, Arc<VolumeData>)>,
+    /// The levels built so far, by shift and reduction (kept: the level a preview takes
+    /// follows what its rays read, and building one reads the whole volume).
+    pub built: Vec<((u32, Reduction), Arc<VolumeData>)>,
 }
 
 impl Lod {

@@ -185,3 +185,110 @@ fn previews_converge_to_the_fine_image_and_bring_only_what_rays_read() {
         assert!(frames[0].0 > 0 && frames[0].2 < frames[frames.len() - 1].2);
     }
 }
+
+/// Lines one point thin, bright in a dim volume (MIP) or dark in a bright one (MinIP): the
+/// stand-ins of a preview keep the largest (smallest) value their points reach, so the
+/// first preview draws the lines at least as bright (dark) as in core, where a mean would
+/// have lowered (raised) them by most of their contrast.
+#[test]
+fn mip_and_minip_previews_keep_thin_lines() {
+    let mut r = renderer();
+    let n = 40u32;
+    let line = |x: f64, y: f64, z: f64| (y == 21.0 && z == 19.0) || (x == 13.0 && z == 25.0);
+    r.set_transfer_function(&TransferFunction::single(component_transfer(
+        &[(0.0, [1.0; 3]), (1.0, [1.0; 3])],
+        &[(0.0, 0.0), (1.0, 1.0)],
+        1.0,
+    )))
+    .unwrap();
+    let view = View::fit(blob_volume(n).bounds(), 64, 64);
+    for (blend, inside, on_line) in [
+        (BlendMode::Maximum, 0.1, 1.0),
+        (BlendMode::Minimum, 0.9, 0.0),
+    ] {
+        let vol = volume(
+            [n; 3],
+            |x, y, z| if line(x, y, z) { on_line } else { inside },
+        );
+        let (_, preview, in_core) = in_core(&mut r, &vol, &view, blend);
+        r.set_volume_with(
+            &vol,
+            UploadOptions {
+                max_brick_points: Some(12),
+                memory_budget: Some((n as u64).pow(3)),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let first = r.render_image(&view, &preview).unwrap();
+        let res = r.residency();
+        save_enlarged(&first, &format!("lod_lines_{blend:?}"));
+        // per image row and column across the middle of the image, the extreme grey inside
+        // the volume's box: the vertical line's and the horizontal line's peaks (the lines
+        // grow wider in the coarser stand-ins, and their ends follow the level's points)
+        let grey = |img: &Image, x: u32, y: u32| img.rgba[((y * img.width + x) * 4) as usize];
+        let middle = 22..42u32;
+        // (the pixels well inside the volume's box, which covers 11–53 of 64)
+        let inside_box = 15..50u32;
+        let extreme = |img: &Image| {
+            let pick = |a: u8, b: u8| {
+                if blend == BlendMode::Maximum {
+                    a.max(b)
+                } else {
+                    a.min(b)
+                }
+            };
+            let rows = middle.clone().map(|y| {
+                inside_box
+                    .clone()
+                    .map(|x| grey(img, x, y))
+                    .reduce(pick)
+                    .unwrap()
+            });
+            let cols = middle.clone().map(|x| {
+                inside_box
+                    .clone()
+                    .map(|y| grey(img, x, y))
+                    .reduce(pick)
+                    .unwrap()
+            });
+            rows.chain(cols).map(f64::from).collect::<Vec<f64>>()
+        };
+        let (a, b) = (extreme(&first), extreme(&in_core));
+        // the lines' contrast: in core, against the grey beside them in the image's centre
+        let beside = f64::from(grey(&in_core, 32, 38));
+        let contrast = b.iter().map(|x| (x - beside).abs()).fold(255.0, f64::min);
+        // how much fainter than in core the preview draws the lines (the stand-ins' lines
+        // are wider: their samples meet the peak where in core a sample between points
+        // meets less of it, so they may be stronger)
+        let fainter = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| {
+                if blend == BlendMode::Maximum {
+                    y - x
+                } else {
+                    x - y
+                }
+            })
+            .fold(f64::MIN, f64::max);
+        println!(
+            "{blend:?}: first preview {} stand-ins read, {} of {} fine bricks resident; the \
+             lines' peak per row and column {:.0}–{:.0}/255, in core {:.0}–{:.0}/255 \
+             (contrast at least {contrast:.0}/255)",
+            res.stand_ins,
+            res.resident,
+            res.bricks,
+            a.iter().copied().fold(255.0, f64::min),
+            a.iter().copied().fold(0.0, f64::max),
+            b.iter().copied().fold(255.0, f64::min),
+            b.iter().copied().fold(0.0, f64::max),
+        );
+        assert!(res.stand_ins > 0, "{blend:?}: the preview reads stand-ins");
+        assert!(contrast > 100.0, "{blend:?}: the lines show in core");
+        assert!(
+            fainter <= 2.0,
+            "{blend:?}: the preview draws the lines up to {fainter}/255 fainter than in core"
+        );
+    }
+}
