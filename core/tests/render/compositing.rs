@@ -585,6 +585,18 @@ fn additive_average_skipping_changes_no_pixel() {
     }
 }
 
+/// `on` (skipping on) and `off` (off) have the same pixels and depths, and more than
+/// `min_lit` pixels drawn.
+fn assert_skipping_changes_nothing(on: &Image, off: &Image, label: &str, min_lit: usize) {
+    let differ = on.rgba.chunks(4).zip(off.rgba.chunks(4));
+    let differ = differ.filter(|(a, b)| a != b).count();
+    let lit = footprint(off);
+    println!("{label}: {lit} pixels lit, {differ} differ with skipping on");
+    assert!(lit > min_lit, "{label}: only {lit} pixels lit");
+    assert_eq!(differ, 0, "{label}: skipping changed {differ} pixels");
+    assert!(on.depth == off.depth, "{label}: skipping changed the depth");
+}
+
 // ---------------------------------------------------------------------------------------
 // Composite and isosurface rays leap the empty space around them: the same image
 // ---------------------------------------------------------------------------------------
@@ -657,14 +669,7 @@ fn leaping_empty_space_changes_no_pixel() {
                 };
                 r.render_image(&view, &p).unwrap()
             });
-            let label = format!("{name} (bricked {bricked})");
-            let differ = on.rgba.chunks(4).zip(off.rgba.chunks(4));
-            let differ = differ.filter(|(a, b)| a != b).count();
-            let lit = footprint(&off);
-            println!("{label}: {lit} pixels lit, {differ} differ with skipping on");
-            assert!(lit > 100, "{label}: only {lit} pixels lit");
-            assert_eq!(differ, 0, "{label}: skipping changed {differ} pixels");
-            assert!(on.depth == off.depth, "{label}: skipping changed the depth");
+            assert_skipping_changes_nothing(&on, &off, &format!("{name} (bricked {bricked})"), 100);
             compared += 1;
         }
     }
@@ -761,13 +766,7 @@ fn mip_minip_skipping_changes_no_pixel() {
                     let label = format!(
                         "{blend:?} {name} bricked={bricked} {interpolation:?} jitter={jitter}"
                     );
-                    let differ = on.rgba.chunks(4).zip(off.rgba.chunks(4));
-                    let differ = differ.filter(|(a, b)| a != b).count();
-                    let lit = footprint(&off);
-                    println!("{label}: {lit} pixels lit, {differ} differ with skipping on");
-                    assert!(lit > 500, "{label}: only {lit} pixels lit");
-                    assert_eq!(differ, 0, "{label}: skipping changed {differ} pixels");
-                    assert!(on.depth == off.depth, "{label}: skipping changed the depth");
+                    assert_skipping_changes_nothing(&on, &off, &label, 500);
                     if !bricked && !jitter && interpolation == Interpolation::Linear {
                         save_enlarged(&on, &format!("skip_{blend:?}_{name}").to_lowercase());
                     }

@@ -238,21 +238,20 @@ fn mip_and_minip_previews_keep_thin_lines() {
                     a.min(b)
                 }
             };
-            let rows = middle.clone().map(|y| {
-                inside_box
-                    .clone()
-                    .map(|x| grey(img, x, y))
-                    .reduce(pick)
-                    .unwrap()
-            });
-            let cols = middle.clone().map(|x| {
-                inside_box
-                    .clone()
-                    .map(|y| grey(img, x, y))
-                    .reduce(pick)
-                    .unwrap()
-            });
-            rows.chain(cols).map(f64::from).collect::<Vec<f64>>()
+            // (a row y is the pixels (x, y) across the box, a column x those (x, y))
+            let across = |i: u32, row: bool| {
+                let at = |j: u32| {
+                    if row {
+                        grey(img, j, i)
+                    } else {
+                        grey(img, i, j)
+                    }
+                };
+                f64::from(inside_box.clone().map(at).reduce(pick).unwrap())
+            };
+            let rows = middle.clone().map(|y| across(y, true));
+            rows.chain(middle.clone().map(|x| across(x, false)))
+                .collect::<Vec<f64>>()
         };
         let (a, b) = (extreme(&first), extreme(&in_core));
         // the lines' contrast: in core, against the grey beside them in the image's centre
