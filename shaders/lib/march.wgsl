@@ -73,7 +73,5 @@ fn leap_exit(r: Ray, p: vec3<f32>, d: u32) -> f32 {
 
 // Distance at which the ray leaves the occupancy block holding p.
 fn block_exit(r: Ray, p: vec3<f32>) -> f32 {
-    let bs = f32(frame.counts.z);
-    let lo = floor(p / bs) * bs;
-    return box_interval(r, lo, lo + bs).y;
+    return leap_exit(r, p, 1u);
 }

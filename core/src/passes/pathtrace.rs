@@ -320,7 +320,7 @@ impl PathTracePass {
         let texels: Vec<f32> = m
             .iter()
             .zip(empty_distances(dims, &medium))
-            .map(|(&x, d)| if x > 0.0 { x } else { -(d as f32) })
+            .map(|(&x, d)| if d == 0 { x } else { -(d as f32) })
             .collect();
         let grid = block_grid(ctx, "path tracing block majorants", dims, &texels);
         self.majorants = Some((key, grid, max));

@@ -102,7 +102,7 @@ impl<K: PartialEq> Occupancy<K> {
 
 /// The farthest an empty block's leap reaches, in blocks ([`empty_distances`]' value where
 /// no block is occupied).
-pub(crate) const LEAP_MAX: u32 = (1 << 24) - 1;
+const LEAP_MAX: u32 = (1 << 24) - 1;
 
 /// The occupancy grid's texels: an occupied block's value as it is (1 to 255), an empty
 /// block's [`empty_distances`] in bits 8–31 (lib/march.wgsl, `leap_exit`).
@@ -110,7 +110,7 @@ fn leap_texels(dims: [u32; 3], occ: &[u32]) -> Vec<u32> {
     let occupied: Vec<bool> = occ.iter().map(|&o| o != 0).collect();
     occ.iter()
         .zip(empty_distances(dims, &occupied))
-        .map(|(&o, d)| if o != 0 { o } else { d << 8 })
+        .map(|(&o, d)| if d == 0 { o } else { d << 8 })
         .collect()
 }
 
