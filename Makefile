@@ -1,6 +1,8 @@
 # ferrovol — GPU volume ray casting on wgpu.
 #   make demo   render the built-in demo volume to build/demo.png
-#   make test   format, lint and run every test (installs what is missing first)
+#   make test   everything CI runs (installs what is missing first): lint, the builds, then
+#               every suite in two lanes, each suite's wall time and a total (scripts/test.sh)
+#   make check  for contributors: rustfmt, clippy and the Rust tests (a few minutes when warm)
 #   make bench  VTK's GPU ray cast benchmark scene, ferrovol vs vtkGPUVolumeRayCastMapper,
 #               then the equal-fidelity table (time and error against converged references)
 #   make bench-vtk  the same scene in a VTK window: vtkFerroVolumeMapper vs vtkGPUVolumeRayCastMapper,
@@ -30,8 +32,10 @@ CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
-.PHONY: deps build demo test lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
-        regression regression-quick fuzz-smoke soak sanitize vtk-asan
+.PHONY: deps build demo test check lint bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
+        regression regression-quick fuzz-smoke soak sanitize vtk-asan \
+        test-build-rust test-rust test-sanitize test-build-vtk test-vtk test-build-vtk-asan \
+        test-vtk-asan test-build-paraview test-paraview test-regression-quick
 
 deps:
 	@bash scripts/install-deps.sh
@@ -41,34 +45,60 @@ build: deps
 	$(CARGO) build --release --locked -p ferrovol-cli
 	$(MAKE) vtk
 
-# The VTK module links the C ABI library (target/release/libferrovol.so); VTK 9.2 is
-# ParaView's (docs/ARCHITECTURE.md, Machines). 2 cores: ninja -j2.
+# The C ABI library the VTK module and the ParaView plugin link. `make vtk` and `make
+# paraview` link the release build; `make test` links the test build instead (target/debug:
+# the crates as the Rust tests compile them, debug assertions on, with the test-only
+# fv_test_panic export), so that one Rust build serves every suite. FFI_TEST builds the
+# workspace's tests with it: the library alone (-p ferrovol-ffi) would resolve its
+# dependencies' features without the tests' and compile them all a second time. `make
+# vtk-asan` always uses the test build. VTK 9.2 is ParaView's (docs/ARCHITECTURE.md,
+# Machines). 2 cores: -j2.
+RELEASE_LIB := target/release/libferrovol.so
+TEST_LIB := target/debug/libferrovol.so
+FFI_RELEASE := $(CARGO) build --release --locked -p ferrovol-ffi
+FFI_TEST := $(CARGO) build --locked --workspace --all-targets
+# $(call cmake_build,SOURCE,BUILD-DIR,LIBRARY,EXTRA CMAKE ARGUMENTS)
+cmake_build = cmake -G Ninja -S $(1) -B $(2) -DFERROVOL_LIBRARY=$(CURDIR)/$(3) $(4) >/dev/null && \
+  ninja -C $(2) -j2
+
 VTK_BUILD := build/vtk
+define VTK_MODULE
+$(call cmake_build,vtk_plugin,$(VTK_BUILD),$(1),-DPython3_EXECUTABLE=/usr/bin/python3)
+cp $(VTK_BUILD)/env.sh build/env.sh
+$(PV_ENV_HOOK)
+endef
 vtk: deps
-	$(CARGO) build --release --locked -p ferrovol-ffi
-	cmake -G Ninja -S vtk_plugin -B $(VTK_BUILD) -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-	ninja -C $(VTK_BUILD) -j2
-	cp $(VTK_BUILD)/env.sh build/env.sh
-	$(PV_ENV_HOOK)
+	$(FFI_RELEASE)
+	$(call VTK_MODULE,$(RELEASE_LIB))
 	@echo "VTK module built: . build/env.sh && /usr/bin/python3 -c 'import vtk, ferrovol'"
+test-build-vtk:
+	$(call VTK_MODULE,$(TEST_LIB))
 
 # C++ and Python tests of vtkFerroVolumeMapper in a private Xvfb (images and measured
 # figures land in build/vtk/test-images).
+VTK_CTEST = env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(1) --output-on-failure -j1
 vtk-test: vtk
 	@scripts/fetch-data.sh >/dev/null || echo "vtk-test: no build/data/cranium.vti; the examples render a synthetic volume"
-	env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(VTK_BUILD) --output-on-failure -j1
+	$(call VTK_CTEST,$(VTK_BUILD))
+test-vtk:
+	$(call VTK_CTEST,$(VTK_BUILD))
 
 # The VTK module, its wrapping, examples and C++ tests built with AddressSanitizer and UBSan
-# (FERROVOL_SANITIZE, vtk_plugin/CMakeLists.txt), and the CTest suite run on them (the Python
-# tests preload the runtimes); the soak is left to `make soak`.
+# (FERROVOL_SANITIZE, vtk_plugin/CMakeLists.txt), and the tests only ASan can add to
+# `make vtk-test` run on them (the label `asan` in vtk_plugin/tests/CMakeLists.txt: the C++
+# units, every C ABI call the mapper makes, resource release, bad input); the Python tests
+# preload the runtimes.
 VTK_ASAN_BUILD := build/vtk-asan
+VTK_ASAN = $(call cmake_build,vtk_plugin,$(VTK_ASAN_BUILD),$(TEST_LIB),-DPython3_EXECUTABLE=/usr/bin/python3 -DFERROVOL_SANITIZE=ON)
+VTK_ASAN_CTEST = $(call VTK_CTEST,$(VTK_ASAN_BUILD)) -L asan
 vtk-asan: deps
-	$(CARGO) build --release --locked -p ferrovol-ffi
-	cmake -G Ninja -S vtk_plugin -B $(VTK_ASAN_BUILD) -DPython3_EXECUTABLE=/usr/bin/python3 \
-	  -DFERROVOL_SANITIZE=ON >/dev/null
-	ninja -C $(VTK_ASAN_BUILD) -j2
-	env -u DISPLAY scripts/with-xvfb.sh ctest --test-dir $(VTK_ASAN_BUILD) --output-on-failure -j1 \
-	  -E '^python.soak$$'
+	$(FFI_TEST)
+	$(VTK_ASAN)
+	$(VTK_ASAN_CTEST)
+test-build-vtk-asan:
+	$(VTK_ASAN)
+test-vtk-asan:
+	$(VTK_ASAN_CTEST)
 
 # The ParaView plugin builds vtkFerroVolumeMapper from vtk_plugin/FerroVolume itself (it
 # does not need build/vtk) and writes build/paraview/env.sh (PV_PLUGIN_PATH); build/env.sh
@@ -81,20 +111,27 @@ define PV_ENV_HOOK
 @grep -qF '$(PV_BUILD)/env.sh' build/env.sh || \
   echo 'if [ -f "$(CURDIR)/$(PV_BUILD)/env.sh" ]; then . "$(CURDIR)/$(PV_BUILD)/env.sh"; fi' >> build/env.sh
 endef
+define PV_PLUGIN
+$(call cmake_build,paraview,$(PV_BUILD),$(1),-Wno-deprecated)
+$(PV_ENV_HOOK)
+endef
 paraview: deps
-	$(CARGO) build --release --locked -p ferrovol-ffi
-	cmake -G Ninja -S paraview -B $(PV_BUILD) -Wno-deprecated >/dev/null
-	ninja -C $(PV_BUILD) -j2
-	$(PV_ENV_HOOK)
+	$(FFI_RELEASE)
+	$(call PV_PLUGIN,$(RELEASE_LIB))
 	@echo "ParaView plugin built: . build/env.sh && pvpython   (\"Ferrovol Volume\" is loaded)"
+test-build-paraview:
+	$(call PV_PLUGIN,$(TEST_LIB))
 
 # pvbatch/pvpython/paraview tests in a private Xvfb (1920x1080 screen); build/data/cranium.vti
 # is used when scripts/fetch-data.sh has made it (the cranium test says SKIP otherwise).
+PV_TESTS = env -u DISPLAY scripts/with-xvfb.sh paraview/tests/run-all.sh $(1)
 paraview-test: paraview
-	env -u DISPLAY scripts/with-xvfb.sh paraview/tests/run-all.sh 2
+	$(call PV_TESTS,2)
+test-paraview:
+	$(call PV_TESTS,2)
 
 paraview-regression: paraview
-	env -u DISPLAY scripts/with-xvfb.sh paraview/tests/run-all.sh 4
+	$(call PV_TESTS,4)
 
 demo: build
 	$(FERROVOL) render --demo wavelet --shade --size 640x640 --azimuth 30 --elevation 20 --out build/demo.png
@@ -108,17 +145,30 @@ lint: deps
 	python3 scripts/check-core-layers.py
 	python3 scripts/check-architecture-doc.py
 
-# The C ABI tests load and link target/debug/libferrovol.so, which `cargo test` alone does
-# not build (it links tests against the rlib).
-test: lint
-	$(CARGO) build --locked -p ferrovol-ffi
+# Everything CI runs (scripts/test.sh: the builds, then the suites in two lanes, each
+# suite's log in build/test-logs and its wall time; `scripts/test.sh NAME...` runs some).
+test: deps
+	@bash scripts/test.sh
+
+# For contributors, before a commit: formatting, clippy and the Rust tests on lavapipe.
+check: deps
+	$(CARGO) fmt --all --check
+	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
 	$(CARGO) test --locked --workspace
-	$(MAKE) sanitize
-	$(MAKE) fuzz-smoke
-	$(MAKE) vtk-test
-	$(MAKE) vtk-asan
-	$(MAKE) paraview-test
-	$(MAKE) regression-quick
+
+# The suites of `make test` one by one, without the builds they need (scripts/test.sh runs
+# those first). The Rust tests' binaries and the test build of the C ABI library (the C ABI
+# tests load and link target/debug/libferrovol.so, which `cargo test` alone does not build),
+# and the real volumes of build/data (scripts/fetch-data.sh) for the suites after it.
+test-build-rust:
+	@scripts/fetch-data.sh >/dev/null || echo "test-build-rust: some of build/data is missing; those tests skip"
+	$(FFI_TEST)
+test-rust:
+	$(CARGO) test --locked --workspace
+test-sanitize:
+	scripts/sanitize.sh
+test-regression-quick:
+	$(REGRESSION) --quick
 
 # The readers' fuzz targets (fuzz/, docs/FUZZING.md) built with coverage and run by AFL++
 # for 20 s each on the committed corpus: fails on a crash, a hang or a heap bound exceeded.

@@ -6,7 +6,8 @@
 #   tsan      thread_stress.c built with -fsanitize=thread, 4 threads x 64 frames
 #   valgrind  render_demo.c (32x32 image of an 8^3 volume) under memcheck, leaks included
 # Usage: scripts/sanitize.sh [asan|tsan|valgrind]...   (all three without arguments)
-# libferrovol.so is the debug build (`cargo build -p ferrovol-ffi`): Rust code is not
+# libferrovol.so is the test build (`cargo build --workspace --all-targets`, as `make test`
+# builds it, with the tests' features, so that nothing is compiled twice): Rust code is not
 # instrumented (stable rustc has no -Zsanitizer); ASan/LSan still replace the allocator
 # the Rust side uses, so leaked handles and heap misuse from C are seen.
 set -euo pipefail
@@ -27,7 +28,7 @@ mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}"
 export __EGL_VENDOR_LIBRARY_FILENAMES="${__EGL_VENDOR_LIBRARY_FILENAMES:-/usr/share/glvnd/egl_vendor.d/50_mesa.json}"
 
-${CARGO:-cargo} build --locked -p ferrovol-ffi
+${CARGO:-cargo} build --locked --workspace --all-targets
 [ -f "$LIB/libferrovol.so" ] || { echo "sanitize: $LIB/libferrovol.so is missing" >&2; exit 1; }
 
 WARN=(-Wall -Wextra -Werror -pedantic -g -O1 -fno-omit-frame-pointer -I "$ROOT/ffi/include")

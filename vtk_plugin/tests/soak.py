@@ -1,12 +1,12 @@
 """Soak test of vtkFerroVolumeMapper: thousands of renders in one VTK window while the camera,
 transfer function, blend mode, shading, window size, input data (scalar type, size,
 components) and output path change, with the volume's ReleaseGraphicsResources (what VTK
-calls when a prop leaves a window) every 500 renders. Fails on a VTK error, on an image
-with nothing drawn (MinIP excepted: its transfer functions make the lowest values
-transparent), and when resident memory, ferrovol's device memory or its GPU objects grow:
-each is compared at the same point of the schedule (the data, output path and releases
-repeat every 1000 renders), the highest value over renders 1001-2000 against the highest
-over the last 1000.
+calls when a prop leaves a window) twice a period. Fails on a VTK error, on an image with
+nothing drawn (MinIP excepted: its transfer functions make the lowest values transparent),
+and when resident memory, ferrovol's device memory or its GPU objects grow: each is
+compared at the same point of the schedule (the data, output path and releases repeat
+every period, 1000 renders by default), the highest value over the second period against
+the highest over the last.
 
     . build/env.sh && scripts/with-xvfb.sh /usr/bin/python3 vtk_plugin/tests/soak.py \\
         --renders 10000 --csv build/soak/soak.csv --svg docs/img/soak-memory.svg
@@ -24,10 +24,9 @@ from vtk.util.numpy_support import vtk_to_numpy
 import ferrovol
 from fvtest import Errors, image_from_array, new_window
 
-PERIOD = 1000
-DATA_EVERY = 200
-RELEASE_EVERY = 500
-PATH_EVERY = 250
+# Within a period of P renders: a new input every P/5 (the five of datasets()), the volume's
+# graphics resources released every P/2, the output path switched every P/4.
+DATA_PARTS, RELEASE_PARTS, PATH_PARTS = 5, 2, 4
 BLEND_MODES = ["Composite", "MaximumIntensity", "MinimumIntensity", "AverageIntensity",
                "Additive", "IsoSurface"]
 SIZES = [(96, 96), (128, 100), (150, 120)]
@@ -132,13 +131,21 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--renders", type=int, default=10000,
                     help="renders (a multiple of 1000, at least 3000)")
+    ap.add_argument("--period", type=int, default=1000,
+                    help="renders in one period of the schedule (a multiple of 20)")
     ap.add_argument("--max-growth", type=float, default=0.05,
                     help="largest allowed growth of resident and device memory")
     ap.add_argument("--csv", help="write render, resident bytes, device bytes, objects here")
     ap.add_argument("--svg", help="write the memory curve as an SVG plot here")
     args = ap.parse_args()
+    PERIOD = args.period
+    if PERIOD < 20 or PERIOD % 20:
+        ap.error("--period must be a positive multiple of 20")
     if args.renders < 3 * PERIOD or args.renders % PERIOD:
         ap.error(f"--renders must be a multiple of {PERIOD}, at least {3 * PERIOD}")
+    DATA_EVERY = PERIOD // DATA_PARTS
+    RELEASE_EVERY = PERIOD // RELEASE_PARTS
+    PATH_EVERY = PERIOD // PATH_PARTS
 
     output = vtk.vtkStringOutputWindow()
     vtk.vtkOutputWindow.SetInstance(output)

@@ -45,7 +45,8 @@ impl DeviceMemory {
     }
 }
 
-/// An adapter, a device and its queue. `Send + Sync`; clones share the same device.
+/// An adapter, a device and its queue, and the shaders compiled on it. `Send + Sync`; clones
+/// share the same device and the same compiled shaders.
 #[derive(Clone)]
 pub struct Context {
     pub adapter: wgpu::Adapter,
@@ -57,6 +58,8 @@ pub struct Context {
     /// The device memory (bytes) allocations may reach before they fail as out of memory;
     /// `u64::MAX` for no cap ([`Context::limit_device_memory`]).
     memory_cap: std::sync::Arc<std::sync::atomic::AtomicU64>,
+    /// The shader modules and compute pipelines of every renderer on this device.
+    pub(crate) shaders: std::sync::Arc<super::pipeline::ShaderStore>,
 }
 
 /// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and
@@ -191,6 +194,7 @@ impl Context {
             info,
             lost,
             memory_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
+            shaders: Default::default(),
         })
     }
 

@@ -1,10 +1,40 @@
-//! Shader modules and compute pipelines: the one way ferrovol creates them, and one cache of
-//! pipelines specialised by pipeline-overridable constants.
+//! Shader modules and compute pipelines: the one way ferrovol creates them, kept per device
+//! ([`ShaderStore`]) and specialised by pipeline-overridable constants.
 
 use super::Context;
 use crate::error::Result;
 use std::collections::HashMap;
 use std::hash::Hash;
+use std::sync::{Mutex, MutexGuard};
+
+/// The compiled shaders of one device, shared by every renderer on it (a [`Context`] and its
+/// clones hold one): shader modules by pass file, compute pipelines by file, entry point and
+/// override constants. Compiling is most of a new renderer's first frame, so a renderer made
+/// on a device that already drew (another volume in the window, or the same one after its
+/// graphics resources were released) compiles only what is new to the device. A cached
+/// pipeline keeps the layout of the renderer that compiled it; another renderer's bind groups
+/// fit it because a pass builds its bind group layouts from the context alone, and wgpu gives
+/// layouts of equal entries one identity on a device.
+#[derive(Default)]
+pub(crate) struct ShaderStore {
+    modules: Mutex<HashMap<&'static str, wgpu::ShaderModule>>,
+    pipelines: Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>,
+}
+
+/// A compiled pipeline's identity: its pass file, entry point and override constants (their
+/// values' bits).
+#[derive(PartialEq, Eq, Hash)]
+struct PipelineKey {
+    file: &'static str,
+    entry: &'static str,
+    constants: Vec<(&'static str, u64)>,
+}
+
+/// The map behind `m`, also after a thread panicked while holding it (what it held is whole:
+/// entries are inserted complete).
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 /// The shader module of pass `file` (composed by [`super::shaders::compose`]), created
 /// without wgpu's injected bounds checks and loop counters: those cost a clamp per access
@@ -16,8 +46,12 @@ use std::hash::Hash;
 /// clamped to MAX_ISO, G-buffer layers below the layer count the textures were made with,
 /// the cone table indexed modulo its length), and every loop advances toward a bound (ray
 /// steps, bisection steps, samples, lights, components, bounces).
-pub(crate) fn shader_module(ctx: &Context, file: &str) -> Result<wgpu::ShaderModule> {
-    ctx.checked(&format!("compiling shader {file}"), || {
+/// The device compiles each file once ([`ShaderStore`]).
+pub(crate) fn shader_module(ctx: &Context, file: &'static str) -> Result<wgpu::ShaderModule> {
+    if let Some(m) = lock(&ctx.shaders.modules).get(file) {
+        return Ok(m.clone());
+    }
+    let module = ctx.checked(&format!("compiling shader {file}"), || {
         let desc = wgpu::ShaderModuleDescriptor {
             label: Some(file),
             source: wgpu::ShaderSource::Wgsl(super::shaders::compose(file).into()),
@@ -27,7 +61,11 @@ pub(crate) fn shader_module(ctx: &Context, file: &str) -> Result<wgpu::ShaderMod
             ctx.device
                 .create_shader_module_trusted(desc, wgpu::ShaderRuntimeChecks::unchecked())
         }
-    })
+    })?;
+    Ok(lock(&ctx.shaders.modules)
+        .entry(file)
+        .or_insert(module)
+        .clone())
 }
 
 /// A pipeline layout of `groups` bind group layouts.
@@ -45,21 +83,31 @@ pub(crate) fn pipeline_layout(
         })
 }
 
-/// The compute pipeline of `module`'s `entry` with these override constants.
+/// The compute pipeline of pass `file`'s `entry` with these override constants, compiled with
+/// `layout` the first time the device needs it ([`ShaderStore`]).
 pub(crate) fn compute_pipeline(
     ctx: &Context,
     label: &str,
     layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    constants: &[(&str, f64)],
+    file: &'static str,
+    entry: &'static str,
+    constants: &[(&'static str, f64)],
 ) -> Result<wgpu::ComputePipeline> {
-    ctx.checked(&format!("creating the {label} pipeline"), || {
+    let key = PipelineKey {
+        file,
+        entry,
+        constants: constants.iter().map(|&(n, v)| (n, v.to_bits())).collect(),
+    };
+    if let Some(p) = lock(&ctx.shaders.pipelines).get(&key) {
+        return Ok(p.clone());
+    }
+    let module = shader_module(ctx, file)?;
+    let pipeline = ctx.checked(&format!("creating the {label} pipeline"), || {
         ctx.device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: Some(layout),
-                module,
+                module: &module,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants,
@@ -68,7 +116,11 @@ pub(crate) fn compute_pipeline(
                 },
                 cache: None,
             })
-    })
+    })?;
+    Ok(lock(&ctx.shaders.pipelines)
+        .entry(key)
+        .or_insert(pipeline)
+        .clone())
 }
 
 /// The override constants of one specialisation of a pass (its `override` declarations).
@@ -119,13 +171,13 @@ macro_rules! pipeline_variant {
 }
 pub(crate) use pipeline_variant;
 
-/// A pass's shader module and pipeline layout with its pipelines, one per variant, created
-/// on first use.
+/// A pass's pipelines, one per variant, compiled on the device's first use of each
+/// ([`ShaderStore`]).
 pub(crate) struct PipelineCache<K> {
+    file: &'static str,
     label: &'static str,
-    module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
-    pipelines: HashMap<K, wgpu::ComputePipeline>,
+    variant: std::marker::PhantomData<K>,
 }
 
 impl<K: Variant> PipelineCache<K> {
@@ -135,29 +187,26 @@ impl<K: Variant> PipelineCache<K> {
         label: &'static str,
         groups: &[&wgpu::BindGroupLayout],
     ) -> Result<PipelineCache<K>> {
+        // compiled here, so that a broken shader fails the pass's creation
+        shader_module(ctx, file)?;
         Ok(PipelineCache {
+            file,
             label,
-            module: shader_module(ctx, file)?,
             layout: pipeline_layout(ctx, file, groups),
-            pipelines: HashMap::new(),
+            variant: std::marker::PhantomData,
         })
     }
 
     /// The pipeline of variant `v`.
-    pub fn get(&mut self, ctx: &Context, v: K) -> Result<wgpu::ComputePipeline> {
-        if let Some(p) = self.pipelines.get(&v) {
-            return Ok(p.clone());
-        }
-        let p = compute_pipeline(
+    pub fn get(&self, ctx: &Context, v: K) -> Result<wgpu::ComputePipeline> {
+        compute_pipeline(
             ctx,
             self.label,
             &self.layout,
-            &self.module,
+            self.file,
             "main",
             &v.constants(),
-        )?;
-        self.pipelines.insert(v, p.clone());
-        Ok(p)
+        )
     }
 }
 
@@ -165,7 +214,7 @@ impl<K: Variant> PipelineCache<K> {
 /// compute pipeline (the small passes: resolve, gradient build, denoiser, sampling checks).
 pub(crate) fn single_group_pipeline(
     ctx: &Context,
-    file: &str,
+    file: &'static str,
     label: &str,
     entries: &[wgpu::BindGroupLayoutEntry],
 ) -> Result<(wgpu::BindGroupLayout, wgpu::ComputePipeline)> {
@@ -176,8 +225,7 @@ pub(crate) fn single_group_pipeline(
             entries,
         });
     let layout = pipeline_layout(ctx, file, &[&bgl]);
-    let module = shader_module(ctx, file)?;
-    let pipeline = compute_pipeline(ctx, label, &layout, &module, "main", &[])?;
+    let pipeline = compute_pipeline(ctx, label, &layout, file, "main", &[])?;
     Ok((bgl, pipeline))
 }
 

@@ -7,7 +7,7 @@ use crate::gpu::binding::{
     bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::uniform_buffer;
-use crate::gpu::pipeline::{compute_pipeline, encode_single_group, pipeline_layout, shader_module};
+use crate::gpu::pipeline::{compute_pipeline, encode_single_group, pipeline_layout};
 use crate::gpu::readback::read_texture_layer;
 use crate::gpu::texture::texture_2d;
 use crate::gpu::uniforms::{EnvUniforms, ENV_EQUIRECT, ENV_SKY};
@@ -45,7 +45,6 @@ const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 impl EnvPipelines {
     pub fn new(ctx: &Context) -> Result<EnvPipelines> {
         let d = &ctx.device;
-        let module = shader_module(ctx, "environment.wgsl")?;
         let bgl = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
@@ -79,13 +78,13 @@ impl EnvPipelines {
                 sampler_entry(6),
             ],
         );
-        let pipeline = |entry: &str, layout: &wgpu::BindGroupLayout| {
+        let pipeline = |entry: &'static str, layout: &wgpu::BindGroupLayout| {
             let pl = pipeline_layout(ctx, entry, &[layout]);
             compute_pipeline(
                 ctx,
                 &format!("environment {entry}"),
                 &pl,
-                &module,
+                "environment.wgsl",
                 entry,
                 &[],
             )

@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# `make test`: every check CI runs, timed suite by suite (README.md, "Tests").
+#
+# First the builds, one after another, each using both cores (cargo, ninja -j2). Then the
+# suites in two lanes side by side: most of a suite's time is one process (a Python or
+# pvbatch test, afl-fuzz, valgrind), so two lanes keep both cores busy. Each suite's output
+# goes to build/test-logs/NAME.log and is printed whole when the suite ends, under a line
+# with its wall time; a suite whose build failed is not run. The last line counts them.
+#
+#   scripts/test.sh            everything (what `make test` runs)
+#   scripts/test.sh NAME...    only those suites (and the builds they need)
+set -uo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+LOGS=$ROOT/build/test-logs
+mkdir -p "$LOGS"
+rm -f "$LOGS"/*.log "$LOGS"/*.status
+MAKE=${MAKE:-make}
+START=$SECONDS
+# Mesa's shader cache in this tree: what the first suites compile, the later ones reuse,
+# and a fresh clone starts cold whatever this machine ran before.
+export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
+
+# The suites, in the order their results are listed; build-* suites are builds.
+SUITES=(lint build-rust build-vtk
+        rust-tests sanitize fuzz-smoke build-paraview paraview
+        vtk build-vtk-asan vtk-asan regression-quick)
+# What each suite needs to have passed first.
+declare -A NEEDS=(
+  [build-vtk]=build-rust
+  [rust-tests]=build-rust [sanitize]=build-rust
+  [build-paraview]=build-rust [paraview]=build-paraview
+  [vtk]=build-vtk [build-vtk-asan]=build-rust [vtk-asan]=build-vtk-asan
+  [regression-quick]=build-vtk
+)
+# What each suite runs: a make target (Makefile), without the builds it depends on.
+declare -A CMD=(
+  [lint]=lint
+  [build-rust]=test-build-rust
+  [build-vtk]=test-build-vtk
+  [rust-tests]=test-rust
+  [sanitize]=test-sanitize
+  [fuzz-smoke]=fuzz-smoke
+  [build-paraview]=test-build-paraview
+  [paraview]=test-paraview
+  [vtk]=test-vtk
+  [build-vtk-asan]=test-build-vtk-asan
+  [vtk-asan]=test-vtk-asan
+  [regression-quick]=test-regression-quick
+)
+
+declare -A WANTED=()
+if [ $# -gt 0 ]; then
+  add() {
+    [ -n "${CMD[$1]:-}" ] || { echo "test.sh: unknown suite '$1'; suites: ${SUITES[*]}" >&2; exit 2; }
+    WANTED[$1]=1
+    local d
+    for d in ${NEEDS[$1]:-}; do add "$d"; done
+  }
+  for s in "$@"; do add "$s"; done
+else
+  for s in "${SUITES[@]}"; do WANTED[$s]=1; done
+fi
+
+# suite NAME: runs it unless unwanted; its result goes to NAME.status (ok, FAILED, skipped).
+suite() {
+  local name=$1 log=$LOGS/$1.log t0=$SECONDS rc=0 d
+  [ -n "${WANTED[$name]:-}" ] || return 0
+  for d in ${NEEDS[$name]:-}; do
+    if [ "$(cat "$LOGS/$d.status" 2>/dev/null)" != ok ]; then
+      echo skipped >"$LOGS/$name.status"
+      report "$name" "skipped ($d did not pass)" ""
+      return 0
+    fi
+  done
+  $MAKE --no-print-directory "${CMD[$name]}" >"$log" 2>&1 </dev/null || rc=$?
+  local took=$((SECONDS - t0))
+  if [ $rc -eq 0 ]; then
+    echo ok >"$LOGS/$name.status"
+    report "$name" "ok in ${took} s" "$log"
+  else
+    echo FAILED >"$LOGS/$name.status"
+    report "$name" "FAILED (exit $rc) after ${took} s; log: build/test-logs/$name.log" "$log"
+  fi
+  echo "$took" >"$LOGS/$name.seconds"
+}
+
+# report NAME RESULT LOG: the suite's log then its result line, printed in one piece even
+# when the other lane finishes at the same moment.
+report() {
+  {
+    flock 9
+    if [ -n "$3" ]; then
+      printf '\n======== %s\n' "$1"
+      cat "$3"
+    fi
+    printf -- '-------- %s: %s (at %d s)\n' "$1" "$2" $((SECONDS - START))
+  } 9>"$LOGS/.print.lock"
+}
+
+echo "make test: logs in build/test-logs; the builds first, then two lanes of suites"
+suite lint
+suite build-rust
+suite build-vtk
+# Lane 1: the Rust tests, the C ABI under sanitizers, fuzzing, the ParaView plugin.
+(
+  suite rust-tests
+  suite sanitize
+  suite fuzz-smoke
+  suite build-paraview
+  suite paraview
+) &
+lane1=$!
+# Lane 2: the VTK module's suite, its ASan build and suite, the quick regression.
+(
+  suite vtk
+  suite build-vtk-asan
+  suite vtk-asan
+  suite regression-quick
+) &
+lane2=$!
+wait $lane1 $lane2
+
+passed=0 failed=0 names=()
+echo
+echo "make test: wall time per suite"
+for s in "${SUITES[@]}"; do
+  [ -n "${WANTED[$s]:-}" ] || continue
+  st=$(cat "$LOGS/$s.status" 2>/dev/null || echo "not run")
+  secs=$(cat "$LOGS/$s.seconds" 2>/dev/null || echo -)
+  printf '  %-18s %-8s %6s s\n' "$s" "$st" "$secs"
+  if [ "$st" = ok ]; then passed=$((passed + 1)); else failed=$((failed + 1)); names+=("$s"); fi
+done
+total=$((SECONDS - START))
+printf '  %-18s %-8s %6s s (%d min %02d s)\n' total "" "$total" $((total / 60)) $((total % 60))
+[ $failed -eq 0 ] || echo "make test: not passed: ${names[*]}"
+echo "suites: $passed passed, $failed failed"
+[ $failed -eq 0 ]
