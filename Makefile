@@ -22,11 +22,11 @@
 #   make fuzz-smoke  every fuzz target of the readers 20 s on its corpus (docs/FUZZING.md);
 #               `make test` runs it
 #   make soak   10 000 renders of vtkFerroVolumeMapper while everything changes: memory flat
-#               (a 3000-render version is in make vtk-test); plot: docs/img/soak-memory.svg
+#               (4 periods of 200 renders are in make vtk-test); plot: docs/img/soak-memory.svg
 #   make sanitize  the C ABI's C/C++ test programs under ASan+UBSan+LSan and TSan, the C
 #               demo under valgrind (docs/RELIABILITY.md); `make test` runs it
-#   make vtk-asan  the VTK module built with ASan+UBSan (build/vtk-asan) and its CTest suite
-#               (all but the soak) run on it; `make test` runs it
+#   make vtk-asan  the VTK module built with ASan+UBSan (build/vtk-asan) and the tests of its
+#               CTest suite that only ASan adds to (label asan); `make test` runs it
 SHELL := /bin/bash
 CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
@@ -150,11 +150,12 @@ lint: deps
 test: deps
 	@bash scripts/test.sh
 
-# For contributors, before a commit: formatting, clippy and the Rust tests on lavapipe.
+# For contributors, before a commit: formatting, clippy and the Rust tests on lavapipe (the
+# test binaries two at a time, scripts/rust-tests.sh).
 check: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
-	$(CARGO) test --locked --workspace
+	scripts/rust-tests.sh
 
 # The suites of `make test` one by one, without the builds they need (scripts/test.sh runs
 # those first). The Rust tests' binaries and the test build of the C ABI library (the C ABI
@@ -164,7 +165,7 @@ test-build-rust:
 	@scripts/fetch-data.sh >/dev/null || echo "test-build-rust: some of build/data is missing; those tests skip"
 	$(FFI_TEST)
 test-rust:
-	$(CARGO) test --locked --workspace
+	scripts/rust-tests.sh
 test-sanitize:
 	scripts/sanitize.sh
 test-regression-quick:

@@ -23,8 +23,8 @@ export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
 SUITES=(lint build-rust build-vtk
-        rust-tests sanitize fuzz-smoke build-paraview paraview
-        vtk build-vtk-asan vtk-asan regression-quick)
+        rust-tests fuzz-smoke build-paraview paraview
+        vtk build-vtk-asan vtk-asan regression-quick sanitize)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
   [build-vtk]=build-rust
@@ -102,21 +102,22 @@ echo "make test: logs in build/test-logs; the builds first, then two lanes of su
 suite lint
 suite build-rust
 suite build-vtk
-# Lane 1: the Rust tests, the C ABI under sanitizers, fuzzing, the ParaView plugin.
+# Lane 1: the Rust tests, fuzzing, the ParaView plugin.
 (
   suite rust-tests
-  suite sanitize
   suite fuzz-smoke
   suite build-paraview
   suite paraview
 ) &
 lane1=$!
-# Lane 2: the VTK module's suite, its ASan build and suite, the quick regression.
+# Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the C
+# ABI under sanitizers.
 (
   suite vtk
   suite build-vtk-asan
   suite vtk-asan
   suite regression-quick
+  suite sanitize
 ) &
 lane2=$!
 wait $lane1 $lane2

@@ -4,6 +4,8 @@
 //! (case-insensitive, e.g. `llvmpipe` or `nvidia`).
 
 use crate::error::{Error, Result};
+use std::collections::HashMap;
+use std::sync::{Mutex, MutexGuard};
 
 /// What the renderer needs to know about the device it runs on.
 #[derive(Clone, Debug)]
@@ -45,6 +47,35 @@ impl DeviceMemory {
     }
 }
 
+/// The compiled shaders of one device, shared by every renderer on it (a [`Context`] and its
+/// clones hold one; the pipeline module fills it): shader modules by pass file, compute
+/// pipelines by file, entry point and override constants. Compiling is most of a new renderer's first frame, so a renderer made
+/// on a device that already drew (another volume in the window, or the same one after its
+/// graphics resources were released) compiles only what is new to the device. A cached
+/// pipeline keeps the layout of the renderer that compiled it; another renderer's bind groups
+/// fit it because a pass builds its bind group layouts from the context alone, and wgpu gives
+/// layouts of equal entries one identity on a device.
+#[derive(Default)]
+pub(crate) struct ShaderStore {
+    pub(crate) modules: Mutex<HashMap<&'static str, wgpu::ShaderModule>>,
+    pub(crate) pipelines: Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>,
+}
+
+/// A compiled pipeline's identity: its pass file, entry point and override constants (their
+/// values' bits).
+#[derive(PartialEq, Eq, Hash)]
+pub(crate) struct PipelineKey {
+    pub(crate) file: &'static str,
+    pub(crate) entry: &'static str,
+    pub(crate) constants: Vec<(&'static str, u64)>,
+}
+
+/// The map behind `m`, also after a thread panicked while holding it (what it held is whole:
+/// entries are inserted complete).
+pub(crate) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// An adapter, a device and its queue, and the shaders compiled on it. `Send + Sync`; clones
 /// share the same device and the same compiled shaders.
 #[derive(Clone)]
@@ -59,7 +90,7 @@ pub struct Context {
     /// `u64::MAX` for no cap ([`Context::limit_device_memory`]).
     memory_cap: std::sync::Arc<std::sync::atomic::AtomicU64>,
     /// The shader modules and compute pipelines of every renderer on this device.
-    pub(crate) shaders: std::sync::Arc<super::pipeline::ShaderStore>,
+    pub(crate) shaders: std::sync::Arc<ShaderStore>,
 }
 
 /// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and

@@ -1,40 +1,10 @@
 //! Shader modules and compute pipelines: the one way ferrovol creates them, kept per device
-//! ([`ShaderStore`]) and specialised by pipeline-overridable constants.
+//! ([`super::context::ShaderStore`]) and specialised by pipeline-overridable constants.
 
+use super::context::{lock, PipelineKey};
 use super::Context;
 use crate::error::Result;
-use std::collections::HashMap;
 use std::hash::Hash;
-use std::sync::{Mutex, MutexGuard};
-
-/// The compiled shaders of one device, shared by every renderer on it (a [`Context`] and its
-/// clones hold one): shader modules by pass file, compute pipelines by file, entry point and
-/// override constants. Compiling is most of a new renderer's first frame, so a renderer made
-/// on a device that already drew (another volume in the window, or the same one after its
-/// graphics resources were released) compiles only what is new to the device. A cached
-/// pipeline keeps the layout of the renderer that compiled it; another renderer's bind groups
-/// fit it because a pass builds its bind group layouts from the context alone, and wgpu gives
-/// layouts of equal entries one identity on a device.
-#[derive(Default)]
-pub(crate) struct ShaderStore {
-    modules: Mutex<HashMap<&'static str, wgpu::ShaderModule>>,
-    pipelines: Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>,
-}
-
-/// A compiled pipeline's identity: its pass file, entry point and override constants (their
-/// values' bits).
-#[derive(PartialEq, Eq, Hash)]
-struct PipelineKey {
-    file: &'static str,
-    entry: &'static str,
-    constants: Vec<(&'static str, u64)>,
-}
-
-/// The map behind `m`, also after a thread panicked while holding it (what it held is whole:
-/// entries are inserted complete).
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 /// The shader module of pass `file` (composed by [`super::shaders::compose`]), created
 /// without wgpu's injected bounds checks and loop counters: those cost a clamp per access
@@ -46,7 +16,7 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 /// clamped to MAX_ISO, G-buffer layers below the layer count the textures were made with,
 /// the cone table indexed modulo its length), and every loop advances toward a bound (ray
 /// steps, bisection steps, samples, lights, components, bounces).
-/// The device compiles each file once ([`ShaderStore`]).
+/// The device compiles each file once ([`super::context::ShaderStore`]).
 pub(crate) fn shader_module(ctx: &Context, file: &'static str) -> Result<wgpu::ShaderModule> {
     if let Some(m) = lock(&ctx.shaders.modules).get(file) {
         return Ok(m.clone());
@@ -84,7 +54,7 @@ pub(crate) fn pipeline_layout(
 }
 
 /// The compute pipeline of pass `file`'s `entry` with these override constants, compiled with
-/// `layout` the first time the device needs it ([`ShaderStore`]).
+/// `layout` the first time the device needs it ([`super::context::ShaderStore`]).
 pub(crate) fn compute_pipeline(
     ctx: &Context,
     label: &str,
@@ -172,7 +142,7 @@ macro_rules! pipeline_variant {
 pub(crate) use pipeline_variant;
 
 /// A pass's pipelines, one per variant, compiled on the device's first use of each
-/// ([`ShaderStore`]).
+/// ([`super::context::ShaderStore`]).
 pub(crate) struct PipelineCache<K> {
     file: &'static str,
     label: &'static str,
