@@ -23,7 +23,7 @@ export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
 SUITES=(lint build-rust build-vtk
-        rust-tests fuzz-smoke build-paraview paraview
+        rust-tests lint-fuzz fuzz-smoke build-paraview paraview
         vtk build-vtk-asan vtk-asan regression-quick sanitize)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
@@ -35,7 +35,8 @@ declare -A NEEDS=(
 )
 # What each suite runs: a make target (Makefile), without the builds it depends on.
 declare -A CMD=(
-  [lint]=lint
+  [lint]=lint-workspace
+  [lint-fuzz]=lint-fuzz
   [build-rust]=test-build-rust
   [build-vtk]=test-build-vtk
   [rust-tests]=test-rust
@@ -102,9 +103,10 @@ echo "make test: logs in build/test-logs; the builds first, then two lanes of su
 suite lint
 suite build-rust
 suite build-vtk
-# Lane 1: the Rust tests, fuzzing, the ParaView plugin.
+# Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the ParaView plugin.
 (
   suite rust-tests
+  suite lint-fuzz
   suite fuzz-smoke
   suite build-paraview
   suite paraview
