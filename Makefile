@@ -42,7 +42,6 @@ deps:
 	@mkdir -p -m 700 $(XDG_RUNTIME_DIR) build
 
 build: deps
-	$(CARGO) build --release --locked -p ferrovol-cli
 	$(MAKE) vtk
 
 # The C ABI library the VTK module and the ParaView plugin link. `make vtk` and `make
@@ -50,12 +49,13 @@ build: deps
 # the crates as the Rust tests compile them, debug assertions on, with the test-only
 # fv_test_panic export), so that one Rust build serves every suite. FFI_TEST builds the
 # workspace's tests with it: the library alone (-p ferrovol-ffi) would resolve its
-# dependencies' features without the tests' and compile them all a second time. `make
+# dependencies' features without the tests' and compile them all a second time; for the
+# same reason FFI_RELEASE builds the `ferrovol` command with the release library. `make
 # vtk-asan` always uses the test build. VTK 9.2 is ParaView's (docs/ARCHITECTURE.md,
 # Machines). 2 cores: -j2.
 RELEASE_LIB := target/release/libferrovol.so
 TEST_LIB := target/debug/libferrovol.so
-FFI_RELEASE := $(CARGO) build --release --locked -p ferrovol-ffi
+FFI_RELEASE := $(CARGO) build --release --locked -p ferrovol-ffi -p ferrovol-cli
 FFI_TEST := $(CARGO) build --locked --workspace --all-targets
 # $(call cmake_build,SOURCE,BUILD-DIR,LIBRARY,EXTRA CMAKE ARGUMENTS)
 cmake_build = cmake -G Ninja -S $(1) -B $(2) -DFERROVOL_LIBRARY=$(CURDIR)/$(3) $(4) >/dev/null && \
