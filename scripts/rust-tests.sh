@@ -41,7 +41,7 @@ EOF
 
 # run_one EXECUTABLE DIR LABEL ARGS...: one binary; its output and result kept in $tmp.
 run_one() {
-  local exe=$1 dir=$2 label=$3 log t0 rc=0
+  local exe=$1 dir=$2 label=$3 log t0 took rc=0
   shift 3
   log="$tmp/$(basename "$exe").log"
   t0=$(date +%s.%N)
@@ -59,11 +59,11 @@ run_one() {
 export -f run_one
 export tmp
 
-# The binaries in the order cargo lists them, JOBS at a time.
+# The binaries, slowest of the last run first, JOBS at a time.
 tr '\n' '\0' <"$tmp/binaries" |
   xargs -0 -P "$JOBS" -I{} bash -c 'IFS=$'"'\t'"' read -r exe dir label <<<"$1"; shift; run_one "$exe" "$dir" "$label" "$@"' _ {} "$@"
 
-$CARGO test --locked --workspace --doc "$@"
+$CARGO test --locked --workspace --doc -- "$@"
 [ $# -gt 0 ] || cp "$tmp/seconds" "$SECONDS_FILE"
 
 if [ -s "$tmp/failed" ]; then

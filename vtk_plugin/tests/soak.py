@@ -130,7 +130,7 @@ def svg_plot(path, rows):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--renders", type=int, default=10000,
-                    help="renders (a multiple of 1000, at least 3000)")
+                    help="renders (a multiple of the period, at least 3 periods)")
     ap.add_argument("--period", type=int, default=1000,
                     help="renders in one period of the schedule (a multiple of 20)")
     ap.add_argument("--max-growth", type=float, default=0.05,
@@ -138,14 +138,14 @@ def main():
     ap.add_argument("--csv", help="write render, resident bytes, device bytes, objects here")
     ap.add_argument("--svg", help="write the memory curve as an SVG plot here")
     args = ap.parse_args()
-    PERIOD = args.period
-    if PERIOD < 20 or PERIOD % 20:
+    period = args.period
+    if period < 20 or period % 20:
         ap.error("--period must be a positive multiple of 20")
-    if args.renders < 3 * PERIOD or args.renders % PERIOD:
-        ap.error(f"--renders must be a multiple of {PERIOD}, at least {3 * PERIOD}")
-    DATA_EVERY = PERIOD // DATA_PARTS
-    RELEASE_EVERY = PERIOD // RELEASE_PARTS
-    PATH_EVERY = PERIOD // PATH_PARTS
+    if args.renders < 3 * period or args.renders % period:
+        ap.error(f"--renders must be a multiple of {period}, at least {3 * period}")
+    data_every = period // DATA_PARTS
+    release_every = period // RELEASE_PARTS
+    path_every = period // PATH_PARTS
 
     output = vtk.vtkStringOutputWindow()
     vtk.vtkOutputWindow.SetInstance(output)
@@ -167,14 +167,14 @@ def main():
     rows = np.zeros((args.renders, 4), dtype=np.int64)
     empty, start = [], time.perf_counter()
     for i in range(args.renders):
-        if i % DATA_EVERY == 0:
-            _, data, (lo, hi), independent = inputs[(i // DATA_EVERY) % len(inputs)]
+        if i % data_every == 0:
+            _, data, (lo, hi), independent = inputs[(i // data_every) % len(inputs)]
             mapper.SetInputData(data)
             prop.SetIndependentComponents(independent)
             components = data.GetPointData().GetScalars().GetNumberOfComponents()
             renderer.ResetCamera()
-        if i % PATH_EVERY == 0:
-            mapper.SetOutputPathToReadback() if (i // PATH_EVERY) % 2 else \
+        if i % path_every == 0:
+            mapper.SetOutputPathToReadback() if (i // path_every) % 2 else \
                 mapper.SetOutputPathToAutomatic()
         if i % 7 == 0:
             set_transfer_function(prop, components if independent else 1, lo, hi,
@@ -190,7 +190,7 @@ def main():
         renderer.GetActiveCamera().OrthogonalizeViewUp()
         renderer.ResetCameraClippingRange()
         window.Render()
-        if i % RELEASE_EVERY == RELEASE_EVERY - 1:
+        if i % release_every == release_every - 1:
             volume.ReleaseGraphicsResources(window)
         if i % 100 == 99 and mapper.GetBlendMode() != mapper.MINIMUM_INTENSITY_BLEND:
             pixels = vtk.vtkUnsignedCharArray()
@@ -203,7 +203,7 @@ def main():
         if errors.messages or "ERROR" in output.GetOutput():
             print(f"render {i + 1}: {errors.last() or output.GetOutput()}", file=sys.stderr)
             return 1
-        if (i + 1) % PERIOD == 0:
+        if (i + 1) % period == 0:
             print(f"{i + 1:6d} renders  {(time.perf_counter() - start) / (i + 1) * 1e3:6.1f} "
                   f"ms/render  resident {rows[i][1] / 2 ** 20:7.1f} MiB  device "
                   f"{rows[i][2] / 2 ** 20:6.2f} MiB in {rows[i][3]} objects", flush=True)
@@ -216,11 +216,11 @@ def main():
         svg_plot(args.svg, rows)
     failed = False
     for column, name in ((1, "resident memory"), (2, "device memory"), (3, "device objects")):
-        early = int(rows[PERIOD:2 * PERIOD, column].max())
-        late = int(rows[-PERIOD:, column].max())
+        early = int(rows[period:2 * period, column].max())
+        late = int(rows[-period:, column].max())
         growth = late / early - 1.0
-        print(f"{name}: highest over renders {PERIOD + 1}-{2 * PERIOD} {early}, over "
-              f"{args.renders - PERIOD + 1}-{args.renders} {late}: {growth * 100:+.2f}%")
+        print(f"{name}: highest over renders {period + 1}-{2 * period} {early}, over "
+              f"{args.renders - period + 1}-{args.renders} {late}: {growth * 100:+.2f}%")
         failed |= growth > args.max_growth
     if empty:
         print(f"nothing drawn at renders {empty}", file=sys.stderr)

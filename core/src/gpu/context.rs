@@ -49,12 +49,13 @@ impl DeviceMemory {
 
 /// The compiled shaders of one device, shared by every renderer on it (a [`Context`] and its
 /// clones hold one; the pipeline module fills it): shader modules by pass file, compute
-/// pipelines by file, entry point and override constants. Compiling is most of a new renderer's first frame, so a renderer made
-/// on a device that already drew (another volume in the window, or the same one after its
-/// graphics resources were released) compiles only what is new to the device. A cached
-/// pipeline keeps the layout of the renderer that compiled it; another renderer's bind groups
-/// fit it because a pass builds its bind group layouts from the context alone, and wgpu gives
-/// layouts of equal entries one identity on a device.
+/// pipelines by file, entry point and override constants. Compiling is most of a new
+/// renderer's first frame, so a renderer made on a device that already drew (another volume
+/// in the window, or the same one after its graphics resources were released) compiles only
+/// what is new to the device. A cached pipeline keeps the layout of the renderer that
+/// compiled it; another renderer's bind groups fit it because a pass builds its bind group
+/// layouts from the context alone, and wgpu gives layouts of equal entries one identity on
+/// a device.
 #[derive(Default)]
 pub(crate) struct ShaderStore {
     pub(crate) modules: Mutex<HashMap<&'static str, wgpu::ShaderModule>>,
