@@ -6,7 +6,7 @@
 #ifndef vtkFerroVolumeDepthReader_h
 #define vtkFerroVolumeDepthReader_h
 
-#include "vtk_glew.h"
+#include "vtkFerroVolumeGL.h"
 
 #include <string>
 #include <vector>

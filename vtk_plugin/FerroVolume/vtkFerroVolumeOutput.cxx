@@ -16,7 +16,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkTextureObject.h"
 #include "vtkVolume.h"
-#include "vtk_glew.h"
+#include "vtkFerroVolumeGL.h"
 
 #if FERROVOL_HAVE_SHARED_OUTPUT
 #include "vtkFerroVolumeSharedOutput.h"

@@ -4,7 +4,7 @@
 #include "vtkMultiProcessController.h"
 #include "vtkTextureObject.h"
 #include "vtkType.h"
-#include "vtk_glew.h"
+#include "vtkFerroVolumeGL.h"
 
 #include <algorithm>
 #include <climits>

@@ -18,7 +18,7 @@
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 #include "vtkVolume.h"
-#include "vtk_glew.h"
+#include "vtkFerroVolumeGL.h"
 
 #include <cstring>
 

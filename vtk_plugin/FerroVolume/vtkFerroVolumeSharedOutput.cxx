@@ -76,7 +76,7 @@ vtkFerroVolumeOutputFacts Facts(const ferrovol::Context& ctx, bool forced)
   f.Forced = forced;
   const GLubyte* glRenderer = glGetString(GL_RENDERER);
   f.GLRenderer = glRenderer ? reinterpret_cast<const char*>(glRenderer) : "no GL_RENDERER";
-  f.GLHasMemoryObjectFd = GLEW_EXT_memory_object_fd;
+  f.GLHasMemoryObjectFd = vtkFerroVolumeGLHasMemoryObjectFd();
   try
   {
     f.AdapterName = ctx.info().name;

@@ -12,7 +12,7 @@
 #include "vtkFerroVolumeOutput.h"
 #include "vtkFerroVolumeOutputChoice.h"
 #include "vtkSmartPointer.h"
-#include "vtk_glew.h"
+#include "vtkFerroVolumeGL.h"
 
 #include <memory>
 #include <string>
