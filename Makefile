@@ -33,8 +33,8 @@ export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
 .PHONY: deps build demo test check lint lint-workspace lint-fuzz bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
-        regression regression-quick fuzz-smoke soak sanitize vtk-asan \
-        test-build-rust test-rust test-sanitize test-build-vtk test-vtk test-build-vtk-asan \
+        regression regression-quick fuzz-smoke soak sanitize vtk-asan vtk-pip wheel \
+        test-build-vtk-pip test-vtk-pip test-wheel test-regression-quick-pip test-build-rust test-rust test-sanitize test-build-vtk test-vtk test-build-vtk-asan \
         test-vtk-asan test-build-paraview test-paraview test-regression-quick
 
 deps:
@@ -99,6 +99,34 @@ test-build-vtk-asan:
 	$(VTK_ASAN)
 test-vtk-asan:
 	$(VTK_ASAN_CTEST)
+
+# The VTK module against PyPI's `vtk` wheel (the version Debian unstable's VTK headers have):
+# scripts/vtk-sdk.sh assembles the SDK (build/vtk-sdk: those headers and wrapping tools, a
+# venv with that wheel, CMake from PyPI), then build/vtk-pip. `make wheel` packs it.
+PIP_SDK := build/vtk-sdk/sdk.env
+PIP_BUILD := build/vtk-pip
+define VTK_PIP_MODULE
+scripts/vtk-sdk.sh >/dev/null
+. $(PIP_SDK) && $$FERROVOL_SDK_CMAKE -G Ninja -S vtk_plugin -B $(PIP_BUILD) \
+  -DFERROVOL_LIBRARY=$(CURDIR)/$(1) -DFERROVOL_VTK_DIR=$$FERROVOL_SDK_VTK_DIR \
+  -DPython3_EXECUTABLE=$$FERROVOL_SDK_PYTHON -DFERROVOL_VTK_WHEEL=ON >/dev/null && \
+  ninja -C $(PIP_BUILD) -j2
+endef
+vtk-pip: deps
+	$(FFI_RELEASE)
+	$(call VTK_PIP_MODULE,$(RELEASE_LIB))
+wheel: vtk-pip
+	. $(PIP_SDK) && $$FERROVOL_SDK_PYTHON scripts/wheel.py $(PIP_BUILD) $(RELEASE_LIB) dist
+test-build-vtk-pip:
+	$(call VTK_PIP_MODULE,$(TEST_LIB))
+# The VTK module's suites on pip's VTK (CTest label pip): the comparisons with that VTK's own
+# mapper, bad input and a short soak.
+test-vtk-pip:
+	$(call VTK_CTEST,$(PIP_BUILD)) -L pip
+# The wheel as a pip user gets it: packed from build/vtk-pip, installed with PyPI's vtk and
+# PyVista into a new venv, tested there (tests/wheel/run.sh).
+test-wheel:
+	tests/wheel/run.sh $(CURDIR)/$(TEST_LIB)
 
 # The ParaView plugin builds vtkFerroVolumeMapper from vtk_plugin/FerroVolume itself (it
 # does not need build/vtk) and writes build/paraview/env.sh (PV_PLUGIN_PATH); build/env.sh
@@ -174,6 +202,12 @@ test-sanitize:
 	scripts/sanitize.sh
 test-regression-quick:
 	$(REGRESSION) --quick
+# The same scenes against pip's VTK (its own vtkGPUVolumeRayCastMapper is the reference).
+REGRESSION_PIP = . $(PIP_SDK) && . $(PIP_BUILD)/env.sh && env -u DISPLAY scripts/with-xvfb.sh \
+  vtk_plugin/tests/retry-on-x-failure.sh $$FERROVOL_SDK_PYTHON tests/regression/run.py \
+  --out build/regression-pip
+test-regression-quick-pip:
+	$(REGRESSION_PIP) --quick
 
 # The readers' fuzz targets (fuzz/, docs/FUZZING.md) built with coverage and run by AFL++
 # for 20 s each on the committed corpus: fails on a crash, a hang or a heap bound exceeded.

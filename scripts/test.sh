@@ -22,9 +22,9 @@ START=$SECONDS
 export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
-SUITES=(lint build-rust build-vtk
-        rust-tests lint-fuzz fuzz-smoke build-paraview paraview
-        vtk build-vtk-asan vtk-asan regression-quick sanitize)
+SUITES=(lint build-rust build-vtk build-vtk-pip
+        rust-tests lint-fuzz fuzz-smoke build-paraview paraview vtk-pip
+        vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
   [build-vtk]=build-rust
@@ -32,6 +32,8 @@ declare -A NEEDS=(
   [build-paraview]=build-rust [paraview]=build-paraview
   [vtk]=build-vtk [build-vtk-asan]=build-rust [vtk-asan]=build-vtk-asan
   [regression-quick]=build-vtk
+  [build-vtk-pip]=build-rust [vtk-pip]=build-vtk-pip [regression-quick-pip]=build-vtk-pip
+  [wheel]=build-vtk-pip
 )
 # What each suite runs: a make target (Makefile), without the builds it depends on.
 declare -A CMD=(
@@ -48,6 +50,10 @@ declare -A CMD=(
   [build-vtk-asan]=test-build-vtk-asan
   [vtk-asan]=test-vtk-asan
   [regression-quick]=test-regression-quick
+  [build-vtk-pip]=test-build-vtk-pip
+  [vtk-pip]=test-vtk-pip
+  [regression-quick-pip]=test-regression-quick-pip
+  [wheel]=test-wheel
 )
 
 declare -A WANTED=()
@@ -103,6 +109,7 @@ echo "make test: logs in build/test-logs; the builds first, then two lanes of su
 suite lint
 suite build-rust
 suite build-vtk
+suite build-vtk-pip
 # Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the ParaView plugin.
 (
   suite rust-tests
@@ -110,6 +117,7 @@ suite build-vtk
   suite fuzz-smoke
   suite build-paraview
   suite paraview
+  suite vtk-pip
 ) &
 lane1=$!
 # Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the C
@@ -120,6 +128,8 @@ lane1=$!
   suite vtk-asan
   suite regression-quick
   suite sanitize
+  suite regression-quick-pip
+  suite wheel
 ) &
 lane2=$!
 wait $lane1 $lane2

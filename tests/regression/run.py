@@ -210,9 +210,23 @@ def save_png(name, img):
 # ---------------------------------------------------------------------------------------
 # Thresholds
 
-def load_thresholds(path):
+def load_thresholds(path, version=None):
+    """The scenes' thresholds for this VTK: a scene's sub-table `vtk_M_N` (VTK M.N's own
+    mapper draws the scene differently from 9.2's) replaces its figures, reason and
+    below_acceptance line for VTK M.N and later, the latest such that applies."""
     with open(path, "rb") as f:
         table = tomllib.load(f)
+    if version is None:
+        version = (vtk.vtkVersion.GetVTKMajorVersion(), vtk.vtkVersion.GetVTKMinorVersion())
+    for name, t in table.items():
+        since = sorted((tuple(int(x) for x in key[4:].split("_")), key)
+                       for key in t if key.startswith("vtk_"))
+        applying = [key for v, key in since if v <= version]
+        base = {k: v for k, v in t.items() if not k.startswith("vtk_")}
+        if applying:
+            base.pop("below_acceptance", None)
+            base.update(t[applying[-1]])
+        table[name] = base
     return table
 
 

@@ -168,13 +168,19 @@ public:
     this->Convergence.reset();
   }
 
-  // The renderer with the output's images in `window` and RenderToImage's, all made from
-  // the renderer's device.
-  void ReleaseDeviceResources(vtkWindow* window)
+  // The output's images in `window` and RenderToImage's, all made from the renderer's
+  // device.
+  void ReleaseWindowResources(vtkWindow* window)
   {
     this->Output.ReleaseGraphicsResources(window);
     this->Peeling.ReleaseGraphicsResources(window);
     this->Image.ReleaseGraphicsResources();
+  }
+
+  // Those and the renderer.
+  void ReleaseDeviceResources(vtkWindow* window)
+  {
+    this->ReleaseWindowResources(window);
     this->FreeRenderer();
   }
 
@@ -378,7 +384,14 @@ vtkTypeInt64 vtkFerroVolumeMapper::GetDeviceObjectsInUse()
 void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 {
   this->Internals->Refinement.Stop();
-  this->Internals->ReleaseDeviceResources(window);
+  if (this->RenderMode == RENDER_MODE_PATH_TRACE && !this->Internals->RendererLost())
+  {
+    this->Internals->ReleaseWindowResources(window);
+  }
+  else
+  {
+    this->Internals->ReleaseDeviceResources(window);
+  }
   this->Superclass::ReleaseGraphicsResources(window);
 }
 

@@ -760,7 +760,12 @@ public:
   void SetPartitions(unsigned short x, unsigned short y, unsigned short z);
 
   /**
-   * Frees the OpenGL resources and the ferrovol renderer; the next Render() uploads again.
+   * Frees the OpenGL resources in `window` and, but for path tracing, the ferrovol renderer
+   * (its device memory); the next Render() uploads again. A path-traced volume keeps its
+   * renderer, and with it the accumulation, until the mapper is destroyed or released
+   * while ray casting: a window that goes away and renders again (VTK 9.2's interactor
+   * finalizes its window when its event loop ends, and a screenshot after Start() or
+   * PyVista's show() renders it again) goes on from the paths already traced.
    */
   void ReleaseGraphicsResources(vtkWindow* window) override;
 

@@ -21,6 +21,8 @@ sys.path.insert(0, os.path.join(ROOT, "tests"))
 from ferrovol_testing.metrics import (  # noqa: E402,F401  (re-exported for the suites)
     coverage, difference_image, luminance, psnr, ssim)
 from ferrovol_testing.png import write_png  # noqa: E402
+# The VTK under test: (major, minor), for the thresholds that differ between VTK versions.
+VTK_VERSION = (vtk.vtkVersion.GetVTKMajorVersion(), vtk.vtkVersion.GetVTKMinorVersion())
 OUTPUT = os.environ.get("FERROVOL_TEST_OUTPUT", os.path.join(ROOT, "build", "vtk", "test-images"))
 DATA = os.environ.get("FERROVOL_DATA_DIR", os.path.join(ROOT, "build", "data"))
 os.makedirs(OUTPUT, exist_ok=True)

@@ -117,8 +117,8 @@ class Rig:
     def new(self):
         m = ferrovol.vtkFerroVolumeMapper()
         m.errors = Errors(m)
-        m.progress = []
-        m.AddObserver("ProgressEvent", lambda o, e: o.progress.append(o.GetProgress()))
+        m.progress_seen = []
+        m.AddObserver("ProgressEvent", lambda o, e: o.progress_seen.append(o.GetProgress()))
         m.SetInputData(self.data)
         self.volume.SetMapper(m)
         self.mapper = m
@@ -197,9 +197,9 @@ def label_one_red(m, rig):
 
 
 def progress_events(m, rig):
-    m.progress.clear()
+    m.progress_seen.clear()
     rig.render()
-    return len(m.progress)
+    return len(m.progress_seen)
 
 
 def depth_type(m, rig):

@@ -144,6 +144,9 @@ class Progressive(unittest.TestCase):
         tag = iren.AddObserver("TimerEvent", check)
         iren.Start()
         iren.RemoveObserver(tag)
+        # VTK 9.2's X interactor finalizes the window as its loop ends (later ones keep it):
+        # a finalized window leaves no observer of the mapper's behind.
+        seen["finalized"] = s.window.GetGenericWindowId() is None
         seen["observing"] = bool(iren.HasObserver("TimerEvent"))
         return seen, times
 
@@ -160,16 +163,17 @@ class Progressive(unittest.TestCase):
                 save("progressive-refined", seen["image"])
             log("interactor refinement, automatic budget %.2f s (run %d): %d paths per pixel "
                 "after the script's one Render(), %d after %.1f s of the event loop alone, in "
-                "%d renders (%s); renders in the %.1f s after: %d; the mapper observes the "
-                "interactor after the window is finalized: %s"
+                "%d renders (%s); renders in the %.1f s after: %d; after the loop, the window "
+                "finalized: %s, the mapper observing the interactor: %s"
                 % (budget, attempt, seen["first"], spp, seen.get("converged", -1),
                    seen.get("renders", -1), distribution(times), rest, seen["later"],
-                   seen["observing"]))
+                   seen["finalized"], seen["observing"]))
             self.assertEqual(self.errors.messages, [])
             self.assertLess(seen["first"], spp)
             self.assertIn("converged", seen, "the accumulation reached SamplesPerPixel")
             self.assertEqual(seen["later"], 0, "renders once converged")
-            self.assertFalse(seen["observing"])
+            if seen["finalized"]:
+                self.assertFalse(seen["observing"])
             if max(times) <= limit:
                 break
         self.assertLessEqual(max(times), limit)

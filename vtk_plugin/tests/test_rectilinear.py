@@ -75,9 +75,12 @@ class Rectilinear(unittest.TestCase):
         xs = coordinates(n + 1, 0.1)
         ys = coordinates(n + 1, 0.0) * 2.0
         grid = rectilinear(wavelet_values(n), xs, ys, ys, cells=True)
-        # measured 0.8648 / 24.6 dB
-        fvtest.assert_matches_vtk(self, "rectilinear_cells", grid, prop, (0.85, 23.5),
-                                  camera=view)
+        # measured 0.8648 / 24.6 dB against VTK 9.2; 0.8726 / 23.1 dB against VTK 9.6.2: from
+        # 9.5 (VTK commit a3a3cdbe, "Fix volume rendering support for rectilinear grid
+        # celldata") VTK's box reaches the last layer of cells, which 9.2 cut off, while its
+        # shader still reads f / N of the N - 1 texel texture
+        floor = (0.85, 23.5) if fvtest.VTK_VERSION < (9, 5) else (0.85, 22.5)
+        fvtest.assert_matches_vtk(self, "rectilinear_cells", grid, prop, floor, camera=view)
 
     def test_isosurface(self):
         n = 32
