@@ -276,3 +276,10 @@ pictures: build
 	for m in preview traced; do $(FERROVOL) render build/data/cranium.vti --mode iso --tf ct-skin-bone --iso 400:1:0.95,0.92,0.85 --iso=-500:1:0.9,0.6,0.5 --scatter-inside $$m --scatter-samples 32 --absorption 0.3 --env-light 1 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 320x320 --out docs/img/cranium-iso-scatter-$$m.png; done
 	for b in 1x64 8x8 64x1; do $(FERROVOL) render build/data/cranium.vti --mode pathtrace --tf ct-bone --budget $$b --g 0.2 --psi 100 --elevation -90 --view-up z --env-up z --zoom 1.3 --env-background --size 256x256 --out docs/img/cranium-budget-$$b.png; done
 	$(FERROVOL) render build/data/colin27.nii.gz --mode iso --iso 60:0.35:0.92,0.72,0.62 --iso 115:1:0.9,0.88,0.82 --ao 16 --elevation 90 --view-up z --env-up z --zoom 1.2 --size 640x640 --out docs/img/mri-iso.png
+
+# ParaView 6.1 from Debian unstable, unpacked into build/pv6-sdk (scripts/pv6-sdk.sh): the
+# plugin built in build/pv6-paraview and the same tests (paraview/README.md).
+.PHONY: paraview6-test
+paraview6-test:
+	$(FFI_RELEASE)
+	env -u DISPLAY scripts/with-xvfb.sh paraview/tests/run-pv6.sh 2

@@ -30,6 +30,17 @@ OUT_DIR = os.environ.get("FERROVOL_PV_TEST_OUT", os.path.join(os.getcwd(), "buil
 BACKGROUND = (0.1, 0.1, 0.15)
 
 
+def pv_version():
+    """ParaView's (major, minor): 5.11 on Debian bookworm, 6.1 from scripts/pv6-sdk.sh."""
+    pm = servermanager.vtkSMProxyManager
+    return (pm.GetVersionMajor(), pm.GetVersionMinor())
+
+
+# The representations' "Position" (its XML name in both) is "Translation" in Python since
+# ParaView 5.13, where disp.Position raises NotSupportedException.
+POSITION = "Translation" if pv_version() >= (5, 13) else "Position"
+
+
 def rank():
     pm = servermanager.vtkProcessModule.GetProcessModule()
     return pm.GetPartitionId() if pm else 0
@@ -81,9 +92,10 @@ def load_plugin(ns=None):
 
 def make_view(size=(400, 400)):
     # paraview.simple.Render() resets the camera on the session's first render: the tests
-    # set their cameras themselves.
+    # set their cameras themselves. (_DisableFirstRenderCameraReset is in 5.11's simple.py and
+    # in 6.x's simple package, where _funcs_internals moved to paraview.simple.session.)
     import paraview.simple
-    paraview.simple._funcs_internals.first_render = False
+    paraview.simple._DisableFirstRenderCameraReset()
     view = CreateRenderView()
     view.ViewSize = list(size)
     view.OrientationAxesVisibility = 0
@@ -117,7 +129,19 @@ def set_camera(view, bounds, azimuth=30.0, elevation=20.0, direction=None, zoom=
 
 
 def color_by(display, array, rgb_points=None, opacity_points=None, association="POINTS"):
-    ColorBy(display, (association, array))
+    if nranks() > 1 and pv_version() >= (6, 0) and rgb_points is not None \
+            and opacity_points is not None:
+        # ParaView 6.1 under pvbatch --symmetric: ColorBy rescales the colour map with a
+        # collective operation (vtkSMTransferFunctionProxy::RescaleTransferFunction all-reduces
+        # the range) that a rank whose piece lacks the array skips (vtkSMColorMapEditorHelper:
+        # "Could not determine array range."): the ranks deadlock (measured: test_mpi.py's
+        # one-cell Wavelet, rank 0 in MPI_Allreduce, rank 1 in the representation's
+        # gather). Both maps are set here, so the display is coloured without the rescale.
+        display.ColorArrayName = [association, array]
+        display.LookupTable = GetColorTransferFunction(array)
+        display.ScalarOpacityFunction = GetOpacityTransferFunction(array)
+    else:
+        ColorBy(display, (association, array))
     lut = GetColorTransferFunction(array)
     pwf = GetOpacityTransferFunction(array)
     if rgb_points is not None:

@@ -15,12 +15,15 @@ OUT="${FERROVOL_PV_TEST_OUT:-$PWD/build/paraview-test}"
 export FERROVOL_PV_TEST_OUT="$OUT"
 mkdir -p "$OUT"
 rm -f "$OUT"/*.png
-if [ ! -f build/paraview/env.sh ]; then
-  echo "paraview-test: build/paraview/env.sh is missing: run make paraview first" >&2
+# FERROVOL_PV_BUILD: the plugin's build directory (paraview/tests/run-pv6.sh: build/pv6-paraview,
+# with Debian unstable's ParaView 6.1 first in PATH).
+PV_BUILD="${FERROVOL_PV_BUILD:-build/paraview}"
+if [ ! -f "$PV_BUILD/env.sh" ]; then
+  echo "paraview-test: $PV_BUILD/env.sh is missing: run make paraview first" >&2
   exit 2
 fi
 # shellcheck source=/dev/null
-. build/paraview/env.sh
+. "$PV_BUILD/env.sh"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/ferrovol-xdg-$(id -u)}"
 mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 MPIEXEC=(mpiexec --oversubscribe -n "$RANKS")
@@ -54,7 +57,7 @@ step() {  # step NAME COMMAND...
 }
 
 start=$(date +%s)
-echo "== ParaView plugin tests (X display $DISPLAY, $RANKS MPI ranks; images and logs in $OUT)"
+echo "== ParaView plugin tests (ParaView $(pvbatch --version 2>/dev/null | grep -o '[0-9][0-9.]*' | head -1), X display $DISPLAY, $RANKS MPI ranks; images and logs in $OUT)"
 step load          /usr/bin/python3 $T/test_load.py
 step wavelet       pvbatch $T/test_wavelet.py
 step cranium       pvbatch $T/test_cranium.py

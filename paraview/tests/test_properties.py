@@ -86,7 +86,7 @@ CHANGES = [
     ("OpacityPoints", [37.35, 0.0, 0.5, 0.0, 200.0, 0.0, 0.5, 0.0, 276.8, 1.0, 0.5, 0.0], True),
     ("RGBPoints", [37.35, 0.0, 0.6, 0.2, 276.8, 1.0, 1.0, 0.0], True),
     (("UseCropping", "CroppingOrigin", "CroppingScale"), [1, [0, 0, 0], [0.5, 1, 1]], True),
-    (("Position", "Orientation"), [[4, 0, 0], [0, 0, 30]], True),
+    ((T.POSITION, "Orientation"), [[4, 0, 0], [0, 0, 30]], True),
     ("FerrovolMidpointQuadrature", 1, True),
     ("FerrovolAdaptiveSampling", 1, True),
     ("FerrovolEmptySpaceSkipping", 0, False),
@@ -209,7 +209,8 @@ disp.Shade, disp.IsosurfaceValues, disp.Specular, disp.SpecularPower = old
 disp.FerrovolShininessRange = [8.0, 64.0]
 
 # The actor's transform goes through the volume matrix as for "Volume".
-disp.Position, disp.Orientation = [4, 0, 0], [0, 0, 30]
+setattr(disp, T.POSITION, [4, 0, 0])
+disp.Orientation = [0, 0, 30]
 moved = {}
 for rep in ("Volume", "Ferrovol Volume"):
     disp.Representation = rep
@@ -218,7 +219,8 @@ for rep in ("Volume", "Ferrovol Volume"):
 T.compare("Position+Orientation vs Volume", moved["Ferrovol Volume"], moved["Volume"], 0.95, 32.0,
           failures)
 disp.Representation = "Ferrovol Volume"
-disp.Position, disp.Orientation = [0, 0, 0], [0, 0, 0]
+setattr(disp, T.POSITION, [0, 0, 0])
+disp.Orientation = [0, 0, 0]
 
 uploads = T.ferrovol_info(disp)["FerrovolVolumeUploadCount"]
 T.log("  volume uploads: %d before the changes, %d after (transfer functions, blend modes, "

@@ -197,7 +197,7 @@ CASES = {
                                 {"GlobalIlluminationReach": 0.4}, DRAWN, 0.94, 27.0),
     "VolumeAnisotropy": (dict(SHADOWS, VolumetricScatteringBlending=2.0),
                          {"VolumeAnisotropy": 0.8}, DRAWN, 0.97, 35.0),
-    "Position": ({}, {"Position": [4, 0, 0]}, DRAWN, 0.95, 33.0),
+    "Position": ({}, {T.POSITION: [4, 0, 0]}, DRAWN, 0.95, 33.0),
     "Orientation": ({}, {"Orientation": [0, 0, 30]}, DRAWN, 0.96, 34.0),
     "Scale": ({}, {"Scale": [1, 1.5, 1]}, DRAWN, 0.95, 35.0),
     "Origin": ({"Orientation": [0, 0, 30]}, {"Origin": [10, 0, 0]}, DRAWN, 0.96, 34.0),
@@ -234,6 +234,10 @@ CASES = {
     "VolumeRenderingMode": ({}, {"VolumeRenderingMode": "GPU Based"}, WARNED_UNCHANGED, None,
                             "Volume Rendering Mode \"GPU Based\""),
 }
+if T.pv_version() >= (6, 0):
+    # ParaView 6.0's Coordinate System (vtkProp3D's: "Navigable" is the world, "Fixed" the
+    # physical space of a VR room, the world itself in a desktop view).
+    CASES["CoordinateSystem"] = ({}, {"CoordinateSystem": "Fixed"}, NO_EFFECT, None, None)
 # Not settings of the image: the pipeline's input, visibility and cache keys.
 NOT_SETTINGS = {"Input", "DummyInput", "Visibility", "ForceUseCache", "ForcedCacheKey"}
 

@@ -148,6 +148,10 @@ class Progressive(unittest.TestCase):
         # a finalized window leaves no observer of the mapper's behind.
         seen["finalized"] = s.window.GetGenericWindowId() is None
         seen["observing"] = bool(iren.HasObserver("TimerEvent"))
+        # a screenshot after Start() returns renders again: the paths traced stay
+        seen["after_loop"] = s.mapper.GetMeanAccumulatedSamples()
+        s.window.Render()
+        seen["after_render"] = s.mapper.GetMeanAccumulatedSamples()
         return seen, times
 
     def test_view_refines_itself_through_the_interactor(self):
@@ -164,10 +168,12 @@ class Progressive(unittest.TestCase):
             log("interactor refinement, automatic budget %.2f s (run %d): %d paths per pixel "
                 "after the script's one Render(), %d after %.1f s of the event loop alone, in "
                 "%d renders (%s); renders in the %.1f s after: %d; after the loop, the window "
-                "finalized: %s, the mapper observing the interactor: %s"
+                "finalized: %s, the mapper observing the interactor: %s; mean paths per "
+                "pixel after the loop %.2f, after one more Render() %.2f"
                 % (budget, attempt, seen["first"], spp, seen.get("converged", -1),
                    seen.get("renders", -1), distribution(times), rest, seen["later"],
-                   seen["finalized"], seen["observing"]))
+                   seen["finalized"], seen["observing"], seen["after_loop"],
+                   seen["after_render"]))
             self.assertEqual(self.errors.messages, [])
             self.assertLess(seen["first"], spp)
             self.assertIn("converged", seen, "the accumulation reached SamplesPerPixel")
