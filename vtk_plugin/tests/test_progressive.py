@@ -180,6 +180,8 @@ class Progressive(unittest.TestCase):
             self.assertEqual(seen["later"], 0, "renders once converged")
             if seen["finalized"]:
                 self.assertFalse(seen["observing"])
+            self.assertGreaterEqual(seen["after_loop"], spp)
+            self.assertGreaterEqual(seen["after_render"], spp)
             if max(times) <= limit:
                 break
         self.assertLessEqual(max(times), limit)
