@@ -20,12 +20,17 @@ from fvtest import log, roughness, save, wavelet
 
 M = ferrovol.vtkFerroVolumeMapper
 
-# A Render() may exceed the budget by 20% and by this much more (seconds): the scheduling
-# noise of a loaded 2-core machine, where lavapipe's threads share the cores with Xvfb.
+# Nine renders in ten may exceed the budget by 20% and by this much more (seconds): the
+# scheduling noise of a loaded 2-core machine, where lavapipe's threads share the cores with
+# Xvfb.
 SLACK = 0.03
-# Other processes on these machines (builds, fuzzers) can halve the CPU time a render gets
-# from one moment to the next. A timed run that exceeds the bound is run again, ATTEMPTS
-# runs in all, each printed; the bound must hold in one of them.
+# Other processes on these machines (builds, fuzzers, the other test lane) can halve the CPU
+# time a render gets from one moment to the next, so the slowest render is held to
+# OUTLIER budgets only: a render that ignored the budget would trace every path at once
+# (seconds here).
+OUTLIER = 5.0
+# A timed run that exceeds the bounds is run again, ATTEMPTS runs in all, each printed; the
+# bounds must hold in one of them.
 ATTEMPTS = 3
 
 
@@ -47,6 +52,13 @@ def path_tracing(spp, budget=0.0, mode=None):
         if mode:
             getattr(m, "SetProgressiveModeTo" + mode)()
     return configure
+
+
+def within_budget(times, budget):
+    """Whether the renders' times keep to `budget`: nine in ten within 20% and SLACK of it,
+    the slowest within OUTLIER budgets."""
+    t = sorted(times)
+    return t[int(0.9 * (len(t) - 1))] <= 1.2 * budget + SLACK and t[-1] <= OUTLIER * budget
 
 
 def distribution(times):
@@ -113,9 +125,9 @@ class Progressive(unittest.TestCase):
                 self.assertGreater(len(times), 2, "the budget spreads the paths over renders")
                 self.assertTrue(all(b > a for a, b in zip(mean, mean[1:-1])),
                                 "each render adds paths: %s" % mean)
-                if max(times) <= limit:
+                if within_budget(times, budget):
                     break
-            self.assertLessEqual(max(times), limit)
+            self.assertTrue(within_budget(times, budget), distribution(times))
 
     def refine_in_event_loop(self, spp, give_up=60.0, rest=0.3):
         """Renders a progressive scene once in an on-screen window with an X interactor, then
@@ -152,15 +164,20 @@ class Progressive(unittest.TestCase):
         seen["after_loop"] = s.mapper.GetMeanAccumulatedSamples()
         s.window.Render()
         seen["after_render"] = s.mapper.GetMeanAccumulatedSamples()
+        # That Render() initialized the interactor again, which puts it back in the X
+        # interactors' process-wide list; VTK (9.2 to 9.6) takes it out only in an event
+        # loop, never in the destructor, so the next test's Start() would fire the timers of
+        # a deleted interactor (a crash without ferrovol too). One pass of the loop, done.
+        iren.TerminateApp()
+        iren.ProcessEvents()
         return seen, times
 
     def test_view_refines_itself_through_the_interactor(self):
         """A VTK program's window with an X interactor: after the script's one Render(), the
-        event loop alone brings the accumulation to SamplesPerPixel, each render within the
-        budget, and then renders no more."""
+        event loop alone brings the accumulation to SamplesPerPixel, the renders within the
+        budget (within_budget), and then renders no more."""
         spp, rest = 64, 0.3
         budget = 0.1  # automatic: 1/DesiredUpdateRate (0.0001 at rest), at most 0.1 s
-        limit = 1.2 * budget + SLACK
         for attempt in range(1, ATTEMPTS + 1):
             seen, times = self.refine_in_event_loop(spp, rest=rest)
             if "image" in seen:
@@ -182,9 +199,9 @@ class Progressive(unittest.TestCase):
                 self.assertFalse(seen["observing"])
             self.assertGreaterEqual(seen["after_loop"], spp)
             self.assertGreaterEqual(seen["after_render"], spp)
-            if max(times) <= limit:
+            if within_budget(times, budget):
                 break
-        self.assertLessEqual(max(times), limit)
+        self.assertTrue(within_budget(times, budget), distribution(times))
 
     def test_refinement_timers(self):
         """An application that runs the interactor's timers itself (a
