@@ -15,7 +15,9 @@ the transfer function range types, FinalColorWindow/Level, LockSampleDistanceToI
 and the render start/end events, CreateCanonicalView, PreLoadData, IsRenderSupported.
 """
 import hashlib
+import inspect
 import math
+import types
 import unittest
 
 import numpy as np
@@ -262,6 +264,13 @@ SETTINGS = {
     "SetAbortExecuteAndUpdateTime": state(calls(("SetAbortExecuteAndUpdateTime",)),
                                           lambda m, r: m.GetAbortExecute() == 1),
     "SetAbortOutput": reads("AbortOutput", True),
+    # (VTK >= 9.3: keys of the output ports' information; a mapper has none)
+    "SetNoPriorTemporalAccessInformationKey": state(
+        calls(("SetNoPriorTemporalAccessInformationKey",)),
+        lambda m, r: m.GetNumberOfOutputPorts() == 0),
+    "RemoveNoPriorTemporalAccessInformationKey": state(
+        calls(("RemoveNoPriorTemporalAccessInformationKey",)),
+        lambda m, r: m.GetNumberOfOutputPorts() == 0),
     "DebugOn": state(calls(("DebugOn",)), lambda m, r: m.GetDebug()),
     "DebugOff": state(calls(("DebugOff",)), lambda m, r: not m.GetDebug(),
                       prepare=calls(("DebugOn",))),
@@ -338,6 +347,11 @@ SETTINGS = {
                                              prepare=calls(("SelectScalarArray", "Cells"))),
     "SelectScalarArray": image(calls(("SelectScalarArray", "Other")),
                                prepare=calls(POINT_FIELD, ("SelectScalarArray", "RTData"))),
+    # (VTK >= 9.6 wraps the array's setters)
+    "SetArrayName": image(calls(("SetArrayName", "Other")),
+                          prepare=calls(POINT_FIELD, ("SelectScalarArray", "RTData"))),
+    "SetArrayId": image(calls(("SetArrayId", 1)),
+                        prepare=calls(POINT_FIELD, ("SelectScalarArray", 0))),
     "SetArrayAccessMode": image(calls(("SetArrayAccessMode", vtk.VTK_GET_ARRAY_BY_ID)),
                                 prepare=calls(POINT_FIELD, ("SelectScalarArray", 0),
                                               ("SelectScalarArray", "Other"))),
@@ -453,16 +467,28 @@ SETTINGS = {
     "SetMaskBlendFactor": image(calls(("SetMaskBlendFactor", 0.5)), prepare=label_one_red),
 
     # not supported: warned
+    "SetDepthPassContourValues": state(
+        lambda m, r: m.SetDepthPassContourValues(contour_values(150.0)),
+        lambda m, r: m.GetDepthPassContourValues().GetValue(0) == 150.0),
     "SetUseDepthPass": warned(calls(("SetUseDepthPass", 1)), "UseDepthPass"),
     "UseDepthPassOn": warned(calls(("UseDepthPassOn",)), "UseDepthPass"),
     "UseDepthPassOff": state(calls(("UseDepthPassOff",)), lambda m, r: m.GetUseDepthPass() == 0,
                              prepare=calls(("UseDepthPassOn",))),
     "SetTransfer2DYAxisArray": warned(calls(("SetTransfer2DYAxisArray", "Other")),
                                       "Transfer2DYAxisArray"),
+    # (VTK >= 9.6 wraps it: the active input ports' bookkeeping, kept as VTK keeps it)
+    "SetPorts": state(calls(("SetPorts", [0])), lambda m, r: tuple(m.GetPorts()) == (0,)),
     "SetPartitions": warned(calls(("SetPartitions", 2, 2, 2)), "SetPartitions"),
     "SetSharedDepthTexture": warned(calls(("SetSharedDepthTexture", vtk.vtkTextureObject())),
                                     "SetSharedDepthTexture"),
 }
+
+
+def contour_values(*values):
+    c = vtk.vtkContourValues()
+    for i, v in enumerate(values):
+        c.SetValue(i, v)
+    return c
 
 
 def is_setting(name):
@@ -533,12 +559,25 @@ DEFAULTS_DIFFER = {"GetMaxMemoryInBytes", "GetMTime", "GetClassName", "GetAddres
                    "GetObjectDescription", "GetReferenceCount", "GetNumberOfGenerationsFromBase"}
 
 
+def wrapped_properties(obj):
+    """The snake_case properties VTK >= 9.4's wrapping adds for Set/Get methods (some
+    write-only): descriptors of the class, not methods or constants."""
+    return {n for n in dir(obj) if not n.startswith("_") and isinstance(
+        inspect.getattr_static(type(obj), n, None), types.GetSetDescriptorType)}
+
+
+def plain(value):
+    return isinstance(value, (int, float, str, tuple, bool)) or value is None
+
+
 class Interface(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.rig = Rig()
-        cls.names = sorted(n for n in dir(vtk.vtkGPUVolumeRayCastMapper())
-                           if not n.startswith("_"))
+        ref = vtk.vtkGPUVolumeRayCastMapper()
+        cls.properties = sorted(wrapped_properties(ref))
+        cls.names = sorted(n for n in dir(ref)
+                           if not n.startswith("_") and n not in cls.properties)
 
     @classmethod
     def tearDownClass(cls):
@@ -564,9 +603,11 @@ class Interface(unittest.TestCase):
             elif not callable(theirs):
                 self.assertEqual(theirs, ours, n)
                 constants += 1
+        self.assertEqual(sorted(set(self.properties) - wrapped_properties(m)), [])
         fvtest.log("  %d public names of vtkOpenGLGPUVolumeRayCastMapper, all on "
-                   "vtkFerroVolumeMapper (%d constants and enum types with VTK's values)"
-                   % (len(self.names), constants))
+                   "vtkFerroVolumeMapper (%d constants and enum types with VTK's values), "
+                   "and %d wrapped properties" % (len(self.names), constants,
+                                                  len(self.properties)))
 
     def test_defaults_are_vtks(self):
         src = fvtest.wavelet(7)
@@ -579,12 +620,26 @@ class Interface(unittest.TestCase):
             if not n.startswith("Get") or n in DEFAULTS_DIFFER or n in ARGS:
                 continue
             theirs = getattr(ref, n)()
-            if isinstance(theirs, (int, float, str, tuple, bool)) or theirs is None:
+            if plain(theirs):
                 self.assertEqual(getattr(m, n)(), theirs, n)
                 compared.append(n)
+        # the wrapped properties (VTK >= 9.4) that read the same getters
+        differ = {n[3:].lower() for n in DEFAULTS_DIFFER}
+        properties = 0
+        for n in self.properties:
+            if n.replace("_", "") in differ:
+                continue
+            try:
+                theirs = getattr(ref, n)
+            except AttributeError:  # write-only
+                continue
+            if plain(theirs):
+                self.assertEqual(getattr(m, n), theirs, n)
+                properties += 1
         self.assertEqual(m.GetMaxMemoryInBytes(), 0)
-        fvtest.log("  %d getters give VTK's defaults; MaxMemoryInBytes is 0 (the device's "
-                   "limit) where VTK's is %d" % (len(compared), ref.GetMaxMemoryInBytes()))
+        fvtest.log("  %d getters and %d wrapped properties give VTK's defaults; "
+                   "MaxMemoryInBytes is 0 (the device's limit) where VTK's is %d"
+                   % (len(compared), properties, ref.GetMaxMemoryInBytes()))
 
     def test_every_method(self):
         """Each public method called with a valid argument, each setting checked."""
