@@ -7,7 +7,7 @@
 #     paraview-dev (headers and CMake package, without its -dev dependencies), all unpacked
 #     with dpkg-deb -x into build/pv6-sdk/root;
 #   - the CMake package patched (inside root/ only) so that find_package(ParaView) looks for
-#     MPI and Python only: every other package it wants (Qt, GDAL, ...) is skipped and every
+#     Threads and MPI only: every other package it wants (Qt, GDAL, ...) is skipped and every
 #     imported target it names from them is an empty stand-in;
 #   - bin/: pvbatch, pvpython, paraview, mpiexec (and the programs they start) that run
 #     unstable's programs through unstable's dynamic loader and libraries (they need its
@@ -21,21 +21,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SDK=$PWD/build/pv6-sdk
 ARCH=x86_64-linux-gnu
-APT="$SDK/apt"
-mkdir -p "$APT/etc/preferences.d" "$APT/etc/sources.list.d" "$APT/state/lists/partial" \
-  "$APT/cache/archives/partial"
-echo "deb [signed-by=/usr/share/keyrings/debian-archive-keyring.gpg] http://deb.debian.org/debian sid main" \
-  >"$APT/etc/sources.list"
+. scripts/sdk/sid-apt.sh
 # An empty dpkg status: apt resolves the whole closure, as for an empty system.
-: >"$APT/state/status.empty"
-apt_opts=(-o "Dir::Etc=$APT/etc" -o "Dir::State=$APT/state" -o "Dir::Cache=$APT/cache"
-  -o "Dir::State::status=$APT/state/status.empty" -o Debug::NoLocking=1
-  -o APT::Sandbox::User=root -o Acquire::Languages=none)
-if [ -z "$(find "$APT/state/lists" -maxdepth 1 -name '*Packages*' -mmin -720 2>/dev/null)" ]; then
-  apt-get "${apt_opts[@]}" -qq update
-fi
-PV_VERSION=$(apt-cache "${apt_opts[@]}" show --no-all-versions paraview-dev |
-  sed -n 's/^Version: \([0-9.]*\)+.*/\1/p')
+sid_apt_init "$SDK/apt" closure
+PV_VERSION=$(sid_version paraview-dev)
 mm=${PV_VERSION%.*}
 if [ -f "$SDK/sdk.env" ] && grep -qx "PARAVIEW_VERSION=$PV_VERSION" "$SDK/sdk.env"; then
   echo "$SDK/sdk.env"
@@ -61,19 +50,15 @@ fi
 # The runtime closure (no recommends; mesa-vulkan-drivers: lavapipe, the Vulkan device of
 # ferrovol beside Mesa's OpenGL, of the same Mesa) and paraview-dev alone (its dependencies are -dev
 # packages of GDAL and Eigen, which a plugin that uses neither does not need).
-mkdir -p "$SDK/debs/partial" "$SDK/root"
-apt-get "${apt_opts[@]}" -qq -o "Dir::Cache::archives=$SDK/debs" install --download-only \
+mkdir -p "$SDK/debs/partial"
+sid_apt -qq -o "Dir::Cache::archives=$SDK/debs" install --download-only \
   --no-install-recommends paraview python3-paraview python3-numpy mpi-default-bin \
-  mesa-vulkan-drivers 2>&1 |
-  grep -v "^W: Download is performed unsandboxed" || true
-(cd "$SDK/debs" && apt-get "${apt_opts[@]}" -qq download paraview-dev 2>&1 |
-  grep -v "^W: Download is performed unsandboxed" || true)
+  mesa-vulkan-drivers
+sid_download "$SDK/debs" paraview-dev
 ndebs=$(find "$SDK/debs" -maxdepth 1 -name '*.deb' | wc -l)
 mb=$(du -sm "$SDK/debs" | cut -f1)
 t1=$(date +%s)
-for deb in "$SDK"/debs/*.deb; do
-  dpkg-deb -x "$deb" "$SDK/root"
-done
+sid_unpack "$SDK/root" "$SDK"/debs/*.deb
 rm -rf "$SDK/debs"
 t2=$(date +%s)
 echo "pv6-sdk: $ndebs packages, $mb MB downloaded in $((t1 - t0)) s, unpacked in $((t2 - t1)) s" \
@@ -81,12 +66,8 @@ echo "pv6-sdk: $ndebs packages, $mb MB downloaded in $((t1 - t0)) s, unpacked in
 
 # Headers and CMake package of VTK 9.6 (ParaView's CMake package finds VTK as an external
 # package) and VTK's wrapping tools (vtk9: vtkWrapHierarchy); alone, like paraview-dev.
-mkdir -p "$SDK/debs"
-(cd "$SDK/debs" && apt-get "${apt_opts[@]}" -qq download libvtk9-dev vtk9 2>&1 |
-  grep -v "^W: Download is performed unsandboxed" || true)
-for deb in "$SDK"/debs/*.deb; do
-  dpkg-deb -x "$deb" "$SDK/root"
-done
+sid_download "$SDK/debs" libvtk9-dev vtk9
+sid_unpack "$SDK/root" "$SDK"/debs/*.deb
 rm -rf "$SDK/debs"
 
 R=$SDK/root
@@ -140,49 +121,11 @@ ln -sf mpiexec.openmpi "$SDK/bin/mpiexec"
 ln -sf mpiexec.openmpi "$SDK/bin/mpirun"
 "$SDK/bin/pvbatch" --version >/dev/null
 
-# CMake packages: every file the targets name that is absent (Java, static libraries of
-# packages not unpacked, ...) becomes an empty file, and of the packages VTK's and ParaView's
-# modules look for only Threads and MPI are looked for (the machine's; unstable's libmpi.so.40
-# is what runs); every other imported target the targets name (Qt, HDF5, TBB, ...) is an
-# empty stand-in.
-python3 - "$L/cmake/vtk-$(ls "$L/cmake" | sed -n 's/^vtk-//p' | head -1)" \
-  "$L/cmake/paraview-$mm" "$R/usr" <<'EOF'
-import pathlib, re, sys
-vtk, pv, usr = (pathlib.Path(p) for p in sys.argv[1:4])
-keep = ("VTK::", "ParaView::", "Threads::", "MPI::")
-macro = (
-    "# ferrovol's SDK (scripts/pv6-sdk.sh): only these packages are looked for.\n"
-    "macro(_ferrovol_sdk_find_package name)\n"
-    "  if (\"${name}\" STREQUAL \"Threads\" OR \"${name}\" STREQUAL \"MPI\")\n"
-    "    find_package(${name} ${ARGN})\n"
-    "  else ()\n"
-    "    set(${name}_FOUND 1)\n"
-    "  endif ()\n"
-    "endmacro ()\n")
-for cmake, config_name in ((vtk, "vtk-config.cmake"), (pv, "paraview-config.cmake")):
-    external = set()
-    for targets in cmake.glob("*-targets*.cmake"):
-        text = targets.read_text()
-        for name in re.findall(r"[A-Za-z0-9_]+::[A-Za-z0-9_:]+", text):
-            if not name.startswith(keep):
-                external.add(name)
-        for ref in set(re.findall(r'\$\{_IMPORT_PREFIX\}/([^";]*)', text)):
-            path = usr / ref
-            if not path.exists():
-                path.parent.mkdir(parents=True, exist_ok=True)
-                path.write_bytes(b"")
-    for finds in cmake.glob("*-vtk-module-find-packages.cmake"):
-        finds.write_text(macro + re.sub(r"(?m)^(\s*)find_package\(", r"\1_ferrovol_sdk_find_package(",
-                                        finds.read_text()))
-    config = cmake / config_name
-    text = config.read_text()
-    text = text.replace('_HAS_VISKORES" "ON"', '_HAS_VISKORES" "OFF"')
-    stubs = "".join(f"if (NOT TARGET {t})\n  add_library({t} INTERFACE IMPORTED)\nendif ()\n"
-                    for t in sorted(external))
-    first = re.search(r'(?m)^\s*include\("\$\{CMAKE_CURRENT_LIST_DIR\}/[^"]*-targets\.cmake"\)', text)
-    text = text[:first.start()] + "\n# scripts/pv6-sdk.sh: stand-ins\n" + stubs + text[first.start():]
-    config.write_text(text)
-EOF
+# CMake packages (scripts/sdk/cmake_package.py): of the packages VTK's and ParaView's modules
+# look for only Threads and MPI are looked for (the machine's; unstable's libmpi.so.40 is what
+# runs), the rest are stand-ins.
+python3 scripts/sdk/cmake_package.py "$R/usr" "$(ls -d "$L"/cmake/vtk-9.*)" \
+  "$L/cmake/paraview-$mm" --find Threads --find MPI
 
 cat >"$SDK/sdk.env" <<EOF
 PARAVIEW_VERSION=$PV_VERSION

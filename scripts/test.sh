@@ -110,7 +110,8 @@ suite lint
 suite build-rust
 suite build-vtk
 suite build-vtk-pip
-# Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the ParaView plugin.
+# Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the ParaView plugin, the VTK
+# module's suites on pip's VTK.
 (
   suite rust-tests
   suite lint-fuzz
@@ -121,7 +122,7 @@ suite build-vtk-pip
 ) &
 lane1=$!
 # Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the C
-# ABI under sanitizers.
+# ABI under sanitizers, the quick regression on pip's VTK, the wheel in a new venv.
 (
   suite vtk
   suite build-vtk-asan

@@ -15,18 +15,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SDK=$PWD/build/vtk-sdk
 ARCH=x86_64-linux-gnu
-APT="$SDK/apt"
-mkdir -p "$APT/etc/preferences.d" "$APT/etc/sources.list.d" "$APT/state/lists/partial" \
-  "$APT/cache/archives/partial"
-echo "deb [signed-by=/usr/share/keyrings/debian-archive-keyring.gpg] http://deb.debian.org/debian sid main" \
-  >"$APT/etc/sources.list"
-apt_opts=(-o "Dir::Etc=$APT/etc" -o "Dir::State=$APT/state" -o "Dir::Cache=$APT/cache"
-  -o Debug::NoLocking=1 -o APT::Sandbox::User=root)
-if [ -z "$(find "$APT/state/lists" -maxdepth 1 -name '*Packages*' -mmin -720 2>/dev/null)" ]; then
-  apt-get "${apt_opts[@]}" -qq update
-fi
-debian_version=$(apt-cache "${apt_opts[@]}" show --no-all-versions libvtk9-dev |
-  sed -n 's/^Version: \([0-9.]*\)+.*/\1/p')
+. scripts/sdk/sid-apt.sh
+sid_apt_init "$SDK/apt"
+debian_version=$(sid_version libvtk9-dev)
 VTK_VERSION=${1:-$debian_version}
 if [ "$VTK_VERSION" != "$debian_version" ]; then
   echo "vtk-sdk: Debian unstable serves VTK $debian_version, not $VTK_VERSION: the headers and" \
@@ -53,13 +44,10 @@ wheel_python=$("$SDK/venv/bin/python" -c 'import sys; print("%d.%d" % sys.versio
 
 # Debian's files: headers + CMake package (root/usr), the wrapping tools and the runtime they
 # need (tools/).
-mkdir -p "$SDK/debs" "$SDK/root" "$SDK/tools"
-(cd "$SDK/debs" && apt-get "${apt_opts[@]}" -qq download libvtk9-dev vtk9 python3-vtk9 \
-  "libvtk$mm" libc6 libstdc++6 libgcc-s1 2>&1 | grep -v "^W: Download is performed unsandboxed" || true)
-dpkg-deb -x "$SDK"/debs/libvtk9-dev_*.deb "$SDK/root"
-for deb in vtk9 python3-vtk9 "libvtk$mm" libc6 libstdc++6 libgcc-s1; do
-  dpkg-deb -x "$SDK"/debs/"${deb}"_*.deb "$SDK/tools"
-done
+sid_download "$SDK/debs/dev" libvtk9-dev
+sid_download "$SDK/debs/tools" vtk9 python3-vtk9 "libvtk$mm" libc6 libstdc++6 libgcc-s1
+sid_unpack "$SDK/root" "$SDK"/debs/dev/*.deb
+sid_unpack "$SDK/tools" "$SDK"/debs/tools/*.deb
 rm -rf "$SDK/debs"
 # The wrapping's hierarchy files ship with the libraries' package.
 cp -r "$SDK/tools/usr/lib/$ARCH/vtk-$mm" "$SDK/root/usr/lib/$ARCH/"
@@ -78,10 +66,10 @@ done
 "$SDK/root/usr/bin/vtkWrapPython-$mm" --version >/dev/null
 
 # Files: every library path the CMake package names is the wheel's library of that module
-# (libvtkX-9.6.so.9.6 -> vtkmodules/libvtkX.so); any other file it names that Debian's
-# packages here lack (modules the wheel lacks, Debian's Python modules, Java tools) is an
-# empty file, which only a build that used it would notice. The wheel's own names sit beside
-# them, where the linker looks for the libraries those depend on.
+# (libvtkX-9.6.so.9.6 -> vtkmodules/libvtkX.so); the wheel's own names sit beside them, where
+# the linker looks for the libraries those depend on. Dependencies: the wheel's libraries
+# carry their own, so of the packages Debian's VTK looks for only Python (the wrapping
+# compiles against it) and Threads are found (scripts/sdk/cmake_package.py: the rest).
 libdir="$SDK/root/usr/lib/$ARCH"
 prefix='${_IMPORT_PREFIX}/'
 grep -ho "$prefix[^\"]*" "$libdir/cmake/vtk-$mm"/*-targets-*.cmake | sort -u |
@@ -94,51 +82,13 @@ grep -ho "$prefix[^\"]*" "$libdir/cmake/vtk-$mm"/*-targets-*.cmake | sort -u |
     [[ $module == vtkWrappingPythonCore* ]] && module=vtkWrappingPythonCore$wheel_python
     if [[ $name == libvtk*-"$mm".so* ]] && [ -f "$wheel_libs/lib$module.so" ]; then
       ln -sf "$wheel_libs/lib$module.so" "$path"
-    elif [ ! -e "$path" ]; then
-      mkdir -p "$(dirname "$path")"
-      : >"$path"
     fi
   done
 for lib in "$wheel_libs"/lib*.so*; do
   ln -sf "$lib" "$libdir/$(basename "$lib")"
 done
-
-# Dependencies: the wheel's libraries carry their own, so of the packages Debian's VTK looks
-# for only Python (the wrapping compiles against it) and Threads are found; every other
-# imported target its targets name (TBB, Qt, HDF5, Viskores …) is an empty stand-in.
-"$SDK/venv/bin/python" - "$libdir/cmake/vtk-$mm" <<'EOF'
-import pathlib, re, sys
-cmake = pathlib.Path(sys.argv[1])
-config = cmake / "vtk-config.cmake"
-text = config.read_text()
-text = text.replace('_HAS_VISKORES" "ON"', '_HAS_VISKORES" "OFF"')
-external = set()
-for targets in cmake.glob("*-targets.cmake"):
-    for name in re.findall(r"[A-Za-z0-9_]+::[A-Za-z0-9_:]+", targets.read_text()):
-        if not name.startswith(("VTK::", "Python3::", "Threads::")):
-            external.add(name)
-finds = cmake / "VTK-vtk-module-find-packages.cmake"
-body = re.sub(r"(?m)^(\s*)find_package\(", r"\1_ferrovol_sdk_find_package(", finds.read_text())
-stubs = "".join(
-    f"if (NOT TARGET {t})\n  add_library({t} INTERFACE IMPORTED)\nendif ()\n"
-    for t in sorted(external))
-include = 'include("${CMAKE_CURRENT_LIST_DIR}/${CMAKE_FIND_PACKAGE_NAME}-targets.cmake")'
-config.write_text(text.replace(include, stubs + include, 1))
-finds.write_text(
-    "# ferrovol's SDK (scripts/vtk-sdk.sh): only these packages are looked for.\n"
-    "macro(_ferrovol_sdk_find_package name)\n"
-    "  if (\"${name}\" STREQUAL \"Python3\")\n"
-    "    # the venv's Python, whichever version the wheel is for\n"
-    "    set(_ferrovol_sdk_args ${ARGN})\n"
-    "    list(POP_FRONT _ferrovol_sdk_args)\n"
-    "    find_package(Python3 ${_ferrovol_sdk_args})\n"
-    "  elseif (\"${name}\" STREQUAL \"Threads\")\n"
-    "    find_package(${name} ${ARGN})\n"
-    "  else ()\n"
-    "    set(${name}_FOUND 1)\n"
-    "  endif ()\n"
-    "endmacro ()\n" + body)
-EOF
+python3 scripts/sdk/cmake_package.py "$SDK/root/usr" "$libdir/cmake/vtk-$mm" \
+  --find Python3 --find Threads
 
 cat >"$SDK/sdk.env" <<EOF
 VTK_VERSION=$VTK_VERSION

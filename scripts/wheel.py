@@ -7,7 +7,9 @@ against: the wheel requires exactly that version (the module calls VTK's C++ API
 no ABI across versions) and is tagged for that Python. The package `ferrovol` holds the
 wrapped module, libvtkFerroVolume.so and libferrovol.so, found through RUNPATH $ORIGIN and
 $ORIGIN/../vtkmodules (the vtk wheel's libraries), so nothing has to be set to import it;
-and the C and C++ headers (ferrovol/include).
+the C and C++ headers (ferrovol/include); and a CMake package for C and C++ programs of the
+C ABI (ferrovol/cmake: find_package(ferrovol) gives ferrovol::ferrovol;
+ferrovol.get_cmake_dir() says where it is).
 """
 import base64
 import hashlib
@@ -39,6 +41,39 @@ def record_line(path, arcname):
         data = f.read()
     digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
     return f"{arcname},sha256={digest},{len(data)}"
+
+
+def cmake_package(version):
+    """ferrovol-config.cmake and its version file: ferrovol::ferrovol, the wheel's
+    libferrovol.so and headers, wherever pip put the package."""
+    config = (
+        "# ferrovol's C ABI from its wheel (scripts/wheel.py): ferrovol::ferrovol.\n"
+        "get_filename_component(_ferrovol_package \"${CMAKE_CURRENT_LIST_DIR}/..\" ABSOLUTE)\n"
+        "if (NOT TARGET ferrovol::ferrovol)\n"
+        "  add_library(ferrovol::ferrovol SHARED IMPORTED)\n"
+        "  set_target_properties(ferrovol::ferrovol PROPERTIES\n"
+        "    IMPORTED_LOCATION \"${_ferrovol_package}/libferrovol.so\"\n"
+        "    IMPORTED_NO_SONAME TRUE\n"
+        "    INTERFACE_INCLUDE_DIRECTORIES \"${_ferrovol_package}/include\")\n"
+        "endif ()\n"
+        "set(ferrovol_INCLUDE_DIR \"${_ferrovol_package}/include\")\n"
+        "set(ferrovol_LIBRARY \"${_ferrovol_package}/libferrovol.so\")\n"
+        "unset(_ferrovol_package)\n")
+    # (the C ABI is stable within a major version: the ABI's own rule, fv_version_major)
+    major = version.split(".")[0]
+    config_version = (
+        f"set(PACKAGE_VERSION \"{version}\")\n"
+        "if (PACKAGE_FIND_VERSION VERSION_GREATER PACKAGE_VERSION OR\n"
+        f"    NOT PACKAGE_FIND_VERSION_MAJOR STREQUAL \"{major}\")\n"
+        "  set(PACKAGE_VERSION_COMPATIBLE FALSE)\n"
+        "else ()\n"
+        "  set(PACKAGE_VERSION_COMPATIBLE TRUE)\n"
+        "  if (PACKAGE_FIND_VERSION STREQUAL PACKAGE_VERSION)\n"
+        "    set(PACKAGE_VERSION_EXACT TRUE)\n"
+        "  endif ()\n"
+        "endif ()\n")
+    return {"ferrovol/cmake/ferrovol-config.cmake": config,
+            "ferrovol/cmake/ferrovol-config-version.cmake": config_version}
 
 
 def main():
@@ -109,8 +144,10 @@ def main():
                                         staged], check=True)
                 whl.write(staged, arcname)
                 records.append(record_line(staged, arcname))
-            for arcname, text in ((f"{info}/METADATA", metadata), (f"{info}/WHEEL", wheel),
-                                  (f"{info}/top_level.txt", "ferrovol\n")):
+            generated = cmake_package(version)
+            generated.update({f"{info}/METADATA": metadata, f"{info}/WHEEL": wheel,
+                              f"{info}/top_level.txt": "ferrovol\n"})
+            for arcname, text in sorted(generated.items()):
                 staged = os.path.join(tmp, arcname)
                 os.makedirs(os.path.dirname(staged), exist_ok=True)
                 with open(staged, "w", encoding="utf-8") as f:

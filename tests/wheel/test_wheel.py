@@ -8,6 +8,7 @@ scene through PyVista, and path tracing refining by itself in an interactive Plo
 import os
 import subprocess
 import sys
+import tempfile
 import time
 import unittest
 
@@ -96,6 +97,38 @@ class Wheel(unittest.TestCase):
         log("import:", out.stdout.strip(), out.stderr.strip())
         self.assertEqual(out.returncode, 0, out.stderr)
         self.assertIn(sys.prefix, out.stdout)
+
+    def test_c_program_through_the_cmake_package(self):
+        """A C program of the C ABI (ffi/tests/c/render_demo.c) built by CMake with
+        find_package(ferrovol) from the wheel's package, run: a non-blank image."""
+        source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "ffi",
+                              "tests", "c")
+        with tempfile.TemporaryDirectory() as tmp:
+            with open(os.path.join(tmp, "CMakeLists.txt"), "w", encoding="utf-8") as f:
+                f.write("cmake_minimum_required(VERSION 3.16)\n"
+                        "project(demo C)\n"
+                        "find_package(ferrovol 0.1 REQUIRED)\n"
+                        "add_executable(render_demo %s/render_demo.c)\n"
+                        "target_include_directories(render_demo PRIVATE %s)\n"
+                        "target_link_libraries(render_demo PRIVATE ferrovol::ferrovol m)\n"
+                        % (source, source))
+            build = os.path.join(tmp, "build")
+            for cmd in (["cmake", "-S", tmp, "-B", build,
+                         "-Dferrovol_DIR=" + ferrovol.get_cmake_dir()],
+                        ["cmake", "--build", build],
+                        [os.path.join(build, "render_demo"), os.path.join(tmp, "c.png"), "96",
+                         "21"]):
+                out = subprocess.run(cmd, capture_output=True, text=True, check=False)
+                self.assertEqual(out.returncode, 0, "%s: %s%s" % (cmd, out.stdout, out.stderr))
+            reader = vtk.vtkPNGReader()
+            reader.SetFileName(os.path.join(tmp, "c.png"))
+            reader.Update()
+            pixels = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())
+        log("C program through find_package(ferrovol) from %s: %d pixels, %.1f levels "
+            "standard deviation" % (ferrovol.get_cmake_dir(), len(pixels), pixels.std()))
+        self.assertTrue(os.path.isfile(os.path.join(ferrovol.get_include(), "ferrovol.hpp")))
+        self.assertEqual(len(pixels), 96 * 96)
+        self.assertGreater(pixels.std(), 5.0)
 
     def test_matches_this_vtk(self):
         """Composite and MIP at SSIM >= 0.98 against this VTK's own GPU mapper, shaded at

@@ -7,7 +7,11 @@ PyVista (or any vtkVolume drawn by another mapper): one call puts ferrovol under
 
     actor = plotter.add_volume(grid, cmap="bone")
     ferrovol.use(actor, path_trace=True)
+
+C and C++ programs of the C ABI (wheel only): get_include(), get_cmake_dir().
 """
+import os
+
 # VTK's own modules first, so the wrapped base classes are registered.
 import vtkmodules.vtkRenderingCore  # noqa: F401
 import vtkmodules.vtkRenderingVolume  # noqa: F401
@@ -79,3 +83,26 @@ def use(volume, path_trace=False, **settings):
         setter(*value) if isinstance(value, tuple) else setter(value)
     volume.SetMapper(mapper)
     return mapper
+
+
+def _packaged(name, what):
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), name)
+    if not os.path.isdir(path):
+        raise FileNotFoundError(
+            f"{path}: this ferrovol was not installed from its wheel, which holds {what}; in "
+            "a source tree the C ABI's headers are ffi/include, its library "
+            "target/release/libferrovol.so")
+    return path
+
+
+def get_include():
+    """The folder of the C and C++ headers (ferrovol.h, ferrovol.hpp, vtkFerroVolumeMapper.h)
+    in the wheel."""
+    return _packaged("include", "the headers")
+
+
+def get_cmake_dir():
+    """The folder of the wheel's CMake package for C and C++ programs of the C ABI:
+    cmake -Dferrovol_DIR=$(python -c 'import ferrovol; print(ferrovol.get_cmake_dir())'),
+    then find_package(ferrovol) and target_link_libraries(app PRIVATE ferrovol::ferrovol)."""
+    return _packaged("cmake", "the CMake package")
