@@ -32,7 +32,7 @@ CARGO ?= cargo
 export XDG_RUNTIME_DIR ?= /tmp/ferrovol-xdg-$(shell id -u)
 FERROVOL := target/release/ferrovol
 
-.PHONY: deps build demo test check lint lint-workspace lint-fuzz bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
+.PHONY: deps build demo test check lint lint-workspace lint-fuzz lint-publish bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
         regression regression-quick fuzz-smoke soak sanitize vtk-asan vtk-pip wheel \
         test-build-vtk-pip test-vtk-pip test-wheel test-regression-quick-pip test-build-rust test-rust test-sanitize test-build-vtk test-vtk test-build-vtk-asan \
         test-vtk-asan test-build-paraview test-paraview test-regression-quick
@@ -165,7 +165,7 @@ demo: build
 	$(FERROVOL) render --demo wavelet --shade --size 640x640 --azimuth 30 --elevation 20 --out build/demo.png
 	@echo "demo image: $(CURDIR)/build/demo.png"
 
-lint: deps lint-workspace lint-fuzz
+lint: deps lint-workspace lint-fuzz lint-publish
 lint-workspace:
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
@@ -176,6 +176,10 @@ lint-workspace:
 lint-fuzz:
 	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
 	$(CARGO) clippy --locked --manifest-path fuzz/Cargo.toml --all-targets -- -D warnings
+# The library crates as crates.io would take them: packaged alone (the shaders inside
+# ferrovol-core) and built from the package.
+lint-publish:
+	$(CARGO) publish --dry-run --locked --allow-dirty -p ferrovol-core -p ferrovol-io
 
 # Everything CI runs (scripts/test.sh: the builds, then the suites in two lanes, each
 # suite's log in build/test-logs and its wall time; `scripts/test.sh NAME...` runs some).

@@ -23,7 +23,7 @@ export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
 SUITES=(lint build-rust build-vtk build-vtk-pip
-        rust-tests lint-fuzz fuzz-smoke build-paraview paraview vtk-pip
+        rust-tests lint-fuzz lint-publish fuzz-smoke build-paraview paraview vtk-pip
         vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
@@ -39,6 +39,7 @@ declare -A NEEDS=(
 declare -A CMD=(
   [lint]=lint-workspace
   [lint-fuzz]=lint-fuzz
+  [lint-publish]=lint-publish
   [build-rust]=test-build-rust
   [build-vtk]=test-build-vtk
   [rust-tests]=test-rust
@@ -110,11 +111,12 @@ suite lint
 suite build-rust
 suite build-vtk
 suite build-vtk-pip
-# Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the ParaView plugin, the VTK
-# module's suites on pip's VTK.
+# Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the crates' publish dry run,
+# the ParaView plugin, the VTK module's suites on pip's VTK.
 (
   suite rust-tests
   suite lint-fuzz
+  suite lint-publish
   suite fuzz-smoke
   suite build-paraview
   suite paraview

@@ -1,111 +1,90 @@
-//! WGSL sources. Each pass is one file in shaders/; shared pieces live in shaders/lib/ and
-//! are pulled in with `#include "lib/NAME.wgsl"` lines, expanded here (each file once). The
-//! constants shared with Rust are not written in WGSL: [`compose`] declares them first, from
-//! [`super::uniforms::WGSL_CONSTANTS`].
+//! WGSL sources. Each pass is one file in the crate's shaders/; shared pieces live in
+//! shaders/lib/ and are pulled in with `#include "lib/NAME.wgsl"` lines, expanded here (each
+//! file once). The constants shared with Rust are not written in WGSL: [`compose`] declares
+//! them first, from [`super::uniforms::WGSL_CONSTANTS`].
 
 /// (path relative to shaders/, source) for every WGSL file.
 pub const FILES: &[(&str, &str)] = &[
     (
         "lib/common.wgsl",
-        include_str!("../../../shaders/lib/common.wgsl"),
+        include_str!("../../shaders/lib/common.wgsl"),
     ),
-    (
-        "lib/ray.wgsl",
-        include_str!("../../../shaders/lib/ray.wgsl"),
-    ),
+    ("lib/ray.wgsl", include_str!("../../shaders/lib/ray.wgsl")),
     (
         "lib/volume.wgsl",
-        include_str!("../../../shaders/lib/volume.wgsl"),
+        include_str!("../../shaders/lib/volume.wgsl"),
     ),
     (
         "lib/shading.wgsl",
-        include_str!("../../../shaders/lib/shading.wgsl"),
+        include_str!("../../shaders/lib/shading.wgsl"),
     ),
     (
         "lib/output.wgsl",
-        include_str!("../../../shaders/lib/output.wgsl"),
+        include_str!("../../shaders/lib/output.wgsl"),
     ),
     (
         "lib/march.wgsl",
-        include_str!("../../../shaders/lib/march.wgsl"),
+        include_str!("../../shaders/lib/march.wgsl"),
     ),
     (
         "lib/envmap.wgsl",
-        include_str!("../../../shaders/lib/envmap.wgsl"),
+        include_str!("../../shaders/lib/envmap.wgsl"),
     ),
-    (
-        "lib/iso.wgsl",
-        include_str!("../../../shaders/lib/iso.wgsl"),
-    ),
+    ("lib/iso.wgsl", include_str!("../../shaders/lib/iso.wgsl")),
     (
         "lib/phase.wgsl",
-        include_str!("../../../shaders/lib/phase.wgsl"),
+        include_str!("../../shaders/lib/phase.wgsl"),
     ),
-    (
-        "lib/bsdf.wgsl",
-        include_str!("../../../shaders/lib/bsdf.wgsl"),
-    ),
+    ("lib/bsdf.wgsl", include_str!("../../shaders/lib/bsdf.wgsl")),
     (
         "lib/shadow.wgsl",
-        include_str!("../../../shaders/lib/shadow.wgsl"),
+        include_str!("../../shaders/lib/shadow.wgsl"),
     ),
     (
         "lib/blanking.wgsl",
-        include_str!("../../../shaders/lib/blanking.wgsl"),
+        include_str!("../../shaders/lib/blanking.wgsl"),
     ),
     (
         "lib/rectilinear.wgsl",
-        include_str!("../../../shaders/lib/rectilinear.wgsl"),
+        include_str!("../../shaders/lib/rectilinear.wgsl"),
     ),
     (
         "lib/table2d.wgsl",
-        include_str!("../../../shaders/lib/table2d.wgsl"),
+        include_str!("../../shaders/lib/table2d.wgsl"),
     ),
     (
         "lib/intermix.wgsl",
-        include_str!("../../../shaders/lib/intermix.wgsl"),
+        include_str!("../../shaders/lib/intermix.wgsl"),
     ),
     (
         "lib/surface.wgsl",
-        include_str!("../../../shaders/lib/surface.wgsl"),
+        include_str!("../../shaders/lib/surface.wgsl"),
     ),
-    ("dvr.wgsl", include_str!("../../../shaders/dvr.wgsl")),
-    (
-        "firsthit.wgsl",
-        include_str!("../../../shaders/firsthit.wgsl"),
-    ),
-    (
-        "deferred.wgsl",
-        include_str!("../../../shaders/deferred.wgsl"),
-    ),
+    ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
+    ("firsthit.wgsl", include_str!("../../shaders/firsthit.wgsl")),
+    ("deferred.wgsl", include_str!("../../shaders/deferred.wgsl")),
     (
         "environment.wgsl",
-        include_str!("../../../shaders/environment.wgsl"),
+        include_str!("../../shaders/environment.wgsl"),
     ),
     (
         "pathtrace.wgsl",
-        include_str!("../../../shaders/pathtrace.wgsl"),
+        include_str!("../../shaders/pathtrace.wgsl"),
     ),
     (
         "phase_test.wgsl",
-        include_str!("../../../shaders/phase_test.wgsl"),
+        include_str!("../../shaders/phase_test.wgsl"),
     ),
     (
         "pathtrace_show.wgsl",
-        include_str!("../../../shaders/pathtrace_show.wgsl"),
+        include_str!("../../shaders/pathtrace_show.wgsl"),
     ),
     (
         "depth_changed.wgsl",
-        include_str!("../../../shaders/depth_changed.wgsl"),
+        include_str!("../../shaders/depth_changed.wgsl"),
     ),
-    (
-        "denoise.wgsl",
-        include_str!("../../../shaders/denoise.wgsl"),
-    ),
-    (
-        "gradient.wgsl",
-        include_str!("../../../shaders/gradient.wgsl"),
-    ),
+    ("denoise.wgsl", include_str!("../../shaders/denoise.wgsl")),
+    ("gradient.wgsl", include_str!("../../shaders/gradient.wgsl")),
 ];
 
 /// The passes (entry files, not library pieces).
