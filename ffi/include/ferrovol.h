@@ -19,7 +19,7 @@
 /**
  * Minor version of this header.
  */
-#define FV_VERSION_MINOR 1
+#define FV_VERSION_MINOR 2
 
 /**
  * Patch version of this header.
@@ -453,6 +453,11 @@ typedef struct FvPlane {
  */
 typedef struct FvRenderParams {
   /**
+   * sizeof(this struct) as the caller's header declares it, written by fv_render_params_default; fields
+   * added in later minor versions take their defaults when it is smaller.
+   */
+  size_t size;
+  /**
    * One of FvBlendMode.
    */
   uint32_t blend_mode;
@@ -561,6 +566,15 @@ typedef struct FvRenderParams {
    */
   bool preintegration;
   /**
+   * An interactive frame: when the bricks it needs exceed the memory budget, draw in one
+   * pass rather than stream the volume itself in several (false, the default: the frame
+   * streams and equals the in-core image). Ray casting and isosurfaces (without ambient
+   * occlusion or scattering) draw the fine bricks resident and a coarser level's bricks
+   * where they are missing, and bring some of those their rays read for the next
+   * preview frame (FvResidency.stand_ins: 0 once complete).
+   */
+  bool preview_level;
+  /**
    * The plane FV_BLEND_MODE_SLICE draws, world coordinates (a non-zero normal; its sign
    * does not matter); ignored by the other blend modes.
    */
@@ -572,15 +586,6 @@ typedef struct FvRenderParams {
    * components'; 0 reads no label.
    */
   float mask_blend_factor;
-  /**
-   * An interactive frame: when the bricks it needs exceed the memory budget, draw in one
-   * pass rather than stream the volume itself in several (false, the default: the frame
-   * streams and equals the in-core image). Ray casting and isosurfaces (without ambient
-   * occlusion or scattering) draw the fine bricks resident and a coarser level's bricks
-   * where they are missing, and bring some of those their rays read for the next
-   * preview frame (FvResidency.stand_ins: 0 once complete).
-   */
-  bool preview_level;
   /**
    * One of FvQuadrature (default FV_QUADRATURE_VTK).
    */
@@ -604,6 +609,11 @@ typedef struct FvIsoValue {
  * Thread use: plain data.
  */
 typedef struct FvIsoParams {
+  /**
+   * sizeof(this struct) as the caller's header declares it, written by fv_iso_params_default; fields
+   * added in later minor versions take their defaults when it is smaller.
+   */
+  size_t size;
   /**
    * 1 to FV_MAX_ISO_VALUES entries of `values` are used.
    */
@@ -684,6 +694,11 @@ typedef struct FvIsoParams {
  * and change what you need. Thread use: plain data.
  */
 typedef struct FvPathTraceParams {
+  /**
+   * sizeof(this struct) as the caller's header declares it, written by fv_path_trace_params_default; fields
+   * added in later minor versions take their defaults when it is smaller.
+   */
+  size_t size;
   /**
    * Paths per pixel each frame adds (1 to 4096).
    */
@@ -1112,9 +1127,11 @@ enum FvStatus fv_renderer_set_lights(struct FvRenderer *renderer,
 
 /**
  * Fills `*params` with the defaults (VTK's: composite, linear, automatic sample
- * distance, no shading, early termination at 1 − 1/255).
+ * distance, no shading, early termination at 1 − 1/255). `size` is `sizeof *params`: it
+ * goes into `params->size`, which tells a later library which fields the program knows
+ * (those it does not take their defaults).
  */
-enum FvStatus fv_render_params_default(struct FvRenderParams *params);
+enum FvStatus fv_render_params_default(struct FvRenderParams *params, size_t size);
 
 /**
  * Sets the render parameters (validated: out-of-range values are refused and the previous
@@ -1127,9 +1144,9 @@ enum FvStatus fv_renderer_set_params(struct FvRenderer *renderer,
  * Fills `*params` with the isosurface defaults (no iso-values yet: set `value_count` and
  * `values`; 8 bisection steps, 4 layers, 16 importance-sampled specular samples,
  * shininess 8 to 64 by gradient magnitude, no Fresnel, no ambient occlusion, environment
- * weight 0.6, no background).
+ * weight 0.6, no background). `size` is `sizeof *params` (see fv_render_params_default).
  */
-enum FvStatus fv_iso_params_default(struct FvIsoParams *params);
+enum FvStatus fv_iso_params_default(struct FvIsoParams *params, size_t size);
 
 /**
  * Sets the isosurfaces and their shading for frames with FV_BLEND_MODE_ISOSURFACE
@@ -1155,8 +1172,9 @@ enum FvStatus fv_renderer_set_environment(struct FvRenderer *renderer,
 /**
  * Fills `*params` with the path tracing defaults (4 paths per pixel and frame, at most 64
  * scattering events, isotropic scattering, environment weight 1, no background, seed 0).
+ * `size` is `sizeof *params` (see fv_render_params_default).
  */
-enum FvStatus fv_path_trace_params_default(struct FvPathTraceParams *params);
+enum FvStatus fv_path_trace_params_default(struct FvPathTraceParams *params, size_t size);
 
 /**
  * Sets how frames with FV_BLEND_MODE_PATH_TRACE sample (validated: out-of-range values are

@@ -259,17 +259,17 @@ public:
   }
   static FvRenderParams default_params() {
     FvRenderParams p{};
-    check(fv_render_params_default(&p));
+    check(fv_render_params_default(&p, sizeof p));
     return p;
   }
   static FvIsoParams default_iso_params() {
     FvIsoParams p{};
-    check(fv_iso_params_default(&p));
+    check(fv_iso_params_default(&p, sizeof p));
     return p;
   }
   static FvPathTraceParams default_path_trace_params() {
     FvPathTraceParams p{};
-    check(fv_path_trace_params_default(&p));
+    check(fv_path_trace_params_default(&p, sizeof p));
     return p;
   }
   void set_volume(const Volume &v) { check(fv_renderer_set_volume(h_.get(), v.get())); }

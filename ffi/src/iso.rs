@@ -41,6 +41,9 @@ pub struct FvIsoValue {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct FvIsoParams {
+    /// sizeof(this struct) as the caller's header declares it, written by fv_iso_params_default; fields
+    /// added in later minor versions take their defaults when it is smaller.
+    pub size: usize,
     /// 1 to FV_MAX_ISO_VALUES entries of `values` are used.
     pub value_count: u32,
     pub values: [FvIsoValue; FV_MAX_ISO_VALUES],
@@ -82,6 +85,8 @@ pub struct FvIsoParams {
     pub scatter_fresnel: f32,
 }
 
+crate::sized::sized_params!(FvIsoParams, "FvIsoParams", scatter_fresnel: f32, 296);
+
 impl FvIsoParams {
     pub fn defaults() -> Self {
         let d = IsoParams::default();
@@ -93,6 +98,7 @@ impl FvIsoParams {
         };
         let ao = AmbientOcclusion::default();
         FvIsoParams {
+            size: std::mem::size_of::<FvIsoParams>(),
             value_count: 0,
             values: [FvIsoValue::default(); FV_MAX_ISO_VALUES],
             bisection_steps: d.bisection_steps,
@@ -217,6 +223,9 @@ pub enum FvScatterRegions {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct FvPathTraceParams {
+    /// sizeof(this struct) as the caller's header declares it, written by fv_path_trace_params_default; fields
+    /// added in later minor versions take their defaults when it is smaller.
+    pub size: usize,
     /// Paths per pixel each frame adds (1 to 4096).
     pub samples_per_frame: u32,
     /// Paths per pixel after which frames add none and show the converged image again (a
@@ -266,10 +275,13 @@ pub struct FvPathTraceParams {
     pub denoise_until: u32,
 }
 
+crate::sized::sized_params!(FvPathTraceParams, "FvPathTraceParams", denoise_until: u32, 80);
+
 impl FvPathTraceParams {
     pub fn defaults() -> Self {
         let d = PathTraceParams::default();
         FvPathTraceParams {
+            size: std::mem::size_of::<FvPathTraceParams>(),
             samples_per_frame: d.samples_per_frame,
             max_samples: d.max_samples,
             max_bounces: d.max_bounces,

@@ -14,6 +14,7 @@ mod frame;
 mod intermix;
 mod iso;
 mod renderer;
+mod sized;
 mod status;
 /// cbindgen:ignore
 #[cfg(feature = "test-hooks")]
@@ -43,7 +44,7 @@ use std::ffi::{c_char, c_void, CStr};
 /// Major version of this header; equals fv_version_major() of a compatible library.
 pub const FV_VERSION_MAJOR: u32 = 0;
 /// Minor version of this header.
-pub const FV_VERSION_MINOR: u32 = 1;
+pub const FV_VERSION_MINOR: u32 = 2;
 /// Patch version of this header.
 pub const FV_VERSION_PATCH: u32 = 0;
 

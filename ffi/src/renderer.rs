@@ -1,6 +1,7 @@
 //! The renderer: settings, frames, the shared output.
 
 use super::*;
+use crate::sized::{self, SizedParams};
 
 /// A renderer: the uploaded volume, transfer tables, pipelines and the frame it draws.
 /// Camera, lights and parameters persist between frames. Thread use: one thread at a
@@ -37,6 +38,19 @@ fn set_from<T: ToCore>(
 ) -> FvStatus {
     with_renderer(renderer, |r| {
         let v = const_ref(value, what)?.to_core()?;
+        apply(r, v)?;
+        Ok(())
+    })
+}
+
+/// As [`set_from`], for a struct that carries its size ([`sized::read`]).
+fn set_sized<T: ToCore + SizedParams>(
+    renderer: *mut FvRenderer,
+    value: *const T,
+    apply: impl FnOnce(&mut FvRenderer, T::Core) -> ferrovol_core::Result<()>,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        let v = sized::read(value, "params")?.to_core()?;
         apply(r, v)?;
         Ok(())
     })
@@ -221,13 +235,15 @@ pub unsafe extern "C" fn fv_renderer_set_lights(
 }
 
 /// Fills `*params` with the defaults (VTK's: composite, linear, automatic sample
-/// distance, no shading, early termination at 1 − 1/255).
+/// distance, no shading, early termination at 1 − 1/255). `size` is `sizeof *params`: it
+/// goes into `params->size`, which tells a later library which fields the program knows
+/// (those it does not take their defaults).
 #[no_mangle]
-pub unsafe extern "C" fn fv_render_params_default(params: *mut FvRenderParams) -> FvStatus {
-    guard(|| {
-        *mut_ref(params, "params")? = FvRenderParams::defaults();
-        Ok(())
-    })
+pub unsafe extern "C" fn fv_render_params_default(
+    params: *mut FvRenderParams,
+    size: usize,
+) -> FvStatus {
+    guard(|| sized::write_defaults(params, size, "params"))
 }
 
 /// Sets the render parameters (validated: out-of-range values are refused and the previous
@@ -237,7 +253,7 @@ pub unsafe extern "C" fn fv_renderer_set_params(
     renderer: *mut FvRenderer,
     params: *const FvRenderParams,
 ) -> FvStatus {
-    set_from(renderer, params, "params", |r, p| {
+    set_sized(renderer, params, |r, p| {
         r.params = p;
         Ok(())
     })
@@ -246,13 +262,10 @@ pub unsafe extern "C" fn fv_renderer_set_params(
 /// Fills `*params` with the isosurface defaults (no iso-values yet: set `value_count` and
 /// `values`; 8 bisection steps, 4 layers, 16 importance-sampled specular samples,
 /// shininess 8 to 64 by gradient magnitude, no Fresnel, no ambient occlusion, environment
-/// weight 0.6, no background).
+/// weight 0.6, no background). `size` is `sizeof *params` (see fv_render_params_default).
 #[no_mangle]
-pub unsafe extern "C" fn fv_iso_params_default(params: *mut FvIsoParams) -> FvStatus {
-    guard(|| {
-        *mut_ref(params, "params")? = FvIsoParams::defaults();
-        Ok(())
-    })
+pub unsafe extern "C" fn fv_iso_params_default(params: *mut FvIsoParams, size: usize) -> FvStatus {
+    guard(|| sized::write_defaults(params, size, "params"))
 }
 
 /// Sets the isosurfaces and their shading for frames with FV_BLEND_MODE_ISOSURFACE
@@ -262,7 +275,7 @@ pub unsafe extern "C" fn fv_renderer_set_isosurface(
     renderer: *mut FvRenderer,
     params: *const FvIsoParams,
 ) -> FvStatus {
-    set_from(renderer, params, "params", |r, p| r.r.set_isosurface(&p))
+    set_sized(renderer, params, |r, p| r.r.set_isosurface(&p))
 }
 
 /// Sets the environment that lights isosurfaces and path-traced media and builds its maps
@@ -303,12 +316,13 @@ pub unsafe extern "C" fn fv_renderer_set_environment(
 
 /// Fills `*params` with the path tracing defaults (4 paths per pixel and frame, at most 64
 /// scattering events, isotropic scattering, environment weight 1, no background, seed 0).
+/// `size` is `sizeof *params` (see fv_render_params_default).
 #[no_mangle]
-pub unsafe extern "C" fn fv_path_trace_params_default(params: *mut FvPathTraceParams) -> FvStatus {
-    guard(|| {
-        *mut_ref(params, "params")? = FvPathTraceParams::defaults();
-        Ok(())
-    })
+pub unsafe extern "C" fn fv_path_trace_params_default(
+    params: *mut FvPathTraceParams,
+    size: usize,
+) -> FvStatus {
+    guard(|| sized::write_defaults(params, size, "params"))
 }
 
 /// Sets how frames with FV_BLEND_MODE_PATH_TRACE sample (validated: out-of-range values are
@@ -319,7 +333,7 @@ pub unsafe extern "C" fn fv_renderer_set_path_tracing(
     renderer: *mut FvRenderer,
     params: *const FvPathTraceParams,
 ) -> FvStatus {
-    set_from(renderer, params, "params", |r, p| r.r.set_path_tracing(&p))
+    set_sized(renderer, params, |r, p| r.r.set_path_tracing(&p))
 }
 
 /// Paths per pixel the last path-traced frame shows into `*samples` (0 before the first);

@@ -241,6 +241,9 @@ pub const FV_MAX_LIGHTS: usize = 8;
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct FvRenderParams {
+    /// sizeof(this struct) as the caller's header declares it, written by fv_render_params_default; fields
+    /// added in later minor versions take their defaults when it is smaller.
+    pub size: usize,
     /// One of FvBlendMode.
     pub blend_mode: u32,
     /// One of FvInterpolation.
@@ -309,6 +312,13 @@ pub struct FvRenderParams {
     /// independent components, without volumetric shadows (see RenderParams::preintegration
     /// in ferrovol-core). Off by default.
     pub preintegration: bool,
+    /// An interactive frame: when the bricks it needs exceed the memory budget, draw in one
+    /// pass rather than stream the volume itself in several (false, the default: the frame
+    /// streams and equals the in-core image). Ray casting and isosurfaces (without ambient
+    /// occlusion or scattering) draw the fine bricks resident and a coarser level's bricks
+    /// where they are missing, and bring some of those their rays read for the next
+    /// preview frame (FvResidency.stand_ins: 0 once complete).
+    pub preview_level: bool,
     /// The plane FV_BLEND_MODE_SLICE draws, world coordinates (a non-zero normal; its sign
     /// does not matter); ignored by the other blend modes.
     pub slice_plane: FvPlane,
@@ -317,13 +327,6 @@ pub struct FvRenderParams {
     /// from its label's functions (fv_transfer_function_set_label_*) rather than the
     /// components'; 0 reads no label.
     pub mask_blend_factor: f32,
-    /// An interactive frame: when the bricks it needs exceed the memory budget, draw in one
-    /// pass rather than stream the volume itself in several (false, the default: the frame
-    /// streams and equals the in-core image). Ray casting and isosurfaces (without ambient
-    /// occlusion or scattering) draw the fine bricks resident and a coarser level's bricks
-    /// where they are missing, and bring some of those their rays read for the next
-    /// preview frame (FvResidency.stand_ins: 0 once complete).
-    pub preview_level: bool,
     /// One of FvQuadrature (default FV_QUADRATURE_VTK).
     pub quadrature: u32,
 }
@@ -420,10 +423,13 @@ pub fn column_major(m: &[f64; 16]) -> DMat4 {
     DMat4::from_cols_array(m)
 }
 
+crate::sized::sized_params!(FvRenderParams, "FvRenderParams", quadrature: u32, 832);
+
 impl FvRenderParams {
     pub fn defaults() -> Self {
         let d = RenderParams::default();
         FvRenderParams {
+            size: std::mem::size_of::<FvRenderParams>(),
             blend_mode: FvBlendMode::Composite as u32,
             interpolation: FvInterpolation::Linear as u32,
             sample_distance: 0.0,

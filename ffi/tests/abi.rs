@@ -69,7 +69,7 @@ type NewTf = unsafe extern "C" fn(u32, bool, *mut H) -> FvStatus;
 type SetPoints = unsafe extern "C" fn(H, u32, *const f64, usize) -> FvStatus;
 type Render = unsafe extern "C" fn(H, u32, u32, *const f32, usize) -> FvStatus;
 type SetParams = unsafe extern "C" fn(H, *const FvRenderParams) -> FvStatus;
-type ParamsDefault = unsafe extern "C" fn(*mut FvRenderParams) -> FvStatus;
+type ParamsDefault = unsafe extern "C" fn(*mut FvRenderParams, usize) -> FvStatus;
 type SetCamera = unsafe extern "C" fn(H, *const FvCamera) -> FvStatus;
 type SetLights = unsafe extern "C" fn(H, *const FvLight, usize) -> FvStatus;
 type SetIso = unsafe extern "C" fn(H, *const FvIsoParams) -> FvStatus;
@@ -505,10 +505,32 @@ fn renderer_errors() {
         }
 
         let defaults = lib.f::<ParamsDefault>("fv_render_params_default");
-        lib.expect(defaults(null_mut()), Null, "params is NULL");
+        let size = size_of::<FvRenderParams>();
+        lib.expect(defaults(null_mut(), size), Null, "params is NULL");
         let mut from_c: FvRenderParams = std::mem::zeroed();
-        lib.ok(defaults(&mut from_c));
+        lib.ok(defaults(&mut from_c, size));
         assert_eq!(from_c.termination_threshold, 1.0 - 1.0 / 255.0);
+        assert_eq!(from_c.size, size);
+        // The size a struct carries: a program that zero-fills the struct instead of
+        // calling fv_render_params_default, or was built against a newer header, is told.
+        lib.expect(
+            defaults(&mut from_c, 4),
+            Invalid,
+            "FvRenderParams.size is 4",
+        );
+        let mut unsized_params = from_c;
+        unsized_params.size = 0;
+        lib.expect(
+            set_params(s.r, &unsized_params),
+            Invalid,
+            "FvRenderParams.size is 0",
+        );
+        unsized_params.size = size + 8;
+        lib.expect(
+            set_params(s.r, &unsized_params),
+            Invalid,
+            "built against a newer ferrovol.h",
+        );
 
         let set_cam = lib.f::<SetCamera>("fv_renderer_set_camera");
         let mut cam = camera([0.0; 3], [0.0; 3], [0.1, 100.0]);
@@ -929,10 +951,15 @@ fn isosurface_errors_and_a_frame() {
         lib.expect(render(s.r, 32, 32, null(), 0), Invalid, "iso-values");
 
         let mut iso: FvIsoParams = std::mem::zeroed();
-        let defaults =
-            lib.f::<unsafe extern "C" fn(*mut FvIsoParams) -> FvStatus>("fv_iso_params_default");
-        lib.expect(defaults(null_mut()), Null, "params is NULL");
-        lib.ok(defaults(&mut iso));
+        let defaults = lib.f::<unsafe extern "C" fn(*mut FvIsoParams, usize) -> FvStatus>(
+            "fv_iso_params_default",
+        );
+        lib.expect(
+            defaults(null_mut(), size_of_val(&iso)),
+            Null,
+            "params is NULL",
+        );
+        lib.ok(defaults(&mut iso, size_of_val(&iso)));
         assert_eq!(iso.bisection_steps, 8);
         lib.expect(set_iso(s.r, &iso), Invalid, "value_count 0");
         iso.value_count = 1;
@@ -1000,13 +1027,13 @@ fn path_tracing_accumulates_and_refuses_bad_settings() {
     p.blend_mode = FvBlendMode::PathTrace as u32;
     s.set_params(&p);
     let set_pt = lib.f::<SetPt>("fv_renderer_set_path_tracing");
-    let defaults = lib.f::<unsafe extern "C" fn(*mut FvPathTraceParams) -> FvStatus>(
+    let defaults = lib.f::<unsafe extern "C" fn(*mut FvPathTraceParams, usize) -> FvStatus>(
         "fv_path_trace_params_default",
     );
     // SAFETY: arguments follow the header; invalid ones are the test.
     unsafe {
         let mut pt: FvPathTraceParams = std::mem::zeroed();
-        lib.ok(defaults(&mut pt));
+        lib.ok(defaults(&mut pt, size_of_val(&pt)));
         type Edit = fn(&mut FvPathTraceParams);
         let cases: [(Edit, &str); 9] = [
             (|p| p.anisotropy = 1.0, "anisotropy 1"),

@@ -107,7 +107,7 @@ class Wheel(unittest.TestCase):
             with open(os.path.join(tmp, "CMakeLists.txt"), "w", encoding="utf-8") as f:
                 f.write("cmake_minimum_required(VERSION 3.16)\n"
                         "project(demo C)\n"
-                        "find_package(ferrovol 0.1 REQUIRED)\n"
+                        "find_package(ferrovol 0.2 REQUIRED)\n"
                         "add_executable(render_demo %s/render_demo.c)\n"
                         "target_include_directories(render_demo PRIVATE %s)\n"
                         "target_link_libraries(render_demo PRIVATE ferrovol::ferrovol m)\n"

@@ -112,7 +112,7 @@ int main(int argc, char **argv) {
   CHECK(fv_renderer_set_lights(renderer, &headlight, 1));
 
   FvRenderParams params;
-  CHECK(fv_render_params_default(&params));
+  CHECK(fv_render_params_default(&params, sizeof params));
   params.shade = true;
   CHECK(fv_renderer_set_params(renderer, &params));
 

@@ -70,7 +70,7 @@ static int make_renderer(FvRenderer **renderer, FvTransferFunction **tf) {
   FV_TRY(fv_transfer_function_set_opacity(*tf, 0, opacity, 3));
   FV_TRY(fv_renderer_set_transfer_function(*renderer, *tf));
   FvRenderParams params;
-  FV_TRY(fv_render_params_default(&params));
+  FV_TRY(fv_render_params_default(&params, sizeof params));
   params.shade = true;
   FV_TRY(fv_renderer_set_params(*renderer, &params));
   return 0;
