@@ -179,7 +179,7 @@ impl Renderer {
     }
 
     /// Sets the isosurfaces and their shading for frames with
-    /// [`BlendMode::Isosurface`](crate::BlendMode::Isosurface).
+    /// [`BlendMode::Isosurface`].
     pub fn set_isosurface(&mut self, iso: &IsoParams) -> Result<()> {
         iso.validate()?;
         self.iso_params = Some(iso.clone());
@@ -219,7 +219,7 @@ impl Renderer {
         }
     }
 
-    /// Sets how frames with [`BlendMode::PathTrace`](crate::BlendMode::PathTrace) sample
+    /// Sets how frames with [`BlendMode::PathTrace`] sample
     /// (a change other than of the paths per frame starts the accumulation over).
     pub fn set_path_tracing(&mut self, p: &PathTraceParams) -> Result<()> {
         p.validate()?;

@@ -25,7 +25,7 @@ pub struct FvIntermixedVolume {
 
 /// Sets the volumes drawn with the main one (`count` at `volumes`, 0 clears them), as
 /// vtkGPUVolumeRayCastMapper draws the ports of a vtkMultiVolume (the main volume is port
-/// 0, volumes[i] port i + 1): each ray marches the world box holding them all at the main
+/// 0, `volumes[i]` port i + 1): each ray marches the world box holding them all at the main
 /// volume's sample distance and, at each sample, composites the main volume and then each
 /// intermixed volume that holds the sample, each classified by its own transfer function
 /// and shaded (when shading is on) by its own gradient with the main volume's lights and

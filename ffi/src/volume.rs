@@ -55,7 +55,7 @@ fn scalar_size(t: FvScalarType) -> usize {
     }
 }
 
-/// Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
+/// Copies a volume: `data` holds `dims[0]·dims[1]·dims[2]·components` values of
 /// `desc->scalar_type`, components interleaved, x fastest; `data_bytes` is its size in
 /// bytes (checked). Scalars are validated (NaN/Inf refused, spacing > 0, direction
 /// invertible). `*out` receives the volume, NULL on failure.

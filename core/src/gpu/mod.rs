@@ -5,11 +5,11 @@
 
 pub(crate) mod binding;
 pub(crate) mod buffers;
-pub mod context;
+pub(crate) mod context;
 pub mod interop;
 pub(crate) mod pipeline;
 pub(crate) mod readback;
-pub mod shaders;
+pub(crate) mod shaders;
 pub(crate) mod texture;
 pub(crate) mod uniforms;
 

@@ -88,6 +88,7 @@ pub const FILES: &[(&str, &str)] = &[
 ];
 
 /// The passes (entry files, not library pieces).
+#[cfg(test)]
 pub const PASSES: &[&str] = &[
     "dvr.wgsl",
     "firsthit.wgsl",
@@ -115,6 +116,7 @@ pub fn compose(path: &str) -> String {
 }
 
 /// The files a pass is composed of: itself and everything it includes, directly or not.
+#[cfg(test)]
 pub fn files_of(path: &str) -> Vec<String> {
     let mut seen = Vec::new();
     expand(path, &mut String::new(), &mut seen);

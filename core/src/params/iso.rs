@@ -108,9 +108,9 @@ impl Default for AmbientOcclusion {
     }
 }
 
-/// Everything an isosurface frame needs beyond [`RenderParams`] (set with
-/// [`Renderer::set_isosurface`]). The material's ambient, diffuse and specular
-/// coefficients come from [`RenderParams::shading`] (lighting is always on in this mode,
+/// Everything an isosurface frame needs beyond [`RenderParams`](crate::RenderParams) (set with
+/// [`Renderer::set_isosurface`](crate::Renderer::set_isosurface)). The material's ambient, diffuse and specular
+/// coefficients come from [`RenderParams::shading`](crate::RenderParams::shading) (lighting is always on in this mode,
 /// whatever `shading.enabled` says); its termination threshold ends marching behind
 /// translucent surfaces; its depth threshold picks the layer whose depth is written. The
 /// field is always interpolated trilinearly (`interpolation` is for the DVR modes), and
@@ -320,7 +320,7 @@ pub struct Hit {
     pub distance: f64,
 }
 
-/// The G-buffer of the last isosurface frame, read back by [`Renderer::read_gbuffer`].
+/// The G-buffer of the last isosurface frame, read back by [`Renderer::read_gbuffer`](crate::Renderer::read_gbuffer).
 #[derive(Clone, Debug)]
 pub struct GBuffer {
     pub width: u32,

@@ -92,7 +92,7 @@ impl BsdfParams {
     }
 }
 
-/// How far the path tracer's accumulation has come ([`Renderer::convergence`]).
+/// How far the path tracer's accumulation has come ([`Renderer::convergence`](crate::Renderer::convergence)).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Convergence {
     /// Paths every pixel has (the passes completed).
@@ -105,7 +105,7 @@ pub struct Convergence {
     pub relative_error: Option<f32>,
 }
 
-/// How the path tracer samples (set with [`Renderer::set_path_tracing`]).
+/// How the path tracer samples (set with [`Renderer::set_path_tracing`](crate::Renderer::set_path_tracing)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTraceParams {
     /// Paths per pixel each frame adds (1 to [`MAX_SAMPLES_PER_FRAME`]).
@@ -148,7 +148,7 @@ pub struct PathTraceParams {
     pub background: bool,
     /// Show the progressive image through the edge-aware à-trous denoiser
     /// (shaders/denoise.wgsl), guided by the normal and depth at the paths' first
-    /// collision. The accumulation ([`Renderer::read_accumulation`]) stays unfiltered.
+    /// collision. The accumulation ([`Renderer::read_accumulation`](crate::Renderer::read_accumulation)) stays unfiltered.
     pub denoise: bool,
     /// Show the image through the denoiser while the pixels have fewer than this many paths
     /// (a preview that gives way to the unfiltered image; 0: only as `denoise` says).

@@ -43,7 +43,7 @@ pub struct UploadOptions {
     /// even they do not fit, ray casting and isosurfaces stream them through the pool, front
     /// to back, in several passes of one frame; path tracing, volumetric shadows, ambient
     /// occlusion and scattering between isosurfaces, whose rays go anywhere, draw the finest
-    /// coarser level that fits ([`VolumeData::downsampled`], reported by
+    /// coarser level that fits ([`VolumeData::downsampled`](crate::VolumeData::downsampled), reported by
     /// [`Residency::level`]).
     pub memory_budget: Option<u64>,
     /// Store the first component's central-difference gradients in a texture beside each
