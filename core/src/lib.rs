@@ -24,7 +24,7 @@ mod resources;
 pub mod synth;
 
 pub use error::{Error, Result};
-pub use gpu::interop::{self, DeviceUuids, OutputPath, SharedImage, SharedOutput};
+pub use gpu::interop::{self, DeviceUuids, OutputPath, SharedImage, SharedTargets};
 pub use gpu::{Context, DeviceInfo, DeviceMemory};
 pub use params::environment::{cube_direction, cube_face_coords, FACE_NAMES};
 pub use params::*;

@@ -3,7 +3,7 @@
 //! needs; every public entry point of ferrovol-core's rendering is here.
 
 use crate::error::{Error, Result};
-use crate::gpu::interop::{OutputPath, SharedOutput};
+use crate::gpu::interop::{OutputPath, SharedTargets};
 use crate::gpu::Context;
 use crate::params::{
     BlendMode, BsdfParams, Convergence, CubeImage, Environment, GBuffer, Image, IntermixedVolume,
@@ -308,9 +308,9 @@ impl Renderer {
     }
 
     /// Like [`Renderer::render`] with a depth input, but the depth is what the host wrote into
-    /// the shared depth-input image ([`SharedOutput::depth_in`], window depth, rows top to
+    /// the shared depth-input image ([`SharedTargets::depth_in`], window depth, rows top to
     /// bottom) instead of an upload. Needs [`OutputPath::Shared`] and output images of the
-    /// view's size already allocated ([`Renderer::prepare_output`] or an earlier frame); the
+    /// view's size already allocated ([`Renderer::prepare_targets`] or an earlier frame); the
     /// host must have finished writing (`glFinish`) before this call.
     pub fn render_with_shared_depth(&mut self, view: &View, params: &RenderParams) -> Result<()> {
         match &self.res.targets {
@@ -324,7 +324,7 @@ impl Renderer {
             {
                 return Err(Error::InvalidParameter(format!(
                     "the shared depth input is {}x{}, the view {}x{}: call \
-                     Renderer::prepare_output({}, {}), import the new images and write the \
+                     Renderer::prepare_targets({}, {}), import the new images and write the \
                      depth into the new depth input first",
                     t.width, t.height, view.width, view.height, view.width, view.height
                 )))
@@ -332,7 +332,7 @@ impl Renderer {
             _ => {
                 return Err(Error::InvalidParameter(
                     "no shared depth input: switch to OutputPath::Shared and call \
-                     Renderer::prepare_output, import SharedOutput::depth_in and write the depth \
+                     Renderer::prepare_targets, import SharedTargets::depth_in and write the depth \
                      into it first"
                         .into(),
                 ))
@@ -447,7 +447,7 @@ impl Renderer {
     /// Chooses where frames go. [`OutputPath::Shared`] needs a device that can export memory
     /// ([`Context::external_memory_support`]); without one this returns that error
     /// ([`Error::Unsupported`], saying why) and the renderer stays on the path it had. The
-    /// output images are reallocated at the next frame or [`Renderer::prepare_output`].
+    /// output images are reallocated at the next frame or [`Renderer::prepare_targets`].
     pub fn set_output_path(&mut self, path: OutputPath) -> Result<()> {
         if path == OutputPath::Shared {
             self.ctx.external_memory_support()?;
@@ -475,7 +475,7 @@ impl Renderer {
     /// Allocates the output images for frames of `width × height` on the current path now
     /// rather than at the next frame, so the host can import them (and write the depth input)
     /// before rendering. Does nothing when they already fit.
-    pub fn prepare_output(&mut self, width: u32, height: u32) -> Result<()> {
+    pub fn prepare_targets(&mut self, width: u32, height: u32) -> Result<()> {
         self.res.ensure_targets(&self.ctx, width, height)
     }
 
@@ -489,9 +489,9 @@ impl Renderer {
     /// Exports the output images: new file descriptors (the caller owns them) with what
     /// OpenGL needs to import them; see [`crate::interop`] for the protocol. Needs
     /// [`OutputPath::Shared`] and images allocated on it (a frame rendered or
-    /// [`Renderer::prepare_output`] called after switching).
-    pub fn shared_output(&self) -> Result<SharedOutput> {
-        self.res.shared_output(&self.ctx)
+    /// [`Renderer::prepare_targets`] called after switching).
+    pub fn shared_targets(&self) -> Result<SharedTargets> {
+        self.res.shared_targets(&self.ctx)
     }
 
     /// Blocks until the GPU has finished every frame submitted so far. With

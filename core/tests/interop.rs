@@ -172,21 +172,21 @@ fn exported_fds_and_generations() {
     let mut r = renderer();
     let p = params();
     r.set_output_path(OutputPath::Readback).expect("readback");
-    let err = r.shared_output().expect_err("not shared yet");
+    let err = r.shared_targets().expect_err("not shared yet");
     println!("readback path: {err}");
     assert!(matches!(err, Error::Unsupported(_)));
 
     r.set_output_path(OutputPath::Shared)
         .expect("sharing (expected of this device class)");
-    r.prepare_output(64, 40).expect("allocating");
+    r.prepare_targets(64, 40).expect("allocating");
     let g0 = r.output_generation();
     r.render(&view(64, 40), &p, None).expect("rendering");
     r.render(&view(64, 40), &p, None).expect("rendering");
     assert_eq!(r.output_generation(), g0, "same size, no reallocation");
 
     let fds_before = open_fds();
-    let a = r.shared_output().expect("exporting");
-    let b = r.shared_output().expect("exporting again");
+    let a = r.shared_targets().expect("exporting");
+    let b = r.shared_targets().expect("exporting again");
     assert_eq!(a.generation, g0);
     assert_eq!(open_fds(), fds_before + 6, "six new descriptors");
     for (name, img, bpp) in [
@@ -239,7 +239,7 @@ fn exported_fds_and_generations() {
         g0 != g1 && g1 != g2 && g2 != g3,
         "each reallocation changes it"
     );
-    assert_eq!(r.shared_output().map(|_| ()).ok(), None);
+    assert_eq!(r.shared_targets().map(|_| ()).ok(), None);
 }
 
 #[test]
@@ -254,7 +254,7 @@ fn replaced_shared_memory_is_freed() {
     let (maps0, fds0) = (memfd_mappings(), open_fds());
     for i in 0..12 {
         r.render(&view(41 + i, 30), &p, None).expect("rendering");
-        let out = r.shared_output().expect("exporting");
+        let out = r.shared_targets().expect("exporting");
         assert_eq!(out.width, 41 + i);
     }
     r.render(&view(40, 30), &p, None).expect("rendering");
@@ -327,7 +327,7 @@ fn gl_backend_child() {
     let e = r.set_output_sharing(true).expect_err("refused");
     assert!(matches!(e, Error::Unsupported(_)));
     assert_eq!(r.output_path(), OutputPath::Readback);
-    assert!(matches!(r.shared_output(), Err(Error::Unsupported(_))));
+    assert!(matches!(r.shared_targets(), Err(Error::Unsupported(_))));
     // Not asserted: whether frames render on wgpu's GL backend does not depend on sharing
     // (on llvmpipe it fails allocating the R32Float depth output as a render attachment).
     let vol = synth::marschner_lobb(17);
@@ -768,8 +768,8 @@ fn with_gl_sharing(test: impl FnOnce(&mut Renderer, &gl::Host)) {
 fn opengl_sees_the_frame() {
     with_gl_sharing(|r, host| {
         let (w, h) = (97, 61);
-        r.prepare_output(w, h).expect("allocating");
-        let out = r.shared_output().expect("exporting");
+        r.prepare_targets(w, h).expect("allocating");
+        let out = r.shared_targets().expect("exporting");
         let generation = out.generation;
         let color = Imported::new(host, out.color).expect("importing the colour into GL");
         let depth = Imported::new(host, out.depth).expect("importing the depth into GL");
@@ -829,7 +829,7 @@ fn opengl_writes_the_depth_input() {
             .expect("rendering with uploaded depth");
         let uploaded = r.read_image().expect("reading back");
 
-        let out = r.shared_output().expect("exporting");
+        let out = r.shared_targets().expect("exporting");
         let depth_in = Imported::new(host, out.depth_in).expect("importing the depth input");
         // GL row 0 is memory row 0, which is the top row of the frame: write the rows as they are.
         depth_in.write_f32(w, h, &depth);

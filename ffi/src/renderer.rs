@@ -477,7 +477,7 @@ pub unsafe extern "C" fn fv_renderer_prepare_targets(
     height: u32,
 ) -> FvStatus {
     with_renderer(renderer, |r| {
-        r.r.prepare_output(width, height)?;
+        r.r.prepare_targets(width, height)?;
         Ok(())
     })
 }
@@ -504,7 +504,7 @@ pub unsafe extern "C" fn fv_renderer_shared_image(
                 "the output is not shared: call fv_renderer_set_output_path(renderer, FV_OUTPUT_PATH_SHARED) first, or read frames with fv_renderer_read_frame",
             ));
         }
-        let shared = r.r.shared_output()?;
+        let shared = r.r.shared_targets()?;
         let img = match target {
             0 => shared.color,
             1 => shared.depth,

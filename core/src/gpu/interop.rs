@@ -2,13 +2,13 @@
 //! output images in Vulkan external memory (`VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD`) and
 //! hands out file descriptors that OpenGL imports with `GL_EXT_memory_object_fd`.
 //!
-//! What the host does (OpenGL, once per [`SharedOutput::generation`]):
+//! What the host does (OpenGL, once per [`SharedTargets::generation`]):
 //!
 //! 1. compare [`Context::device_uuids`] with GL's device UUIDs
 //!    (`glGetUnsignedBytei_vEXT(GL_DEVICE_UUID_EXT, i)` for i below `GL_NUM_DEVICE_UUIDS_EXT`)
 //!    and `glGetUnsignedBytevEXT(GL_DRIVER_UUID_EXT)`; import only when the device is one of
 //!    GL's and the drivers are equal, whether the device is a GPU or a CPU;
-//! 2. per image of [`Renderer::shared_output`](crate::Renderer::shared_output):
+//! 2. per image of [`Renderer::shared_targets`](crate::Renderer::shared_targets):
 //!    `glCreateMemoryObjectsEXT`, `glMemoryObjectParameterivEXT(GL_DEDICATED_MEMORY_OBJECT_EXT,
 //!    GL_TRUE)` (the allocations are dedicated), `glImportMemoryFdEXT(mem, size,
 //!    GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd)`, then on a new texture
@@ -31,7 +31,7 @@
 //! Row 0 of every image is the top row of the frame (wgpu's convention); GL's texture row 0
 //! is its bottom row, so the host flips when it draws.
 //!
-//! Ownership: each call of `shared_output` makes new file descriptors (`vkGetMemoryFdKHR`),
+//! Ownership: each call of `shared_targets` makes new file descriptors (`vkGetMemoryFdKHR`),
 //! owned by the caller as [`OwnedFd`](std::os::fd::OwnedFd). `glImportMemoryFdEXT` takes an
 //! fd over when it succeeds (pass `fd.into_raw_fd()` and do not close it); an fd that is not
 //! imported is closed when dropped. The renderer keeps its own reference to the memory and
@@ -58,7 +58,7 @@ pub enum OutputPath {
     #[default]
     Readback,
     /// Exportable memory another API imports
-    /// ([`Renderer::shared_output`](crate::Renderer::shared_output)); `read_image` still works.
+    /// ([`Renderer::shared_targets`](crate::Renderer::shared_targets)); `read_image` still works.
     Shared,
 }
 
@@ -84,7 +84,7 @@ pub struct SharedImage {
 
 /// The renderer's output images, exported.
 #[derive(Debug)]
-pub struct SharedOutput {
+pub struct SharedTargets {
     /// Changes whenever the images are reallocated (size changed, sharing switched on);
     /// when it differs from the one imported, delete the old GL objects and import again.
     pub generation: u64,

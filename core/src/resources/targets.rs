@@ -3,7 +3,7 @@
 
 use super::Resources;
 use crate::error::{Error, Result};
-use crate::gpu::interop::{self, ExportableMemory, OutputPath, SharedOutput};
+use crate::gpu::interop::{self, ExportableMemory, OutputPath, SharedTargets};
 use crate::gpu::readback::read_texture_layer;
 use crate::gpu::texture::{texture_2d, upload_texture};
 use crate::gpu::uniforms::PIXEL_STATE_BYTES;
@@ -183,8 +183,8 @@ impl Resources {
     /// Exports the output images: new file descriptors (the caller owns them) with what
     /// OpenGL needs to import them; see [`crate::interop`] for the protocol. Needs
     /// [`OutputPath::Shared`] and images allocated on it (a frame rendered or
-    /// [`Renderer::prepare_output`] called after switching).
-    pub fn shared_output(&self, ctx: &Context) -> Result<SharedOutput> {
+    /// [`Renderer::prepare_targets`] called after switching).
+    pub fn shared_targets(&self, ctx: &Context) -> Result<SharedTargets> {
         if self.output_path != OutputPath::Shared {
             return Err(Error::Unsupported(
                 "the output is not shared: call Renderer::set_output_path(OutputPath::Shared) \
@@ -199,11 +199,11 @@ impl Resources {
         else {
             return Err(Error::InvalidParameter(
                 "the output images are not allocated in shared memory yet: render a frame or \
-                 call Renderer::prepare_output(width, height) first"
+                 call Renderer::prepare_targets(width, height) first"
                     .into(),
             ));
         };
-        Ok(SharedOutput {
+        Ok(SharedTargets {
             generation: t.generation,
             width: t.width,
             height: t.height,
