@@ -122,13 +122,13 @@ impl OverrideValue for u32 {
 /// Declares a pass's pipeline variant: a struct with one field per override constant
 /// (`field: type => "WGSL_NAME"`) and its [`Variant`] implementation.
 macro_rules! pipeline_variant {
-    ($(#[$meta:meta])* struct $name:ident {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident {
         $($(#[$fmeta:meta])* $field:ident: $ty:ty => $wgsl:literal,)*
     }) => {
         $(#[$meta])*
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-        struct $name {
-            $($(#[$fmeta])* $field: $ty,)*
+        $vis struct $name {
+            $($(#[$fmeta])* $vis $field: $ty,)*
         }
 
         impl $crate::gpu::pipeline::Variant for $name {

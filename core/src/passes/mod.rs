@@ -5,6 +5,7 @@
 pub(crate) mod denoise;
 pub(crate) mod depth_check;
 pub(crate) mod dvr;
+pub(crate) mod dvr_variant;
 pub(crate) mod frame;
 pub(crate) mod iso;
 pub(crate) mod medium;
