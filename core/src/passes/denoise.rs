@@ -37,25 +37,26 @@ pub(crate) struct DenoisePass {
 }
 
 impl DenoisePass {
-    pub fn new(ctx: &Context) -> Result<DenoisePass> {
+    /// The denoiser's bind group (denoise.wgsl).
+    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
         use wgpu::BufferBindingType as B;
-        let (bgl, pipeline) = single_group_pipeline(
-            ctx,
-            "denoise.wgsl",
-            "denoise",
-            &[
-                dynamic_uniform_entry::<DenoiseUniforms>(0),
-                buffer_entry(1, B::Storage { read_only: true }),
-                buffer_entry(2, B::Storage { read_only: false }),
-                buffer_entry(3, B::Storage { read_only: true }),
-                buffer_entry(4, B::Storage { read_only: true }),
-                storage_texture_entry(
-                    5,
-                    wgpu::TextureFormat::Rgba8Unorm,
-                    wgpu::TextureViewDimension::D2,
-                ),
-            ],
-        )?;
+        [
+            dynamic_uniform_entry::<DenoiseUniforms>(0),
+            buffer_entry(1, B::Storage { read_only: true }),
+            buffer_entry(2, B::Storage { read_only: false }),
+            buffer_entry(3, B::Storage { read_only: true }),
+            buffer_entry(4, B::Storage { read_only: true }),
+            storage_texture_entry(
+                5,
+                wgpu::TextureFormat::Rgba8Unorm,
+                wgpu::TextureViewDimension::D2,
+            ),
+        ]
+    }
+
+    pub fn new(ctx: &Context) -> Result<DenoisePass> {
+        let (bgl, pipeline) =
+            single_group_pipeline(ctx, "denoise.wgsl", "denoise", &Self::layout_entries())?;
         let uniforms = uniform_buffer(
             ctx,
             "denoiser uniforms",

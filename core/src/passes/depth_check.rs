@@ -22,18 +22,23 @@ pub(crate) struct DepthCheck {
 }
 
 impl DepthCheck {
-    pub fn new(ctx: &Context) -> Result<DepthCheck> {
+    /// The depth comparison's bind group (depth_changed.wgsl).
+    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 4] {
         use wgpu::BufferBindingType as B;
+        [
+            buffer_entry(0, B::Uniform),
+            texture_entry(1, false, wgpu::TextureViewDimension::D2),
+            buffer_entry(2, B::Storage { read_only: false }),
+            buffer_entry(3, B::Storage { read_only: false }),
+        ]
+    }
+
+    pub fn new(ctx: &Context) -> Result<DepthCheck> {
         let (bgl, pipeline) = single_group_pipeline(
             ctx,
             "depth_changed.wgsl",
             "depth comparison",
-            &[
-                buffer_entry(0, B::Uniform),
-                texture_entry(1, false, wgpu::TextureViewDimension::D2),
-                buffer_entry(2, B::Storage { read_only: false }),
-                buffer_entry(3, B::Storage { read_only: false }),
-            ],
+            &Self::layout_entries(),
         )?;
         Ok(DepthCheck {
             bgl,

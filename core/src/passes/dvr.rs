@@ -41,32 +41,37 @@ pub(crate) struct DvrPass {
 }
 
 impl DvrPass {
-    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
+    /// The frame's bind group (group 0 of dvr.wgsl; the volume's is group 1).
+    pub fn layout_entries(filterable: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
+        [
+            buffer_entry(0, B::Uniform),
+            texture_entry(1, false, V::D2),
+            texture_entry(2, false, V::D3),
+            sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
+            texture_entry(4, false, V::D2),
+            texture_entry(25, false, V::D2),
+            storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
+            buffer_entry(7, B::Storage { read_only: false }),
+            blanking_layout_entry(),
+            texture_entry(9, true, V::D2),
+            sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
+            tables_2d_layout_entry(),
+            grid_lookup_layout_entry(),
+        ]
+        .into_iter()
+        .chain(IntermixBinding::layout_entries(filterable))
+        .collect()
+    }
+
+    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
         let bgl = ctx
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("dvr frame"),
-                entries: &[
-                    buffer_entry(0, B::Uniform),
-                    texture_entry(1, false, V::D2),
-                    texture_entry(2, false, V::D3),
-                    sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
-                    texture_entry(4, false, V::D2),
-                    texture_entry(25, false, V::D2),
-                    storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-                    storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
-                    buffer_entry(7, B::Storage { read_only: false }),
-                    blanking_layout_entry(),
-                    texture_entry(9, true, V::D2),
-                    sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
-                    tables_2d_layout_entry(),
-                    grid_lookup_layout_entry(),
-                ]
-                .into_iter()
-                .chain(IntermixBinding::layout_entries(ctx))
-                .collect::<Vec<_>>(),
+                entries: &Self::layout_entries(ctx.info.float32_filterable),
             });
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
         let no_blanking = block_grid(ctx, "no blanking", [1; 3], &[0u8]);

@@ -201,48 +201,61 @@ fn random_unit_vectors(n: usize) -> Vec<[f32; 4]> {
 const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 impl IsoPass {
-    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<IsoPass> {
+    /// The first-hit pass's bind group (group 0 of firsthit.wgsl; the volume's is group 1).
+    pub fn firsthit_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
-        let d = &ctx.device;
         let gb_write = |b| storage_texture_entry(b, GBUFFER_FORMAT, V::D2Array);
+        vec![
+            buffer_entry(0, B::Uniform),
+            buffer_entry(2, B::Storage { read_only: false }),
+            sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
+            texture_entry(4, false, V::D2),
+            buffer_entry(7, B::Uniform),
+            gb_write(8),
+            gb_write(9),
+            gb_write(10),
+            sampler_entry(11),
+            sampled_texture_entry(12, wgpu::TextureSampleType::Uint, V::D3),
+            blanking_layout_entry(),
+            grid_lookup_layout_entry(),
+        ]
+    }
+
+    /// The deferred shading pass's bind group (group 0 of deferred.wgsl; the volume's is
+    /// group 1).
+    pub fn deferred_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        vec![
+            buffer_entry(0, B::Uniform),
+            buffer_entry(2, B::Storage { read_only: true }),
+            storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
+            buffer_entry(7, B::Uniform),
+            texture_entry(8, false, V::D2Array),
+            texture_entry(9, false, V::D2Array),
+            texture_entry(10, false, V::D2Array),
+            texture_entry(11, true, V::Cube),
+            texture_entry(12, true, V::Cube),
+            sampler_entry(13),
+            buffer_entry(14, B::Storage { read_only: true }),
+            sampled_texture_entry(15, wgpu::TextureSampleType::Uint, V::D3),
+            texture_entry(1, false, V::D2),
+            blanking_layout_entry(),
+            grid_lookup_layout_entry(),
+        ]
+    }
+
+    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<IsoPass> {
+        let d = &ctx.device;
         let firsthit_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("first hit"),
-            entries: &[
-                buffer_entry(0, B::Uniform),
-                buffer_entry(2, B::Storage { read_only: false }),
-                sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
-                texture_entry(4, false, V::D2),
-                buffer_entry(7, B::Uniform),
-                gb_write(8),
-                gb_write(9),
-                gb_write(10),
-                sampler_entry(11),
-                sampled_texture_entry(12, wgpu::TextureSampleType::Uint, V::D3),
-                blanking_layout_entry(),
-                grid_lookup_layout_entry(),
-            ],
+            entries: &Self::firsthit_layout_entries(),
         });
         let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("deferred"),
-            entries: &[
-                buffer_entry(0, B::Uniform),
-                buffer_entry(2, B::Storage { read_only: true }),
-                storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-                storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
-                buffer_entry(7, B::Uniform),
-                texture_entry(8, false, V::D2Array),
-                texture_entry(9, false, V::D2Array),
-                texture_entry(10, false, V::D2Array),
-                texture_entry(11, true, V::Cube),
-                texture_entry(12, true, V::Cube),
-                sampler_entry(13),
-                buffer_entry(14, B::Storage { read_only: true }),
-                sampled_texture_entry(15, wgpu::TextureSampleType::Uint, V::D3),
-                texture_entry(1, false, V::D2),
-                blanking_layout_entry(),
-                grid_lookup_layout_entry(),
-            ],
+            entries: &Self::deferred_layout_entries(),
         });
         let firsthit = PipelineCache::new(
             ctx,

@@ -11,3 +11,6 @@ pub(crate) mod iso;
 pub(crate) mod medium;
 pub(crate) mod pathtrace;
 pub(crate) mod scatter_check;
+
+#[cfg(test)]
+mod layout_tests;

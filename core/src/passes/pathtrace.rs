@@ -146,37 +146,57 @@ pub(crate) struct PathTracePass {
 }
 
 impl PathTracePass {
-    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<PathTracePass> {
+    /// The path tracer's bind group (group 0 of pathtrace.wgsl; the volume's is group 1).
+    pub fn layout_entries(filterable: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
-        let d = &ctx.device;
-        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("path tracing"),
-            entries: &[
-                buffer_entry(0, B::Uniform),
-                texture_entry(1, false, V::D2),
-                buffer_entry(2, B::Storage { read_only: false }),
-                texture_entry(4, false, V::D2),
-                buffer_entry(5, B::Storage { read_only: false }),
-                dynamic_uniform_entry::<PathTraceUniforms>(7),
-                texture_entry(11, true, V::Cube),
-                sampler_entry(13),
-                buffer_entry(14, B::Storage { read_only: true }),
-                sampled_texture_entry(
-                    15,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    V::D3,
-                ),
-                buffer_entry(16, B::Storage { read_only: false }),
-                sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
-                blanking_layout_entry(),
-                grid_lookup_layout_entry(),
-                tables_2d_layout_entry(),
-            ]
-            .into_iter()
-            .chain(IntermixBinding::layout_entries(ctx))
-            .collect::<Vec<_>>(),
-        });
+        [
+            buffer_entry(0, B::Uniform),
+            texture_entry(1, false, V::D2),
+            buffer_entry(2, B::Storage { read_only: false }),
+            texture_entry(4, false, V::D2),
+            buffer_entry(5, B::Storage { read_only: false }),
+            dynamic_uniform_entry::<PathTraceUniforms>(7),
+            texture_entry(11, true, V::Cube),
+            sampler_entry(13),
+            buffer_entry(14, B::Storage { read_only: true }),
+            sampled_texture_entry(
+                15,
+                wgpu::TextureSampleType::Float { filterable: false },
+                V::D3,
+            ),
+            buffer_entry(16, B::Storage { read_only: false }),
+            sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
+            blanking_layout_entry(),
+            grid_lookup_layout_entry(),
+            tables_2d_layout_entry(),
+        ]
+        .into_iter()
+        .chain(IntermixBinding::layout_entries(filterable))
+        .collect()
+    }
+
+    /// The bind group of pathtrace_show.wgsl, which turns the accumulation into the image.
+    pub fn show_layout_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        [
+            buffer_entry(0, B::Uniform),
+            buffer_entry(1, B::Storage { read_only: true }),
+            buffer_entry(2, B::Storage { read_only: true }),
+            buffer_entry(3, B::Storage { read_only: false }),
+            storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(5, wgpu::TextureFormat::R32Float, V::D2),
+        ]
+    }
+
+    pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<PathTracePass> {
+        let bgl = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("path tracing"),
+                entries: &Self::layout_entries(ctx.info.float32_filterable),
+            });
         let pipelines =
             PipelineCache::new(ctx, "pathtrace.wgsl", "path tracing", &[&bgl, brick_bgl])?;
         let uniforms = uniform_buffer(
@@ -188,14 +208,7 @@ impl PathTracePass {
             ctx,
             "pathtrace_show.wgsl",
             "path tracing image",
-            &[
-                buffer_entry(0, B::Uniform),
-                buffer_entry(1, B::Storage { read_only: true }),
-                buffer_entry(2, B::Storage { read_only: true }),
-                buffer_entry(3, B::Storage { read_only: false }),
-                storage_texture_entry(4, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-                storage_texture_entry(5, wgpu::TextureFormat::R32Float, V::D2),
-            ],
+            &Self::show_layout_entries(),
         )?;
         let show_uniforms = uniform_buffer(ctx, "path tracing image uniforms", UNIFORM_STRIDE);
         Ok(PathTracePass {

@@ -61,6 +61,15 @@ pub(crate) fn sample_bsdf(
 }
 
 /// Runs shaders/phase_test.wgsl: `u.counts[0]` samples.
+/// The check's bind group (phase_test.wgsl).
+pub(crate) fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+    use wgpu::BufferBindingType as B;
+    [
+        buffer_entry(0, B::Uniform),
+        buffer_entry(1, B::Storage { read_only: false }),
+    ]
+}
+
 fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>> {
     let n = u.counts[0];
     if n == 0 || n > 1 << 24 {
@@ -68,16 +77,8 @@ fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>
             "scattering check: the sample count {n} must be in 1 to 2^24"
         )));
     }
-    use wgpu::BufferBindingType as B;
-    let (bgl, pipeline) = single_group_pipeline(
-        ctx,
-        "phase_test.wgsl",
-        "phase test",
-        &[
-            buffer_entry(0, B::Uniform),
-            buffer_entry(1, B::Storage { read_only: false }),
-        ],
-    )?;
+    let (bgl, pipeline) =
+        single_group_pipeline(ctx, "phase_test.wgsl", "phase test", &layout_entries())?;
     let ubuf = uniform_buffer(
         ctx,
         "phase test uniforms",

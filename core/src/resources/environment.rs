@@ -43,41 +43,40 @@ pub(crate) struct GpuEnvironment {
 const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 impl EnvPipelines {
+    /// environment.wgsl's entry points (build, downsample, irradiance), each with its bind
+    /// group.
+    pub fn layouts() -> [(&'static str, Vec<wgpu::BindGroupLayoutEntry>); 3] {
+        use wgpu::TextureViewDimension as V;
+        let with = |more: Vec<wgpu::BindGroupLayoutEntry>| {
+            let mut entries = vec![
+                buffer_entry(0, wgpu::BufferBindingType::Uniform),
+                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
+            ];
+            entries.extend(more);
+            entries
+        };
+        [
+            (
+                "build",
+                with(vec![texture_entry(1, true, V::D2), sampler_entry(2)]),
+            ),
+            ("downsample", with(vec![texture_entry(4, true, V::D2Array)])),
+            (
+                "irradiance",
+                with(vec![texture_entry(5, true, V::Cube), sampler_entry(6)]),
+            ),
+        ]
+    }
+
     pub fn new(ctx: &Context) -> Result<EnvPipelines> {
         let d = &ctx.device;
-        let bgl = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
-        };
-        use wgpu::TextureViewDimension as V;
-        let build_bgl = bgl(
-            "environment build",
-            &[
-                buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                texture_entry(1, true, V::D2),
-                sampler_entry(2),
-                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
-            ],
-        );
-        let downsample_bgl = bgl(
-            "environment downsample",
-            &[
-                buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
-                texture_entry(4, true, V::D2Array),
-            ],
-        );
-        let irradiance_bgl = bgl(
-            "environment irradiance",
-            &[
-                buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                storage_texture_entry(3, ENV_FORMAT, V::D2Array),
-                texture_entry(5, true, V::Cube),
-                sampler_entry(6),
-            ],
-        );
+        let [build_bgl, downsample_bgl, irradiance_bgl] =
+            Self::layouts().map(|(entry, entries)| {
+                d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(&format!("environment {entry}")),
+                    entries: &entries,
+                })
+            });
         let pipeline = |entry: &'static str, layout: &wgpu::BindGroupLayout| {
             let pl = pipeline_layout(ctx, entry, &[layout]);
             compute_pipeline(

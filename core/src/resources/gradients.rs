@@ -15,20 +15,25 @@ pub(crate) struct GradientPass {
 }
 
 impl GradientPass {
+    /// The gradient build's bind group (gradient.wgsl).
+    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
+        [
+            buffer_entry(0, wgpu::BufferBindingType::Uniform),
+            texture_entry(1, false, wgpu::TextureViewDimension::D3),
+            storage_texture_entry(
+                2,
+                wgpu::TextureFormat::Rgba16Float,
+                wgpu::TextureViewDimension::D3,
+            ),
+        ]
+    }
+
     pub fn new(ctx: &Context) -> Result<GradientPass> {
         let (bgl, pipeline) = single_group_pipeline(
             ctx,
             "gradient.wgsl",
             "gradient build",
-            &[
-                buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                texture_entry(1, false, wgpu::TextureViewDimension::D3),
-                storage_texture_entry(
-                    2,
-                    wgpu::TextureFormat::Rgba16Float,
-                    wgpu::TextureViewDimension::D3,
-                ),
-            ],
+            &Self::layout_entries(),
         )?;
         Ok(GradientPass { bgl, pipeline })
     }

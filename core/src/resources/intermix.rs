@@ -199,8 +199,7 @@ impl IntermixBinding {
     }
 
     /// The layout entries of the four bindings.
-    pub fn layout_entries(ctx: &Context) -> [wgpu::BindGroupLayoutEntry; 4] {
-        let filterable = ctx.info.float32_filterable;
+    pub fn layout_entries(filterable: bool) -> [wgpu::BindGroupLayoutEntry; 4] {
         let sampler = if filterable {
             wgpu::SamplerBindingType::Filtering
         } else {

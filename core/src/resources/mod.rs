@@ -78,27 +78,29 @@ pub(super) fn no_volume() -> Error {
     Error::InvalidParameter("no volume has been set".into())
 }
 
+/// The volume's bind group (group 1 of the passes that march it; lib/volume.wgsl).
+pub(crate) fn brick_layout_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
+    use wgpu::TextureViewDimension as V;
+    [
+        buffer_entry(0, wgpu::BufferBindingType::Uniform),
+        texture_entry(1, true, V::D3),
+        entry(
+            2,
+            wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        ),
+        texture_entry(3, true, V::D3),
+        sampled_texture_entry(4, wgpu::TextureSampleType::Uint, V::D3),
+        texture_entry(5, false, V::D3),
+        buffer_entry(6, wgpu::BufferBindingType::Storage { read_only: false }),
+    ]
+}
+
 impl Resources {
     pub fn new(ctx: &Context) -> Resources {
         let d = &ctx.device;
         let brick_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("brick"),
-            entries: &[
-                buffer_entry(0, wgpu::BufferBindingType::Uniform),
-                texture_entry(1, true, wgpu::TextureViewDimension::D3),
-                entry(
-                    2,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                ),
-                texture_entry(3, true, wgpu::TextureViewDimension::D3),
-                sampled_texture_entry(
-                    4,
-                    wgpu::TextureSampleType::Uint,
-                    wgpu::TextureViewDimension::D3,
-                ),
-                texture_entry(5, false, wgpu::TextureViewDimension::D3),
-                buffer_entry(6, wgpu::BufferBindingType::Storage { read_only: false }),
-            ],
+            entries: &brick_layout_entries(),
         });
         let sampler = |f: wgpu::FilterMode| {
             d.create_sampler(&wgpu::SamplerDescriptor {
