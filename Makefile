@@ -171,6 +171,7 @@ lint-workspace:
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --locked --no-deps -p ferrovol-core -p ferrovol-io -p ferrovol-ffi
 	python3 scripts/check-core-layers.py
+	python3 scripts/check-file-sizes.py
 	python3 scripts/check-architecture-doc.py
 # The fuzz targets are a workspace of their own (fuzz/Cargo.toml), checked in their own
 # target folder.

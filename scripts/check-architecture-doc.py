@@ -63,7 +63,7 @@ def main():
         )
 
     # Types: CamelCase words.
-    for name in set(re.findall(r"\b([A-Z][a-z0-9]+(?:[A-Z][a-z0-9]*)+|vtkFerro\w+|Fv[A-Z]\w*)\b", doc)):
+    for name in set(re.findall(r"\b([A-Z][a-z0-9]+(?:[A-Z][a-z0-9]*)+|vtkFerro\w+|Fv[A-Z]\w*)\b(?!\.(?:rs|wgsl|cxx|hpp|h|py)\b)", doc)):
         if EXTERNAL.match(name):
             continue
         if not (re.search(rf"\b(struct|enum|trait|class|type)\s+{name}\b", sources)

@@ -1,0 +1,362 @@
+// vtkFerroVolumeMapper's render: Render (progressive path tracing's timer and budget around
+// it) and GPURender, which brings the units up to date and draws the frame (see
+// vtkFerroVolumeMapper.cxx for the units).
+#include "vtkFerroVolumeMapperInternals.h"
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  if (this->GeneratingCanonicalView)
+  {
+    this->GPURender(ren, vol);
+    return;
+  }
+  this->InvokeEvent(vtkCommand::VolumeMapperRenderStartEvent, nullptr);
+  vtkNew<vtkTimerLog> timer;
+  timer->StartTimer();
+  // (the same on every process of a parallel render: the sum is a collective operation)
+  this->Internals->PieceSum.Begin(this->SumsPieces() && ren && vol && !ren->GetSelector() &&
+    !this->RenderToImage && !vtkFerroVolumeDepthPeeling::PeelingPass(vol));
+  this->GPURender(ren, vol);
+  this->Internals->PieceSum.Finish();
+  timer->StopTimer();
+  this->TimeToDraw = timer->GetElapsedTime();
+  (vol->GetAllocatedRenderTime() < 1.0 ? this->SmallTimeToDraw : this->BigTimeToDraw) =
+    this->TimeToDraw;
+  this->InvokeEvent(vtkCommand::VolumeMapperRenderEndEvent, nullptr);
+}
+
+namespace
+{
+// A hardware-selection pass of `selector` over `image` (placed by `vol`): what
+// vtkGPUVolumeRayCastMapper writes, where the frame shows the volume (vtkFerroVolumeSelection).
+bool DrawSelection(vtkFerroVolumeOutput& output, vtkRenderer* ren, vtkVolume* vol,
+  vtkImageData* image, vtkHardwareSelector* selector, const vtkFerroVolumeFrameRequest& req,
+  const int rect[4], std::string& error)
+{
+  vtkFerroVolumeSelection select;
+  switch (selector->GetCurrentPass())
+  {
+    case vtkHardwareSelector::CELL_ID_LOW24:
+      select.What = vtkFerroVolumeSelection::Write::PointLow24;
+      break;
+    case vtkHardwareSelector::CELL_ID_HIGH24:
+      select.What = vtkFerroVolumeSelection::Write::PointHigh24;
+      break;
+    default:
+      select.What = vtkFerroVolumeSelection::Write::Prop;
+      break;
+  }
+  // device coordinates → world → the point index relative to the extent's first point
+  vtkNew<vtkMatrix4x4> deviceToWorld;
+  deviceToWorld->DeepCopy(ren->GetActiveCamera()->GetCompositeProjectionTransformMatrix(
+    static_cast<double>(req.ViewportW) / req.ViewportH, -1, 1));
+  deviceToWorld->Invert();
+  const int* extent = image->GetExtent();
+  vtkNew<vtkMatrix4x4> fromExtent;
+  for (int k = 0; k < 3; ++k)
+  {
+    fromExtent->SetElement(k, 3, extent[2 * k]);
+  }
+  vtkNew<vtkMatrix4x4> indexToWorld;
+  vtkMatrix4x4::Multiply4x4(vol->GetMatrix(), image->GetIndexToPhysicalMatrix(), indexToWorld);
+  vtkMatrix4x4::Multiply4x4(indexToWorld, fromExtent, indexToWorld);
+  indexToWorld->Invert();
+  vtkNew<vtkMatrix4x4> deviceToIndex;
+  vtkMatrix4x4::Multiply4x4(indexToWorld, deviceToWorld, deviceToIndex);
+  select.DeviceToIndex = deviceToIndex;
+  image->GetDimensions(select.Dims);
+  selector->BeginRenderProp();
+  selector->GetPropColorValue(select.PropColor);
+  const bool drawn = output.Select(req, rect, select, error) != vtkFerroVolumeOutput::Composited::Failed;
+  const vtkIdType points =
+    static_cast<vtkIdType>(select.Dims[0]) * select.Dims[1] * select.Dims[2];
+  selector->UpdateMaximumPointId(points);
+  selector->UpdateMaximumCellId(points);
+  selector->EndRenderProp();
+  return drawn;
+}
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
+{
+  this->LastRenderDrew = 0;
+  this->LastRenderProgressive = 0;
+  vtkInternals* in = this->Internals;
+  in->Refinement.Begin();
+  if (!ren || !vol)
+  {
+    return;
+  }
+  // Hardware selection: cell selections, as vtkGPUVolumeRayCastMapper (other associations
+  // leave the volume out).
+  vtkHardwareSelector* selector = ren->GetSelector();
+  if (selector && selector->GetFieldAssociation() != vtkDataObject::FIELD_ASSOCIATION_CELLS)
+  {
+    return;
+  }
+  // Inside vtkDualDepthPeelingPass's volumetric peels: the volume between its layers.
+  vtkRenderPass* peeling = vtkFerroVolumeDepthPeeling::PeelingPass(vol);
+  if (peeling &&
+    (this->RenderMode == RENDER_MODE_PATH_TRACE || this->BlendMode == ISOSURFACE_BLEND ||
+      this->BlendMode == SLICE_BLEND))
+  {
+    if (in->FirstTime("depth-peeling"))
+    {
+      vtkWarningMacro(<< "depth peeling for volumes (vtkRenderer UseDepthPeelingForVolumes "
+                         "with translucent geometry) draws ray-cast volumes between the "
+                         "translucent layers; path tracing, isosurfaces and slices are not "
+                         "drawn there: turn UseDepthPeelingForVolumes off to have this volume "
+                         "composited over the translucent geometry (in ParaView: the render "
+                         "view's DepthPeelingForVolumes, on by default)");
+    }
+    return;
+  }
+  vtkOpenGLRenderWindow* win = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!win)
+  {
+    vtkErrorMacro(<< "vtkFerroVolumeMapper needs an OpenGL render window (vtkOpenGLRenderWindow)");
+    return;
+  }
+
+  // After a device loss the output's images (imported from the lost device) go with the
+  // renderer; both are made again below.
+  if (in->RendererLost())
+  {
+    in->ReleaseDeviceResources(win);
+  }
+
+  // A vtkMultiVolume (vtkGPUVolumeRayCastMapper's several inputs): port 0's vtkVolume
+  // places and classifies the main volume, the other ports' volumes are intermixed with it;
+  // the multi-volume itself gives the box of them all.
+  vtkMultiVolume* multi = vtkMultiVolume::SafeDownCast(vol);
+  vtkVolume* main = multi ? multi->GetVolume(0) : vol;
+  if (!main)
+  {
+    vtkErrorMacro(<< "the vtkMultiVolume has no vtkVolume on port 0 (SetVolume(volume, 0))");
+    return;
+  }
+
+  // Blend mode, input, volume (on change), tables (on change), frame parameters.
+  std::string error;
+  if (!in->Settings.SelectBlendMode(this, error) || !in->Prepare(this, main, multi, error))
+  {
+    vtkErrorMacro(<< error);
+    return;
+  }
+  vtkImageData* image = in->Input.GetImage();
+  // GetTransformedInput and GetBoundsFromPort see the input, as after the base class's
+  // validation.
+  this->CloneInput(image, 0);
+  // Progressive path tracing: what is left of the render's budget for the tracing.
+  const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
+  const bool progressive = pathTrace && in->Refinement.IsProgressive(this->ProgressiveMode, win);
+  if (!progressive)
+  {
+    in->Refinement.Stop();
+  }
+  // The preview is denoised while the accumulation is short of PathTracingDenoiseUntil, as
+  // it is after a change (which interactive renders usually follow).
+  const uint32_t denoiseUntil = vtkFerroVolumeSettings::DenoiseUntil(this);
+  double traceBudget = 0.0;
+  // (restarts of the accumulation before this render: the refinement stops when the renders
+  // it asks for keep starting over)
+  FvStats statsBefore{};
+  if (progressive && !in->Stats(statsBefore))
+  {
+    vtkErrorMacro(<< "the renderer's counters are unavailable: " << fv_last_error());
+    return;
+  }
+  if (progressive)
+  {
+    uint32_t before = 0;
+    if (!vtkFerroVolumeCall("count the accumulated paths", error,
+          [&] { before = in->Renderer->accumulated_samples(); }))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+    const bool denoised = this->PathTracingDenoise ||
+      (denoiseUntil > 0 && (before < denoiseUntil || win->GetDesiredUpdateRate() > 1.0));
+    traceBudget = in->Refinement.TraceBudget(
+      vtkFerroVolumeRefinement::FrameBudget(this->PathTracingTimeBudget, win), denoised);
+  }
+  in->Settings.SetIntermixing(multi != nullptr);
+  switch (
+    in->Settings.Apply(this, ren, main, in->Input, *in->Renderer, traceBudget, in->Warned, error))
+  {
+    case vtkFerroVolumeSettings::Result::Failed:
+      vtkErrorMacro(<< error);
+      return;
+    case vtkFerroVolumeSettings::Result::NothingVisible:
+      return;
+    case vtkFerroVolumeSettings::Result::Ready:
+      break;
+  }
+
+  // Camera and lights for this viewport.
+  vtkFerroVolumeFrameRequest req;
+  req.Window = win;
+  ren->GetTiledSizeAndOrigin(&req.ViewportW, &req.ViewportH, &req.ViewportX, &req.ViewportY);
+  if (req.ViewportW < 1 || req.ViewportH < 1)
+  {
+    return;
+  }
+  if (!in->Settings.ApplyView(
+        this, ren, req.ViewportW, req.ViewportH, *in->Renderer, in->Warned, error))
+  {
+    vtkErrorMacro(<< error);
+    return;
+  }
+
+  // Render at the resolution ImageSampleDistance reduces the viewport to (whether
+  // AutoAdjustSampleDistances is on or off, as VTK 9.2), through the output path.
+  req.RenderW = std::max(1, static_cast<int>(req.ViewportW / this->ImageSampleDistance));
+  req.RenderH = std::max(1, static_cast<int>(req.ViewportH / this->ImageSampleDistance));
+  req.UseDepth = vtkFerroVolumeDepthReader::SceneHasOpaqueGeometry(ren, vol);
+  req.ColorScale = 1.0f / this->FinalColorWindow;
+  req.ColorBias = 0.5f - this->FinalColorLevel / this->FinalColorWindow;
+  if (peeling && !selector && !this->RenderToImage)
+  {
+    if (!in->Peeling.Draw(peeling, this, vol, *in->Renderer, req, error))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+    this->LastRenderSize[0] = req.RenderW;
+    this->LastRenderSize[1] = req.RenderH;
+    this->LastRenderDrew = 1;
+    return;
+  }
+  std::string warning;
+  // (a frame summed across processes is read back, and the sum written into its texture)
+  const int outputPath = in->PieceSum.Pending() ? OUTPUT_PATH_READBACK : this->OutputPath;
+  if (!in->Output.Render(this, outputPath, *in->Renderer, req, error, warning))
+  {
+    vtkErrorMacro(<< error);
+    return;
+  }
+  if (!warning.empty() && in->Warned.insert(warning).second)
+  {
+    vtkWarningMacro(<< warning);
+  }
+  bool draw = true;
+  std::string sumMessage;
+  if (!in->PieceSum.Add(
+        in->Output.ColorTexture(), req.RenderW, req.RenderH, draw, sumMessage))
+  {
+    vtkErrorMacro(<< sumMessage);
+    return;
+  }
+  if (!sumMessage.empty() && in->Warned.insert(sumMessage).second)
+  {
+    vtkWarningMacro(<< sumMessage);
+  }
+  this->LastRenderSize[0] = req.RenderW;
+  this->LastRenderSize[1] = req.RenderH;
+  if (!draw)
+  {
+    this->LastRenderDrew = 1; // another process draws the sum this frame joined
+    return;
+  }
+
+  // The part of the viewport the volume can cover (where the frame is composited).
+  int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
+  if (!in->Settings.CoversViewport())
+  {
+    const double* spacing = image->GetSpacing();
+    const double pad = vtkFerroVolumeLookupTables::MatrixScale(vol) *
+      std::max({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) });
+    vtkFerroVolumeOutput::ProjectedRect(ren, vol, pad, req.ViewportW, req.ViewportH, rect);
+  }
+  if (selector)
+  {
+    if (!DrawSelection(in->Output, ren, main, image, selector, req, rect, error))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+    this->LastRenderDrew = 1;
+    return;
+  }
+  if (this->RenderToImage)
+  {
+    // The frame goes into the images, not the window.
+    int depthType = this->DepthImageScalarType;
+    if (!vtkFerroVolumeRenderToImage::IsDepthType(depthType))
+    {
+      if (in->FirstTime("depth-image-type"))
+      {
+        vtkWarningMacro(<< "DepthImageScalarType " << depthType
+                        << " is not supported (unsigned char, unsigned short and float are): "
+                           "the depth image is float");
+      }
+      depthType = VTK_FLOAT;
+    }
+    vtkNew<vtkMatrix4x4> boxToClip;
+    vtkFerroVolumeRenderToImage::BoxToClip(ren, main, image, boxToClip);
+    if (!in->Image.Capture(req, in->Output.ColorTexture(), in->Output.DepthTexture(), depthType,
+          boxToClip, this->ClampDepthToBackface != 0, error))
+    {
+      vtkErrorMacro(<< error);
+      return;
+    }
+  }
+  else
+  {
+    switch (in->Output.Composite(req, rect, error))
+    {
+      case vtkFerroVolumeOutput::Composited::Failed:
+        vtkErrorMacro(<< error);
+        return;
+      case vtkFerroVolumeOutput::Composited::OffScreen:
+        this->LastRenderDrew = 1; // nothing to composite
+        return;
+      case vtkFerroVolumeOutput::Composited::Drawn:
+        break;
+    }
+    if (this->GeneratingCanonicalView && this->CanonicalViewImageData)
+    {
+      // CreateCanonicalView: the window as drawn so far (its other props are hidden).
+      int dims[3];
+      this->CanonicalViewImageData->GetDimensions(dims);
+      vtkUnsignedCharArray* pixels = vtkUnsignedCharArray::SafeDownCast(
+        this->CanonicalViewImageData->GetPointData()->GetScalars());
+      if (pixels && pixels->GetNumberOfComponents() == 3)
+      {
+        win->GetPixelData(0, 0, dims[0] - 1, dims[1] - 1, 0, pixels, 0);
+      }
+    }
+  }
+  this->LastRenderDrew = 1;
+  if (progressive)
+  {
+    // Refine while the accumulation is short of SamplesPerPixel.
+    uint32_t samples = 0;
+    if (!vtkFerroVolumeCall("count the accumulated paths", error,
+          [&] { samples = in->Renderer->accumulated_samples(); }))
+    {
+      vtkErrorMacro(<< error);
+      in->Refinement.Stop();
+      return;
+    }
+    const uint32_t target = static_cast<uint32_t>(this->SamplesPerPixel);
+    in->Refinement.End(samples < target, this->PathTracingDenoise || samples < denoiseUntil,
+      req.RenderW, req.RenderH);
+    FvStats statsAfter{};
+    const bool restarted =
+      !in->Stats(statsAfter) || statsAfter.accumulation_restarts != statsBefore.accumulation_restarts;
+    if (!in->Refinement.Continue(win, samples, target, restarted) &&
+      in->Warned.insert("restarts").second)
+    {
+      vtkWarningMacro(<< "path tracing starts over at every render (something the image "
+                         "depends on changes each time, such as opaque geometry moved on "
+                         "every render), so the view stops refining itself at "
+                      << samples
+                      << " paths per pixel; render with ProgressiveModeToOff for "
+                         "SamplesPerPixel paths");
+    }
+    this->LastRenderProgressive = 1;
+  }
+}

@@ -1,0 +1,213 @@
+// The state vtkFerroVolumeMapper keeps between renders (its units and the ferrovol renderer),
+// shared by the mapper's two sources: vtkFerroVolumeMapper.cxx (settings, queries,
+// resources) and vtkFerroVolumeMapperFrame.cxx (a render). Private: neither wrapped nor
+// installed.
+#ifndef vtkFerroVolumeMapperInternals_h
+#define vtkFerroVolumeMapperInternals_h
+
+#include "vtkFerroVolumeMapper.h"
+
+#include "vtkFerroVolumeContext.h"
+#include "vtkFerroVolumeDepthPeeling.h"
+#include "vtkFerroVolumeDepthReader.h"
+#include "vtkFerroVolumeInputHelper.h"
+#include "vtkFerroVolumeIntermix.h"
+#include "vtkFerroVolumeLookupTables.h"
+#include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumePieceSum.h"
+#include "vtkFerroVolumeRefinement.h"
+#include "vtkFerroVolumeRenderToImage.h"
+#include "vtkFerroVolumeSettings.h"
+#include "vtkBoundingBox.h"
+#include "vtkCamera.h"
+#include "vtkCommand.h"
+#include "vtkDataObject.h"
+#include "vtkHardwareSelector.h"
+#include "vtkInformation.h"
+#include "vtkInformationObjectBaseVectorKey.h"
+#include "vtkImageData.h"
+#include "vtkMatrix4x4.h"
+#include "vtkMultiVolume.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkPointData.h"
+#include "vtkRenderer.h"
+#include "vtkTimerLog.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+
+class vtkFerroVolumeMapper::vtkInternals
+{
+public:
+  std::unique_ptr<ferrovol::Renderer> Renderer;
+  // vtkFerroVolumeContext::Generation() when the renderer was made
+  unsigned RendererGeneration = 0;
+  vtkFerroVolumeInputHelper Input;
+  vtkFerroVolumeLookupTables Tables;
+  vtkFerroVolumeIntermix Intermix;
+  vtkFerroVolumeSettings Settings;
+  vtkFerroVolumeOutput Output;
+  vtkFerroVolumeDepthPeeling Peeling;
+  vtkFerroVolumeRenderToImage Image;
+  vtkFerroVolumeRefinement Refinement;
+  vtkFerroVolumePieceSum PieceSum;
+  vtkFerroVolumeInputHelper::WholeRanges WholeRanges{};
+  // warnings said once per mapper
+  std::set<std::string> Warned;
+  // the convergence read back for the frame counted `ConvergenceFrame` (stats().frames)
+  std::optional<FvConvergence> Convergence;
+  uint32_t ConvergenceFrame = 0;
+
+  ~vtkInternals() { this->FreeRenderer(); }
+
+  // The renderer, created on first use from the process-wide device; the passes of a
+  // streamed frame (a volume over the memory budget) report to `self`'s progress.
+  // Whether the renderer was made on a device since lost.
+  bool RendererLost() const
+  {
+    return this->Renderer && this->RendererGeneration != vtkFerroVolumeContext::Generation();
+  }
+
+  // A renderer made on a device since lost is made again (with its input and tables).
+  bool MakeRenderer(vtkFerroVolumeMapper* self, std::string& error)
+  {
+    if (this->Renderer && !this->RendererLost())
+    {
+      return true;
+    }
+    this->FreeRenderer();
+    const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(error);
+    this->RendererGeneration = vtkFerroVolumeContext::Generation();
+    return ctx && vtkFerroVolumeCall("create a renderer", error, [&] {
+      this->Renderer.reset(new ferrovol::Renderer(*ctx));
+      this->Renderer->set_progress(&vtkInternals::StreamProgress, self);
+    });
+  }
+
+  // Each pass of a streamed frame is a ProgressEvent while ReportProgress is on.
+  static void StreamProgress(void* mapper, uint32_t done, uint32_t total)
+  {
+    vtkFerroVolumeMapper* self = static_cast<vtkFerroVolumeMapper*>(mapper);
+    if (self->GetReportProgress())
+    {
+      self->UpdateProgress(static_cast<double>(done) / static_cast<double>(total));
+    }
+  }
+
+  // The input selected and uploaded (on change) within the mapper's memory budget, the
+  // property's tables (on change) and the volumes of `multi`'s other ports (none: cleared);
+  // false with the reason.
+  bool Prepare(
+    vtkFerroVolumeMapper* self, vtkVolume* vol, vtkMultiVolume* multi, std::string& error)
+  {
+    const vtkIdType bytes = self->GetMaxMemoryInBytes();
+    const uint64_t budget = bytes > 0
+      ? static_cast<uint64_t>(static_cast<double>(bytes) * self->GetMaxMemoryFraction())
+      : 0;
+    vtkFerroVolumeLookupTables::RangeTypes types;
+    types.Color = self->GetColorRangeType();
+    types.ScalarOpacity = self->GetScalarOpacityRangeType();
+    types.GradientOpacity = self->GetGradientOpacityRangeType();
+    this->Input.SetWholeRanges(this->WholeRanges);
+    if (!(this->Input.Select(self, error) && this->MakeRenderer(self, error) &&
+          this->Input.Upload(*this->Renderer, budget, error)))
+    {
+      return false;
+    }
+    std::string blanking;
+    if (!this->Input.UpdateBlanking(*this->Renderer, blanking) && this->FirstTime("blanking"))
+    {
+      vtkWarningWithObjectMacro(
+        self, << "the ghost arrays' blanking is not applied (the cells are drawn): " << blanking);
+    }
+    if (!this->Input.UpdateMask(
+          self->GetMaskInput(), self->GetMaskType(), *this->Renderer, error))
+    {
+      error = "MaskInput: " + error;
+      return false;
+    }
+    return this->Tables.Update(vol, this->Input, types, *this->Renderer, error) &&
+      this->Intermix.Update(self, multi, types, *this->Renderer, error);
+  }
+
+  // A warning said once per mapper for `key`.
+  bool FirstTime(const std::string& key) { return this->Warned.insert(key).second; }
+
+  void FreeRenderer()
+  {
+    this->Renderer.reset();
+    this->Input.Reset();
+    this->Tables.Reset();
+    this->Intermix.Reset();
+    this->Settings.Reset();
+    this->Convergence.reset();
+  }
+
+  // The output's images in `window` and RenderToImage's, all made from the renderer's
+  // device.
+  void ReleaseWindowResources(vtkWindow* window)
+  {
+    this->Output.ReleaseGraphicsResources(window);
+    this->Peeling.ReleaseGraphicsResources(window);
+    this->Image.ReleaseGraphicsResources();
+  }
+
+  // Those and the renderer.
+  void ReleaseDeviceResources(vtkWindow* window)
+  {
+    this->ReleaseWindowResources(window);
+    this->FreeRenderer();
+  }
+
+  // The renderer's counters; false before the first frame.
+  bool Stats(FvStats& s) const
+  {
+    if (!this->Renderer)
+    {
+      return false;
+    }
+    try
+    {
+      s = this->Renderer->stats();
+      return true;
+    }
+    catch (const ferrovol::Error&)
+    {
+      return false;
+    }
+  }
+
+  // The path tracer's convergence, read back once per frame; false before the first frame.
+  bool ReadConvergence(FvConvergence& c)
+  {
+    FvStats s;
+    if (!this->Stats(s))
+    {
+      return false;
+    }
+    try
+    {
+      if (!this->Convergence || this->ConvergenceFrame != s.frames)
+      {
+        this->Convergence = this->Renderer->convergence();
+        this->ConvergenceFrame = s.frames;
+      }
+      c = *this->Convergence;
+      return true;
+    }
+    catch (const ferrovol::Error&)
+    {
+      return false;
+    }
+  }
+};
+
+#endif
