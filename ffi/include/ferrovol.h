@@ -1036,7 +1036,7 @@ enum FvStatus fv_frame_write_png(const struct FvFrame *frame,
 /**
  * Sets the volumes drawn with the main one (`count` at `volumes`, 0 clears them), as
  * vtkGPUVolumeRayCastMapper draws the ports of a vtkMultiVolume (the main volume is port
- * 0, volumes[i] port i + 1): each ray marches the world box holding them all at the main
+ * 0, `volumes[i]` port i + 1): each ray marches the world box holding them all at the main
  * volume's sample distance and, at each sample, composites the main volume and then each
  * intermixed volume that holds the sample, each classified by its own transfer function
  * and shaded (when shading is on) by its own gradient with the main volume's lights and
@@ -1406,7 +1406,7 @@ enum FvStatus fv_transfer_function_set_table_2d(struct FvTransferFunction *tf,
                                                 double gradient_max);
 
 /**
- * Copies a volume: `data` holds dims[0]·dims[1]·dims[2]·components values of
+ * Copies a volume: `data` holds `dims[0]·dims[1]·dims[2]·components` values of
  * `desc->scalar_type`, components interleaved, x fastest; `data_bytes` is its size in
  * bytes (checked). Scalars are validated (NaN/Inf refused, spacing > 0, direction
  * invertible). `*out` receives the volume, NULL on failure.
