@@ -197,6 +197,11 @@ struct RenderArgs {
     /// accumulation over, as a moving camera does, and traces --spp paths per pixel.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     repeat: u32,
+    /// With --repeat: frames the device may still be drawing when the next is recorded. 2
+    /// (the default): each frame waits only for the one before it, so the device draws while
+    /// the next frame is prepared; 1: each frame waits for its own end.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=2))]
+    frames_in_flight: u32,
     /// With --repeat: turn the camera by this many degrees about the view up vector
     /// (azimuth) before each frame after the first, an interactive camera path; the summary
     /// adds the bricks uploaded per frame and, with --preview-level, the frames that drew
@@ -587,9 +592,14 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             } else {
                 r.render(&view, &params, None)?;
             }
-            r.finish()?;
+            if a.frames_in_flight == 1 {
+                r.finish()?;
+            } else {
+                r.wait_for_previous_frame()?;
+            }
             stand_ins.push(r.residency().stand_ins);
         }
+        r.finish()?;
         timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);
         uploads = Some((r.stats().brick_uploads - before) as f64 / (a.repeat - 1) as f64);
         img = r.read_image()?;
@@ -647,9 +657,10 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     if let (Some(ms), Some(uploads)) = (timing, uploads) {
         println!(
             "ferrovol: {:.1} ms/frame, {uploads:.1} bricks uploaded per frame (mean of {} \
-             frames after the first)",
+             frames after the first, {} in flight)",
             ms,
-            a.repeat - 1
+            a.repeat - 1,
+            a.frames_in_flight
         );
     }
     Ok(())

@@ -31,6 +31,10 @@ pub struct Renderer {
     pt: Option<Box<PathTracePass>>,
     iso_params: Option<IsoParams>,
     pt_params: PathTraceParams,
+    /// The submissions that end the last frame and the one before it
+    /// ([`Renderer::wait_for_previous_frame`]).
+    last_frame: Option<wgpu::SubmissionIndex>,
+    previous_frame: Option<wgpu::SubmissionIndex>,
 }
 
 /// The pass in `slot`, created by `new` on first use.
@@ -54,6 +58,8 @@ impl Renderer {
             pt: None,
             iso_params: None,
             pt_params: Default::default(),
+            last_frame: None,
+            previous_frame: None,
         })
     }
 
@@ -436,6 +442,9 @@ impl Renderer {
             _ => self.dvr.render(input(&mut *res)),
         };
         res.leave_level();
+        if done.is_ok() {
+            self.previous_frame = std::mem::replace(&mut self.last_frame, ctx.last_submission());
+        }
         done
     }
 
@@ -500,6 +509,24 @@ impl Renderer {
     /// shared; Mesa's llvmpipe has no `GL_EXT_semaphore_fd`).
     pub fn finish(&self) -> Result<()> {
         self.ctx.wait_idle()
+    }
+
+    /// Blocks until every frame but the last has finished on the device: two frames in
+    /// flight. A host that renders frame after frame calls it before recording the next, so
+    /// that the device draws one frame while the host prepares the next, instead of idling
+    /// while the host waits ([`Renderer::finish`]) and then records.
+    pub fn wait_for_previous_frame(&mut self) -> Result<()> {
+        let Some(previous) = self.previous_frame.take() else {
+            return Ok(());
+        };
+        let polled = self.ctx.device.poll(wgpu::PollType::Wait {
+            submission_index: Some(previous),
+            timeout: None,
+        });
+        self.ctx.check_lost("waiting for the previous frame")?;
+        polled
+            .map(|_| ())
+            .map_err(|e| Error::Gpu(format!("waiting for the previous frame: {e}")))
     }
 
     /// Waits for the last frame and copies its colour and depth to the CPU.

@@ -92,6 +92,8 @@ pub struct Context {
     memory_cap: std::sync::Arc<std::sync::atomic::AtomicU64>,
     /// The shader modules and compute pipelines of every renderer on this device.
     pub(crate) shaders: std::sync::Arc<ShaderStore>,
+    /// The latest submission to the queue ([`Context::submit`]).
+    last_submission: std::sync::Arc<Mutex<Option<wgpu::SubmissionIndex>>>,
 }
 
 /// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and
@@ -227,6 +229,7 @@ impl Context {
             lost,
             memory_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
             shaders: Default::default(),
+            last_submission: Default::default(),
         })
     }
 
@@ -260,6 +263,22 @@ impl Context {
             return Err(Error::Gpu(format!("{what}: {e}")));
         }
         Ok(out)
+    }
+
+    /// Submits `commands` to the queue: the one way ferrovol submits, so that
+    /// [`Context::last_submission`] knows where a frame's work ends.
+    pub(crate) fn submit(
+        &self,
+        commands: impl IntoIterator<Item = wgpu::CommandBuffer>,
+    ) -> wgpu::SubmissionIndex {
+        let index = self.queue.submit(commands);
+        *lock(&self.last_submission) = Some(index.clone());
+        index
+    }
+
+    /// The latest submission to the queue, by any renderer on this device.
+    pub(crate) fn last_submission(&self) -> Option<wgpu::SubmissionIndex> {
+        lock(&self.last_submission).clone()
     }
 
     /// Blocks until the GPU has finished all submitted work.

@@ -50,7 +50,7 @@ pub(crate) fn read_texture_layer(
             depth_or_array_layers: 1,
         },
     );
-    ctx.queue.submit([enc.finish()]);
+    ctx.submit([enc.finish()]);
     let bytes = map_read(ctx, &buf)?;
     let mut out = Vec::with_capacity((row * h) as usize);
     for y in 0..h as usize {
@@ -69,7 +69,7 @@ pub(crate) fn read_buffer(ctx: &Context, src: &wgpu::Buffer) -> Result<Vec<u8>> 
     );
     let mut enc = ctx.device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(src, 0, &buf, 0, src.size());
-    ctx.queue.submit([enc.finish()]);
+    ctx.submit([enc.finish()]);
     map_read(ctx, &buf)
 }
 

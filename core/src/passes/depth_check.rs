@@ -104,7 +104,7 @@ impl DepthCheck {
             [gx, gy, 1],
         );
         ctx.checked("comparing the depth input", || {
-            ctx.queue.submit([enc.finish()]);
+            ctx.submit([enc.finish()]);
         })?;
         let flag = read_buffer(ctx, &self.flag)?;
         Ok(fresh || flag != [0; 4])

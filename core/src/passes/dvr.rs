@@ -254,19 +254,19 @@ impl DvrPass {
         match plan {
             None => {
                 dispatch(&mut enc, vol.bind_group(variant.nearest));
-                q.submit([enc.finish()]);
+                ctx.submit([enc.finish()]);
             }
             Some(plan) => {
                 // One pass per group of bricks, front to back: each ray marches what is
                 // resident and stops where its next brick waits, its state in `t.state`.
                 enc.clear_buffer(&t.state, 0, None);
-                q.submit([enc.finish()]);
+                ctx.submit([enc.finish()]);
                 for g in 0..plan.groups.len() {
                     res.load_stream_group(ctx, &plan, g)?;
                     let vol = res.volume()?;
                     let mut enc = d.create_command_encoder(&Default::default());
                     dispatch(&mut enc, vol.bind_group(variant.nearest));
-                    q.submit([enc.finish()]);
+                    ctx.submit([enc.finish()]);
                     res.streamed_pass(&plan, g);
                 }
             }

@@ -746,12 +746,12 @@ impl IsoPass {
                 // deferred shading of the layers they wrote.
                 let state = t.state.clone();
                 enc.clear_buffer(&state, 0, None);
-                q.submit([enc.finish()]);
+                ctx.submit([enc.finish()]);
                 for g in 0..plan.groups.len() {
                     res.load_stream_group(ctx, plan, g)?;
                     let mut enc = d.create_command_encoder(&Default::default());
                     first_hit(&mut enc, res.volume()?.bind_group(false));
-                    q.submit([enc.finish()]);
+                    ctx.submit([enc.finish()]);
                     res.streamed_pass(plan, g);
                 }
                 enc = d.create_command_encoder(&Default::default());
@@ -770,7 +770,7 @@ impl IsoPass {
             pass.dispatch_workgroups(gs[0], gs[1], 1);
         }
         ctx.checked("rendering the isosurface frame", || {
-            q.submit([enc.finish()]);
+            ctx.submit([enc.finish()]);
         })?;
         if lod {
             res.read_lod_requests(ctx)?;

@@ -622,7 +622,7 @@ impl PathTracePass {
             }
             let timed = Instant::now();
             ctx.checked("rendering the path-traced frame", || {
-                q.submit([enc.finish()]);
+                ctx.submit([enc.finish()]);
             })?;
             added += n;
             if budget > 0.0 {
@@ -683,7 +683,7 @@ impl PathTracePass {
             }
         }
         ctx.checked("showing the path-traced frame", || {
-            q.submit([enc.finish()]);
+            ctx.submit([enc.finish()]);
         })?;
         res.stats.frames += 1;
         Ok(())

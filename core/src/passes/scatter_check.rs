@@ -104,7 +104,7 @@ fn run_phase_check(ctx: &Context, u: &PhaseTestUniforms) -> Result<Vec<[f32; 4]>
         [n.div_ceil(64), 1, 1],
     );
     ctx.checked("running the scattering check", || {
-        ctx.queue.submit([enc.finish()]);
+        ctx.submit([enc.finish()]);
     })?;
     let bytes = read_buffer(ctx, &out)?;
     Ok(bytemuck::cast_slice(&bytes).to_vec())

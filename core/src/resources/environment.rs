@@ -339,7 +339,7 @@ impl GpuEnvironment {
             [groups(IRRADIANCE_SIZE), groups(IRRADIANCE_SIZE), 6],
         );
         ctx.checked("computing the environment maps", || {
-            q.submit([enc.finish()]);
+            ctx.submit([enc.finish()]);
         })?;
         ctx.wait_idle()?;
         drop(keep);

@@ -82,7 +82,7 @@ impl GradientPass {
             ],
         );
         ctx.checked("computing the gradients", || {
-            ctx.queue.submit([enc.finish()]);
+            ctx.submit([enc.finish()]);
         })?;
         Ok(texture)
     }

@@ -202,7 +202,7 @@ impl Resources {
         }
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&vol.requests, 0, None);
-        ctx.queue.submit([enc.finish()]);
+        ctx.submit([enc.finish()]);
         self.finish_residency(ctx)?;
         Ok(true)
     }

@@ -150,7 +150,7 @@ impl Resources {
                 // writes its depth.
                 let far: Vec<f32> = vec![1.0; width as usize * height as usize];
                 upload_texture(&ctx.queue, &depth_in, bytemuck::cast_slice(&far), 4);
-                ctx.queue.submit([enc.finish()]);
+                ctx.submit([enc.finish()]);
                 // Wait: the host may write the depth input through its own API right after
                 // this returns, and a clear landing later would wipe it.
                 ctx.wait_idle()?;

@@ -812,7 +812,7 @@ fn shrink(ctx: &Context, vol: &mut GpuVolume, layers: u32, needed: &[bool]) {
             },
         );
     }
-    ctx.queue.submit([enc.finish()]);
+    ctx.submit([enc.finish()]);
     vol.pool = Some(pool);
     vol.layers = layers;
     // (the page table follows in apply_moves)
@@ -836,7 +836,7 @@ pub(super) fn apply_moves(
         if let Some(old) = vol.pool.as_ref() {
             let mut enc = ctx.device.create_command_encoder(&Default::default());
             enc.copy_texture_to_texture(old.as_image_copy(), pool.as_image_copy(), old.size());
-            ctx.queue.submit([enc.finish()]);
+            ctx.submit([enc.finish()]);
         }
         vol.pool = Some(pool);
         vol.layers = layers;

@@ -19,6 +19,7 @@ mod compositing;
 mod intermix;
 mod lod;
 mod masks;
+mod pipelining;
 mod preintegration;
 mod quadrature;
 mod rectilinear;
