@@ -179,12 +179,9 @@ lint-fuzz:
 	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
 	$(CARGO) clippy --locked --manifest-path fuzz/Cargo.toml --all-targets -- -D warnings
 # The library crates as crates.io would take them: packaged alone (the shaders inside
-# ferrovol-core) and built from the package, with the workspace's dev profile (Cargo.toml)
-# so that the dependencies the test build compiled serve (a package is its own workspace).
-PUBLISH_PROFILE = --config 'profile.dev.opt-level=2' --config 'profile.dev.debug="line-tables-only"' \
-  --config 'profile.dev.package."*".opt-level=2' --config 'profile.dev.package."*".debug=false'
+# ferrovol-core) and built from the package.
 lint-publish:
-	$(CARGO) publish --dry-run --locked --allow-dirty -p ferrovol-core -p ferrovol-io $(PUBLISH_PROFILE)
+	$(CARGO) publish --dry-run --locked --allow-dirty -p ferrovol-core -p ferrovol-io
 
 # Everything CI runs (scripts/test.sh: the builds, then the suites in two lanes, each
 # suite's log in build/test-logs and its wall time; `scripts/test.sh NAME...` runs some).
