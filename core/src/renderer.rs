@@ -516,17 +516,12 @@ impl Renderer {
     /// that the device draws one frame while the host prepares the next, instead of idling
     /// while the host waits ([`Renderer::finish`]) and then records.
     pub fn wait_for_previous_frame(&mut self) -> Result<()> {
-        let Some(previous) = self.previous_frame.take() else {
-            return Ok(());
-        };
-        let polled = self.ctx.device.poll(wgpu::PollType::Wait {
-            submission_index: Some(previous),
-            timeout: None,
-        });
-        self.ctx.check_lost("waiting for the previous frame")?;
-        polled
-            .map(|_| ())
-            .map_err(|e| Error::Gpu(format!("waiting for the previous frame: {e}")))
+        match self.previous_frame.take() {
+            Some(previous) => self
+                .ctx
+                .wait_for(Some(previous), "waiting for the previous frame"),
+            None => Ok(()),
+        }
     }
 
     /// Waits for the last frame and copies its colour and depth to the CPU.

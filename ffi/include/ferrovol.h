@@ -453,8 +453,9 @@ typedef struct FvPlane {
  */
 typedef struct FvRenderParams {
   /**
-   * sizeof(this struct) as the caller's header declares it, written by fv_render_params_default; fields
-   * added in later minor versions take their defaults when it is smaller.
+   * sizeof(this struct) as the caller's header declares it, written by
+   * fv_render_params_default; fields added in later minor versions take their defaults
+   * when it is smaller.
    */
   size_t size;
   /**
@@ -610,8 +611,9 @@ typedef struct FvIsoValue {
  */
 typedef struct FvIsoParams {
   /**
-   * sizeof(this struct) as the caller's header declares it, written by fv_iso_params_default; fields
-   * added in later minor versions take their defaults when it is smaller.
+   * sizeof(this struct) as the caller's header declares it, written by
+   * fv_iso_params_default; fields added in later minor versions take their defaults
+   * when it is smaller.
    */
   size_t size;
   /**
@@ -695,8 +697,9 @@ typedef struct FvIsoParams {
  */
 typedef struct FvPathTraceParams {
   /**
-   * sizeof(this struct) as the caller's header declares it, written by fv_path_trace_params_default; fields
-   * added in later minor versions take their defaults when it is smaller.
+   * sizeof(this struct) as the caller's header declares it, written by
+   * fv_path_trace_params_default; fields added in later minor versions take their defaults
+   * when it is smaller.
    */
   size_t size;
   /**

@@ -41,8 +41,9 @@ pub struct FvIsoValue {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct FvIsoParams {
-    /// sizeof(this struct) as the caller's header declares it, written by fv_iso_params_default; fields
-    /// added in later minor versions take their defaults when it is smaller.
+    /// sizeof(this struct) as the caller's header declares it, written by
+    /// fv_iso_params_default; fields added in later minor versions take their defaults
+    /// when it is smaller.
     pub size: usize,
     /// 1 to FV_MAX_ISO_VALUES entries of `values` are used.
     pub value_count: u32,
@@ -223,8 +224,9 @@ pub enum FvScatterRegions {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct FvPathTraceParams {
-    /// sizeof(this struct) as the caller's header declares it, written by fv_path_trace_params_default; fields
-    /// added in later minor versions take their defaults when it is smaller.
+    /// sizeof(this struct) as the caller's header declares it, written by
+    /// fv_path_trace_params_default; fields added in later minor versions take their defaults
+    /// when it is smaller.
     pub size: usize,
     /// Paths per pixel each frame adds (1 to 4096).
     pub samples_per_frame: u32,

@@ -1,7 +1,7 @@
 //! The renderer: settings, frames, the shared output.
 
 use super::*;
-use crate::sized::{self, SizedParams};
+use crate::sized;
 
 /// A renderer: the uploaded volume, transfer tables, pipelines and the frame it draws.
 /// Camera, lights and parameters persist between frames. Thread use: one thread at a
@@ -29,29 +29,14 @@ fn with_renderer_ref(
     guard(|| f(const_ref(renderer, "renderer")?))
 }
 
-/// Converts the C description at `value` (`what` names it when NULL) and hands it to `apply`.
-fn set_from<T: ToCore>(
+/// Hands what `read` converts from a C description to `apply`.
+fn set_from<C>(
     renderer: *mut FvRenderer,
-    value: *const T,
-    what: &str,
-    apply: impl FnOnce(&mut FvRenderer, T::Core) -> ferrovol_core::Result<()>,
+    read: impl FnOnce() -> FfiResult<C>,
+    apply: impl FnOnce(&mut FvRenderer, C) -> ferrovol_core::Result<()>,
 ) -> FvStatus {
     with_renderer(renderer, |r| {
-        let v = const_ref(value, what)?.to_core()?;
-        apply(r, v)?;
-        Ok(())
-    })
-}
-
-/// As [`set_from`], for a struct that carries its size ([`sized::read`]).
-fn set_sized<T: ToCore + SizedParams>(
-    renderer: *mut FvRenderer,
-    value: *const T,
-    apply: impl FnOnce(&mut FvRenderer, T::Core) -> ferrovol_core::Result<()>,
-) -> FvStatus {
-    with_renderer(renderer, |r| {
-        let v = sized::read(value, "params")?.to_core()?;
-        apply(r, v)?;
+        apply(r, read()?)?;
         Ok(())
     })
 }
@@ -187,7 +172,11 @@ pub unsafe extern "C" fn fv_renderer_set_transfer_function(
     renderer: *mut FvRenderer,
     tf: *const FvTransferFunction,
 ) -> FvStatus {
-    set_from(renderer, tf, "tf", |r, t| r.r.set_transfer_function(&t))
+    set_from(
+        renderer,
+        || const_ref(tf, "tf")?.to_core(),
+        |r, t| r.r.set_transfer_function(&t),
+    )
 }
 
 /// Sets the camera for the following frames.
@@ -196,10 +185,14 @@ pub unsafe extern "C" fn fv_renderer_set_camera(
     renderer: *mut FvRenderer,
     camera: *const FvCamera,
 ) -> FvStatus {
-    set_from(renderer, camera, "camera", |r, c| {
-        r.view.camera = c;
-        Ok(())
-    })
+    set_from(
+        renderer,
+        || const_ref(camera, "camera")?.to_core(),
+        |r, c| {
+            r.view.camera = c;
+            Ok(())
+        },
+    )
 }
 
 /// Sets the lights (`count` may be 0: shading then has ambient light only; at most
@@ -253,10 +246,14 @@ pub unsafe extern "C" fn fv_renderer_set_params(
     renderer: *mut FvRenderer,
     params: *const FvRenderParams,
 ) -> FvStatus {
-    set_sized(renderer, params, |r, p| {
-        r.params = p;
-        Ok(())
-    })
+    set_from(
+        renderer,
+        || sized::read(params, "params")?.to_core(),
+        |r, p| {
+            r.params = p;
+            Ok(())
+        },
+    )
 }
 
 /// Fills `*params` with the isosurface defaults (no iso-values yet: set `value_count` and
@@ -275,7 +272,11 @@ pub unsafe extern "C" fn fv_renderer_set_isosurface(
     renderer: *mut FvRenderer,
     params: *const FvIsoParams,
 ) -> FvStatus {
-    set_sized(renderer, params, |r, p| r.r.set_isosurface(&p))
+    set_from(
+        renderer,
+        || sized::read(params, "params")?.to_core(),
+        |r, p| r.r.set_isosurface(&p),
+    )
 }
 
 /// Sets the environment that lights isosurfaces and path-traced media and builds its maps
@@ -333,7 +334,11 @@ pub unsafe extern "C" fn fv_renderer_set_path_tracing(
     renderer: *mut FvRenderer,
     params: *const FvPathTraceParams,
 ) -> FvStatus {
-    set_sized(renderer, params, |r, p| r.r.set_path_tracing(&p))
+    set_from(
+        renderer,
+        || sized::read(params, "params")?.to_core(),
+        |r, p| r.r.set_path_tracing(&p),
+    )
 }
 
 /// Paths per pixel the last path-traced frame shows into `*samples` (0 before the first);

@@ -241,8 +241,9 @@ pub const FV_MAX_LIGHTS: usize = 8;
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct FvRenderParams {
-    /// sizeof(this struct) as the caller's header declares it, written by fv_render_params_default; fields
-    /// added in later minor versions take their defaults when it is smaller.
+    /// sizeof(this struct) as the caller's header declares it, written by
+    /// fv_render_params_default; fields added in later minor versions take their defaults
+    /// when it is smaller.
     pub size: usize,
     /// One of FvBlendMode.
     pub blend_mode: u32,

@@ -283,11 +283,24 @@ impl Context {
 
     /// Blocks until the GPU has finished all submitted work.
     pub fn wait_idle(&self) -> Result<()> {
-        let polled = self.device.poll(wgpu::PollType::wait_indefinitely());
-        self.check_lost("waiting for the GPU")?;
+        self.wait_for(None, "waiting for the GPU")
+    }
+
+    /// Blocks until the GPU has finished `submission` (None: all submitted work); `what`
+    /// names the wait in errors.
+    pub(crate) fn wait_for(
+        &self,
+        submission: Option<wgpu::SubmissionIndex>,
+        what: &str,
+    ) -> Result<()> {
+        let polled = self.device.poll(wgpu::PollType::Wait {
+            submission_index: submission,
+            timeout: None,
+        });
+        self.check_lost(what)?;
         polled
             .map(|_| ())
-            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+            .map_err(|e| Error::Gpu(format!("{what}: {e}")))
     }
 
     /// The buffers, textures and device memory the context holds now.
