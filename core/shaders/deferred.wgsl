@@ -35,8 +35,8 @@ override SCATTER: u32 = 0u;
 override ISO_COMP: u32 = 0u;
 
 @group(0) @binding(2) var<storage, read> state: array<PixelState>;
-@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(SLOT_OUT_COLOR) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(SLOT_OUT_DEPTH) var out_depth: texture_storage_2d<r32float, write>;
 @group(0) @binding(8) var g_position: texture_2d_array<f32>;
 @group(0) @binding(9) var g_normal: texture_2d_array<f32>;
 @group(0) @binding(10) var g_extra: texture_2d_array<f32>;
@@ -143,7 +143,7 @@ fn absorption_at(x: vec3<f32>) -> f32 {
 // Optical depth from x along the unit direction d over `len` world units (midpoint rule
 // in steps of at most the sample distance).
 fn optical_depth(x: vec3<f32>, d: vec3<f32>, len: f32) -> f32 {
-    let n = min(u32(ceil(max(len, 0.0) / frame.misc.x)), 8192u);
+    let n = min(u32(ceil(max(len, 0.0) / frame.sample_distance)), 8192u);
     let h = len / f32(max(n, 1u));
     var tau = 0.0;
     for (var i = 0u; i < n; i = i + 1u) {
@@ -175,7 +175,7 @@ fn scattered_light(x1: vec3<f32>, n1: vec3<f32>, c1: vec3<f32>, t_in: f32, px: v
         let u = hammersley(k, count);
         let l = cosine_hemisphere(vec2<f32>(u.x, fract(u.y + turn / (2.0 * PI))));
         let w = b * l;
-        let start = x1 + 1e-3 * frame.misc.x * w;
+        let start = x1 + 1e-3 * frame.sample_distance * w;
         let tau = optical_depth(start, w, volume_exit(start, w));
         // each direction reads the mip level whose texels cover the solid angle it stands
         // for (filtered importance sampling, as the specular lobe): a small bright sun is
@@ -199,7 +199,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let fr = frame.rect;
     var layers = 0u;
     if (px.x >= fr.x && px.x < fr.z && px.y >= fr.y && px.y < fr.w) {
-        layers = min(u32(state[px.y * frame.viewport.x + px.x].color.x), iso.counts.z);
+        layers = min(u32(state[px.y * frame.width + px.x].color.x), iso.counts.z);
     }
     let ray = make_ray(px);
     let v = -ray.dir;
@@ -239,7 +239,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let rgb = shade_surface(surface.rgb, gp.xyz, gn.xyz, gn.w, ge.y, v);
         let w = (1.0 - color.a) * surface.a;
         color = vec4<f32>(color.rgb + w * rgb, color.a + w);
-        if (!depth_set && color.a > frame.misc.z) {
+        if (!depth_set && color.a > frame.depth_threshold) {
             depth = ge.x;
             depth_set = true;
         }

@@ -254,7 +254,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
         return;
     }
-    let pix = px.y * frame.viewport.x + px.x;
+    let pix = px.y * frame.width + px.x;
     var st: PixelState;
     if (STREAMING) {
         st = state[pix];
@@ -266,7 +266,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var layers = u32(st.color.x);
     var alpha = st.color.y;
     let max_layers = iso.counts.z;
-    let ert = frame.misc.y;
+    let ert = frame.termination;
     if (max_layers == 0u || ert <= 0.0) {
         state[pix] = st;
         return;
@@ -279,10 +279,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         state[pix] = st;
         return;
     }
-    let dt = frame.misc.x;
+    let dt = frame.sample_distance;
     var jit = 0.0;
     if (has_flag(FLAG_JITTER)) {
-        jit = hash01(pix ^ frame.viewport.w);
+        jit = hash01(pix ^ frame.jitter_seed);
     }
     // Lattice sample k lies at lattice + (k + jit) dt: from the segment's start, or for a
     // piece of a whole volume (FLAG_PIECE) on the whole's lattice, so that a piece samples

@@ -557,7 +557,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         }
         // ... and the lights: directional (the headlight along the camera ray) and
         // positional, with VTK's attenuation and spot cone.
-        for (var i = 0u; i < frame.counts.y; i = i + 1u) {
+        for (var i = 0u; i < frame.light_count; i = i + 1u) {
             let light = frame.lights[i];
             var l = select(light.position.xyz, -camera_ray.dir, light.position.w > 1.5);
             var reach = 3.0e38;
@@ -613,7 +613,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (px.x >= pt.rect.z || px.y >= pt.rect.w) {
         return;
     }
-    let idx = px.y * frame.viewport.x + px.x;
+    let idx = px.y * frame.width + px.x;
     // the primary ray's stream, shared by the counts.x paths of one primary ray
     var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ (pt.counts.y / pt.counts.x));
     let secondary = rng_seed(idx, pcg_hash(pt.counts.w ^ 0x68e31da4u) ^ pt.counts.y);

@@ -1,7 +1,8 @@
 // VTK's blanking (ghost arrays, vtkUniformGrid): per point of the grid, non-zero where the
 // point is hidden (Renderer::set_blanking); BLANKING is on when the volume has one. Ray
 // casting, isosurfaces and the path tracer leave blanked samples out.
-@group(0) @binding(22) var blanking_mask: texture_3d<u32>;
+#include "lib/common.wgsl"
+@group(0) @binding(SLOT_BLANKING) var blanking_mask: texture_3d<u32>;
 override BLANKING: bool = false;
 
 // Whether the sample at index-space point p is blanked: vtkGPUVolumeRayCastMapper skips it

@@ -9,6 +9,7 @@
 //     propagation direction, kept where it passes through the surface, weight (1 − F)·t.
 // Each lobe integrates to at most 1 and the weights sum to 1, so the albedo is at most
 // the colour's. Needs PI, basis_around, cosine_hemisphere and phong_lobe (lib/envmap.wgsl).
+#include "lib/envmap.wgsl"
 
 struct Bsdf {
     n: vec3<f32>,      // unit normal on the side the path comes from

@@ -45,7 +45,10 @@ struct Frame {
     material: vec4<f32>,          // ambient, diffuse, specular, specular power
     crop_lo: vec4<f32>,           // cropping planes, data coordinates
     crop_hi: vec4<f32>,
-    misc: vec4<f32>,              // sample distance, termination threshold, depth threshold, gradient epsilon
+    sample_distance: f32,         // world distance between samples
+    termination: f32,             // early ray termination: the opacity a ray stops at
+    depth_threshold: f32,         // the opacity at which a ray's depth is taken
+    gradient_epsilon: f32,        // shorter gradients shade as having no normal (lib/shading.wgsl)
     average_range: vec4<f32>,     // xy: scalar range the average blend mode keeps
     additive_scale: vec4<f32>,    // per component: sample distance / unit distance
     scatter: vec4<f32>,           // volumetric shadows: x blending (0 off), y anisotropy, z reach (texture units), w 2 / data range
@@ -54,9 +57,18 @@ struct Frame {
     whole_lo: vec4<f32>,          // FLAG_PIECE: the whole volume's box in this piece's index space
     whole_hi: vec4<f32>,
     lights: array<Light, 8>,
-    viewport: vec4<u32>,          // width, height, 0 (camera index base: lib/ray.wgsl), jitter seed
-    mode: vec4<u32>,              // blend, flags, crop regions, unused
-    counts: vec4<u32>,            // clip planes, lights, occupancy block size, components
+    width: u32,                   // the image's pixels
+    height: u32,
+    camera_index: u32,            // 0, not a constant to the compiler (lib/ray.wgsl)
+    jitter_seed: u32,
+    blend: u32,                   // BLEND_* (a pass's BLEND pipeline constant where it has one)
+    flags: u32,                   // FLAG_* bits
+    crop_regions: u32,            // VTK's cropping region flags (27 bits)
+    unused: u32,
+    clip_planes: u32,             // clipping planes in `clip`
+    light_count: u32,             // lights in `lights`
+    block_size: u32,              // points per edge of an occupancy block
+    components: u32,              // the volume's components
     occupancy_dims: vec4<u32>,    // blocks per axis
     rect: vec4<u32>,              // pixels the passes cover: x0, y0, x1, y1 (exclusive)
     component_materials: array<vec4<f32>, 4>, // each independent component's material
@@ -68,7 +80,7 @@ struct Frame {
     t2d_inv_gmax: vec4<f32>,      // 1 / gradient magnitude at the last row's edge (0: first row)
 }
 
-@group(0) @binding(0) var<uniform> frame_ubo: Frame;
+@group(0) @binding(SLOT_FRAME) var<uniform> frame_ubo: Frame;
 // The passes read the frame's uniforms from this private copy, which each entry point
 // fills first (`frame = frame_ubo;`). Lavapipe reads a uniform inside a loop or a branch
 // with a masked per-lane gather and a bounds check per lane; the copy is read once per
@@ -78,7 +90,7 @@ var<private> frame: Frame;
 // step), row 2·c + 1 holds (alpha as given, gradient opacity, 0, 0). Composite reads one
 // entry per sample. A texture rather than a storage buffer: lavapipe reads storage buffers
 // at per-lane indices one lane at a time.
-@group(0) @binding(1) var tables: texture_2d<f32>;
+@group(0) @binding(SLOT_TABLES) var tables: texture_2d<f32>;
 
 // Per-pixel ray state: the first-hit pass's layer counts, and a streamed ray's state between
 // the passes of its frame (shaders/dvr.wgsl).
@@ -89,7 +101,7 @@ struct PixelState {
 }
 
 fn has_flag(f: u32) -> bool {
-    return (frame.mode.y & f) != 0u;
+    return (frame.flags & f) != 0u;
 }
 
 // Linear lookup into table `which` (0: colour + corrected alpha, 1: alpha & gradient opacity)

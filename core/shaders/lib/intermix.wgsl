@@ -3,6 +3,7 @@
 // stacked along z from dims.w, classified by tables of their own (two rows each, as
 // lib/common.wgsl lays a component's out: colour with the step-corrected opacity, then the
 // opacity as given). dvr.wgsl composites them per sample, pathtrace.wgsl adds their media.
+#include "lib/common.wgsl"
 override INTERMIX: u32 = 0u;
 
 struct IntermixedVolume {
@@ -20,12 +21,12 @@ struct Intermix {
     volumes: array<IntermixedVolume, MAX_INTERMIXED>,
 }
 
-@group(0) @binding(18) var<uniform> intermix: Intermix;
-@group(0) @binding(19) var intermix_atlas: texture_3d<f32>;
-@group(0) @binding(20) var intermix_tables: texture_2d<f32>;
+@group(0) @binding(SLOT_INTERMIX) var<uniform> intermix: Intermix;
+@group(0) @binding(SLOT_INTERMIX_ATLAS) var intermix_atlas: texture_3d<f32>;
+@group(0) @binding(SLOT_INTERMIX_TABLES) var intermix_tables: texture_2d<f32>;
 // Linear where r32float is filterable (INTERMIX_FILTERED: one fetch per value, weighted as
 // VTK's textures are), else nearest and unused (the shader interpolates eight loads).
-@group(0) @binding(21) var intermix_sampler: sampler;
+@group(0) @binding(SLOT_INTERMIX_SAMPLER) var intermix_sampler: sampler;
 override INTERMIX_FILTERED: bool = false;
 
 // Intermixed volume j's index-space point at world point pos.

@@ -18,7 +18,7 @@ struct Iso {
                                   // distance, y traced directions, z Fresnel F0
 }
 
-@group(0) @binding(7) var<uniform> iso_ubo: Iso;
+@group(0) @binding(SLOT_ISO) var<uniform> iso_ubo: Iso;
 // A private copy filled by each entry point (`iso = iso_ubo;`), as lib/common.wgsl's
 // `frame`.
 var<private> iso: Iso;

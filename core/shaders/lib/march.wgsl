@@ -1,6 +1,8 @@
 // Marching a ray through the volume, shared by the ray-casting passes (dvr, firsthit): the
 // ray's segment inside the volume (near/far planes, the host's opaque depth, clipping
 // planes), VTK's cropping regions and the occupancy grid for empty-space skipping.
+#include "lib/common.wgsl"
+#include "lib/ray.wgsl"
 
 // Per block of the occupancy grid (a texture: lavapipe reads storage buffers at per-lane
 // indices one lane at a time): non-zero when the block may hold something the pass looks
@@ -9,9 +11,9 @@
 // low 8 bits, 0 there when the pass can skip it; an empty block's bits 8–31 hold its
 // Chebyshev distance in blocks to the nearest occupied one (core/src/resources/tables.rs,
 // leap_texels), so that a ray leaps the whole cube of empty blocks around it (leap_exit).
-@group(0) @binding(3) var occupancy: texture_3d<u32>;
+@group(0) @binding(SLOT_OCCUPANCY) var occupancy: texture_3d<u32>;
 // The host's opaque depth (window depth per pixel), read when FLAG_DEPTH_INPUT is set.
-@group(0) @binding(4) var depth_in: texture_2d<f32>;
+@group(0) @binding(SLOT_DEPTH_IN) var depth_in: texture_2d<f32>;
 
 // The part of the ray inside the volume, in front of the far plane and the host's opaque
 // geometry and on the kept side of every clipping plane.
@@ -37,13 +39,13 @@ fn in_crop(p: vec3<f32>) -> bool {
     let r = select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_lo.xyz)
           + select(vec3<u32>(0u), vec3<u32>(1u), d >= frame.crop_hi.xyz);
     let bit = r.x + 3u * r.y + 9u * r.z;
-    return ((frame.mode.z >> bit) & 1u) != 0u;
+    return ((frame.crop_regions >> bit) & 1u) != 0u;
 }
 
 // The min–max block holding index-space point p (clamped to the grid): its texel in the
 // per-block textures (occupancy, majorants).
 fn block_coord(p: vec3<f32>) -> vec3<i32> {
-    let bs = f32(frame.counts.z);
+    let bs = f32(frame.block_size);
     let b = min(vec3<u32>(max(floor(p / bs), vec3<f32>(0.0))), frame.occupancy_dims.xyz - 1u);
     return vec3<i32>(b);
 }
@@ -65,7 +67,7 @@ fn block_texel(p: vec3<f32>) -> u32 {
 // blocks from the nearest occupied one: the cube of the blocks less than d away along
 // every axis.
 fn leap_exit(r: Ray, p: vec3<f32>, d: u32) -> f32 {
-    let bs = f32(frame.counts.z);
+    let bs = f32(frame.block_size);
     let reach = f32(max(d, 1u) - 1u) * bs;
     let lo = floor(p / bs) * bs;
     return box_interval(r, lo - reach, lo + bs + reach).y;

@@ -1,16 +1,17 @@
 // Turning a ray's final state into the output pixel: premultiplied RGBA and a window
 // depth. For the projection modes (maximum, minimum, average, additive) the transfer
 // function is applied here, once, to the value the ray found (shaders/dvr.wgsl).
+#include "lib/common.wgsl"
 
-@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(6) var out_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(SLOT_OUT_COLOR) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(SLOT_OUT_DEPTH) var out_depth: texture_storage_2d<r32float, write>;
 
 // Premultiplied colour of a projected value (maximum, minimum): the transfer function
 // applied to the value found, un-corrected opacity; dependent components as in composite
 // (2: colour table on the first, opacity on the second; 4: the data's RGB, opacity on the
 // fourth); independent components mixed as VTK does (colour and opacity summed, weighted).
 fn classify_value(v: vec4<f32>) -> vec4<f32> {
-    let ncomp = frame.counts.w;
+    let ncomp = frame.components;
     if (!has_flag(FLAG_INDEPENDENT)) {
         let oc = ncomp - 1u;
         let a = raw_alpha(0u, v[oc]);
@@ -44,7 +45,7 @@ fn closes_sum(blend: u32) -> bool {
 }
 
 fn write_pixel(px: vec2<u32>, st: PixelState) {
-    let blend = frame.mode.x;
+    let blend = frame.blend;
     var color = vec4<f32>(0.0);
     var depth = 1.0;
     if (blend == BLEND_COMPOSITE || blend == BLEND_SLICE) {
@@ -67,7 +68,7 @@ fn write_pixel(px: vec2<u32>, st: PixelState) {
             }
             var g = v.x;
             if (has_flag(FLAG_INDEPENDENT)) {
-                g = dot(v, frame.weights * vec4<f32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(frame.counts.w)));
+                g = dot(v, frame.weights * vec4<f32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(frame.components)));
             }
             let grey = clamp(g, 0.0, 1.0);
             var alpha = 1.0;
@@ -79,7 +80,7 @@ fn write_pixel(px: vec2<u32>, st: PixelState) {
             color = classify_value(st.value);
             if (has_flag(FLAG_EXTREMUM_DEPTH)) {
                 // (dependent components: their extremum is the opacity component's)
-                let key = select(0u, frame.counts.w - 1u, !has_flag(FLAG_INDEPENDENT));
+                let key = select(0u, frame.components - 1u, !has_flag(FLAG_INDEPENDENT));
                 let u = clamp(scalar_coord(0u, st.value[key]), 0.0, 1.0);
                 depth = 0.5 * select(u, 1.0 - u, blend == BLEND_MAXIMUM);
             }

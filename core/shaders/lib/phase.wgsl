@@ -1,6 +1,7 @@
 // Random numbers and the Henyey–Greenstein phase function, shared by the path tracer
 // (pathtrace.wgsl) and the phase-function sampling check (phase_test.wgsl). Needs PI and
 // basis_around (lib/envmap.wgsl).
+#include "lib/envmap.wgsl"
 
 // PCG hash (O'Neill): a well-mixed u32 from a u32.
 fn pcg_hash(v: u32) -> u32 {

@@ -1,5 +1,6 @@
 // Rays: one per pixel through the pixel centre, in world space and in the volume's index
 // space, parameterised by world distance from the near plane.
+#include "lib/common.wgsl"
 
 struct Ray {
     origin: vec3<f32>,      // world, on the near plane
@@ -14,11 +15,11 @@ struct Ray {
 // shader and recompiles it whenever one of them changes, and it picked the camera — a full
 // LLVM compile at every camera move (docs/PERFORMANCE.md has the figures).
 fn inv_view_proj() -> mat4x4<f32> {
-    return frame_ubo.camera[frame_ubo.viewport.z];
+    return frame_ubo.camera[frame_ubo.camera_index];
 }
 
 fn view_proj() -> mat4x4<f32> {
-    return frame_ubo.camera[frame_ubo.viewport.z + 1u];
+    return frame_ubo.camera[frame_ubo.camera_index + 1u];
 }
 
 fn unproject(ndc: vec3<f32>) -> vec3<f32> {
@@ -28,7 +29,7 @@ fn unproject(ndc: vec3<f32>) -> vec3<f32> {
 
 // NDC of the point p of the image (pixels, from the top left corner).
 fn image_ndc(p: vec2<f32>) -> vec2<f32> {
-    let size = vec2<f32>(f32(frame.viewport.x), f32(frame.viewport.y));
+    let size = vec2<f32>(f32(frame.width), f32(frame.height));
     let uv = p / size;
     return vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
 }
@@ -96,7 +97,7 @@ fn distance_to_depth(r: Ray, t: f32) -> f32 {
 // Narrows [t.x, t.y] by the clipping planes.
 fn clip_interval(r: Ray, t_in: vec2<f32>) -> vec2<f32> {
     var t = t_in;
-    for (var i = 0u; i < frame.counts.x; i = i + 1u) {
+    for (var i = 0u; i < frame.clip_planes; i = i + 1u) {
         let pl = frame.clip[i];
         let dist = dot(pl.xyz, r.index_origin) + pl.w;   // signed, at t = 0
         let rate = dot(pl.xyz, r.index_dir);

@@ -4,7 +4,9 @@
 // coordinate at evenly spaced lattice points, column j at j·(n_a − 1)/(width − 1), read
 // linearly between columns. A uniform grid binds a placeholder and leaves it unread. Ray
 // casting and isosurfaces read it.
-@group(0) @binding(23) var grid_lookup: texture_3d<f32>;
+#include "lib/common.wgsl"
+#include "lib/volume.wgsl"
+@group(0) @binding(SLOT_GRID_LOOKUP) var grid_lookup: texture_3d<f32>;
 override RECTILINEAR: bool = false;
 
 // The grid's index-space point for the lattice point p, and the rate it changes with p

@@ -4,6 +4,7 @@
 // highlights); the specular term uses the reflection vector, as VTK does; with two-sided
 // lighting a light behind the surface lights its back. Where the gradient vanishes there
 // is no normal and only the ambient term remains.
+#include "lib/common.wgsl"
 
 // Whether any light is positional (a pipeline constant: directional-only scenes, the
 // common case with VTK's headlight, carry no attenuation or spotlight code).
@@ -46,7 +47,7 @@ fn shade_material(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: v
     var ambient = vec3<f32>(0.0);
     var diffuse = vec3<f32>(0.0);
     var specular = vec3<f32>(0.0);
-    let has_normal = glen > frame.misc.w;
+    let has_normal = glen > frame.gradient_epsilon;
     var n = vec3<f32>(0.0);
     if (has_normal) {
         n = -grad / glen;

@@ -9,6 +9,9 @@
 // gradient shading by a weight that grows with the blending where the gradient and the
 // opacity are small. Distances are measured in texture space (the volume's point box
 // mapped to the unit cube), as VTK's are. Needs lib/common.wgsl and lib/volume.wgsl.
+#include "lib/common.wgsl"
+#include "lib/volume.wgsl"
+#include "lib/shading.wgsl"
 
 // The shadow and jitter offset of the current pixel (dvr.wgsl sets it: VTK reuses the
 // primary ray's jitter, 0 without jittering).
@@ -127,7 +130,7 @@ fn vtk_gradient_magnitude(grad: vec3<f32>, of_opacity: bool) -> f32 {
 fn volumetric_shade(color: vec3<f32>, a: f32, gm: f32, surface: vec3<f32>,
                     p: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>, grad_opacity: bool) -> vec3<f32> {
     let pt = index_to_tex(p);
-    let dt = length((frame.world_to_index * vec4<f32>(view_dir * frame.misc.x, 0.0)).xyz / frame.dims.xyz);
+    let dt = length((frame.world_to_index * vec4<f32>(view_dir * frame.sample_distance, 0.0)).xyz / frame.dims.xyz);
     let eye = tex_direction(-view_dir);
     let kd = frame.material.y;
     let ka = frame.material.x;

@@ -2,6 +2,7 @@
 // VTK's light kinds as lib/shading.wgsl places them (light_incidence): directional, positional with
 // attenuation and spotlight cone, and the headlight shining along each ray.
 #include "lib/shading.wgsl"
+#include "lib/common.wgsl"
 
 // Sums over the lights; the caller weights them with the material.
 struct LightSum {

@@ -3,7 +3,8 @@
 // the components' tables stacked (core/src/resources/tables.rs). Ray casting reads the
 // opacity per sample, as VTK does; the path tracer as the 1D functions' (per unit
 // distance).
-@group(0) @binding(24) var tables_2d: texture_2d<f32>;
+#include "lib/common.wgsl"
+@group(0) @binding(SLOT_TABLES_2D) var tables_2d: texture_2d<f32>;
 override TF2D: u32 = 0u;
 
 fn has_2d(c: u32) -> bool {

@@ -5,6 +5,7 @@
 // not need (nothing in it is visible) is not resident and reads as a constant from its own
 // range, which is as invisible as every value of the brick. A volume of one brick
 // (SINGLE_BRICK) is its own texture and is sampled directly.
+#include "lib/common.wgsl"
 
 struct Pool {
     brick: vec4<f32>,     // x: cells per brick edge, y: apron points around a brick's core,
@@ -14,25 +15,25 @@ struct Pool {
     inv_size: vec4<f32>,  // 1 / the pool texture's size in points, per axis
 }
 
-@group(1) @binding(0) var<uniform> pool_ubo: Pool;
+@group(1) @binding(SLOT_POOL) var<uniform> pool_ubo: Pool;
 // A private copy filled by each entry point (`enter_volume`), as lib/common.wgsl's `frame`.
 var<private> pool: Pool;
-@group(1) @binding(1) var volume_tex: texture_3d<f32>;
-@group(1) @binding(2) var volume_sampler: sampler;
+@group(1) @binding(SLOT_VOLUME) var volume_tex: texture_3d<f32>;
+@group(1) @binding(SLOT_VOLUME_SAMPLER) var volume_sampler: sampler;
 // The first component's central differences per texel of the pool (shaders/gradient.wgsl),
 // where the upload made them (PRECOMPUTED_GRADIENT); otherwise the pool again, unused.
-@group(1) @binding(3) var gradient_tex: texture_3d<f32>;
+@group(1) @binding(SLOT_GRADIENTS) var gradient_tex: texture_3d<f32>;
 // Per brick, x: its slot's position in the pool (PAGE_SLOT_BITS bits per axis, x lowest),
 // or PAGE_EMPTY when it is not resident, or PAGE_MISSING when a later pass of a streamed
 // frame brings it; y: 0, or, in a preview frame where the brick is not resident, the
 // log2 of the factor of the coarser level whose brick in that slot stands in for it.
-@group(1) @binding(4) var page_table: texture_3d<u32>;
+@group(1) @binding(SLOT_PAGE_TABLE) var page_table: texture_3d<u32>;
 // Per brick: the texel value a non-resident brick reads as (each component's lowest value).
-@group(1) @binding(5) var brick_constants: texture_3d<f32>;
+@group(1) @binding(SLOT_BRICK_CONSTANTS) var brick_constants: texture_3d<f32>;
 // Per brick, in a preview frame: READ_STAND_IN when a ray sampled it from a coarser level's
 // stand-in, READ_FINE when from the brick itself (what the next preview frame brings and
 // keeps, resources/lod.rs).
-@group(1) @binding(6) var<storage, read_write> brick_requests: array<u32>;
+@group(1) @binding(SLOT_BRICK_REQUESTS) var<storage, read_write> brick_requests: array<u32>;
 
 // The volume is one brick, its texture the pool: no page-table lookups (a pipeline
 // constant each pass sets from the volume).
@@ -207,7 +208,7 @@ fn brick_gradient(p: vec3<f32>, s: vec4<f32>) -> Gradient {
 
 // Whether index-space point q lies beyond a clipping plane.
 fn beyond_clip(q: vec3<f32>) -> bool {
-    for (var i = 0u; i < frame.counts.x; i = i + 1u) {
+    for (var i = 0u; i < frame.clip_planes; i = i + 1u) {
         let pl = frame.clip[i];
         if (dot(pl.xyz, q) + pl.w < 0.0) {
             return true;

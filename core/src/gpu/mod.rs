@@ -10,6 +10,7 @@ pub mod interop;
 pub(crate) mod pipeline;
 pub(crate) mod readback;
 pub(crate) mod shaders;
+pub(crate) mod slots;
 pub(crate) mod texture;
 pub(crate) mod uniforms;
 

@@ -1,7 +1,7 @@
 //! WGSL sources. Each pass is one file in the crate's shaders/; shared pieces live in
 //! shaders/lib/ and are pulled in with `#include "lib/NAME.wgsl"` lines, expanded here (each
 //! file once). The constants shared with Rust are not written in WGSL: [`compose`] declares
-//! them first, from [`super::uniforms::WGSL_CONSTANTS`].
+//! them first, from [`super::uniforms::WGSL_CONSTANTS`] and [`super::slots::WGSL_SLOTS`].
 
 /// (path relative to shaders/, source) for every WGSL file.
 pub const FILES: &[(&str, &str)] = &[
@@ -60,6 +60,10 @@ pub const FILES: &[(&str, &str)] = &[
         "lib/surface.wgsl",
         include_str!("../../shaders/lib/surface.wgsl"),
     ),
+    (
+        "lib/classify.wgsl",
+        include_str!("../../shaders/lib/classify.wgsl"),
+    ),
     ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
     ("firsthit.wgsl", include_str!("../../shaders/firsthit.wgsl")),
     ("deferred.wgsl", include_str!("../../shaders/deferred.wgsl")),
@@ -106,10 +110,13 @@ fn source(path: &str) -> Option<&'static str> {
     FILES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s)
 }
 
-/// The complete source of a pass: the shared constants, then the pass with its includes
-/// expanded.
+/// The complete source of a pass: the shared constants and binding slots, then the pass
+/// with its includes expanded.
 pub fn compose(path: &str) -> String {
     let mut out = super::uniforms::wgsl_constants();
+    for (name, slot) in super::slots::WGSL_SLOTS {
+        out.push_str(&format!("const {name}: u32 = {slot}u;\n"));
+    }
     let mut seen = Vec::new();
     expand(path, &mut out, &mut seen);
     out

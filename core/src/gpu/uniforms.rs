@@ -1,6 +1,6 @@
 //! Rust mirrors of the WGSL structs in shaders/lib/common.wgsl and shaders/lib/volume.wgsl.
-//! Only vec4-sized fields, so std140/std430 and `repr(C)` agree; `layout_tests` checks every
-//! field offset against naga's reflection of the WGSL.
+//! Only 16-byte fields or runs of four 4-byte scalars, so std140/std430 and `repr(C)` agree;
+//! `layout_tests` checks every field's name and offset against naga's reflection of the WGSL.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -34,7 +34,14 @@ pub struct FrameUniforms {
     pub material: [f32; 4],
     pub crop_lo: [f32; 4],
     pub crop_hi: [f32; 4],
-    pub misc: [f32; 4],
+    /// World distance between samples.
+    pub sample_distance: f32,
+    /// Early ray termination: the opacity a ray stops at.
+    pub termination: f32,
+    /// The opacity at which a ray's depth is taken.
+    pub depth_threshold: f32,
+    /// Shorter gradients shade as having no normal.
+    pub gradient_epsilon: f32,
     pub average_range: [f32; 4],
     pub additive_scale: [f32; 4],
     pub scatter: [f32; 4],
@@ -43,9 +50,23 @@ pub struct FrameUniforms {
     pub whole_lo: [f32; 4],
     pub whole_hi: [f32; 4],
     pub lights: [GpuLight; 8],
-    pub viewport: [u32; 4],
-    pub mode: [u32; 4],
-    pub counts: [u32; 4],
+    pub width: u32,
+    pub height: u32,
+    /// Always 0, read by the shaders as the camera matrices' index (lib/ray.wgsl).
+    pub camera_index: u32,
+    pub jitter_seed: u32,
+    /// BlendMode::code.
+    pub blend: u32,
+    /// FLAG_* bits.
+    pub flags: u32,
+    /// VTK's cropping region flags.
+    pub crop_regions: u32,
+    pub unused: u32,
+    pub clip_planes: u32,
+    pub light_count: u32,
+    /// Points per edge of an occupancy block.
+    pub block_size: u32,
+    pub components: u32,
     pub occupancy_dims: [u32; 4],
     pub rect: [u32; 4],
     /// Each independent component's material (ambient, diffuse, specular, power).
@@ -189,7 +210,7 @@ pub fn mat(m: glam::DMat4) -> [f32; 16] {
 // `const` declaration (WGSL_CONSTANTS) to every pass, so the shaders cannot disagree.
 // ---------------------------------------------------------------------------------------
 
-/// Blend mode codes (`frame.mode.x`; BlendMode::code).
+/// Blend mode codes (`frame.blend`; BlendMode::code).
 pub const BLEND_COMPOSITE: u32 = 0;
 pub const BLEND_MAXIMUM: u32 = 1;
 pub const BLEND_MINIMUM: u32 = 2;
@@ -199,7 +220,7 @@ pub const BLEND_ISOSURFACE: u32 = 5;
 pub const BLEND_PATHTRACE: u32 = 6;
 pub const BLEND_SLICE: u32 = 7;
 
-/// Frame flag bits (`frame.mode.y`).
+/// Frame flag bits (`frame.flags`).
 pub const FLAG_JITTER: u32 = 2;
 pub const FLAG_TWO_SIDED: u32 = 16;
 pub const FLAG_INDEPENDENT: u32 = 64;
@@ -400,7 +421,10 @@ mod layout_tests {
                     material,
                     crop_lo,
                     crop_hi,
-                    misc,
+                    sample_distance,
+                    termination,
+                    depth_threshold,
+                    gradient_epsilon,
                     average_range,
                     additive_scale,
                     scatter,
@@ -409,9 +433,18 @@ mod layout_tests {
                     whole_lo,
                     whole_hi,
                     lights,
-                    viewport,
-                    mode,
-                    counts,
+                    width,
+                    height,
+                    camera_index,
+                    jitter_seed,
+                    blend,
+                    flags,
+                    crop_regions,
+                    unused,
+                    clip_planes,
+                    light_count,
+                    block_size,
+                    components,
                     occupancy_dims,
                     rect,
                     component_materials,
@@ -508,16 +541,39 @@ mod layout_tests {
         }
     }
 
+    fn validate(path: &str, m: &naga::Module) {
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(m)
+        .unwrap_or_else(|e| panic!("{path} fails validation: {e:?}"));
+    }
+
     #[test]
     fn every_pass_validates_with_naga() {
         for pass in crate::gpu::shaders::PASSES {
-            let m = module(pass);
-            naga::valid::Validator::new(
-                naga::valid::ValidationFlags::all(),
-                naga::valid::Capabilities::all(),
-            )
-            .validate(&m)
-            .unwrap_or_else(|e| panic!("{pass} fails validation: {e:?}"));
+            validate(pass, &module(pass));
         }
+    }
+
+    /// A library file includes what it uses: composed alone (with its own includes), it
+    /// parses and validates, so no pass has to include its dependencies for it, in order.
+    #[test]
+    fn every_library_file_includes_what_it_uses() {
+        let mut failures = Vec::new();
+        for (path, _) in crate::gpu::shaders::FILES {
+            if path.starts_with("lib/") {
+                match naga::front::wgsl::parse_str(&crate::gpu::shaders::compose(path)) {
+                    Ok(m) => validate(path, &m),
+                    Err(e) => failures.push(format!("{path}: {e}")),
+                }
+            }
+        }
+        assert!(
+            failures.is_empty(),
+            "composed alone:\n{}",
+            failures.join("\n")
+        );
     }
 }

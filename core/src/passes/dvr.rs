@@ -12,6 +12,7 @@ use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::pipeline::PipelineCache;
+use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::FLAG_DEPTH_RANGE;
 use crate::gpu::Context;
@@ -46,18 +47,18 @@ impl DvrPass {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
         [
-            buffer_entry(0, B::Uniform),
-            texture_entry(1, false, V::D2),
-            texture_entry(2, false, V::D3),
-            sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
-            texture_entry(4, false, V::D2),
-            texture_entry(25, false, V::D2),
-            storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-            storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
-            buffer_entry(7, B::Storage { read_only: false }),
+            buffer_entry(slots::FRAME, B::Uniform),
+            texture_entry(slots::TABLES, false, V::D2),
+            texture_entry(slots::BLOCK_RANGE, false, V::D3),
+            sampled_texture_entry(slots::OCCUPANCY, wgpu::TextureSampleType::Uint, V::D3),
+            texture_entry(slots::DEPTH_IN, false, V::D2),
+            texture_entry(slots::DEPTH_NEAR, false, V::D2),
+            storage_texture_entry(slots::OUT_COLOR, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(slots::OUT_DEPTH, wgpu::TextureFormat::R32Float, V::D2),
+            buffer_entry(slots::RAY_STATE, B::Storage { read_only: false }),
             blanking_layout_entry(),
-            texture_entry(9, true, V::D2),
-            sampled_texture_entry(10, wgpu::TextureSampleType::Uint, V::D3),
+            texture_entry(slots::PREINT_TABLES, true, V::D2),
+            sampled_texture_entry(slots::MASK, wgpu::TextureSampleType::Uint, V::D3),
             tables_2d_layout_entry(),
             grid_lookup_layout_entry(),
         ]
@@ -139,7 +140,7 @@ impl DvrPass {
         let depth_input = !matches!(depth, DepthSource::None);
         let mut f = frame::frame(res, view, params, step, depth_input)?;
         if matches!(depth, DepthSource::Range(..)) {
-            f.uniforms.mode[1] |= FLAG_DEPTH_RANGE;
+            f.uniforms.flags |= FLAG_DEPTH_RANGE;
         }
         let streaming = plan.is_some();
         let vol = res.volume()?;
@@ -209,19 +210,43 @@ impl DvrPass {
             label: Some("dvr frame"),
             layout: &self.bgl,
             entries: &[
-                bind(0, res.frame_buf.as_entire_binding()),
-                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
-                bind(2, wgpu::BindingResource::TextureView(&vol.ranges)),
-                bind(3, wgpu::BindingResource::TextureView(occupancy)),
-                bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
-                bind(25, wgpu::BindingResource::TextureView(&depth_near_view)),
-                bind(5, wgpu::BindingResource::TextureView(&color_view)),
-                bind(6, wgpu::BindingResource::TextureView(&depth_view)),
-                bind(7, t.state.as_entire_binding()),
-                res.blanking_entry(&self.no_blanking),
-                bind(9, wgpu::BindingResource::TextureView(&preintegrated.view)),
+                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
                 bind(
-                    10,
+                    slots::TABLES,
+                    wgpu::BindingResource::TextureView(&tables.view),
+                ),
+                bind(
+                    slots::BLOCK_RANGE,
+                    wgpu::BindingResource::TextureView(&vol.ranges),
+                ),
+                bind(
+                    slots::OCCUPANCY,
+                    wgpu::BindingResource::TextureView(occupancy),
+                ),
+                bind(
+                    slots::DEPTH_IN,
+                    wgpu::BindingResource::TextureView(&depth_in_view),
+                ),
+                bind(
+                    slots::DEPTH_NEAR,
+                    wgpu::BindingResource::TextureView(&depth_near_view),
+                ),
+                bind(
+                    slots::OUT_COLOR,
+                    wgpu::BindingResource::TextureView(&color_view),
+                ),
+                bind(
+                    slots::OUT_DEPTH,
+                    wgpu::BindingResource::TextureView(&depth_view),
+                ),
+                bind(slots::RAY_STATE, t.state.as_entire_binding()),
+                res.blanking_entry(&self.no_blanking),
+                bind(
+                    slots::PREINT_TABLES,
+                    wgpu::BindingResource::TextureView(&preintegrated.view),
+                ),
+                bind(
+                    slots::MASK,
                     wgpu::BindingResource::TextureView(
                         res.mask.as_ref().map_or(&self.no_blanking, |(m, _)| m),
                     ),

@@ -86,7 +86,7 @@ pub(crate) struct Frame {
 impl Frame {
     /// Lights the frame carries.
     pub fn lights(&self) -> u32 {
-        self.uniforms.counts[1]
+        self.uniforms.light_count
     }
 
     /// Whether any of them is positional.
@@ -298,14 +298,11 @@ pub(crate) fn frame(
             c.planes[5] as f32,
             0.0,
         ];
-        u.mode[2] = c.regions;
+        u.crop_regions = c.regions;
     }
-    u.misc = [
-        step as f32,
-        params.termination_threshold,
-        params.depth_threshold,
-        0.0,
-    ];
+    u.sample_distance = step as f32;
+    u.termination = params.termination_threshold;
+    u.depth_threshold = params.depth_threshold;
     if let Some(r) = params.average_range {
         flags |= FLAG_AVERAGE_RANGE;
         u.average_range = [r[0] as f32, r[1] as f32, 0.0, 0.0];
@@ -413,17 +410,17 @@ pub(crate) fn frame(
             (2.0 / range) as f32,
         ];
     }
-    u.viewport = [view.width, view.height, 0, 0x9e37_79b9];
+    u.width = view.width;
+    u.height = view.height;
+    u.jitter_seed = 0x9e37_79b9;
     let last = vol.data_dims.map(|d| d as f64 - 1.0);
     u.rect = screen_rect(vp, index_to_world, [0.0; 3], last, view.width, view.height);
-    u.mode[0] = params.blend.code();
-    u.mode[1] = flags;
-    u.counts = [
-        params.clip_planes.len() as u32,
-        nl as u32,
-        BLOCK_SIZE,
-        vol.components,
-    ];
+    u.blend = params.blend.code();
+    u.flags = flags;
+    u.clip_planes = params.clip_planes.len() as u32;
+    u.light_count = nl as u32;
+    u.block_size = BLOCK_SIZE;
+    u.components = vol.components;
     u.occupancy_dims = [
         vol.minmax.dims[0],
         vol.minmax.dims[1],

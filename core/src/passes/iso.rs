@@ -32,6 +32,7 @@ use crate::gpu::binding::{
 use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
 use crate::gpu::readback::{read_buffer, read_texture_layer};
+use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND, MASK_BINARY, MASK_NONE};
 use crate::gpu::Context;
@@ -207,11 +208,11 @@ impl IsoPass {
         use wgpu::TextureViewDimension as V;
         let gb_write = |b| storage_texture_entry(b, GBUFFER_FORMAT, V::D2Array);
         vec![
-            buffer_entry(0, B::Uniform),
+            buffer_entry(slots::FRAME, B::Uniform),
             buffer_entry(2, B::Storage { read_only: false }),
-            sampled_texture_entry(3, wgpu::TextureSampleType::Uint, V::D3),
-            texture_entry(4, false, V::D2),
-            buffer_entry(7, B::Uniform),
+            sampled_texture_entry(slots::OCCUPANCY, wgpu::TextureSampleType::Uint, V::D3),
+            texture_entry(slots::DEPTH_IN, false, V::D2),
+            buffer_entry(slots::ISO, B::Uniform),
             gb_write(8),
             gb_write(9),
             gb_write(10),
@@ -228,11 +229,11 @@ impl IsoPass {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
         vec![
-            buffer_entry(0, B::Uniform),
+            buffer_entry(slots::FRAME, B::Uniform),
             buffer_entry(2, B::Storage { read_only: true }),
-            storage_texture_entry(5, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-            storage_texture_entry(6, wgpu::TextureFormat::R32Float, V::D2),
-            buffer_entry(7, B::Uniform),
+            storage_texture_entry(slots::OUT_COLOR, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(slots::OUT_DEPTH, wgpu::TextureFormat::R32Float, V::D2),
+            buffer_entry(slots::ISO, B::Uniform),
             texture_entry(8, false, V::D2Array),
             texture_entry(9, false, V::D2Array),
             texture_entry(10, false, V::D2Array),
@@ -241,7 +242,7 @@ impl IsoPass {
             sampler_entry(13),
             buffer_entry(14, B::Storage { read_only: true }),
             sampled_texture_entry(15, wgpu::TextureSampleType::Uint, V::D3),
-            texture_entry(1, false, V::D2),
+            texture_entry(slots::TABLES, false, V::D2),
             blanking_layout_entry(),
             grid_lookup_layout_entry(),
         ]
@@ -676,11 +677,17 @@ impl IsoPass {
             label: Some("first hit"),
             layout: &self.firsthit_bgl,
             entries: &[
-                bind(0, res.frame_buf.as_entire_binding()),
+                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
                 bind(2, t.state.as_entire_binding()),
-                bind(3, wgpu::BindingResource::TextureView(occupancy)),
-                bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
-                bind(7, self.iso_buf.as_entire_binding()),
+                bind(
+                    slots::OCCUPANCY,
+                    wgpu::BindingResource::TextureView(occupancy),
+                ),
+                bind(
+                    slots::DEPTH_IN,
+                    wgpu::BindingResource::TextureView(&depth_in_view),
+                ),
+                bind(slots::ISO, self.iso_buf.as_entire_binding()),
                 bind(8, wgpu::BindingResource::TextureView(&gp)),
                 bind(9, wgpu::BindingResource::TextureView(&gn)),
                 bind(10, wgpu::BindingResource::TextureView(&ge)),
@@ -699,11 +706,17 @@ impl IsoPass {
             label: Some("deferred"),
             layout: &self.deferred_bgl,
             entries: &[
-                bind(0, res.frame_buf.as_entire_binding()),
+                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
                 bind(2, t.state.as_entire_binding()),
-                bind(5, wgpu::BindingResource::TextureView(&color_view)),
-                bind(6, wgpu::BindingResource::TextureView(&depth_view)),
-                bind(7, self.iso_buf.as_entire_binding()),
+                bind(
+                    slots::OUT_COLOR,
+                    wgpu::BindingResource::TextureView(&color_view),
+                ),
+                bind(
+                    slots::OUT_DEPTH,
+                    wgpu::BindingResource::TextureView(&depth_view),
+                ),
+                bind(slots::ISO, self.iso_buf.as_entire_binding()),
                 bind(8, wgpu::BindingResource::TextureView(&gp)),
                 bind(9, wgpu::BindingResource::TextureView(&gn)),
                 bind(10, wgpu::BindingResource::TextureView(&ge)),
@@ -717,7 +730,10 @@ impl IsoPass {
                         res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
                     ),
                 ),
-                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+                bind(
+                    slots::TABLES,
+                    wgpu::BindingResource::TextureView(&tables.view),
+                ),
                 res.blanking_entry(&self.no_mask),
                 res.grid_lookup_entry(&self.no_grid_lookup)?,
             ],

@@ -41,6 +41,7 @@ use crate::gpu::pipeline::{
     encode_single_group, pipeline_variant, single_group_pipeline, PipelineCache,
 };
 use crate::gpu::readback::read_buffer;
+use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
 use crate::gpu::uniforms::{
     flag_bits, PathTraceUniforms, ShowUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE,
@@ -151,10 +152,10 @@ impl PathTracePass {
         use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
         [
-            buffer_entry(0, B::Uniform),
-            texture_entry(1, false, V::D2),
+            buffer_entry(slots::FRAME, B::Uniform),
+            texture_entry(slots::TABLES, false, V::D2),
             buffer_entry(2, B::Storage { read_only: false }),
-            texture_entry(4, false, V::D2),
+            texture_entry(slots::DEPTH_IN, false, V::D2),
             buffer_entry(5, B::Storage { read_only: false }),
             dynamic_uniform_entry::<PathTraceUniforms>(7),
             texture_entry(11, true, V::Cube),
@@ -535,10 +536,16 @@ impl PathTracePass {
             label: Some("path tracing"),
             layout: &self.bgl,
             entries: &[
-                bind(0, res.frame_buf.as_entire_binding()),
-                bind(1, wgpu::BindingResource::TextureView(&tables.view)),
+                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
+                bind(
+                    slots::TABLES,
+                    wgpu::BindingResource::TextureView(&tables.view),
+                ),
                 bind(2, acc.sums.as_entire_binding()),
-                bind(4, wgpu::BindingResource::TextureView(&depth_in_view)),
+                bind(
+                    slots::DEPTH_IN,
+                    wgpu::BindingResource::TextureView(&depth_in_view),
+                ),
                 bind(5, acc.moments.as_entire_binding()),
                 bind_block::<PathTraceUniforms>(7, &self.uniforms),
                 bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),

@@ -6,6 +6,7 @@ use super::tables::Tables;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, buffer_entry, entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
+use crate::gpu::slots;
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::{mat, IntermixUniforms, PT_MAX_OPACITY, TABLE_SIZE};
 use crate::gpu::Context;
@@ -206,10 +207,18 @@ impl IntermixBinding {
             wgpu::SamplerBindingType::NonFiltering
         };
         [
-            buffer_entry(18, wgpu::BufferBindingType::Uniform),
-            texture_entry(19, filterable, wgpu::TextureViewDimension::D3),
-            texture_entry(20, false, wgpu::TextureViewDimension::D2),
-            entry(21, wgpu::BindingType::Sampler(sampler)),
+            buffer_entry(slots::INTERMIX, wgpu::BufferBindingType::Uniform),
+            texture_entry(
+                slots::INTERMIX_ATLAS,
+                filterable,
+                wgpu::TextureViewDimension::D3,
+            ),
+            texture_entry(
+                slots::INTERMIX_TABLES,
+                false,
+                wgpu::TextureViewDimension::D2,
+            ),
+            entry(slots::INTERMIX_SAMPLER, wgpu::BindingType::Sampler(sampler)),
         ]
     }
 
@@ -220,10 +229,19 @@ impl IntermixBinding {
             None => (&self.none.0, &self.none.1, &self.none.2.view),
         };
         [
-            bind(18, uniforms.as_entire_binding()),
-            bind(19, wgpu::BindingResource::TextureView(atlas)),
-            bind(20, wgpu::BindingResource::TextureView(tables)),
-            bind(21, wgpu::BindingResource::Sampler(&self.sampler)),
+            bind(slots::INTERMIX, uniforms.as_entire_binding()),
+            bind(
+                slots::INTERMIX_ATLAS,
+                wgpu::BindingResource::TextureView(atlas),
+            ),
+            bind(
+                slots::INTERMIX_TABLES,
+                wgpu::BindingResource::TextureView(tables),
+            ),
+            bind(
+                slots::INTERMIX_SAMPLER,
+                wgpu::BindingResource::Sampler(&self.sampler),
+            ),
         ]
     }
 }

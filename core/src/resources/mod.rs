@@ -17,6 +17,7 @@ use crate::error::{Error, Result};
 use crate::gpu::binding::{buffer_entry, entry, sampled_texture_entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::interop::OutputPath;
+use crate::gpu::slots;
 use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Context;
 use crate::params::{MaskKind, RenderParams, Stats, StreamProgress, TransferFunction};
@@ -82,16 +83,19 @@ pub(super) fn no_volume() -> Error {
 pub(crate) fn brick_layout_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
     use wgpu::TextureViewDimension as V;
     [
-        buffer_entry(0, wgpu::BufferBindingType::Uniform),
-        texture_entry(1, true, V::D3),
+        buffer_entry(slots::POOL, wgpu::BufferBindingType::Uniform),
+        texture_entry(slots::VOLUME, true, V::D3),
         entry(
-            2,
+            slots::VOLUME_SAMPLER,
             wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
         ),
-        texture_entry(3, true, V::D3),
-        sampled_texture_entry(4, wgpu::TextureSampleType::Uint, V::D3),
-        texture_entry(5, false, V::D3),
-        buffer_entry(6, wgpu::BufferBindingType::Storage { read_only: false }),
+        texture_entry(slots::GRADIENTS, true, V::D3),
+        sampled_texture_entry(slots::PAGE_TABLE, wgpu::TextureSampleType::Uint, V::D3),
+        texture_entry(slots::BRICK_CONSTANTS, false, V::D3),
+        buffer_entry(
+            slots::BRICK_REQUESTS,
+            wgpu::BufferBindingType::Storage { read_only: false },
+        ),
     ]
 }
 

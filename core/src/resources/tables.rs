@@ -4,6 +4,7 @@ use super::bricks::BLOCK_SIZE;
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, texture_entry};
+use crate::gpu::slots;
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
 use crate::gpu::Context;
@@ -233,12 +234,9 @@ fn table_2d_rows(tf: &TransferFunction, comps: usize) -> (Vec<[f32; 4]>, [u32; 2
     (data, [w, h * comps as u32])
 }
 
-/// The 2D tables' binding in the passes that read them (lib/table2d.wgsl).
-const TABLES_2D_BINDING: u32 = 24;
-
 /// The 2D tables' layout entry (lib/table2d.wgsl).
 pub(crate) fn tables_2d_layout_entry() -> wgpu::BindGroupLayoutEntry {
-    texture_entry(TABLES_2D_BINDING, false, wgpu::TextureViewDimension::D2)
+    texture_entry(slots::TABLES_2D, false, wgpu::TextureViewDimension::D2)
 }
 
 impl Resources {
@@ -249,7 +247,7 @@ impl Resources {
             Some((_, t)) if used => &t.view,
             _ => &none.view,
         };
-        bind(TABLES_2D_BINDING, wgpu::BindingResource::TextureView(view))
+        bind(slots::TABLES_2D, wgpu::BindingResource::TextureView(view))
     }
 
     /// Builds the 2D tables for the transfer function, unless they are current (a transfer

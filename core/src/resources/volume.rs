@@ -12,6 +12,7 @@ use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, sampled_texture_entry};
 use crate::gpu::buffers::{buffer, uniform_buffer};
+use crate::gpu::slots;
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
 use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS, READ_STAND_IN};
 use crate::gpu::Context;
@@ -20,15 +21,10 @@ use crate::params::{MaskKind, Residency, UploadOptions, VolumeData};
 use glam::DMat4;
 use std::sync::Arc;
 
-/// The blanking mask's binding in the passes that read it (lib/blanking.wgsl).
-const BLANKING_BINDING: u32 = 22;
-/// A rectilinear grid's lookup's binding (lib/rectilinear.wgsl).
-const GRID_LOOKUP_BINDING: u32 = 23;
-
 /// A rectilinear grid's lookup's layout entry (lib/rectilinear.wgsl).
 pub(crate) fn grid_lookup_layout_entry() -> wgpu::BindGroupLayoutEntry {
     sampled_texture_entry(
-        GRID_LOOKUP_BINDING,
+        slots::GRID_LOOKUP,
         wgpu::TextureSampleType::Float { filterable: false },
         wgpu::TextureViewDimension::D3,
     )
@@ -42,7 +38,7 @@ pub(crate) fn no_grid_lookup(ctx: &Context) -> wgpu::TextureView {
 /// The blanking mask's layout entry (lib/blanking.wgsl).
 pub(crate) fn blanking_layout_entry() -> wgpu::BindGroupLayoutEntry {
     sampled_texture_entry(
-        BLANKING_BINDING,
+        slots::BLANKING,
         wgpu::TextureSampleType::Uint,
         wgpu::TextureViewDimension::D3,
     )
@@ -386,7 +382,7 @@ impl Resources {
         none: &'a wgpu::TextureView,
     ) -> Result<wgpu::BindGroupEntry<'a>> {
         Ok(bind(
-            GRID_LOOKUP_BINDING,
+            slots::GRID_LOOKUP,
             wgpu::BindingResource::TextureView(self.volume()?.grid_lookup.as_ref().unwrap_or(none)),
         ))
     }
@@ -394,7 +390,7 @@ impl Resources {
     /// The blanking mask's bind group entry (lib/blanking.wgsl), or `none` without one.
     pub fn blanking_entry<'a>(&'a self, none: &'a wgpu::TextureView) -> wgpu::BindGroupEntry<'a> {
         bind(
-            BLANKING_BINDING,
+            slots::BLANKING,
             wgpu::BindingResource::TextureView(self.blanking.as_ref().unwrap_or(none)),
         )
     }
@@ -631,16 +627,22 @@ impl Resources {
                 label: Some("volume"),
                 layout: &self.brick_bgl,
                 entries: &[
-                    bind(0, vol.uniform.as_entire_binding()),
-                    bind(1, wgpu::BindingResource::TextureView(&view)),
-                    bind(2, wgpu::BindingResource::Sampler(s)),
+                    bind(slots::POOL, vol.uniform.as_entire_binding()),
+                    bind(slots::VOLUME, wgpu::BindingResource::TextureView(&view)),
+                    bind(slots::VOLUME_SAMPLER, wgpu::BindingResource::Sampler(s)),
                     bind(
-                        3,
+                        slots::GRADIENTS,
                         wgpu::BindingResource::TextureView(gradient_view.as_ref().unwrap_or(&view)),
                     ),
-                    bind(4, wgpu::BindingResource::TextureView(&page_view)),
-                    bind(5, wgpu::BindingResource::TextureView(&constants_view)),
-                    bind(6, vol.requests.as_entire_binding()),
+                    bind(
+                        slots::PAGE_TABLE,
+                        wgpu::BindingResource::TextureView(&page_view),
+                    ),
+                    bind(
+                        slots::BRICK_CONSTANTS,
+                        wgpu::BindingResource::TextureView(&constants_view),
+                    ),
+                    bind(slots::BRICK_REQUESTS, vol.requests.as_entire_binding()),
                 ],
             })
         };
