@@ -4,13 +4,13 @@
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFerroVolumeContext.h"
-#include "vtkFerroVolumeMapper.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkPointData.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkVolumeMapper.h"
 
 #include <algorithm>
 #include <cmath>
@@ -64,7 +64,7 @@ bool ToFvScalarType(int vtkType, uint32_t& fvType, size_t& size)
 
 // The scalars of the input as VTK's mappers pick them (ScalarMode, SelectScalarArray), or an
 // error saying why there are none.
-vtkDataArray* FindScalars(vtkFerroVolumeMapper* self, vtkImageData* image, int& cellFlag,
+vtkDataArray* FindScalars(vtkVolumeMapper* self, vtkImageData* image, int& cellFlag,
   std::string& error)
 {
   cellFlag = 0;
@@ -394,7 +394,7 @@ int vtkFerroVolumeInputHelper::GetDataType() const
   return this->Scalars ? this->Scalars->GetDataType() : VTK_VOID;
 }
 
-bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& error)
+bool vtkFerroVolumeInputHelper::Select(vtkVolumeMapper* self, std::string& error)
 {
   this->Image = nullptr;
   this->Scalars = nullptr;

@@ -19,9 +19,9 @@
 
 class vtkDataArray;
 class vtkDataObject;
-class vtkFerroVolumeMapper;
 class vtkImageData;
 class vtkRectilinearGrid;
+class vtkVolumeMapper;
 
 class vtkFerroVolumeInputHelper
 {
@@ -30,7 +30,7 @@ public:
 
   // Updates the mapper's input and finds its image and scalars (ScalarMode,
   // SelectScalarArray); false with the reason when there are none to render.
-  bool Select(vtkFerroVolumeMapper* self, std::string& error);
+  bool Select(vtkVolumeMapper* self, std::string& error);
 
   // Gives the renderer the selected scalars as a volume, within `budget` bytes of device
   // memory (0: the device's limit), when they or the budget changed since the last upload.

@@ -4,19 +4,19 @@
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
 #include "vtkFerroVolumeContext.h"
-#include "vtkFerroVolumeMapper.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkMultiVolume.h"
 #include "vtkVolume.h"
+#include "vtkVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
 #include <cstring>
 
 bool vtkFerroVolumeIntermix::Convert(
-  vtkFerroVolumeMapper* self, int port, Port& p, std::string& error)
+  vtkVolumeMapper* self, int port, Port& p, std::string& error)
 {
   const std::string name = "port " + std::to_string(port);
   if (vtkAlgorithm* source = self->GetInputAlgorithm(port, 0))
@@ -113,7 +113,7 @@ bool vtkFerroVolumeIntermix::Convert(
   return true;
 }
 
-bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* multi,
+bool vtkFerroVolumeIntermix::Update(vtkVolumeMapper* self, vtkMultiVolume* multi,
   const vtkFerroVolumeLookupTables::RangeTypes& types, ferrovol::Renderer& renderer,
   std::string& error)
 {

@@ -3,7 +3,7 @@
 #include "vtkCamera.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeDepthReader.h"
-#include "vtkFerroVolumeMapper.h"
+#include "vtkFerroVolumeEnums.h"
 #include "vtkLogger.h"
 #include "vtkMatrix4x4.h"
 #include "vtkOpenGLError.h"
@@ -278,12 +278,12 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
   this->Preference = preference;
   this->PathWindow = win;
 #if FERROVOL_HAVE_SHARED_OUTPUT
-  if (preference != vtkFerroVolumeMapper::OUTPUT_PATH_READBACK)
+  if (preference != vtkFerroVolumeEnums::OUTPUT_PATH_READBACK)
   {
     std::string ignored;
     vtkFerroVolumeOutputChoice choice;
     this->Path = vtkFerroVolumeSharedOutput::Create(*vtkFerroVolumeContext::Acquire(ignored),
-      renderer, preference == vtkFerroVolumeMapper::OUTPUT_PATH_SHARED, choice);
+      renderer, preference == vtkFerroVolumeEnums::OUTPUT_PATH_SHARED, choice);
     this->PathReason = choice.Reason;
     if (!this->Path)
     {

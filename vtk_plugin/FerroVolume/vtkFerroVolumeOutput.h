@@ -93,7 +93,7 @@ public:
   ~vtkFerroVolumeOutput();
 
   // Renders the frame through the path for this window and `preference` (an
-  // vtkFerroVolumeMapper::OutputPaths value; the path is chosen again when either changed).
+  // vtkFerroVolumeEnums::OutputPaths value; the path is chosen again when either changed).
   // `self` receives the warnings; `warning` is something this frame lacks.
   bool Render(vtkObject* self, int preference, ferrovol::Renderer& renderer,
     const vtkFerroVolumeFrameRequest& req, std::string& error, std::string& warning);
