@@ -17,6 +17,7 @@
 #include <vector>
 
 class vtkDataArray;
+class vtkFerroVolumeReport;
 class vtkImageData;
 class vtkMultiVolume;
 class vtkVolumeMapper;
@@ -29,7 +30,7 @@ public:
   // when any of them, its matrix or its property changed; false with the reason.
   bool Update(vtkVolumeMapper* self, vtkMultiVolume* multi,
     const vtkFerroVolumeLookupTables::RangeTypes& types, ferrovol::Renderer& renderer,
-    std::string& error);
+    vtkFerroVolumeReport& report);
 
   // Forget what was given (the renderer is gone).
   void Reset()
@@ -55,7 +56,7 @@ private:
     double Matrix[16] = {};
   };
   // The port's volume converted again when its data changed; false with the reason.
-  bool Convert(vtkVolumeMapper* self, int port, Port& p, std::string& error);
+  bool Convert(vtkVolumeMapper* self, int port, Port& p, vtkFerroVolumeReport& report);
 
   std::vector<Port> Ports;
   // Whether the renderer holds intermixed volumes (then an empty update clears them).
