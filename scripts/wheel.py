@@ -99,6 +99,8 @@ def main():
         "ferrovol/include/ferrovol.hpp": os.path.join(ROOT, "ffi", "include", "ferrovol.hpp"),
         "ferrovol/include/vtkFerroVolumeMapper.h":
             os.path.join(ROOT, "vtk_plugin", "FerroVolume", "vtkFerroVolumeMapper.h"),
+        "ferrovol/include/vtkFerroVolumeEnums.h":
+            os.path.join(ROOT, "vtk_plugin", "FerroVolume", "vtkFerroVolumeEnums.h"),
         "ferrovol/include/vtkFerroVolumeModule.h":
             os.path.join(build, "FerroVolume", "vtkFerroVolumeModule.h"),
     }

@@ -8,7 +8,7 @@ vtkFerroVolumeContext& vtkFerroVolumeContext::Get()
   return instance;
 }
 
-const ferrovol::Context* vtkFerroVolumeContext::Acquire(std::string& error)
+const ferrovol::Context* vtkFerroVolumeContext::Acquire(vtkFerroVolumeReport& report)
 {
   vtkFerroVolumeContext& self = Get();
   std::lock_guard<std::mutex> lock(self.Mutex);
@@ -41,7 +41,10 @@ const ferrovol::Context* vtkFerroVolumeContext::Acquire(std::string& error)
       }
     }
   }
-  error = self.Error;
+  if (!self.Context)
+  {
+    report.Fail(self.Error);
+  }
   return self.Context;
 }
 
@@ -87,8 +90,8 @@ void vtkFerroVolumeContext::LimitDeviceMemory(vtkTypeUInt64 bytes)
 
 const char* vtkFerroVolumeContext::Description()
 {
-  std::string error;
-  Acquire(error);
+  vtkFerroVolumeReport report;
+  Acquire(report);
   return Get().Desc.c_str();
 }
 

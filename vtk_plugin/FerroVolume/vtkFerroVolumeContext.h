@@ -4,6 +4,7 @@
 #define vtkFerroVolumeContext_h
 
 #include "ferrovol.hpp"
+#include "vtkFerroVolumeReport.h"
 #include "vtkType.h"
 
 #include <mutex>
@@ -16,7 +17,7 @@ public:
   // lost): renderers created from it keep the device alive, and tearing a Vulkan device down
   // from static destructors at exit is fragile. nullptr, with the reason in `error`, when
   // there is none.
-  static const ferrovol::Context* Acquire(std::string& error);
+  static const ferrovol::Context* Acquire(vtkFerroVolumeReport& report);
 
   // Counts the devices lost: a renderer made under an older generation was made on a device
   // since lost, and is made again.
@@ -59,7 +60,7 @@ std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e);
 // Runs `call` (ferrovol.hpp calls); when one fails, says so in `error` (see
 // vtkFerroVolumeFailure) and returns false.
 template <typename Call>
-bool vtkFerroVolumeCall(const char* what, std::string& error, Call&& call)
+bool vtkFerroVolumeCall(const char* what, vtkFerroVolumeReport& report, Call&& call)
 {
   try
   {
@@ -68,7 +69,7 @@ bool vtkFerroVolumeCall(const char* what, std::string& error, Call&& call)
   }
   catch (const ferrovol::Error& e)
   {
-    error = vtkFerroVolumeFailure(what, e);
+    report.Fail(vtkFerroVolumeFailure(what, e));
     return false;
   }
 }

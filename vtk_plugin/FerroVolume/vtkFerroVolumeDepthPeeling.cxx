@@ -5,6 +5,7 @@
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeDepthReader.h"
 #include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkInformation.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLQuadHelper.h"
@@ -162,7 +163,7 @@ vtkRenderPass* vtkFerroVolumeDepthPeeling::PeelingPass(vtkVolume* vol)
   return nullptr;
 }
 
-bool vtkFerroVolumeDepthPeeling::Prepare(vtkOpenGLRenderWindow* win, std::string& error)
+bool vtkFerroVolumeDepthPeeling::Prepare(vtkOpenGLRenderWindow* win, vtkFerroVolumeReport& report)
 {
   if (this->Window != win)
   {
@@ -185,7 +186,7 @@ bool vtkFerroVolumeDepthPeeling::Prepare(vtkOpenGLRenderWindow* win, std::string
   if (!this->Probe->Program || !this->Quads[0]->Program || !this->Quads[1]->Program ||
     !this->Quads[2]->Program)
   {
-    error = "could not compile the shaders that draw the volume into depth peeling's layers";
+    report.Fail("could not compile the shaders that draw the volume into depth peeling's layers");
     this->ReleaseGraphicsResources(nullptr);
     return false;
   }
@@ -196,7 +197,7 @@ bool vtkFerroVolumeDepthPeeling::Prepare(vtkOpenGLRenderWindow* win, std::string
 
 bool vtkFerroVolumeDepthPeeling::ReadPassTexture(vtkOpenGLRenderWindow* win,
   const char* uniform, int components, int width, int height, std::vector<float>& out,
-  std::string& error)
+  vtkFerroVolumeReport& report)
 {
   const GLuint program = static_cast<GLuint>(this->Probe->Program->GetHandle());
   const GLint location = glGetUniformLocation(program, uniform);
@@ -207,8 +208,7 @@ bool vtkFerroVolumeDepthPeeling::ReadPassTexture(vtkOpenGLRenderWindow* win,
   }
   if (unit < 0)
   {
-    error = std::string("depth peeling's ") + uniform + " is not bound";
-    return false;
+    return report.Fail(std::string("depth peeling's ") + uniform + " is not bound");
   }
   vtkOpenGLState* ostate = win->GetState();
   vtkOpenGLState::ScopedglActiveTexture unitSaver(ostate);
@@ -222,10 +222,9 @@ bool vtkFerroVolumeDepthPeeling::ReadPassTexture(vtkOpenGLRenderWindow* win,
   }
   if (texture == 0 || w != width || h != height)
   {
-    error = std::string("depth peeling's ") + uniform + " is " + std::to_string(w) + "x" +
-      std::to_string(h) + ", the viewport " + std::to_string(width) + "x" +
-      std::to_string(height);
-    return false;
+    return report.Fail(std::string("depth peeling's ") + uniform + " is " +
+      std::to_string(w) + "x" + std::to_string(h) + ", the viewport " + std::to_string(width) +
+      "x" + std::to_string(height));
   }
   out.resize(static_cast<size_t>(width) * height * components);
   // (into client memory: a pixel-pack buffer left bound would take the texels instead)
@@ -241,14 +240,14 @@ bool vtkFerroVolumeDepthPeeling::ReadPassTexture(vtkOpenGLRenderWindow* win,
 
 bool vtkFerroVolumeDepthPeeling::Render(ferrovol::Renderer& renderer,
   const vtkFerroVolumeFrameRequest& req, const std::vector<float>& near,
-  const std::vector<float>& far, vtkTextureObject* texture, std::string& error)
+  const std::vector<float>& far, vtkTextureObject* texture, vtkFerroVolumeReport& report)
 {
   std::vector<unsigned char> clear;
   const unsigned char* rgba = nullptr;
   std::unique_ptr<ferrovol::Frame> frame;
   if (AnyRange(near, far))
   {
-    if (!vtkFerroVolumeCall("render the volume between depth peeling's layers", error, [&] {
+    if (!vtkFerroVolumeCall("render the volume between depth peeling's layers", report, [&] {
           renderer.render_between(static_cast<uint32_t>(req.RenderW),
             static_cast<uint32_t>(req.RenderH), near, far);
           frame.reset(new ferrovol::Frame(renderer.read_frame()));
@@ -260,8 +259,7 @@ bool vtkFerroVolumeDepthPeeling::Render(ferrovol::Renderer& renderer,
     if (frame->width() != static_cast<uint32_t>(req.RenderW) ||
       frame->height() != static_cast<uint32_t>(req.RenderH) || !rgba)
     {
-      error = "ferrovol returned a frame of an unexpected size";
-      return false;
+      return report.Fail("ferrovol returned a frame of an unexpected size");
     }
   }
   else
@@ -273,24 +271,22 @@ bool vtkFerroVolumeDepthPeeling::Render(ferrovol::Renderer& renderer,
   if (!texture->Create2DFromRaw(req.RenderW, req.RenderH, 4, VTK_UNSIGNED_CHAR,
         const_cast<void*>(static_cast<const void*>(rgba))))
   {
-    error = "could not upload the volume's layer into an OpenGL texture";
-    return false;
+    return report.Fail("could not upload the volume's layer into an OpenGL texture");
   }
   return true;
 }
 
 bool vtkFerroVolumeDepthPeeling::Draw(vtkRenderPass* pass, vtkAbstractVolumeMapper* mapper,
   vtkVolume* vol, ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
-  std::string& error)
+  vtkFerroVolumeReport& report)
 {
   vtkOpenGLRenderWindow* win = req.Window;
   Stage stage = Stage::Outside;
   if (!DetectStage(pass, mapper, vol, stage))
   {
-    error = "this vtkDualDepthPeelingPass is in a stage ferrovol does not know";
-    return false;
+    return report.Fail("this vtkDualDepthPeelingPass is in a stage ferrovol does not know");
   }
-  if (!this->Prepare(win, error))
+  if (!this->Prepare(win, report))
   {
     return false;
   }
@@ -302,10 +298,10 @@ bool vtkFerroVolumeDepthPeeling::Draw(vtkRenderPass* pass, vtkAbstractVolumeMapp
   const int vw = req.ViewportW, vh = req.ViewportH, rw = req.RenderW, rh = req.RenderH;
   const bool blend = stage == Stage::Blend;
   if (!this->ReadPassTexture(win, blend ? "depthRangeTex" : "outerDepthTex", 2, vw, vh,
-        this->Outer, error) ||
-    (!blend && !this->ReadPassTexture(win, "innerDepthTex", 2, vw, vh, this->Inner, error)) ||
+        this->Outer, report) ||
+    (!blend && !this->ReadPassTexture(win, "innerDepthTex", 2, vw, vh, this->Inner, report)) ||
     (stage == Stage::Peel &&
-      !this->ReadPassTexture(win, "opaqueDepthTex", 1, vw, vh, this->Opaque, error)))
+      !this->ReadPassTexture(win, "opaqueDepthTex", 1, vw, vh, this->Opaque, report)))
   {
     return false;
   }
@@ -381,8 +377,8 @@ bool vtkFerroVolumeDepthPeeling::Draw(vtkRenderPass* pass, vtkAbstractVolumeMapp
     }
   }
   if ((!blend &&
-        !this->Render(renderer, req, this->NearFront, this->FarFront, this->Front, error)) ||
-    !this->Render(renderer, req, this->NearBack, this->FarBack, this->Back, error))
+        !this->Render(renderer, req, this->NearFront, this->FarFront, this->Front, report)) ||
+    !this->Render(renderer, req, this->NearBack, this->FarBack, this->Back, report))
   {
     return false;
   }

@@ -24,6 +24,7 @@
 #include <vector>
 
 class vtkAbstractVolumeMapper;
+class vtkFerroVolumeReport;
 class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
 class vtkRenderPass;
@@ -47,7 +48,8 @@ public:
   // Renders the volume for `pass`'s current stage (`renderer` set up for the frame `req`)
   // and writes it into the pass's targets.
   bool Draw(vtkRenderPass* pass, vtkAbstractVolumeMapper* mapper, vtkVolume* vol,
-    ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req, std::string& error);
+    ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
+    vtkFerroVolumeReport& report);
 
   // Frees the GL resources with `window`'s context current; nullptr forgets them.
   void ReleaseGraphicsResources(vtkWindow* window);
@@ -60,14 +62,14 @@ public:
   };
 
 private:
-  bool Prepare(vtkOpenGLRenderWindow* win, std::string& error);
+  bool Prepare(vtkOpenGLRenderWindow* win, vtkFerroVolumeReport& report);
   // Reads `pass`'s texture for `uniform` (as the pass binds it for this stage) into `out`,
   // rows bottom to top; `components` floats per texel (2: a min-max depth, 1: a depth).
   bool ReadPassTexture(vtkOpenGLRenderWindow* win, const char* uniform, int components,
-    int width, int height, std::vector<float>& out, std::string& error);
+    int width, int height, std::vector<float>& out, vtkFerroVolumeReport& report);
   bool Render(ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
     const std::vector<float>& near, const std::vector<float>& far, vtkTextureObject* texture,
-    std::string& error);
+    vtkFerroVolumeReport& report);
 
   vtkWeakPointer<vtkOpenGLRenderWindow> Window;
   // A program sampling every texture the pass binds: the pass sets its uniforms, which

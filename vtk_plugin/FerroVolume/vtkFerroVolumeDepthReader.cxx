@@ -1,6 +1,7 @@
 #include "vtkFerroVolumeDepthReader.h"
 
 #include "vtkCollection.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLState.h"
@@ -29,7 +30,7 @@ bool vtkFerroVolumeDepthReader::SceneHasOpaqueGeometry(vtkRenderer* ren, vtkVolu
 }
 
 bool vtkFerroVolumeDepthReader::Read(vtkOpenGLRenderWindow* win, int x, int y, int w, int h,
-  std::vector<float>& out, std::string& error)
+  std::vector<float>& out, vtkFerroVolumeReport& report)
 {
   vtkOpenGLState* ostate = win->GetState();
   out.assign(static_cast<size_t>(w) * h, 1.0f);
@@ -66,7 +67,7 @@ bool vtkFerroVolumeDepthReader::Read(vtkOpenGLRenderWindow* win, int x, int y, i
     GLenum format = DepthFormatOf(readFbo);
     if (format == GL_NONE)
     {
-      error = "the framebuffer's depth attachment has an unknown format";
+      report.Fail("the framebuffer's depth attachment has an unknown format");
       ok = false;
     }
     else
@@ -91,7 +92,7 @@ bool vtkFerroVolumeDepthReader::Read(vtkOpenGLRenderWindow* win, int x, int y, i
   {
     std::ostringstream s;
     s << "reading the depth buffer failed (OpenGL error 0x" << std::hex << err << ")";
-    error = s.str();
+    report.Fail(s.str());
     ok = false;
   }
   if (!ok)

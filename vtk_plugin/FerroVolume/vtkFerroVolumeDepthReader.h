@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+class vtkFerroVolumeReport;
 class vtkOpenGLRenderWindow;
 class vtkRenderer;
 class vtkVolume;
@@ -40,7 +41,7 @@ public:
   // receives w·h floats, rows bottom to top (OpenGL order); 1 everywhere, with the reason in
   // `error`, when it cannot be read.
   bool Read(vtkOpenGLRenderWindow* win, int x, int y, int w, int h, std::vector<float>& out,
-    std::string& error);
+    vtkFerroVolumeReport& report);
 
   // The internal format of the depth buffer of framebuffer `fbo` (bound for reading), or
   // GL_NONE when it is not one this reader knows.

@@ -4,13 +4,14 @@
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFerroVolumeContext.h"
-#include "vtkFerroVolumeMapper.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkPointData.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkVolumeMapper.h"
 
 #include <algorithm>
 #include <cmath>
@@ -64,8 +65,8 @@ bool ToFvScalarType(int vtkType, uint32_t& fvType, size_t& size)
 
 // The scalars of the input as VTK's mappers pick them (ScalarMode, SelectScalarArray), or an
 // error saying why there are none.
-vtkDataArray* FindScalars(vtkFerroVolumeMapper* self, vtkImageData* image, int& cellFlag,
-  std::string& error)
+vtkDataArray* FindScalars(vtkVolumeMapper* self, vtkImageData* image, int& cellFlag,
+  vtkFerroVolumeReport& report)
 {
   cellFlag = 0;
   vtkDataArray* scalars = vtkAbstractMapper::GetScalars(image, self->GetScalarMode(),
@@ -92,20 +93,20 @@ vtkDataArray* FindScalars(vtkFerroVolumeMapper* self, vtkImageData* image, int& 
   }
   if (abstract)
   {
-    error = "the selected " + what + " (" + abstract->GetClassName() +
-      ") is not numeric: volume rendering needs numeric scalars";
+    report.Fail("the selected " + what + " (" + abstract->GetClassName() +
+      ") is not numeric: volume rendering needs numeric scalars");
   }
   else if (mode == VTK_SCALAR_MODE_USE_POINT_FIELD_DATA ||
     mode == VTK_SCALAR_MODE_USE_CELL_FIELD_DATA)
   {
-    error = std::string("the input has no ") +
+    report.Fail(std::string("the input has no ") +
       (mode == VTK_SCALAR_MODE_USE_POINT_FIELD_DATA ? "point" : "cell") + " data " + what +
-      " (see SelectScalarArray)";
+      " (see SelectScalarArray)");
   }
   else
   {
-    error = "the input has no scalars to render (set point or cell scalars, or select an "
-            "array with SetScalarModeToUsePointFieldData + SelectScalarArray)";
+    report.Fail("the input has no scalars to render (set point or cell scalars, or select an "
+                "array with SetScalarModeToUsePointFieldData + SelectScalarArray)");
   }
   return nullptr;
 }
@@ -120,8 +121,8 @@ struct PreparedVolume
   double MeanSpacing = 1.0;
 };
 
-bool PrepareVolume(
-  vtkImageData* image, vtkDataArray* scalars, bool cells, PreparedVolume& out, std::string& error)
+bool PrepareVolume(vtkImageData* image, vtkDataArray* scalars, bool cells, PreparedVolume& out,
+  vtkFerroVolumeReport& report)
 {
   int pointDims[3];
   image->GetDimensions(pointDims);
@@ -150,9 +151,9 @@ bool PrepareVolume(
   {
     if (pointDims[a] < 1)
     {
-      error = "the input image is empty (dimensions " + std::to_string(pointDims[0]) + "x" +
-        std::to_string(pointDims[1]) + "x" + std::to_string(pointDims[2]) + ")";
-      return false;
+      return report.Fail("the input image is empty (dimensions " +
+        std::to_string(pointDims[0]) + "x" + std::to_string(pointDims[1]) + "x" +
+        std::to_string(pointDims[2]) + ")");
     }
   }
 
@@ -173,27 +174,24 @@ bool PrepareVolume(
   const int comps = scalars->GetNumberOfComponents();
   if (comps < 1 || comps > 4)
   {
-    error = "the scalars '" + std::string(scalars->GetName() ? scalars->GetName() : "") +
+    return report.Fail("the scalars '" + std::string(scalars->GetName() ? scalars->GetName() : "") +
       "' have " + std::to_string(comps) +
       " components; ferrovol renders 1 to 4 (pick components with "
-      "vtkImageExtractComponents)";
-    return false;
+      "vtkImageExtractComponents)");
   }
   const vtkIdType expected = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
   if (scalars->GetNumberOfTuples() != expected)
   {
-    error = "the scalars have " + std::to_string(scalars->GetNumberOfTuples()) + " tuples but " +
-      std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]) +
-      (cells ? " cells" : " points") + " need " + std::to_string(expected);
-    return false;
+    return report.Fail("the scalars have " + std::to_string(scalars->GetNumberOfTuples()) +
+      " tuples but " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+      std::to_string(dims[2]) + (cells ? " cells" : " points") + " need " + std::to_string(expected));
   }
   uint32_t fvType = 0;
   size_t typeSize = 0;
   if (!ToFvScalarType(scalars->GetDataType(), fvType, typeSize))
   {
-    error = std::string("scalars of type ") + scalars->GetDataTypeAsString() +
-      " cannot be volume rendered (cast them with vtkImageCast)";
-    return false;
+    return report.Fail(std::string("scalars of type ") + scalars->GetDataTypeAsString() +
+      " cannot be volume rendered (cast them with vtkImageCast)");
   }
 
   // Spacing: positive along every axis (a negative one flips the direction column); an
@@ -204,8 +202,7 @@ bool PrepareVolume(
   {
     if (!std::isfinite(spacing[a]))
     {
-      error = "the input spacing is not finite";
-      return false;
+      return report.Fail("the input spacing is not finite");
     }
     if (spacing[a] != 0.0)
     {
@@ -223,8 +220,7 @@ bool PrepareVolume(
         s << "the input spacing (" << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
           << ") is zero along " << axisName[a] << ", which has " << dims[a]
           << " points: every spacing must be non-zero";
-        error = s.str();
-        return false;
+        return report.Fail(s.str());
       }
       positive[a] = std::isfinite(minPositive) ? minPositive : 1.0;
     }
@@ -265,8 +261,7 @@ bool PrepareVolume(
   }
   if (!src)
   {
-    error = "the scalars' memory could not be read";
-    return false;
+    return report.Fail("the scalars' memory could not be read");
   }
 
   // An axis with a single point becomes a slab one spacing thick, centred on the plane:
@@ -394,15 +389,14 @@ int vtkFerroVolumeInputHelper::GetDataType() const
   return this->Scalars ? this->Scalars->GetDataType() : VTK_VOID;
 }
 
-bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& error)
+bool vtkFerroVolumeInputHelper::Select(vtkVolumeMapper* self, vtkFerroVolumeReport& report)
 {
   this->Image = nullptr;
   this->Scalars = nullptr;
   vtkAlgorithm* alg = self->GetInputAlgorithm();
   if (!alg || self->GetNumberOfInputConnections(0) < 1)
   {
-    error = "no input: connect a vtkImageData (SetInputData / SetInputConnection)";
-    return false;
+    return report.Fail("no input: connect a vtkImageData (SetInputData / SetInputConnection)");
   }
   alg->Update();
   vtkDataSet* dataset = self->GetInput();
@@ -410,7 +404,7 @@ bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& 
   this->Grid = vtkRectilinearGrid::SafeDownCast(dataset);
   if (this->Grid)
   {
-    image = this->ImageOfGrid(error);
+    image = this->ImageOfGrid(report);
     if (!image)
     {
       return false;
@@ -418,19 +412,18 @@ bool vtkFerroVolumeInputHelper::Select(vtkFerroVolumeMapper* self, std::string& 
   }
   if (!image)
   {
-    error = std::string("the input is ") + (dataset ? dataset->GetClassName() : "empty") +
-      ": vtkFerroVolumeMapper renders vtkImageData and vtkRectilinearGrid";
-    return false;
+    return report.Fail(std::string("the input is ") +
+      (dataset ? dataset->GetClassName() : "empty") +
+      ": vtkFerroVolumeMapper renders vtkImageData and vtkRectilinearGrid");
   }
-  vtkDataArray* scalars = FindScalars(self, image, this->CellFlag, error);
+  vtkDataArray* scalars = FindScalars(self, image, this->CellFlag, report);
   if (!scalars)
   {
     return false;
   }
   if (this->CellFlag == 2)
   {
-    error = "field data scalars cannot be volume rendered: select point or cell data";
-    return false;
+    return report.Fail("field data scalars cannot be volume rendered: select point or cell data");
   }
   this->Image = image;
   this->Scalars = scalars;
@@ -455,7 +448,7 @@ void vtkFerroVolumeInputHelper::GetCellSpacing(double spacing[3]) const
   }
 }
 
-vtkImageData* vtkFerroVolumeInputHelper::ImageOfGrid(std::string& error)
+vtkImageData* vtkFerroVolumeInputHelper::ImageOfGrid(vtkFerroVolumeReport& report)
 {
   vtkRectilinearGrid* grid = this->Grid;
   if (this->GridImage && this->GridImageMTime == grid->GetMTime())
@@ -472,9 +465,9 @@ vtkImageData* vtkFerroVolumeInputHelper::ImageOfGrid(std::string& error)
   {
     if (!arrays[a] || arrays[a]->GetNumberOfTuples() != dims[a] || dims[a] < 1)
     {
-      error = std::string("the rectilinear grid's ") + axisName[a] + " coordinates number " +
+      report.Fail(std::string("the rectilinear grid's ") + axisName[a] + " coordinates number " +
         std::to_string(arrays[a] ? arrays[a]->GetNumberOfTuples() : 0) + " for " +
-        std::to_string(dims[a]) + " points along " + axisName[a] + ": give one per point";
+        std::to_string(dims[a]) + " points along " + axisName[a] + ": give one per point");
       return nullptr;
     }
     const vtkIdType n = dims[a];
@@ -520,7 +513,7 @@ void vtkFerroVolumeInputHelper::CountGhosts()
 }
 
 bool vtkFerroVolumeInputHelper::Upload(
-  ferrovol::Renderer& renderer, uint64_t budget, std::string& error)
+  ferrovol::Renderer& renderer, uint64_t budget, vtkFerroVolumeReport& report)
 {
   Key key;
   key.Budget = budget;
@@ -538,12 +531,12 @@ bool vtkFerroVolumeInputHelper::Upload(
   }
   this->Uploaded.reset();
   PreparedVolume pv;
-  if (!PrepareVolume(this->Image, this->Scalars, this->CellFlag == 1, pv, error))
+  if (!PrepareVolume(this->Image, this->Scalars, this->CellFlag == 1, pv, report))
   {
     return false;
   }
   std::unique_ptr<ferrovol::Volume> volume;
-  if (!vtkFerroVolumeCall("take the input volume", error,
+  if (!vtkFerroVolumeCall("take the input volume", report,
         [&] {
           volume.reset(new ferrovol::Volume(pv.Desc, pv.Data, pv.Bytes));
           if (this->Grid)
@@ -552,7 +545,7 @@ bool vtkFerroVolumeInputHelper::Upload(
             volume->set_coordinates(c[0], c[1], c[2]);
           }
         }) ||
-    !vtkFerroVolumeCall("upload the volume", error, [&] {
+    !vtkFerroVolumeCall("upload the volume", report, [&] {
       renderer.set_memory_budget(budget);
       renderer.set_volume(*volume);
     }))
@@ -601,7 +594,8 @@ void vtkFerroVolumeInputHelper::SetWholeRanges(const WholeRanges& whole)
 // its point ghost byte, or the byte of the cell it starts (the last cell for an axis's last
 // point), is non-zero. Cell data (a grid of cell centres): the cell's own byte, or its first
 // corner's point byte. An axis of one point, uploaded as two, repeats it.
-bool vtkFerroVolumeInputHelper::UpdateBlanking(ferrovol::Renderer& renderer, std::string& error)
+bool vtkFerroVolumeInputHelper::UpdateBlanking(
+  ferrovol::Renderer& renderer, vtkFerroVolumeReport& report)
 {
   if (!this->BlankingStale)
   {
@@ -611,7 +605,7 @@ bool vtkFerroVolumeInputHelper::UpdateBlanking(ferrovol::Renderer& renderer, std
   if (this->GhostCounts.Points == 0 && this->GhostCounts.Cells == 0)
   {
     return vtkFerroVolumeCall(
-      "clear the blanking", error, [&] { renderer.set_blanking(nullptr, 0); });
+      "clear the blanking", report, [&] { renderer.set_blanking(nullptr, 0); });
   }
   vtkUnsignedCharArray* pg = vtkUnsignedCharArray::SafeDownCast(this->Image->GetPointGhostArray());
   vtkUnsignedCharArray* cg = vtkUnsignedCharArray::SafeDownCast(this->Image->GetCellGhostArray());
@@ -647,7 +641,7 @@ bool vtkFerroVolumeInputHelper::UpdateBlanking(ferrovol::Renderer& renderer, std
     }
   }
   return vtkFerroVolumeCall(
-    "blank the volume", error, [&] { renderer.set_blanking(mask.data(), mask.size()); });
+    "blank the volume", report, [&] { renderer.set_blanking(mask.data(), mask.size()); });
 }
 
 // vtkGPUVolumeRayCastMapper's mask texture, on ferrovol's grid: the mask image must have the
@@ -655,7 +649,7 @@ bool vtkFerroVolumeInputHelper::UpdateBlanking(ferrovol::Renderer& renderer, std
 // component). Binary: a point is kept where its value is above 0 (VTK tests the texture
 // value > 0). Label map: the value is the point's label, an integer 0 to 255.
 bool vtkFerroVolumeInputHelper::UpdateMask(
-  vtkImageData* mask, int maskType, ferrovol::Renderer& renderer, std::string& error)
+  vtkImageData* mask, int maskType, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report)
 {
   vtkDataArray* scalars = nullptr;
   if (mask)
@@ -673,7 +667,7 @@ bool vtkFerroVolumeInputHelper::UpdateMask(
   auto clear = [&] { renderer.set_mask(nullptr, 0, FV_MASK_TYPE_BINARY); };
   if (!mask)
   {
-    return vtkFerroVolumeCall("clear the mask", error, clear);
+    return vtkFerroVolumeCall("clear the mask", report, clear);
   }
   std::string problem;
   int md[3], pd[3];
@@ -740,11 +734,10 @@ bool vtkFerroVolumeInputHelper::UpdateMask(
   }
   if (!problem.empty())
   {
-    vtkFerroVolumeCall("clear the mask", error, clear);
-    error = problem;
-    return false;
+    vtkFerroVolumeCall("clear the mask", report, clear);
+    return report.Fail(problem);
   }
-  return vtkFerroVolumeCall("set the mask", error, [&] {
+  return vtkFerroVolumeCall("set the mask", report, [&] {
     renderer.set_mask(
       values.data(), values.size(), labels ? FV_MASK_TYPE_LABEL_MAP : FV_MASK_TYPE_BINARY);
   });

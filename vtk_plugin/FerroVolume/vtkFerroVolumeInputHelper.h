@@ -19,9 +19,10 @@
 
 class vtkDataArray;
 class vtkDataObject;
-class vtkFerroVolumeMapper;
+class vtkFerroVolumeReport;
 class vtkImageData;
 class vtkRectilinearGrid;
+class vtkVolumeMapper;
 
 class vtkFerroVolumeInputHelper
 {
@@ -30,11 +31,11 @@ public:
 
   // Updates the mapper's input and finds its image and scalars (ScalarMode,
   // SelectScalarArray); false with the reason when there are none to render.
-  bool Select(vtkFerroVolumeMapper* self, std::string& error);
+  bool Select(vtkVolumeMapper* self, vtkFerroVolumeReport& report);
 
   // Gives the renderer the selected scalars as a volume, within `budget` bytes of device
   // memory (0: the device's limit), when they or the budget changed since the last upload.
-  bool Upload(ferrovol::Renderer& renderer, uint64_t budget, std::string& error);
+  bool Upload(ferrovol::Renderer& renderer, uint64_t budget, vtkFerroVolumeReport& report);
 
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }
@@ -72,14 +73,14 @@ public:
 
   // Gives the renderer the blanking mask of the ghost arrays (or clears it) when they or the
   // uploaded volume changed; false with the reason when the renderer refuses it.
-  bool UpdateBlanking(ferrovol::Renderer& renderer, std::string& error);
+  bool UpdateBlanking(ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   // Gives the renderer `mask` (vtkGPUVolumeRayCastMapper's MaskInput, nullptr for none)
   // with `maskType` (BinaryMaskType or LabelMapMaskType), or clears it, when the mask, its
   // scalars, the type or the uploaded volume changed; false with the reason (the mask is
   // then cleared).
   bool UpdateMask(
-    vtkImageData* mask, int maskType, ferrovol::Renderer& renderer, std::string& error);
+    vtkImageData* mask, int maskType, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
 private:
   // What the uploaded volume was made from: anything here changing means a new upload.
@@ -108,7 +109,7 @@ private:
 
   // The image of the rectilinear input (GetImage), made again when the grid changed; null
   // with the reason when its coordinate arrays do not match its dimensions.
-  vtkImageData* ImageOfGrid(std::string& error);
+  vtkImageData* ImageOfGrid(vtkFerroVolumeReport& report);
 
   // Counts the marked entries of the image's ghost arrays, when they changed.
   void CountGhosts();

@@ -4,19 +4,20 @@
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
 #include "vtkFerroVolumeContext.h"
-#include "vtkFerroVolumeMapper.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkMultiVolume.h"
 #include "vtkVolume.h"
+#include "vtkVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
 #include <cstring>
 
 bool vtkFerroVolumeIntermix::Convert(
-  vtkFerroVolumeMapper* self, int port, Port& p, std::string& error)
+  vtkVolumeMapper* self, int port, Port& p, vtkFerroVolumeReport& report)
 {
   const std::string name = "port " + std::to_string(port);
   if (vtkAlgorithm* source = self->GetInputAlgorithm(port, 0))
@@ -26,24 +27,21 @@ bool vtkFerroVolumeIntermix::Convert(
   vtkImageData* image = vtkImageData::SafeDownCast(self->GetInputDataObject(port, 0));
   if (!image)
   {
-    error = "the input on " + name +
-      " is not a vtkImageData: volumes intermixed with port 0's are images";
-    return false;
+    return report.Fail("the input on " + name +
+      " is not a vtkImageData: volumes intermixed with port 0's are images");
   }
   int cellFlag = 0;
   vtkDataArray* scalars = vtkAbstractMapper::GetScalars(image, self->GetScalarMode(),
     self->GetArrayAccessMode(), self->GetArrayId(), self->GetArrayName(), cellFlag);
   if (!scalars)
   {
-    error = "the input on " + name + " has no scalars (the mapper's array settings apply to "
-      "every port)";
-    return false;
+    return report.Fail("the input on " + name +
+      " has no scalars (the mapper's array settings apply to every port)");
   }
   if (cellFlag != 0)
   {
-    error = "the scalars on " + name + " are cell data: volumes intermixed with port 0's "
-      "take point data";
-    return false;
+    return report.Fail("the scalars on " + name +
+      " are cell data: volumes intermixed with port 0's take point data");
   }
   if (p.Volume && p.Image == image && p.ImageMTime == image->GetMTime() &&
     p.Scalars == scalars && p.ScalarsMTime == scalars->GetMTime())
@@ -70,8 +68,7 @@ bool vtkFerroVolumeIntermix::Convert(
   {
     if (!(spacing[a] > 0.0))
     {
-      error = "the spacing on " + name + " is not positive along every axis";
-      return false;
+      return report.Fail("the spacing on " + name + " is not positive along every axis");
     }
     d.dims[a] = static_cast<uint32_t>(std::max(dims[a], 0));
     d.spacing[a] = spacing[a];
@@ -95,7 +92,7 @@ bool vtkFerroVolumeIntermix::Convert(
     values[static_cast<size_t>(i)] = static_cast<float>(scalars->GetComponent(i, 0));
   }
   std::unique_ptr<ferrovol::Volume> volume;
-  if (!vtkFerroVolumeCall(("copy the volume on " + name).c_str(), error, [&] {
+  if (!vtkFerroVolumeCall(("copy the volume on " + name).c_str(), report, [&] {
         volume.reset(new ferrovol::Volume(d, values.data(), values.size() * sizeof(float)));
       }))
   {
@@ -113,9 +110,9 @@ bool vtkFerroVolumeIntermix::Convert(
   return true;
 }
 
-bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* multi,
+bool vtkFerroVolumeIntermix::Update(vtkVolumeMapper* self, vtkMultiVolume* multi,
   const vtkFerroVolumeLookupTables::RangeTypes& types, ferrovol::Renderer& renderer,
-  std::string& error)
+  vtkFerroVolumeReport& report)
 {
   std::vector<int> ports;
   if (multi)
@@ -126,10 +123,9 @@ bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* 
       {
         if (!multi->GetVolume(port))
         {
-          error = "the mapper has an input on port " + std::to_string(port) +
+          return report.Fail("the mapper has an input on port " + std::to_string(port) +
             " but the vtkMultiVolume no vtkVolume there (SetVolume(volume, " +
-            std::to_string(port) + "))";
-          return false;
+            std::to_string(port) + "))");
         }
         ports.push_back(port);
       }
@@ -137,10 +133,9 @@ bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* 
   }
   if (ports.size() > FV_MAX_INTERMIXED_VOLUMES)
   {
-    error = std::to_string(ports.size() + 1) + " inputs: ferrovol intermixes at most " +
+    return report.Fail(std::to_string(ports.size() + 1) + " inputs: ferrovol intermixes at most " +
       std::to_string(FV_MAX_INTERMIXED_VOLUMES + 1) + " volumes (ports 0 to " +
-      std::to_string(FV_MAX_INTERMIXED_VOLUMES) + ")";
-    return false;
+      std::to_string(FV_MAX_INTERMIXED_VOLUMES) + ")");
   }
   bool changed = ports.size() != this->Ports.size();
   this->Ports.resize(ports.size());
@@ -153,7 +148,7 @@ bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* 
       p.Index = ports[i];
     }
     const FvVolume* old = p.Volume ? p.Volume->get() : nullptr;
-    if (!this->Convert(self, ports[i], p, error))
+    if (!this->Convert(self, ports[i], p, report))
     {
       return false;
     }
@@ -184,9 +179,9 @@ bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* 
   for (size_t i = 0; i < this->Ports.size(); ++i)
   {
     Port& p = this->Ports[i];
-    if (!vtkFerroVolumeLookupTables::BuildIntermixed(p.Property, p.Range, types, tfs[i], error))
+    if (!vtkFerroVolumeLookupTables::BuildIntermixed(p.Property, p.Range, types, tfs[i], report))
     {
-      error = "port " + std::to_string(p.Index) + ": " + error;
+      report.PrefixError("port " + std::to_string(p.Index) + ": ");
       p.Property = nullptr;
       return false;
     }
@@ -197,7 +192,7 @@ bool vtkFerroVolumeIntermix::Update(vtkFerroVolumeMapper* self, vtkMultiVolume* 
     given[i].transfer_function = tfs[i]->get();
     std::copy(p.Matrix, p.Matrix + 16, given[i].matrix);
   }
-  if (!vtkFerroVolumeCall("intermix the volumes of the mapper's ports", error,
+  if (!vtkFerroVolumeCall("intermix the volumes of the mapper's ports", report,
         [&] { renderer.set_intermixed_volumes(given); }))
   {
     this->Ports.clear();

@@ -17,9 +17,10 @@
 #include <vector>
 
 class vtkDataArray;
-class vtkFerroVolumeMapper;
+class vtkFerroVolumeReport;
 class vtkImageData;
 class vtkMultiVolume;
+class vtkVolumeMapper;
 class vtkVolumeProperty;
 
 class vtkFerroVolumeIntermix
@@ -27,9 +28,9 @@ class vtkFerroVolumeIntermix
 public:
   // Gives the renderer the volumes of `multi`'s ports other than 0 (none: clears them)
   // when any of them, its matrix or its property changed; false with the reason.
-  bool Update(vtkFerroVolumeMapper* self, vtkMultiVolume* multi,
+  bool Update(vtkVolumeMapper* self, vtkMultiVolume* multi,
     const vtkFerroVolumeLookupTables::RangeTypes& types, ferrovol::Renderer& renderer,
-    std::string& error);
+    vtkFerroVolumeReport& report);
 
   // Forget what was given (the renderer is gone).
   void Reset()
@@ -55,7 +56,7 @@ private:
     double Matrix[16] = {};
   };
   // The port's volume converted again when its data changed; false with the reason.
-  bool Convert(vtkFerroVolumeMapper* self, int port, Port& p, std::string& error);
+  bool Convert(vtkVolumeMapper* self, int port, Port& p, vtkFerroVolumeReport& report);
 
   std::vector<Port> Ports;
   // Whether the renderer holds intermixed volumes (then an empty update clears them).

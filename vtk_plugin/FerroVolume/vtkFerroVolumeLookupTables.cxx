@@ -3,6 +3,7 @@
 #include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkDataArray.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkImageResize.h"
@@ -251,18 +252,17 @@ void GradientOpacityNodes(vtkPiecewiseFunction* gof, const std::array<double, 2>
 bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
   const vtkFerroVolumeInputHelper::Ranges& ranges,
   const vtkFerroVolumeLookupTables::RangeTypes& types, double gradientScale,
-  std::unique_ptr<ferrovol::TransferFunction>& tf, std::string& error)
+  std::unique_ptr<ferrovol::TransferFunction>& tf, vtkFerroVolumeReport& report)
 {
   const bool independent = comps == 1 || prop->GetIndependentComponents();
   if (!independent && comps != 2 && comps != 4)
   {
-    error = "IndependentComponents is off with " + std::to_string(comps) +
+    return report.Fail("IndependentComponents is off with " + std::to_string(comps) +
       " components: dependent components need 2 (colour scalar, opacity scalar) or 4 (RGB + "
-      "opacity scalar)";
-    return false;
+      "opacity scalar)");
   }
   const int n = independent ? comps : 1;
-  if (!vtkFerroVolumeCall("create a transfer function", error, [&] {
+  if (!vtkFerroVolumeCall("create a transfer function", report, [&] {
         tf.reset(new ferrovol::TransferFunction(static_cast<uint32_t>(n), independent));
       }))
   {
@@ -291,14 +291,14 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
       ranges[opacityComp][0], ranges[opacityComp][1] };
     ColorNodes(prop, c, lo, hi, xs, colorLookup, pts);
     if (!vtkFerroVolumeCall(
-          "set the colour transfer function", error, [&] { tf->set_color(component, pts); }))
+          "set the colour transfer function", report, [&] { tf->set_color(component, pts); }))
     {
       return false;
     }
     OpacityNodes(prop, c, lo, hi, xs, opacityLookup, pts);
     if (!vtkFerroVolumeCall(
-          "set the scalar opacity function", error, [&] { tf->set_opacity(component, pts); }) ||
-      !vtkFerroVolumeCall("set the scalar opacity unit distance", error, [&] {
+          "set the scalar opacity function", report, [&] { tf->set_opacity(component, pts); }) ||
+      !vtkFerroVolumeCall("set the scalar opacity unit distance", report, [&] {
         tf->set_unit_distance(component, prop->GetScalarOpacityUnitDistance(opacityComp),
           prop->GetComponentWeight(c));
       }))
@@ -311,7 +311,7 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
       const float material[4] = { static_cast<float>(prop->GetAmbient(c)),
         static_cast<float>(prop->GetDiffuse(c)), static_cast<float>(prop->GetSpecular(c)),
         static_cast<float>(prop->GetSpecularPower(c)) };
-      if (!vtkFerroVolumeCall("set the component's shading material", error,
+      if (!vtkFerroVolumeCall("set the component's shading material", report,
             [&] { tf->set_material(component, material); }))
       {
         return false;
@@ -322,7 +322,7 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
     {
       GradientOpacityNodes(prop->GetStoredGradientOpacity(goIndex), ranges[opacityComp],
         types.GradientOpacity == vtkGPUVolumeRayCastMapper::NATIVE, gradientScale, pts);
-      if (!vtkFerroVolumeCall("set the gradient opacity function", error,
+      if (!vtkFerroVolumeCall("set the gradient opacity function", report,
             [&] { tf->set_gradient_opacity(component, pts); }))
       {
         return false;
@@ -337,7 +337,7 @@ bool BuildTransferFunction(vtkVolumeProperty* prop, int comps,
 // the component's data range, gradient opacity as the component's. Labels above 255 are left
 // out: a label map holds labels 0 to 255.
 bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
-  double gradientScale, ferrovol::TransferFunction& tf, std::string& error)
+  double gradientScale, ferrovol::TransferFunction& tf, vtkFerroVolumeReport& report)
 {
   std::vector<double> xs, pts, values;
   TablePositions(range[0], range[1], xs);
@@ -363,7 +363,7 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
         }
       }
       if (!vtkFerroVolumeCall(
-            "set a label's colour function", error, [&] { tf.set_label_color(l, pts); }))
+            "set a label's colour function", report, [&] { tf.set_label_color(l, pts); }))
       {
         return false;
       }
@@ -379,7 +379,7 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
         pts[2 * i + 1] = Clamp01(values[i]);
       }
       if (!vtkFerroVolumeCall(
-            "set a label's opacity function", error, [&] { tf.set_label_opacity(l, pts); }))
+            "set a label's opacity function", report, [&] { tf.set_label_opacity(l, pts); }))
       {
         return false;
       }
@@ -392,7 +392,7 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
         // (a constant 1: no attenuation, which the first component's function may have)
         pts = { 0.0, 1.0 };
       }
-      if (!vtkFerroVolumeCall("set a label's gradient opacity function", error,
+      if (!vtkFerroVolumeCall("set a label's gradient opacity function", report,
             [&] { tf.set_label_gradient_opacity(l, pts); }))
       {
         return false;
@@ -412,7 +412,7 @@ bool BuildLabels(vtkVolumeProperty* prop, const std::array<double, 2>& range,
 // corner points on corner texels): so is the table handed to ferrovol, which then reads it
 // as VTK's texture is read.
 bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& range,
-  double gradientScale, ferrovol::TransferFunction& tf, std::string& error)
+  double gradientScale, ferrovol::TransferFunction& tf, vtkFerroVolumeReport& report)
 {
   vtkImageData* image = prop->GetTransferFunction2D(c);
   vtkDataArray* scalars = image ? image->GetPointData()->GetScalars() : nullptr;
@@ -436,8 +436,7 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
          << (scalars ? scalars->GetNumberOfComponents() : 0)
          << " components per point: it must be a 2D image of RGBA values";
     }
-    error = os.str();
-    return false;
+    return report.Fail(os.str());
   }
   const auto texels = [](int n) { return std::max(1024, vtkMath::NearestPowerOfTwo(n)); };
   const int width = texels(dims[0]);
@@ -469,7 +468,7 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
   const double lo = range[0];
   const double hi = span > 0.0 ? range[1] : range[0] + 1.0;
   const double gmax = 0.25 * (span != 0.0 ? span : 1.0) * gradientScale;
-  return vtkFerroVolumeCall("set the 2D transfer function", error, [&] {
+  return vtkFerroVolumeCall("set the 2D transfer function", report, [&] {
     tf.set_table_2d(static_cast<uint32_t>(c), static_cast<uint32_t>(dims[0]),
       static_cast<uint32_t>(dims[1]), rgba, lo, hi, gmax);
   });
@@ -478,7 +477,7 @@ bool Table2DOf(vtkVolumeProperty* prop, int c, const std::array<double, 2>& rang
 // Every component's 2D table in TF_2D mode (one or independent components; VTK's dependent
 // components read one table differently, which ferrovol does not do: an error).
 bool Build2D(bool twoD, vtkVolumeProperty* prop, const vtkFerroVolumeLookupTables::Key& key,
-  ferrovol::TransferFunction& tf, std::string& error)
+  ferrovol::TransferFunction& tf, vtkFerroVolumeReport& report)
 {
   if (!twoD)
   {
@@ -486,13 +485,12 @@ bool Build2D(bool twoD, vtkVolumeProperty* prop, const vtkFerroVolumeLookupTable
   }
   if (key.Components > 1 && !prop->GetIndependentComponents())
   {
-    error = "2D transfer functions (TF_2D) with dependent components are not supported by "
-            "vtkFerroVolumeMapper: nothing is drawn";
-    return false;
+    return report.Fail("2D transfer functions (TF_2D) with dependent components are not "
+                       "supported by vtkFerroVolumeMapper: nothing is drawn");
   }
   for (int c = 0; c < key.Components; ++c)
   {
-    if (!Table2DOf(prop, c, key.Ranges[c], key.GradientScale, tf, error))
+    if (!Table2DOf(prop, c, key.Ranges[c], key.GradientScale, tf, report))
     {
       return false;
     }
@@ -532,36 +530,33 @@ double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
 
 bool vtkFerroVolumeLookupTables::BuildIntermixed(vtkVolumeProperty* prop,
   const std::array<double, 2>& range, const RangeTypes& types,
-  std::unique_ptr<ferrovol::TransferFunction>& tf, std::string& error)
+  std::unique_ptr<ferrovol::TransferFunction>& tf, vtkFerroVolumeReport& report)
 {
   if (prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D)
   {
-    error = "its property has a 2D transfer function: intermixed volumes are classified by "
-            "1D colour and scalar opacity functions";
-    return false;
+    return report.Fail("its property has a 2D transfer function: intermixed volumes are "
+                       "classified by 1D colour and scalar opacity functions");
   }
   if (prop->HasGradientOpacity(0) && !prop->GetDisableGradientOpacity(0))
   {
-    error = "its property has a gradient opacity function: intermixed volumes are classified "
-            "by colour and scalar opacity only (DisableGradientOpacityOn)";
-    return false;
+    return report.Fail("its property has a gradient opacity function: intermixed volumes are "
+                       "classified by colour and scalar opacity only (DisableGradientOpacityOn)");
   }
   vtkFerroVolumeInputHelper::Ranges ranges{};
   ranges[0] = range;
-  return BuildTransferFunction(prop, 1, ranges, types, 1.0, tf, error);
+  return BuildTransferFunction(prop, 1, ranges, types, 1.0, tf, report);
 }
 
 bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   const vtkFerroVolumeInputHelper& input, const RangeTypes& rangeTypes,
-  ferrovol::Renderer& renderer, std::string& error)
+  ferrovol::Renderer& renderer, vtkFerroVolumeReport& report)
 {
   vtkVolumeProperty* prop = volume->GetProperty();
   const bool twoD = prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D;
   const double matrixScale = MatrixScale(volume);
   if (!(matrixScale > 0.0) || !std::isfinite(matrixScale))
   {
-    error = "the vtkVolume's matrix is singular (zero scale?): nothing is drawn";
-    return false;
+    return report.Fail("the vtkVolume's matrix is singular (zero scale?): nothing is drawn");
   }
   Key key;
   key.Property = prop;
@@ -588,12 +583,12 @@ bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,
   this->Uploaded.reset();
   std::unique_ptr<ferrovol::TransferFunction> tf;
   if (!BuildTransferFunction(
-        prop, key.Components, key.Ranges, key.Types, key.GradientScale, tf, error) ||
+        prop, key.Components, key.Ranges, key.Types, key.GradientScale, tf, report) ||
     (key.Components == 1 &&
-      !BuildLabels(prop, key.Ranges[0], key.GradientScale, *tf, error)) ||
-    !Build2D(twoD, prop, key, *tf, error) ||
+      !BuildLabels(prop, key.Ranges[0], key.GradientScale, *tf, report)) ||
+    !Build2D(twoD, prop, key, *tf, report) ||
     !vtkFerroVolumeCall(
-      "set the transfer function", error, [&] { renderer.set_transfer_function(*tf); }))
+      "set the transfer function", report, [&] { renderer.set_transfer_function(*tf); }))
   {
     return false;
   }

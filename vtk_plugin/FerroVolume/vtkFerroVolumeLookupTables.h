@@ -17,6 +17,7 @@
 #include <optional>
 #include <string>
 
+class vtkFerroVolumeReport;
 class vtkVolume;
 class vtkVolumeProperty;
 
@@ -45,14 +46,14 @@ public:
   // anything they are made from changed; false with the reason when the property or the
   // volume's matrix cannot be rendered.
   bool Update(vtkVolume* volume, const vtkFerroVolumeInputHelper& input,
-    const RangeTypes& rangeTypes, ferrovol::Renderer& renderer, std::string& error);
+    const RangeTypes& rangeTypes, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   // The transfer function of `prop`'s first component over the data range `range`, for a
   // volume intermixed with the main one (colour and scalar opacity: a gradient opacity or
   // 2D function is refused); false with the reason.
   static bool BuildIntermixed(vtkVolumeProperty* prop, const std::array<double, 2>& range,
     const RangeTypes& types, std::unique_ptr<ferrovol::TransferFunction>& tf,
-    std::string& error);
+    vtkFerroVolumeReport& report);
 
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }

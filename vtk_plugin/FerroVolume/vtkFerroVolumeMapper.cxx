@@ -6,7 +6,9 @@
 //   vtkFerroVolumeLookupTables  property → ferrovol transfer function, only when the property
 //                               (or its functions) or the ranges changed
 //   vtkFerroVolumeSettings      mapper, property, volume matrix, camera, lights → ferrovol
-//                               parameters (every frame, no upload)
+//                               parameters (every frame, no upload; Apply's parts by
+//                               concern, the isosurface and path tracing modes in
+//                               vtkFerroVolumeSettingsModes.cxx)
 //   vtkFerroVolumeDepthReader   VTK's depth buffer (this viewport) → ferrovol's depth input
 //   vtkFerroVolumeOutput        ferrovol renders; the frame reaches GL textures (readback, or
 //                               vtkFerroVolumeSharedOutput: zero copy) and one full-screen
@@ -19,6 +21,10 @@
 //   vtkFerroVolumeRefinement    progressive path tracing: whether a render is, its time
 //                               budget, the interactor timer that renders again
 //   vtkFerroVolumeContext       the process-wide ferrovol device
+//   vtkFerroVolumeReport        what goes wrong: the render's error (ends as vtkErrorMacro)
+//                               and the warnings said once per mapper; every unit takes it
+// The mode constants are in vtkFerroVolumeEnums.h, which units include instead of the
+// mapper's header.
 #include "vtkFerroVolumeMapper.h"
 #include "vtkFerroVolumeMapperInternals.h"
 
@@ -74,7 +80,7 @@ vtkFerroVolumeMapper::vtkFerroVolumeMapper()
   , MidpointQuadrature(0)
   , AdaptiveSampling(0)
   , CubicInterpolation(0)
-  , Internals(new vtkInternals)
+  , Internals(new vtkInternals(this))
 {
   // ferrovol's default: the device's limit (vtkGPUVolumeRayCastMapper's constructor probed
   // the GPU's memory, 128 MiB when it found none).
@@ -196,8 +202,8 @@ void vtkFerroVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 int vtkFerroVolumeMapper::IsRenderSupported(
   vtkRenderWindow* vtkNotUsed(window), vtkVolumeProperty* vtkNotUsed(property))
 {
-  std::string error;
-  return vtkFerroVolumeContext::Acquire(error) ? 1 : 0;
+  vtkFerroVolumeReport report;
+  return vtkFerroVolumeContext::Acquire(report) ? 1 : 0;
 }
 
 void vtkFerroVolumeMapper::GetReductionRatio(double ratio[3])
@@ -207,7 +213,8 @@ void vtkFerroVolumeMapper::GetReductionRatio(double ratio[3])
 
 bool vtkFerroVolumeMapper::PreLoadData(vtkRenderer* vtkNotUsed(ren), vtkVolume* vol)
 {
-  std::string error;
+  vtkFerroVolumeReport& report = this->Internals->Report;
+  report.ClearError();
   if (!vol)
   {
     vtkErrorMacro(<< "PreLoadData needs the vtkVolume whose property gives the tables");
@@ -220,9 +227,9 @@ bool vtkFerroVolumeMapper::PreLoadData(vtkRenderer* vtkNotUsed(ren), vtkVolume* 
     vtkErrorMacro(<< "the vtkMultiVolume has no vtkVolume on port 0 (SetVolume(volume, 0))");
     return false;
   }
-  if (!this->Internals->Prepare(this, main, multi, error))
+  if (!this->Internals->Prepare(this, main, multi, report))
   {
-    vtkErrorMacro(<< error);
+    vtkErrorMacro(<< report.GetError());
     return false;
   }
   return true;
@@ -250,7 +257,7 @@ vtkTextureObject* vtkFerroVolumeMapper::GetDepthTexture()
 
 void vtkFerroVolumeMapper::SetSharedDepthTexture(vtkTextureObject* texture)
 {
-  if (texture && this->Internals->FirstTime("shared-depth-texture"))
+  if (texture && this->Internals->Report.FirstTime("shared-depth-texture"))
   {
     vtkWarningMacro(<< "SetSharedDepthTexture is not supported by ferrovol, which reads VTK's "
                        "depth buffer itself: the texture is not used");
@@ -259,7 +266,7 @@ void vtkFerroVolumeMapper::SetSharedDepthTexture(vtkTextureObject* texture)
 
 void vtkFerroVolumeMapper::SetPartitions(unsigned short x, unsigned short y, unsigned short z)
 {
-  if ((x != 1 || y != 1 || z != 1) && this->Internals->FirstTime("partitions"))
+  if ((x != 1 || y != 1 || z != 1) && this->Internals->Report.FirstTime("partitions"))
   {
     vtkWarningMacro(<< "SetPartitions(" << x << ", " << y << ", " << z
                     << ") is not used: ferrovol splits a volume over the memory budget "

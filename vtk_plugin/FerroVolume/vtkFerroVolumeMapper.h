@@ -111,6 +111,7 @@
 #ifndef vtkFerroVolumeMapper_h
 #define vtkFerroVolumeMapper_h
 
+#include "vtkFerroVolumeEnums.h"  // For the modes
 #include "vtkFerroVolumeModule.h" // For export macro
 #include "vtkGPUVolumeRayCastMapper.h"
 
@@ -128,6 +129,10 @@ public:
   static vtkFerroVolumeMapper* New();
   vtkTypeMacro(vtkFerroVolumeMapper, vtkGPUVolumeRayCastMapper);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  // The constants of the mode settings (SPECULAR_*, ISOSURFACE_SCATTERING_*, RENDER_MODE_*,
+  // PROGRESSIVE_*, SCATTER_*, OUTPUT_PATH_*), declared in vtkFerroVolumeEnums.h.
+  vtkFerroVolumeEnumsMacro;
 
   ///@{
   /**
@@ -317,12 +322,6 @@ public:
   vtkBooleanMacro(EnvironmentBackground, vtkTypeBool);
   ///@}
 
-  enum SpecularSamplingModes
-  {
-    SPECULAR_CONE = 0,
-    SPECULAR_IMPORTANCE = 1
-  };
-
   ///@{
   /**
    * How the specular environment light is sampled: SPECULAR_IMPORTANCE (the default)
@@ -387,13 +386,6 @@ public:
   vtkGetMacro(IsosurfaceLayers, int);
   ///@}
 
-  enum IsosurfaceScatteringModes
-  {
-    ISOSURFACE_SCATTERING_OFF = 0,
-    ISOSURFACE_SCATTERING_PREVIEW = 1,
-    ISOSURFACE_SCATTERING_TRACED = 2
-  };
-
   ///@{
   /**
    * Isosurface blend mode: light scattered between the isosurfaces (the fast path of
@@ -413,12 +405,6 @@ public:
   vtkSetClampMacro(IsosurfaceScatteringAbsorption, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(IsosurfaceScatteringAbsorption, double);
   ///@}
-
-  enum RenderModes
-  {
-    RENDER_MODE_RAY_CAST = 0,
-    RENDER_MODE_PATH_TRACE = 1
-  };
 
   ///@{
   /**
@@ -461,13 +447,6 @@ public:
   vtkSetClampMacro(PathTracingDenoiseUntil, int, 0, 1000000);
   vtkGetMacro(PathTracingDenoiseUntil, int);
   ///@}
-
-  enum ProgressiveModes
-  {
-    PROGRESSIVE_AUTOMATIC = 0,
-    PROGRESSIVE_ON = 1,
-    PROGRESSIVE_OFF = 2
-  };
 
   ///@{
   /**
@@ -520,14 +499,6 @@ public:
   vtkGetMacro(StochasticBlend, double);
   ///@}
 
-  enum ScatterRegionModes
-  {
-    SCATTER_NOWHERE = 0,
-    SCATTER_SURFACES = 1,
-    SCATTER_BETWEEN = 2,
-    SCATTER_EVERYWHERE = 3
-  };
-
   ///@{
   /**
    * Path tracing: where collisions scatter (SCATTER_EVERYWHERE by default; SURFACES: only
@@ -578,13 +549,6 @@ public:
   double GetMeanAccumulatedSamples();
   double GetPathTracingError();
   ///@}
-
-  enum OutputPaths
-  {
-    OUTPUT_PATH_AUTOMATIC = 0,
-    OUTPUT_PATH_READBACK = 1,
-    OUTPUT_PATH_SHARED = 2
-  };
 
   ///@{
   /**

@@ -32,7 +32,7 @@ namespace
 // vtkGPUVolumeRayCastMapper writes, where the frame shows the volume (vtkFerroVolumeSelection).
 bool DrawSelection(vtkFerroVolumeOutput& output, vtkRenderer* ren, vtkVolume* vol,
   vtkImageData* image, vtkHardwareSelector* selector, const vtkFerroVolumeFrameRequest& req,
-  const int rect[4], std::string& error)
+  const int rect[4], vtkFerroVolumeReport& report)
 {
   vtkFerroVolumeSelection select;
   switch (selector->GetCurrentPass())
@@ -68,7 +68,8 @@ bool DrawSelection(vtkFerroVolumeOutput& output, vtkRenderer* ren, vtkVolume* vo
   image->GetDimensions(select.Dims);
   selector->BeginRenderProp();
   selector->GetPropColorValue(select.PropColor);
-  const bool drawn = output.Select(req, rect, select, error) != vtkFerroVolumeOutput::Composited::Failed;
+  const bool drawn =
+    output.Select(req, rect, select, report) != vtkFerroVolumeOutput::Composited::Failed;
   const vtkIdType points =
     static_cast<vtkIdType>(select.Dims[0]) * select.Dims[1] * select.Dims[2];
   selector->UpdateMaximumPointId(points);
@@ -102,7 +103,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     (this->RenderMode == RENDER_MODE_PATH_TRACE || this->BlendMode == ISOSURFACE_BLEND ||
       this->BlendMode == SLICE_BLEND))
   {
-    if (in->FirstTime("depth-peeling"))
+    if (in->Report.FirstTime("depth-peeling"))
     {
       vtkWarningMacro(<< "depth peeling for volumes (vtkRenderer UseDepthPeelingForVolumes "
                          "with translucent geometry) draws ray-cast volumes between the "
@@ -139,10 +140,11 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   }
 
   // Blend mode, input, volume (on change), tables (on change), frame parameters.
-  std::string error;
-  if (!in->Settings.SelectBlendMode(this, error) || !in->Prepare(this, main, multi, error))
+  vtkFerroVolumeReport& report = in->Report;
+  report.ClearError();
+  if (!in->Settings.SelectBlendMode(this, report) || !in->Prepare(this, main, multi, report))
   {
-    vtkErrorMacro(<< error);
+    vtkErrorMacro(<< report.GetError());
     return;
   }
   vtkImageData* image = in->Input.GetImage();
@@ -171,10 +173,10 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   if (progressive)
   {
     uint32_t before = 0;
-    if (!vtkFerroVolumeCall("count the accumulated paths", error,
+    if (!vtkFerroVolumeCall("count the accumulated paths", report,
           [&] { before = in->Renderer->accumulated_samples(); }))
     {
-      vtkErrorMacro(<< error);
+      vtkErrorMacro(<< report.GetError());
       return;
     }
     const bool denoised = this->PathTracingDenoise ||
@@ -184,10 +186,10 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   }
   in->Settings.SetIntermixing(multi != nullptr);
   switch (
-    in->Settings.Apply(this, ren, main, in->Input, *in->Renderer, traceBudget, in->Warned, error))
+    in->Settings.Apply(this, ren, main, in->Input, *in->Renderer, traceBudget, report))
   {
     case vtkFerroVolumeSettings::Result::Failed:
-      vtkErrorMacro(<< error);
+      vtkErrorMacro(<< report.GetError());
       return;
     case vtkFerroVolumeSettings::Result::NothingVisible:
       return;
@@ -204,9 +206,9 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   if (!in->Settings.ApplyView(
-        this, ren, req.ViewportW, req.ViewportH, *in->Renderer, in->Warned, error))
+        this, ren, req.ViewportW, req.ViewportH, *in->Renderer, report))
   {
-    vtkErrorMacro(<< error);
+    vtkErrorMacro(<< report.GetError());
     return;
   }
 
@@ -219,9 +221,9 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   req.ColorBias = 0.5f - this->FinalColorLevel / this->FinalColorWindow;
   if (peeling && !selector && !this->RenderToImage)
   {
-    if (!in->Peeling.Draw(peeling, this, vol, *in->Renderer, req, error))
+    if (!in->Peeling.Draw(peeling, this, vol, *in->Renderer, req, report))
     {
-      vtkErrorMacro(<< error);
+      vtkErrorMacro(<< report.GetError());
       return;
     }
     this->LastRenderSize[0] = req.RenderW;
@@ -232,26 +234,20 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   std::string warning;
   // (a frame summed across processes is read back, and the sum written into its texture)
   const int outputPath = in->PieceSum.Pending() ? OUTPUT_PATH_READBACK : this->OutputPath;
-  if (!in->Output.Render(this, outputPath, *in->Renderer, req, error, warning))
+  if (!in->Output.Render(outputPath, *in->Renderer, req, report, warning))
   {
-    vtkErrorMacro(<< error);
+    vtkErrorMacro(<< report.GetError());
     return;
   }
-  if (!warning.empty() && in->Warned.insert(warning).second)
+  if (!warning.empty())
   {
-    vtkWarningMacro(<< warning);
+    report.WarnOnce(warning);
   }
   bool draw = true;
-  std::string sumMessage;
-  if (!in->PieceSum.Add(
-        in->Output.ColorTexture(), req.RenderW, req.RenderH, draw, sumMessage))
+  if (!in->PieceSum.Add(in->Output.ColorTexture(), req.RenderW, req.RenderH, draw, report))
   {
-    vtkErrorMacro(<< sumMessage);
+    vtkErrorMacro(<< report.GetError());
     return;
-  }
-  if (!sumMessage.empty() && in->Warned.insert(sumMessage).second)
-  {
-    vtkWarningMacro(<< sumMessage);
   }
   this->LastRenderSize[0] = req.RenderW;
   this->LastRenderSize[1] = req.RenderH;
@@ -272,9 +268,9 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   }
   if (selector)
   {
-    if (!DrawSelection(in->Output, ren, main, image, selector, req, rect, error))
+    if (!DrawSelection(in->Output, ren, main, image, selector, req, rect, report))
     {
-      vtkErrorMacro(<< error);
+      vtkErrorMacro(<< report.GetError());
       return;
     }
     this->LastRenderDrew = 1;
@@ -286,7 +282,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     int depthType = this->DepthImageScalarType;
     if (!vtkFerroVolumeRenderToImage::IsDepthType(depthType))
     {
-      if (in->FirstTime("depth-image-type"))
+      if (in->Report.FirstTime("depth-image-type"))
       {
         vtkWarningMacro(<< "DepthImageScalarType " << depthType
                         << " is not supported (unsigned char, unsigned short and float are): "
@@ -297,18 +293,18 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     vtkNew<vtkMatrix4x4> boxToClip;
     vtkFerroVolumeRenderToImage::BoxToClip(ren, main, image, boxToClip);
     if (!in->Image.Capture(req, in->Output.ColorTexture(), in->Output.DepthTexture(), depthType,
-          boxToClip, this->ClampDepthToBackface != 0, error))
+          boxToClip, this->ClampDepthToBackface != 0, report))
     {
-      vtkErrorMacro(<< error);
+      vtkErrorMacro(<< report.GetError());
       return;
     }
   }
   else
   {
-    switch (in->Output.Composite(req, rect, error))
+    switch (in->Output.Composite(req, rect, report))
     {
       case vtkFerroVolumeOutput::Composited::Failed:
-        vtkErrorMacro(<< error);
+        vtkErrorMacro(<< report.GetError());
         return;
       case vtkFerroVolumeOutput::Composited::OffScreen:
         this->LastRenderDrew = 1; // nothing to composite
@@ -334,10 +330,10 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     // Refine while the accumulation is short of SamplesPerPixel.
     uint32_t samples = 0;
-    if (!vtkFerroVolumeCall("count the accumulated paths", error,
+    if (!vtkFerroVolumeCall("count the accumulated paths", report,
           [&] { samples = in->Renderer->accumulated_samples(); }))
     {
-      vtkErrorMacro(<< error);
+      vtkErrorMacro(<< report.GetError());
       in->Refinement.Stop();
       return;
     }
@@ -348,7 +344,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     const bool restarted =
       !in->Stats(statsAfter) || statsAfter.accumulation_restarts != statsBefore.accumulation_restarts;
     if (!in->Refinement.Continue(win, samples, target, restarted) &&
-      in->Warned.insert("restarts").second)
+      report.FirstTime("restarts"))
     {
       vtkWarningMacro(<< "path tracing starts over at every render (something the image "
                          "depends on changes each time, such as opaque geometry moved on "

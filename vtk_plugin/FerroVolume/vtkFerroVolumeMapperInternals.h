@@ -17,6 +17,7 @@
 #include "vtkFerroVolumePieceSum.h"
 #include "vtkFerroVolumeRefinement.h"
 #include "vtkFerroVolumeRenderToImage.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkFerroVolumeSettings.h"
 #include "vtkBoundingBox.h"
 #include "vtkCamera.h"
@@ -41,7 +42,6 @@
 #include <cmath>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 
 class vtkFerroVolumeMapper::vtkInternals
@@ -60,12 +60,16 @@ public:
   vtkFerroVolumeRefinement Refinement;
   vtkFerroVolumePieceSum PieceSum;
   vtkFerroVolumeInputHelper::WholeRanges WholeRanges{};
-  // warnings said once per mapper
-  std::set<std::string> Warned;
+  // the render's error and the warnings said once per mapper
+  vtkFerroVolumeReport Report;
   // the convergence read back for the frame counted `ConvergenceFrame` (stats().frames)
   std::optional<FvConvergence> Convergence;
   uint32_t ConvergenceFrame = 0;
 
+  explicit vtkInternals(vtkFerroVolumeMapper* self)
+    : Report(self)
+  {
+  }
   ~vtkInternals() { this->FreeRenderer(); }
 
   // The renderer, created on first use from the process-wide device; the passes of a
@@ -77,16 +81,16 @@ public:
   }
 
   // A renderer made on a device since lost is made again (with its input and tables).
-  bool MakeRenderer(vtkFerroVolumeMapper* self, std::string& error)
+  bool MakeRenderer(vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report)
   {
     if (this->Renderer && !this->RendererLost())
     {
       return true;
     }
     this->FreeRenderer();
-    const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(error);
+    const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(report);
     this->RendererGeneration = vtkFerroVolumeContext::Generation();
-    return ctx && vtkFerroVolumeCall("create a renderer", error, [&] {
+    return ctx && vtkFerroVolumeCall("create a renderer", report, [&] {
       this->Renderer.reset(new ferrovol::Renderer(*ctx));
       this->Renderer->set_progress(&vtkInternals::StreamProgress, self);
     });
@@ -106,7 +110,7 @@ public:
   // property's tables (on change) and the volumes of `multi`'s other ports (none: cleared);
   // false with the reason.
   bool Prepare(
-    vtkFerroVolumeMapper* self, vtkVolume* vol, vtkMultiVolume* multi, std::string& error)
+    vtkFerroVolumeMapper* self, vtkVolume* vol, vtkMultiVolume* multi, vtkFerroVolumeReport& report)
   {
     const vtkIdType bytes = self->GetMaxMemoryInBytes();
     const uint64_t budget = bytes > 0
@@ -117,29 +121,26 @@ public:
     types.ScalarOpacity = self->GetScalarOpacityRangeType();
     types.GradientOpacity = self->GetGradientOpacityRangeType();
     this->Input.SetWholeRanges(this->WholeRanges);
-    if (!(this->Input.Select(self, error) && this->MakeRenderer(self, error) &&
-          this->Input.Upload(*this->Renderer, budget, error)))
+    if (!(this->Input.Select(self, report) && this->MakeRenderer(self, report) &&
+          this->Input.Upload(*this->Renderer, budget, report)))
     {
       return false;
     }
-    std::string blanking;
-    if (!this->Input.UpdateBlanking(*this->Renderer, blanking) && this->FirstTime("blanking"))
+    if (!this->Input.UpdateBlanking(*this->Renderer, report))
     {
-      vtkWarningWithObjectMacro(
-        self, << "the ghost arrays' blanking is not applied (the cells are drawn): " << blanking);
+      report.WarnOnce("blanking",
+        "the ghost arrays' blanking is not applied (the cells are drawn): " + report.GetError());
+      report.ClearError();
     }
     if (!this->Input.UpdateMask(
-          self->GetMaskInput(), self->GetMaskType(), *this->Renderer, error))
+          self->GetMaskInput(), self->GetMaskType(), *this->Renderer, report))
     {
-      error = "MaskInput: " + error;
+      report.PrefixError("MaskInput: ");
       return false;
     }
-    return this->Tables.Update(vol, this->Input, types, *this->Renderer, error) &&
-      this->Intermix.Update(self, multi, types, *this->Renderer, error);
+    return this->Tables.Update(vol, this->Input, types, *this->Renderer, report) &&
+      this->Intermix.Update(self, multi, types, *this->Renderer, report);
   }
-
-  // A warning said once per mapper for `key`.
-  bool FirstTime(const std::string& key) { return this->Warned.insert(key).second; }
 
   void FreeRenderer()
   {

@@ -3,7 +3,8 @@
 #include "vtkCamera.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeDepthReader.h"
-#include "vtkFerroVolumeMapper.h"
+#include "vtkFerroVolumeEnums.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkLogger.h"
 #include "vtkMatrix4x4.h"
 #include "vtkOpenGLError.h"
@@ -47,19 +48,19 @@ public:
   const char* Name() const override { return "readback"; }
 
   bool Render(ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
-    std::string& error, std::string& warning) override
+    vtkFerroVolumeReport& report, std::string& warning) override
   {
     // VTK's depth for the viewport (rows bottom to top), sampled at the centres of the
     // pixels ferrovol renders (rows top to bottom), picking texels as OpenGL's nearest
     // filtering does (the shared path samples the same depth on the GPU).
-    std::string depthError;
+    vtkFerroVolumeReport depthError;
     const int rw = req.RenderW, rh = req.RenderH, vw = req.ViewportW, vh = req.ViewportH;
     const bool haveDepth = req.UseDepth &&
       this->Depth.Read(req.Window, req.ViewportX, req.ViewportY, req.ViewportW, req.ViewportH,
         this->WindowDepth, depthError);
     if (req.UseDepth && !haveDepth)
     {
-      warning = "the volume ignores opaque geometry in this frame: " + depthError;
+      warning = "the volume ignores opaque geometry in this frame: " + depthError.GetError();
     }
     this->DepthInput.resize(haveDepth ? static_cast<size_t>(rw) * rh : 0);
     for (int y = 0; haveDepth && y < rh; ++y)
@@ -80,14 +81,14 @@ public:
       }
     }
 
-    if (!vtkFerroVolumeCall("render the frame", error, [&] {
+    if (!vtkFerroVolumeCall("render the frame", report, [&] {
           renderer.render(static_cast<uint32_t>(rw), static_cast<uint32_t>(rh), this->DepthInput);
         }))
     {
       return false;
     }
     std::unique_ptr<ferrovol::Frame> frame;
-    if (!vtkFerroVolumeCall("read the frame back", error,
+    if (!vtkFerroVolumeCall("read the frame back", report,
           [&] { frame.reset(new ferrovol::Frame(renderer.read_frame())); }))
     {
       return false;
@@ -97,10 +98,9 @@ public:
     if (frame->width() != static_cast<uint32_t>(rw) ||
       frame->height() != static_cast<uint32_t>(rh) || !rgba || !depth)
     {
-      error = "ferrovol returned a frame of an unexpected size";
-      return false;
+      return report.Fail("ferrovol returned a frame of an unexpected size");
     }
-    return this->Upload(req.Window, rw, rh, rgba, depth, error);
+    return this->Upload(req.Window, rw, rh, rgba, depth, report);
   }
 
   vtkTextureObject* ColorTexture() override { return this->Color; }
@@ -128,7 +128,7 @@ public:
 
 private:
   bool Upload(vtkOpenGLRenderWindow* win, int w, int h, const uint8_t* rgba, const float* depth,
-    std::string& error)
+    vtkFerroVolumeReport& report)
   {
     if (!this->Color)
     {
@@ -145,8 +145,7 @@ private:
       !this->DepthTex->Create2DFromRaw(
         w, h, 1, VTK_FLOAT, const_cast<void*>(static_cast<const void*>(depth))))
     {
-      error = "could not upload the frame into OpenGL textures";
-      return false;
+      return report.Fail("could not upload the frame into OpenGL textures");
     }
     return true;
   }
@@ -263,8 +262,8 @@ void vtkFerroVolumeOutput::UseReadback(ferrovol::Renderer& renderer)
   this->Path.reset(new ReadbackOutput);
 }
 
-void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Renderer& renderer,
-  vtkOpenGLRenderWindow* win)
+void vtkFerroVolumeOutput::Choose(int preference, ferrovol::Renderer& renderer,
+  vtkOpenGLRenderWindow* win, vtkFerroVolumeReport& report)
 {
   if (this->Path && this->Preference == preference && this->PathWindow == win)
   {
@@ -278,16 +277,16 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
   this->Preference = preference;
   this->PathWindow = win;
 #if FERROVOL_HAVE_SHARED_OUTPUT
-  if (preference != vtkFerroVolumeMapper::OUTPUT_PATH_READBACK)
+  if (preference != vtkFerroVolumeEnums::OUTPUT_PATH_READBACK)
   {
-    std::string ignored;
+    vtkFerroVolumeReport ignored;
     vtkFerroVolumeOutputChoice choice;
     this->Path = vtkFerroVolumeSharedOutput::Create(*vtkFerroVolumeContext::Acquire(ignored),
-      renderer, preference == vtkFerroVolumeMapper::OUTPUT_PATH_SHARED, choice);
+      renderer, preference == vtkFerroVolumeEnums::OUTPUT_PATH_SHARED, choice);
     this->PathReason = choice.Reason;
     if (!this->Path)
     {
-      this->AnnounceReadback(self, choice.Reason, choice.Warn);
+      this->AnnounceReadback(choice.Reason, choice.Warn, report);
     }
   }
   else
@@ -299,7 +298,7 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
     this->UseReadback(renderer);
   }
 #else
-  (void)self;
+  (void)report;
   (void)renderer;
   this->PathReason = "this build's ferrovol.h has no shared output path (readback only)";
   this->Path.reset(new ReadbackOutput);
@@ -308,15 +307,12 @@ void vtkFerroVolumeOutput::Choose(vtkObject* self, int preference, ferrovol::Ren
 
 #if FERROVOL_HAVE_SHARED_OUTPUT
 void vtkFerroVolumeOutput::AnnounceReadback(
-  vtkObject* self, const std::string& reason, bool warn)
+  const std::string& reason, bool warn, vtkFerroVolumeReport& report)
 {
   if (warn)
   {
-    if (this->Warned.insert(reason).second)
-    {
-      vtkWarningWithObjectMacro(
-        self, << "shared output unavailable, frames go through the CPU: " << reason);
-    }
+    report.WarnOnce(
+      "readback: " + reason, "shared output unavailable, frames go through the CPU: " + reason);
     return;
   }
   static std::mutex mutex;
@@ -329,11 +325,11 @@ void vtkFerroVolumeOutput::AnnounceReadback(
 }
 #endif
 
-bool vtkFerroVolumeOutput::Render(vtkObject* self, int preference, ferrovol::Renderer& renderer,
-  const vtkFerroVolumeFrameRequest& req, std::string& error, std::string& warning)
+bool vtkFerroVolumeOutput::Render(int preference, ferrovol::Renderer& renderer,
+  const vtkFerroVolumeFrameRequest& req, vtkFerroVolumeReport& report, std::string& warning)
 {
-  this->Choose(self, preference, renderer, req.Window);
-  if (this->Path->Render(renderer, req, error, warning))
+  this->Choose(preference, renderer, req.Window, report);
+  if (this->Path->Render(renderer, req, report, warning))
   {
     return true;
   }
@@ -341,23 +337,23 @@ bool vtkFerroVolumeOutput::Render(vtkObject* self, int preference, ferrovol::Ren
   if (std::strcmp(this->Path->Name(), "shared") == 0)
   {
     // Fall back to the readback path for good and try this frame again.
-    vtkWarningWithObjectMacro(
-      self, << "shared output failed, frames go through the CPU from now on: " << error);
+    report.Warn("shared output failed, frames go through the CPU from now on: " +
+      report.GetError());
     this->Path->ReleaseGraphicsResources(req.Window);
     this->UseReadback(renderer);
-    this->PathReason = "the shared output failed: " + error;
-    error.clear();
+    this->PathReason = "the shared output failed: " + report.GetError();
+    report.ClearError();
     warning.clear();
-    return this->Path->Render(renderer, req, error, warning);
+    return this->Path->Render(renderer, req, report, warning);
   }
 #endif
   return false;
 }
 
 vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Composite(
-  const vtkFerroVolumeFrameRequest& req, const int rect[4], std::string& error)
+  const vtkFerroVolumeFrameRequest& req, const int rect[4], vtkFerroVolumeReport& report)
 {
-  return this->DrawQuad(this->Quad, CompositeFragmentShader, req, rect, true, error,
+  return this->DrawQuad(this->Quad, CompositeFragmentShader, req, rect, true, report,
     [&](vtkShaderProgram* program)
     {
       program->SetUniformf("fvColorScale", req.ColorScale);
@@ -367,9 +363,9 @@ vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Composite(
 
 vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Select(
   const vtkFerroVolumeFrameRequest& req, const int rect[4], const vtkFerroVolumeSelection& select,
-  std::string& error)
+  vtkFerroVolumeReport& report)
 {
-  return this->DrawQuad(this->SelectQuad, SelectFragmentShader, req, rect, false, error,
+  return this->DrawQuad(this->SelectQuad, SelectFragmentShader, req, rect, false, report,
     [&](vtkShaderProgram* program)
     {
       program->SetUniformi("fvWrite", static_cast<int>(select.What));
@@ -392,8 +388,8 @@ vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::Select(
 template <typename Uniforms>
 vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::DrawQuad(
   std::unique_ptr<vtkOpenGLQuadHelper>& quad, const char* shader,
-  const vtkFerroVolumeFrameRequest& req, const int rect[4], bool blend, std::string& error,
-  Uniforms uniforms)
+  const vtkFerroVolumeFrameRequest& req, const int rect[4], bool blend,
+  vtkFerroVolumeReport& report, Uniforms uniforms)
 {
   vtkOpenGLRenderWindow* win = req.Window;
   if (this->QuadWindow != win)
@@ -408,7 +404,7 @@ vtkFerroVolumeOutput::Composited vtkFerroVolumeOutput::DrawQuad(
   }
   if (!quad->Program)
   {
-    error = "could not compile the shader that composites the volume into OpenGL";
+    report.Fail("could not compile the shader that composites the volume into OpenGL");
     quad.reset();
     return Composited::Failed;
   }

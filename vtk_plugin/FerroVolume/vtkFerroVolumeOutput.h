@@ -17,9 +17,9 @@
 #include "ferrovol.hpp"
 
 #include <memory>
-#include <set>
 #include <string>
 
+class vtkFerroVolumeReport;
 class vtkMatrix4x4;
 class vtkObject;
 class vtkOpenGLQuadHelper;
@@ -77,7 +77,7 @@ public:
   // Renders the frame into the two textures; `warning`: something this frame lacks (it is
   // still drawn).
   virtual bool Render(ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
-    std::string& error, std::string& warning) = 0;
+    vtkFerroVolumeReport& report, std::string& warning) = 0;
   virtual vtkTextureObject* ColorTexture() = 0;
   virtual vtkTextureObject* DepthTexture() = 0;
   // nullptr: the context is gone, GL names are forgotten rather than deleted.
@@ -93,10 +93,11 @@ public:
   ~vtkFerroVolumeOutput();
 
   // Renders the frame through the path for this window and `preference` (an
-  // vtkFerroVolumeMapper::OutputPaths value; the path is chosen again when either changed).
-  // `self` receives the warnings; `warning` is something this frame lacks.
-  bool Render(vtkObject* self, int preference, ferrovol::Renderer& renderer,
-    const vtkFerroVolumeFrameRequest& req, std::string& error, std::string& warning);
+  // vtkFerroVolumeEnums::OutputPaths value; the path is chosen again when either changed).
+  // The warnings go to `report`; `warning` is something this frame lacks (said by the
+  // caller once the frame is drawn).
+  bool Render(int preference, ferrovol::Renderer& renderer,
+    const vtkFerroVolumeFrameRequest& req, vtkFerroVolumeReport& report, std::string& warning);
 
   enum class Composited
   {
@@ -107,11 +108,11 @@ public:
   // Draws the last frame over the viewport, scissored to `rect` (x, y, w, h relative to the
   // viewport), its colour scaled by req's ColorScale and ColorBias.
   Composited Composite(
-    const vtkFerroVolumeFrameRequest& req, const int rect[4], std::string& error);
+    const vtkFerroVolumeFrameRequest& req, const int rect[4], vtkFerroVolumeReport& report);
   // Draws the last frame's selection ids (`select`) over the viewport instead, scissored
   // to `rect`, where the volume shows; elsewhere what is there stays.
   Composited Select(const vtkFerroVolumeFrameRequest& req, const int rect[4],
-    const vtkFerroVolumeSelection& select, std::string& error);
+    const vtkFerroVolumeSelection& select, vtkFerroVolumeReport& report);
 
   // The viewport pixels (x, y, w, h relative to the viewport) the volume's world bounding
   // box, grown by `pad` world units on every side, can cover (a volume one point thick
@@ -135,26 +136,25 @@ public:
   void ReleaseGraphicsResources(vtkWindow* window);
 
 private:
-  void Choose(vtkObject* self, int preference, ferrovol::Renderer& renderer,
-    vtkOpenGLRenderWindow* win);
+  void Choose(int preference, ferrovol::Renderer& renderer, vtkOpenGLRenderWindow* win,
+    vtkFerroVolumeReport& report);
   void UseReadback(ferrovol::Renderer& renderer);
-  // Says why frames go through the CPU: with `warn`, a warning on `self`, once per mapper
+  // Says why frames go through the CPU: with `warn`, a warning in `report`, once per mapper
   // for each reason; otherwise an INFO line in VTK's log, once per process for each reason
   // (the reason names the device and the OpenGL renderer, so another OpenGL is said again).
-  void AnnounceReadback(vtkObject* self, const std::string& reason, bool warn);
+  void AnnounceReadback(const std::string& reason, bool warn, vtkFerroVolumeReport& report);
 
   std::unique_ptr<vtkFerroVolumeFramePath> Path;
   int Preference = -1;
   // weak: a window destroyed behind our back reads as null, and its GL names are forgotten
   vtkWeakPointer<vtkOpenGLRenderWindow> PathWindow;
   std::string PathReason;
-  std::set<std::string> Warned;
   // Draws `quad` (made from `shader` for `req`'s window when missing) over the viewport,
   // scissored to `rect`, after `uniforms` set its own uniforms beside fvColor and fvDepth.
   template <typename Uniforms>
   Composited DrawQuad(std::unique_ptr<vtkOpenGLQuadHelper>& quad, const char* shader,
-    const vtkFerroVolumeFrameRequest& req, const int rect[4], bool blend, std::string& error,
-    Uniforms uniforms);
+    const vtkFerroVolumeFrameRequest& req, const int rect[4], bool blend,
+    vtkFerroVolumeReport& report, Uniforms uniforms);
 
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
   std::unique_ptr<vtkOpenGLQuadHelper> SelectQuad;

@@ -1,6 +1,7 @@
 #include "vtkFerroVolumePieceSum.h"
 
 #include "vtkCommunicator.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkMultiProcessController.h"
 #include "vtkTextureObject.h"
 #include "vtkType.h"
@@ -28,9 +29,10 @@ void vtkFerroVolumePieceSum::Begin(bool active)
 }
 
 bool vtkFerroVolumePieceSum::Add(
-  vtkTextureObject* color, int w, int h, bool& draw, std::string& message)
+  vtkTextureObject* color, int w, int h, bool& draw, vtkFerroVolumeReport& report)
 {
   draw = true;
+  const char* warning = nullptr;
   if (!this->Waiting)
   {
     return true;
@@ -65,26 +67,28 @@ bool vtkFerroVolumePieceSum::Add(
       draw = false;
       break;
     case Outcome::DrawOwn:
-      message = "the additive blend mode's frames differ in size between the processes (an "
+      warning = "the additive blend mode's frames differ in size between the processes (an "
                 "ImageSampleDistance of their own?): each process's sum is composited with "
                 "\"over\", which darkens where two pieces' sums add up past 1";
       break;
     case Outcome::Draw:
       if (!color->Create2DFromRaw(w, h, 4, VTK_UNSIGNED_CHAR, this->Pixels.data()))
       {
-        message = "could not write the additive sum of the processes' frames into the frame's "
-                  "texture";
         draw = false;
-        return false;
+        return report.Fail("could not write the additive sum of the processes' frames into "
+                           "the frame's texture");
       }
       break;
   }
   if (!read)
   {
-    message = "could not read the frame back to add it to the other processes' (additive "
-              "blend mode)";
     draw = false;
-    return false;
+    return report.Fail("could not read the frame back to add it to the other processes' "
+                       "(additive blend mode)");
+  }
+  if (warning)
+  {
+    report.WarnOnce(warning);
   }
   return true;
 }

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+class vtkFerroVolumeReport;
 class vtkTextureObject;
 
 class vtkFerroVolumePieceSum
@@ -26,11 +27,11 @@ public:
   bool Pending() const { return this->Waiting; }
   // Adds this process's frame (its colour texture: premultiplied RGBA8, w x h), and
   // replaces it by the sum on the process that draws it. `draw`: whether this process
-  // composites its frame into its window. False with `message` when the texture could not
-  // be read or written (the sum went on without this frame; nothing to draw); true with a
-  // `message` when the processes' frames differ in size (each then draws its own, which
-  // "over" composites as before).
-  bool Add(vtkTextureObject* color, int w, int h, bool& draw, std::string& message);
+  // composites its frame into its window. False with the report's error when the texture
+  // could not be read or written (the sum went on without this frame; nothing to draw); true
+  // with a warning (once) when the processes' frames differ in size (each then draws its
+  // own, which "over" composites as before).
+  bool Add(vtkTextureObject* color, int w, int h, bool& draw, vtkFerroVolumeReport& report);
   // Ends the render: takes part with nothing when Add was not called.
   void Finish();
 

@@ -2,7 +2,7 @@
 
 #include "vtkCallbackCommand.h"
 #include "vtkCommand.h"
-#include "vtkFerroVolumeMapper.h"
+#include "vtkFerroVolumeEnums.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderWindowInteractor.h"
 
@@ -54,9 +54,9 @@ bool vtkFerroVolumeRefinement::IsProgressive(int mode, vtkRenderWindow* win)
 {
   switch (mode)
   {
-    case vtkFerroVolumeMapper::PROGRESSIVE_ON:
+    case vtkFerroVolumeEnums::PROGRESSIVE_ON:
       return true;
-    case vtkFerroVolumeMapper::PROGRESSIVE_OFF:
+    case vtkFerroVolumeEnums::PROGRESSIVE_OFF:
       return false;
     default:
       return win && this->CanRefine(win->GetInteractor());

@@ -26,7 +26,7 @@ public:
   ~vtkFerroVolumeRefinement();
 
   // Whether renders into `win` trace within a time budget: `mode` (a
-  // vtkFerroVolumeMapper::ProgressiveModes value) is ON, or AUTOMATIC and the window has an
+  // vtkFerroVolumeEnums::ProgressiveModes value) is ON, or AUTOMATIC and the window has an
   // interactor that can refine it (see CanRefine).
   bool IsProgressive(int mode, vtkRenderWindow* win);
 

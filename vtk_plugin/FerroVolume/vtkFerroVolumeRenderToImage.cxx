@@ -3,6 +3,7 @@
 #include "vtkCamera.h"
 #include "vtkDataArray.h"
 #include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNew.h"
@@ -164,7 +165,7 @@ void vtkFerroVolumeRenderToImage::BoxToClip(
 
 bool vtkFerroVolumeRenderToImage::Capture(const vtkFerroVolumeFrameRequest& req,
   vtkTextureObject* color, vtkTextureObject* depth, int depthType, vtkMatrix4x4* boxToClip,
-  bool clampDepth, std::string& error)
+  bool clampDepth, vtkFerroVolumeReport& report)
 {
   vtkOpenGLRenderWindow* win = req.Window;
   if (this->Window != win)
@@ -185,7 +186,7 @@ bool vtkFerroVolumeRenderToImage::Capture(const vtkFerroVolumeFrameRequest& req,
   }
   if (!this->Quad->Program)
   {
-    error = "could not compile the shader that writes the RenderToImage images";
+    report.Fail("could not compile the shader that writes the RenderToImage images");
     this->Quad.reset();
     return false;
   }
@@ -239,8 +240,7 @@ bool vtkFerroVolumeRenderToImage::Capture(const vtkFerroVolumeFrameRequest& req,
   vtkOpenGLCheckErrorMacro("after writing the RenderToImage images");
   if (!complete)
   {
-    error = "the RenderToImage images cannot be drawn into (incomplete framebuffer)";
-    return false;
+    return report.Fail("the RenderToImage images cannot be drawn into (incomplete framebuffer)");
   }
   return true;
 }

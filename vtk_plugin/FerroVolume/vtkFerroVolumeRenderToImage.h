@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+class vtkFerroVolumeReport;
 class vtkImageData;
 class vtkMatrix4x4;
 class vtkOpenGLFramebufferObject;
@@ -50,7 +51,7 @@ public:
   // texture has `depthType` (IsDepthType).
   bool Capture(const vtkFerroVolumeFrameRequest& req, vtkTextureObject* color,
     vtkTextureObject* depth, int depthType, vtkMatrix4x4* boxToClip, bool clampDepth,
-    std::string& error);
+    vtkFerroVolumeReport& report);
 
   // The textures of the last capture; nullptr before one.
   vtkTextureObject* ColorTexture() const;

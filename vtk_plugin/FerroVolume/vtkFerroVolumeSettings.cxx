@@ -2,11 +2,10 @@
 
 #include "vtkCamera.h"
 #include "vtkCommand.h"
-#include "vtkContourValues.h"
-#include "vtkColorTransferFunction.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeInputHelper.h"
 #include "vtkFerroVolumeMapper.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkImageData.h"
 #include "vtkImplicitFunction.h"
 #include "vtkLight.h"
@@ -15,7 +14,6 @@
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkOpenGLCamera.h"
-#include "vtkPiecewiseFunction.h"
 #include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
 #include "vtkRenderWindow.h"
@@ -27,12 +25,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <iterator>
-#include <limits>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -104,7 +99,7 @@ FvLight ToFvLight(vtkLight* light, bool defaultLighting)
 
 // The renderer's switched-on lights (at most FV_MAX_LIGHTS, warned once when more).
 std::vector<FvLight> SceneLights(vtkFerroVolumeMapper* self, vtkRenderer* ren,
-  std::set<std::string>& warned)
+  vtkFerroVolumeReport& report)
 {
   std::vector<FvLight> lights;
   vtkLightCollection* lc = ren->GetLights();
@@ -118,7 +113,7 @@ std::vector<FvLight> SceneLights(vtkFerroVolumeMapper* self, vtkRenderer* ren,
       ++on;
     }
   }
-  if (on > FV_MAX_LIGHTS && warned.insert("lights").second)
+  if (on > FV_MAX_LIGHTS && report.FirstTime("lights"))
   {
     vtkWarningWithObjectMacro(
       self, << on << " lights are on: ferrovol uses the first " << FV_MAX_LIGHTS);
@@ -195,7 +190,8 @@ double ClippedIntensityInDataUnits(int type, double value, const std::array<doub
 
 } // namespace
 
-bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::string& error)
+bool vtkFerroVolumeSettings::SelectBlendMode(
+  vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report)
 {
   static const std::pair<int, FvBlendMode> modes[] = {
     { vtkVolumeMapper::COMPOSITE_BLEND, FV_BLEND_MODE_COMPOSITE },
@@ -210,10 +206,9 @@ bool vtkFerroVolumeSettings::SelectBlendMode(vtkFerroVolumeMapper* self, std::st
     [&](const std::pair<int, FvBlendMode>& m) { return m.first == self->GetBlendMode(); });
   if (mode == std::end(modes))
   {
-    error = "blend mode " + std::to_string(self->GetBlendMode()) +
+    return report.Fail("blend mode " + std::to_string(self->GetBlendMode()) +
       " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
-      "additive, isosurface and slice are): nothing is drawn";
-    return false;
+      "additive, isosurface and slice are): nothing is drawn");
   }
   this->Blend = self->GetRenderMode() == vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE
     ? FV_BLEND_MODE_PATH_TRACE
@@ -259,71 +254,111 @@ double vtkFerroVolumeSettings::UpdateReductionFactor(
 
 vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMapper* self,
   vtkRenderer* ren, vtkVolume* vol, const vtkFerroVolumeInputHelper& input,
-  ferrovol::Renderer& renderer, double traceBudget, std::set<std::string>& warned,
-  std::string& error)
+  ferrovol::Renderer& renderer, double traceBudget, vtkFerroVolumeReport& report)
 {
-  vtkVolumeProperty* prop = vol->GetProperty();
   FvRenderParams& params = this->Params;
-  if (!vtkFerroVolumeCall("use the mapper's settings", error,
+  if (!vtkFerroVolumeCall("use the mapper's settings", report,
         [&] { params = ferrovol::Renderer::default_params(); }))
   {
     return Result::Failed;
   }
   params.blend_mode = this->Blend;
   params.mask_blend_factor = self->GetMaskBlendFactor();
-  if (this->Blend == FV_BLEND_MODE_SLICE)
+  if (this->Blend == FV_BLEND_MODE_SLICE && !this->SetUpSlicePlane(vol, report))
   {
-    // As vtkOpenGLGPUVolumeRayCastMapper: the plane's origin and normal in world
-    // coordinates (the implicit function's own transform is not applied).
-    vtkPlane* plane = vtkPlane::SafeDownCast(prop->GetSliceFunction());
-    if (!plane)
+    return Result::Failed;
+  }
+  this->SetUpInterpolation(self, vol->GetProperty(), report);
+  if (!this->SetUpSampling(self, vol, input, report))
+  {
+    return Result::Failed;
+  }
+  this->SetUpShading(self, ren, vol, input, report);
+  this->SetUpCroppingAndClipping(self, vol->GetProperty(), input, report);
+  this->SetUpRayOptions(self, ren);
+  this->SetUpWholeExtent(self, input);
+  this->SetUpQuadrature(self, report);
+  ToColumnMajor(vol->GetMatrix(), params.volume_matrix);
+  this->Background = false;
+  if (this->Blend == FV_BLEND_MODE_ISOSURFACE)
+  {
+    const Result iso = this->SetUpIsosurfaces(self, vol, input.GetComponents(), renderer, report);
+    if (iso != Result::Ready)
     {
-      error = std::string("SLICE_BLEND needs a vtkPlane as the volume property's "
-                          "SliceFunction (it has ") +
-        (prop->GetSliceFunction() ? prop->GetSliceFunction()->GetClassName() : "none") +
-        "): nothing is drawn";
-      return Result::Failed;
+      return iso;
     }
-    // vtkOpenGLGPUVolumeRayCastMapper takes the plane into the volume's data coordinates
-    // with the vtkVolume's inverse matrix, its normal as a direction (w = 0) rather than
-    // as a normal: with a rotation and a uniform scale that is the same plane, under a
-    // non-uniform scale or a shear another one. The world plane it draws has the same
-    // origin and the normal (A·Aᵀ)⁻¹·n (A: the matrix's linear part), given here.
-    plane->GetOrigin(params.slice_plane.origin);
-    double n[3];
-    plane->GetNormal(n);
-    vtkMatrix4x4* m = vol->GetMatrix();
-    double aat[3][3];
-    for (int i = 0; i < 3; ++i)
+  }
+  if (this->Blend == FV_BLEND_MODE_PATH_TRACE &&
+    !this->SetUpPathTracing(self, ren, vol, renderer, traceBudget, report))
+  {
+    return Result::Failed;
+  }
+  if (!vtkFerroVolumeCall(
+        "use the mapper's settings", report, [&] { renderer.set_params(params); }))
+  {
+    return Result::Failed;
+  }
+  return Result::Ready;
+}
+
+bool vtkFerroVolumeSettings::SetUpSlicePlane(vtkVolume* vol, vtkFerroVolumeReport& report)
+{
+  // As vtkOpenGLGPUVolumeRayCastMapper: the plane's origin and normal in world
+  // coordinates (the implicit function's own transform is not applied).
+  vtkVolumeProperty* prop = vol->GetProperty();
+  vtkPlane* plane = vtkPlane::SafeDownCast(prop->GetSliceFunction());
+  if (!plane)
+  {
+    return report.Fail(std::string("SLICE_BLEND needs a vtkPlane as the volume property's "
+                       "SliceFunction (it has ") +
+      (prop->GetSliceFunction() ? prop->GetSliceFunction()->GetClassName() : "none") +
+      "): nothing is drawn");
+  }
+  // vtkOpenGLGPUVolumeRayCastMapper takes the plane into the volume's data coordinates
+  // with the vtkVolume's inverse matrix, its normal as a direction (w = 0) rather than
+  // as a normal: with a rotation and a uniform scale that is the same plane, under a
+  // non-uniform scale or a shear another one. The world plane it draws has the same
+  // origin and the normal (A·Aᵀ)⁻¹·n (A: the matrix's linear part), given here.
+  plane->GetOrigin(this->Params.slice_plane.origin);
+  double n[3];
+  plane->GetNormal(n);
+  vtkMatrix4x4* m = vol->GetMatrix();
+  double aat[3][3];
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
     {
-      for (int j = 0; j < 3; ++j)
+      aat[i][j] = 0.0;
+      for (int k = 0; k < 3; ++k)
       {
-        aat[i][j] = 0.0;
-        for (int k = 0; k < 3; ++k)
-        {
-          aat[i][j] += m->GetElement(i, k) * m->GetElement(j, k);
-        }
+        aat[i][j] += m->GetElement(i, k) * m->GetElement(j, k);
       }
     }
-    double inv[3][3];
-    vtkMath::Invert3x3(aat, inv);
-    vtkMath::Multiply3x3(inv, n, params.slice_plane.normal);
   }
+  double inv[3][3];
+  vtkMath::Invert3x3(aat, inv);
+  vtkMath::Multiply3x3(inv, n, this->Params.slice_plane.normal);
+  return true;
+}
+
+void vtkFerroVolumeSettings::SetUpInterpolation(
+  vtkFerroVolumeMapper* self, vtkVolumeProperty* prop, vtkFerroVolumeReport& report)
+{
   switch (prop->GetInterpolationType())
   {
     case VTK_NEAREST_INTERPOLATION:
-      params.interpolation = FV_INTERPOLATION_NEAREST;
+      this->Params.interpolation = FV_INTERPOLATION_NEAREST;
       break;
     case VTK_LINEAR_INTERPOLATION:
       // (path tracing traces the trilinear field)
-      params.interpolation =
+      this->Params.interpolation =
         self->GetCubicInterpolation() && this->Blend != FV_BLEND_MODE_PATH_TRACE
         ? FV_INTERPOLATION_CUBIC
         : FV_INTERPOLATION_LINEAR;
       break;
     default:
-      params.interpolation = FV_INTERPOLATION_LINEAR;
-      if (warned.insert("interpolation").second)
+      this->Params.interpolation = FV_INTERPOLATION_LINEAR;
+      if (report.FirstTime("interpolation"))
       {
         vtkWarningWithObjectMacro(self, << "interpolation type "
                                         << prop->GetInterpolationTypeAsString()
@@ -332,6 +367,12 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       }
       break;
   }
+}
+
+bool vtkFerroVolumeSettings::SetUpSampling(vtkFerroVolumeMapper* self, vtkVolume* vol,
+  const vtkFerroVolumeInputHelper& input, vtkFerroVolumeReport& report)
+{
+  FvRenderParams& params = this->Params;
   if (!self->GetAutoAdjustSampleDistances())
   {
     if (self->GetLockSampleDistanceToInputSpacing())
@@ -360,9 +401,8 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       const float distance = self->GetSampleDistance();
       if (!(distance > 0.0f) || !std::isfinite(distance))
       {
-        error = "SampleDistance " + std::to_string(distance) +
-          " must be positive (or turn AutoAdjustSampleDistances on)";
-        return Result::Failed;
+        return report.Fail("SampleDistance " + std::to_string(distance) +
+          " must be positive (or turn AutoAdjustSampleDistances on)");
       }
       params.sample_distance = distance;
     }
@@ -394,15 +434,23 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       }
     }
   }
+  return true;
+}
+
+void vtkFerroVolumeSettings::SetUpShading(vtkFerroVolumeMapper* self, vtkRenderer* ren,
+  vtkVolume* vol, const vtkFerroVolumeInputHelper& input, vtkFerroVolumeReport& report)
+{
+  FvRenderParams& params = this->Params;
+  vtkVolumeProperty* prop = vol->GetProperty();
   params.jitter = self->GetUseJittering() != 0;
   const bool isosurface = this->Blend == FV_BLEND_MODE_ISOSURFACE;
   params.shade = prop->GetShade(0) != 0 &&
     (this->Blend == FV_BLEND_MODE_COMPOSITE || isosurface || this->Blend == FV_BLEND_MODE_SLICE);
-  this->WarnUnsupported(self, vol, warned);
+  this->WarnUnsupported(self, vol, report);
   if (self->GetMaskInput() &&
     self->GetMaskType() == vtkGPUVolumeRayCastMapper::LabelMapMaskType &&
     this->Blend == FV_BLEND_MODE_COMPOSITE && input.GetComponents() > 1 &&
-    warned.insert("label-components").second)
+    report.FirstTime("label-components"))
   {
     vtkWarningWithObjectMacro(self, << "a label map (MaskType LabelMapMaskType) colours "
                                        "one-component volumes, as vtkGPUVolumeRayCastMapper's: "
@@ -417,7 +465,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     // components.
     const bool dependent = input.GetComponents() > 1 && !prop->GetIndependentComponents();
     params.normal_from_opacity = !isosurface && !dependent;
-    if (!params.normal_from_opacity && warned.insert("normal-from-opacity").second)
+    if (!params.normal_from_opacity && report.FirstTime("normal-from-opacity"))
     {
       vtkWarningWithObjectMacro(self, << "ComputeNormalFromOpacity: ferrovol takes normals "
                                          "from the opacity in the composite blend mode of "
@@ -439,50 +487,64 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
     params.scattering_anisotropy =
       std::max(-1.0f, std::min(1.0f, prop->GetScatteringAnisotropy()));
   }
+}
+
+void vtkFerroVolumeSettings::SetUpCroppingAndClipping(vtkFerroVolumeMapper* self,
+  vtkVolumeProperty* prop, const vtkFerroVolumeInputHelper& input, vtkFerroVolumeReport& report)
+{
+  FvRenderParams& params = this->Params;
   params.cropping = self->GetCropping() != 0;
   const double* crop = self->GetCroppingRegionPlanes();
   std::copy(crop, crop + 6, params.cropping_planes);
   params.cropping_regions = static_cast<uint32_t>(self->GetCroppingRegionFlags());
-  if (vtkPlaneCollection* planes = self->GetClippingPlanes())
+  vtkPlaneCollection* planes = self->GetClippingPlanes();
+  if (!planes)
   {
-    int count = planes->GetNumberOfItems();
-    if (count > FV_MAX_CLIP_PLANES)
-    {
-      if (warned.insert("planes").second)
-      {
-        vtkWarningWithObjectMacro(self,
-          << count << " clipping planes: ferrovol, as vtkGPUVolumeRayCastMapper, takes at most "
-          << FV_MAX_CLIP_PLANES << " and uses the first " << FV_MAX_CLIP_PLANES);
-      }
-      count = FV_MAX_CLIP_PLANES;
-    }
-    for (int i = 0; i < count; ++i)
-    {
-      vtkPlane* plane = planes->GetItem(i);
-      plane->GetOrigin(params.clip_planes[i].origin);
-      plane->GetNormal(params.clip_planes[i].normal);
-    }
-    params.clip_plane_count = static_cast<uint32_t>(count);
-    if (prop->GetUseClippedVoxelIntensity() && count > 0)
-    {
-      params.clipped_voxel_enabled = true;
-      for (int c = 0; c < 4; ++c)
-      {
-        params.clipped_voxel_value[c] = ClippedIntensityInDataUnits(
-          input.GetDataType(), prop->GetClippedVoxelIntensity(), input.GetRanges()[c]);
-      }
-      if ((isosurface || params.normal_from_opacity) &&
-        warned.insert("clipped-voxel-intensity").second)
-      {
-        vtkWarningWithObjectMacro(self, << "UseClippedVoxelIntensity: ferrovol uses "
-                                           "ClippedVoxelIntensity in the scalar gradient of "
-                                           "composite ray casting; "
-                                        << (isosurface ? "isosurface normals"
-                                                       : "normals from the opacity")
-                                        << " read the data beyond the clipping planes");
-      }
-    }
+    return;
   }
+  int count = planes->GetNumberOfItems();
+  if (count > FV_MAX_CLIP_PLANES)
+  {
+    if (report.FirstTime("planes"))
+    {
+      vtkWarningWithObjectMacro(self,
+        << count << " clipping planes: ferrovol, as vtkGPUVolumeRayCastMapper, takes at most "
+        << FV_MAX_CLIP_PLANES << " and uses the first " << FV_MAX_CLIP_PLANES);
+    }
+    count = FV_MAX_CLIP_PLANES;
+  }
+  for (int i = 0; i < count; ++i)
+  {
+    vtkPlane* plane = planes->GetItem(i);
+    plane->GetOrigin(params.clip_planes[i].origin);
+    plane->GetNormal(params.clip_planes[i].normal);
+  }
+  params.clip_plane_count = static_cast<uint32_t>(count);
+  if (!prop->GetUseClippedVoxelIntensity() || count == 0)
+  {
+    return;
+  }
+  params.clipped_voxel_enabled = true;
+  for (int c = 0; c < 4; ++c)
+  {
+    params.clipped_voxel_value[c] = ClippedIntensityInDataUnits(
+      input.GetDataType(), prop->GetClippedVoxelIntensity(), input.GetRanges()[c]);
+  }
+  const bool isosurface = this->Blend == FV_BLEND_MODE_ISOSURFACE;
+  if ((isosurface || params.normal_from_opacity) && report.FirstTime("clipped-voxel-intensity"))
+  {
+    vtkWarningWithObjectMacro(self, << "UseClippedVoxelIntensity: ferrovol uses "
+                                       "ClippedVoxelIntensity in the scalar gradient of "
+                                       "composite ray casting; "
+                                    << (isosurface ? "isosurface normals"
+                                                   : "normals from the opacity")
+                                    << " read the data beyond the clipping planes");
+  }
+}
+
+void vtkFerroVolumeSettings::SetUpRayOptions(vtkFerroVolumeMapper* self, vtkRenderer* ren)
+{
+  FvRenderParams& params = this->Params;
   params.average_range_enabled = this->Blend == FV_BLEND_MODE_AVERAGE;
   const double* average = self->GetAverageIPScalarRange();
   params.average_range[0] = average[0];
@@ -497,8 +559,14 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   vtkRenderWindow* window = ren->GetRenderWindow();
   params.preview_level = this->Blend != FV_BLEND_MODE_PATH_TRACE && window &&
     window->GetDesiredUpdateRate() > 1.0;
+}
+
+void vtkFerroVolumeSettings::SetUpWholeExtent(
+  vtkFerroVolumeMapper* self, const vtkFerroVolumeInputHelper& input)
+{
   // A piece of a whole extent: the whole's box in the piece's index space (points, or the
   // cell centres with cell data).
+  FvRenderParams& params = this->Params;
   const int* whole = self->GetWholeExtent();
   const int* extent = input.GetImage()->GetExtent();
   params.whole_box_enabled = whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5];
@@ -511,12 +579,18 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
       params.whole_box[3 + a] = std::max(whole[2 * a], whole[2 * a + 1] - cells) - extent[2 * a];
     }
   }
+}
+
+void vtkFerroVolumeSettings::SetUpQuadrature(
+  vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report)
+{
   // MidpointQuadrature and AdaptiveSampling: samples placed mid-step (not jittered), on one
   // whole volume.
+  FvRenderParams& params = this->Params;
   const bool midpoints = self->GetMidpointQuadrature() || self->GetAdaptiveSampling();
   const char* quadrature = self->GetAdaptiveSampling() ? "AdaptiveSampling" : "MidpointQuadrature";
   if (midpoints && (params.whole_box_enabled || this->Intermixing) &&
-    warned.insert("midpoint-pieces").second)
+    report.FirstTime("midpoint-pieces"))
   {
     vtkWarningWithObjectMacro(self, << quadrature << " is not applied to "
                                     << (this->Intermixing ? "a vtkMultiVolume"
@@ -527,41 +601,20 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   {
     params.quadrature =
       self->GetAdaptiveSampling() ? FV_QUADRATURE_ADAPTIVE : FV_QUADRATURE_MIDPOINT;
-    if (params.jitter && warned.insert("midpoint-jitter").second)
+    if (params.jitter && report.FirstTime("midpoint-jitter"))
     {
       vtkWarningWithObjectMacro(self, << "UseJittering is not applied with " << quadrature
                                       << ": its samples sit in the middle of their steps");
     }
     params.jitter = false;
   }
-  ToColumnMajor(vol->GetMatrix(), params.volume_matrix);
-  this->Background = false;
-  if (isosurface)
-  {
-    const Result iso =
-      this->SetUpIsosurfaces(self, vol, input.GetComponents(), renderer, warned, error);
-    if (iso != Result::Ready)
-    {
-      return iso;
-    }
-  }
-  if (this->Blend == FV_BLEND_MODE_PATH_TRACE &&
-    !this->SetUpPathTracing(self, ren, vol, renderer, traceBudget, error))
-  {
-    return Result::Failed;
-  }
-  if (!vtkFerroVolumeCall("use the mapper's settings", error, [&] { renderer.set_params(params); }))
-  {
-    return Result::Failed;
-  }
-  return Result::Ready;
 }
 
 bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw,
-  int vh, ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error)
+  int vh, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report)
 {
   if (!vtkFerroVolumeCall(
-        "use the camera", error, [&] { renderer.set_camera(ToFvCamera(ren, vw, vh)); }))
+        "use the camera", report, [&] { renderer.set_camera(ToFvCamera(ren, vw, vh)); }))
   {
     return false;
   }
@@ -580,14 +633,14 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
   }
   else if (this->Params.shade || this->Blend == FV_BLEND_MODE_PATH_TRACE)
   {
-    lights = SceneLights(self, ren, warned);
+    lights = SceneLights(self, ren, report);
   }
   return vtkFerroVolumeCall(
-    "use the renderer's lights", error, [&] { renderer.set_lights(lights); });
+    "use the renderer's lights", report, [&] { renderer.set_lights(lights); });
 }
 
 void vtkFerroVolumeSettings::WarnUnsupported(
-  vtkFerroVolumeMapper* self, vtkVolume* vol, std::set<std::string>& warned) const
+  vtkFerroVolumeMapper* self, vtkVolume* vol, vtkFerroVolumeReport& report) const
 {
   // vtkOpenGLGPUVolumeRayCastMapper applies the volume's shader property to its GLSL ray
   // caster and fires UpdateShaderEvent with the program; ferrovol runs no GLSL ray caster.
@@ -599,26 +652,26 @@ void vtkFerroVolumeSettings::WarnUnsupported(
       customUniforms(shader->GetVertexCustomUniforms()) ||
       customUniforms(shader->GetFragmentCustomUniforms()) ||
       customUniforms(shader->GetGeometryCustomUniforms())) &&
-    warned.insert("shader-property").second)
+    report.FirstTime("shader-property"))
   {
     vtkWarningWithObjectMacro(self, << "the volume's ShaderProperty (custom shader code, "
                                        "replacements or uniforms) is not applied: ferrovol "
                                        "ray casts in its own shaders, not VTK's GLSL");
   }
   if (self->HasObserver(vtkCommand::UpdateShaderEvent) &&
-    warned.insert("update-shader-event").second)
+    report.FirstTime("update-shader-event"))
   {
     vtkWarningWithObjectMacro(self, << "UpdateShaderEvent is never fired: ferrovol ray casts "
                                        "in its own shaders, there is no GLSL program to update");
   }
   if (self->GetUseDepthPass() && this->Blend == FV_BLEND_MODE_COMPOSITE &&
-    warned.insert("depth-pass").second)
+    report.FirstTime("depth-pass"))
   {
     vtkWarningWithObjectMacro(self, << "UseDepthPass (rays starting at the surface of "
                                        "DepthPassContourValues) is not supported by ferrovol: "
                                        "rays start where they enter the volume");
   }
-  if (self->GetTransfer2DYAxisArray() && warned.insert("transfer-2d-y").second)
+  if (self->GetTransfer2DYAxisArray() && report.FirstTime("transfer-2d-y"))
   {
     vtkWarningWithObjectMacro(self, << "Transfer2DYAxisArray '" << self->GetTransfer2DYAxisArray()
                                     << "' is not used: ferrovol's 2D transfer functions read "
@@ -627,7 +680,7 @@ void vtkFerroVolumeSettings::WarnUnsupported(
   for (int port = 1; port < self->GetNumberOfInputPorts(); ++port)
   {
     if (!this->Intermixing && self->GetNumberOfInputConnections(port) > 0 &&
-      warned.insert("port-" + std::to_string(port)).second)
+      report.FirstTime("port-" + std::to_string(port)))
     {
       vtkWarningWithObjectMacro(self, << "the input on port " << port
                                       << " is not drawn: the inputs of ports other than 0 are "
@@ -647,233 +700,4 @@ void vtkFerroVolumeSettings::Reset()
 {
   this->HaveEnvironment = false;
   this->EnvironmentKey.clear();
-}
-
-//------------------------------------------------------------------------------------------
-// Gives the renderer the mapper's environment when the map or its placement changed since
-// the last frame; false (said once per setting with vtkErrorMacro) when it cannot be used.
-bool vtkFerroVolumeSettings::UseEnvironment(
-  vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer)
-{
-  const char* file = self->GetEnvironmentMap();
-  const bool sky = !file || !*file;
-  const double* up = self->GetEnvironmentUp();
-  std::ostringstream key;
-  key << (sky ? "" : file) << '|' << up[0] << ',' << up[1] << ',' << up[2] << '|'
-      << self->GetEnvironmentAzimuth() << '|' << self->GetEnvironmentIntensity();
-  if (!this->HaveEnvironment ||
-    (this->EnvironmentKey != key.str() && this->EnvironmentKey != "failed:" + key.str()))
-  {
-    this->HaveEnvironment = true;
-    this->EnvironmentKey = key.str();
-    std::string error;
-    if (!vtkFerroVolumeCall("use the environment map", error, [&] {
-          renderer.set_environment(sky ? nullptr : file,
-            static_cast<float>(self->GetEnvironmentIntensity()), up,
-            self->GetEnvironmentAzimuth());
-        }))
-    {
-      vtkErrorWithObjectMacro(self, << error << " (drawing without environment light)");
-      this->EnvironmentKey = "failed:" + key.str();
-    }
-  }
-  return this->EnvironmentKey.rfind("failed:", 0) != 0;
-}
-
-// Gives the renderer the path tracing settings: the property's ScatteringAnisotropy, the
-// mapper's budget (progressive: `traceBudget` seconds of paths toward SamplesPerPixel;
-// otherwise the still budget, or InteractiveSamplesPerPixel per frame while the window
-// renders interactively), the preview denoising (until PathTracingDenoiseUntil paths, never
-// past SamplesPerPixel), bounces and environment (weight 1; background when
-// EnvironmentBackground is on).
-bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren,
-  vtkVolume* vol, ferrovol::Renderer& renderer, double traceBudget, std::string& error)
-{
-  FvPathTraceParams pt;
-  if (!vtkFerroVolumeCall("use the path tracing settings", error,
-        [&] { pt = ferrovol::Renderer::default_path_trace_params(); }))
-  {
-    return false;
-  }
-  vtkRenderWindow* win = ren->GetRenderWindow();
-  const bool interactive = win && win->GetDesiredUpdateRate() > 1.0;
-  const uint32_t spp = static_cast<uint32_t>(self->GetSamplesPerPixel());
-  if (interactive && !(traceBudget > 0.0))
-  {
-    pt.samples_per_frame = static_cast<uint32_t>(self->GetInteractiveSamplesPerPixel());
-    pt.max_samples = 0;
-  }
-  else
-  {
-    pt.samples_per_frame = std::min(spp, 4096u);
-    pt.max_samples = spp;
-    pt.time_budget = static_cast<float>(traceBudget);
-  }
-  if (!interactive)
-  {
-    pt.secondary_rays = static_cast<uint32_t>(self->GetSecondaryRays());
-  }
-  pt.denoise_until = DenoiseUntil(self);
-  pt.max_bounces = static_cast<uint32_t>(self->GetPathTracingBounces());
-  const double psi = self->GetGradientThreshold();
-  pt.gradient_threshold = psi >= static_cast<double>(FLT_MAX)
-    ? std::numeric_limits<float>::infinity()
-    : static_cast<float>(psi);
-  pt.stochastic_blend = static_cast<float>(std::min(self->GetStochasticBlend(), 1e30));
-  pt.scatter_regions = static_cast<uint32_t>(self->GetScatterRegions());
-  pt.attenuation = self->GetAttenuation() != 0;
-  pt.denoise = self->GetPathTracingDenoise() != 0;
-  pt.roughness = static_cast<float>(self->GetBsdfRoughness());
-  pt.fresnel = static_cast<float>(self->GetBsdfFresnel());
-  pt.transmission = static_cast<float>(self->GetTransmission());
-  pt.cone_angle = static_cast<float>(self->GetTransmissionConeAngle());
-  // (|g| = 1 is a delta, which a Monte Carlo estimate cannot sample: clamp inside)
-  pt.anisotropy =
-    std::max(-0.99f, std::min(0.99f, vol->GetProperty()->GetScatteringAnisotropy()));
-  pt.background = self->GetEnvironmentBackground() != 0;
-  if (!this->UseEnvironment(self, renderer))
-  {
-    pt.environment_light = 0.0f;
-    pt.background = false;
-  }
-  this->Background = pt.background;
-  return vtkFerroVolumeCall(
-    "use the path tracing settings", error, [&] { renderer.set_path_tracing(pt); });
-}
-
-// Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
-// environment when it changed. The surfaces' colours and opacities are the property's
-// colour and scalar opacity functions at the iso-values, as vtkGPUVolumeRayCastMapper's:
-// those of the component the surfaces are of (independent components: the one of the
-// largest weight, the first of equal ones, as ferrovol's core picks it; else the first); Shade off draws flat colours (ambient 1, no diffuse or
-// specular light, no environment light). Without iso-values nothing is drawn, silently, as
-// vtkGPUVolumeRayCastMapper does.
-vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
-  vtkFerroVolumeMapper* self, vtkVolume* vol, int components, ferrovol::Renderer& renderer,
-  std::set<std::string>& warned, std::string& error)
-{
-  vtkVolumeProperty* prop = vol->GetProperty();
-  int comp = 0;
-  if (prop->GetIndependentComponents())
-  {
-    for (int c = 1; c < components; ++c)
-    {
-      if (prop->GetComponentWeight(c) > prop->GetComponentWeight(comp))
-      {
-        comp = c;
-      }
-    }
-  }
-  FvRenderParams& params = this->Params;
-  vtkContourValues* contours = prop->GetIsoSurfaceValues();
-  const int n = contours ? contours->GetNumberOfContours() : 0;
-  if (n < 1)
-  {
-    return Result::NothingVisible;
-  }
-  if (n > FV_MAX_ISO_VALUES && warned.insert("iso-count").second)
-  {
-    vtkWarningWithObjectMacro(self, << n << " iso-values: ferrovol draws the first "
-                                    << FV_MAX_ISO_VALUES);
-  }
-  FvIsoParams iso;
-  if (!vtkFerroVolumeCall("use the isosurface settings", error,
-        [&] { iso = ferrovol::Renderer::default_iso_params(); }))
-  {
-    return Result::Failed;
-  }
-  // (Get{Gray,RGB}TransferFunction create a default function, and switch the property to
-  // it, when it has none: ask for the one the property uses.)
-  const bool grayColor = prop->GetColorChannels(comp) == 1;
-  vtkColorTransferFunction* rgb = grayColor ? nullptr : prop->GetRGBTransferFunction(comp);
-  vtkPiecewiseFunction* gray = grayColor ? prop->GetGrayTransferFunction(comp) : nullptr;
-  vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(comp);
-  uint32_t count = 0;
-  for (int i = 0; i < std::min(n, static_cast<int>(FV_MAX_ISO_VALUES)); ++i)
-  {
-    const double v = contours->GetValue(i);
-    const double a = std::min(1.0, opacity->GetValue(v));
-    if (!(a > 0.0))
-    {
-      if (warned.insert("iso-transparent-" + std::to_string(v)).second)
-      {
-        vtkWarningWithObjectMacro(self, << "iso-value " << v
-                                        << " has opacity 0 in the scalar opacity function: "
-                                           "it is not drawn");
-      }
-      continue;
-    }
-    FvIsoValue& iv = iso.values[count++];
-    iv.value = v;
-    double c[3];
-    if (grayColor)
-    {
-      c[0] = c[1] = c[2] = gray->GetValue(v);
-    }
-    else
-    {
-      rgb->GetColor(v, c);
-    }
-    for (int k = 0; k < 3; ++k)
-    {
-      iv.color[k] = static_cast<float>(std::min(1.0, std::max(0.0, c[k])));
-    }
-    iv.opacity = static_cast<float>(a);
-  }
-  if (count == 0)
-  {
-    return Result::NothingVisible;
-  }
-  iso.value_count = count;
-  iso.max_layers = static_cast<uint32_t>(self->GetIsosurfaceLayers());
-  iso.specular_mode = self->GetSpecularSampling() == vtkFerroVolumeMapper::SPECULAR_CONE
-    ? FV_SPECULAR_MODE_CONE
-    : FV_SPECULAR_MODE_IMPORTANCE;
-  iso.specular_samples = static_cast<uint32_t>(self->GetSpecularSamples());
-  if (self->GetShininessFromGradient())
-  {
-    const double* e = self->GetShininessRange();
-    const double* g = self->GetShininessGradientRange();
-    iso.shininess[0] = static_cast<float>(e[0]);
-    iso.shininess[1] = static_cast<float>(e[1]);
-    iso.shininess_range[0] = g[0];
-    iso.shininess_range[1] = g[1];
-  }
-  else
-  {
-    iso.shininess[0] = iso.shininess[1] = params.specular_power;
-  }
-  iso.fresnel = static_cast<float>(self->GetFresnel());
-  iso.scatter_mode = static_cast<uint32_t>(self->GetIsosurfaceScattering());
-  iso.scatter_samples = static_cast<uint32_t>(self->GetIsosurfaceScatteringSamples());
-  iso.scatter_absorption =
-    static_cast<float>(std::min(self->GetIsosurfaceScatteringAbsorption(), 1e30));
-  if (self->GetFresnel() >= 0.0)
-  {
-    iso.scatter_fresnel = static_cast<float>(self->GetFresnel());
-  }
-  iso.ao_samples = static_cast<uint32_t>(self->GetAmbientOcclusionSamples());
-  iso.ao_steps = static_cast<uint32_t>(self->GetAmbientOcclusionSteps());
-  iso.ao_radius = self->GetAmbientOcclusionRadius();
-  iso.background = self->GetEnvironmentBackground() != 0;
-  iso.environment_light = params.shade ? static_cast<float>(self->GetEnvironmentLighting()) : 0.0f;
-  if (!params.shade)
-  {
-    params.ambient = 1.0f;
-    params.diffuse = 0.0f;
-    params.specular = 0.0f;
-  }
-
-  if ((iso.environment_light > 0.0f || iso.background) && !this->UseEnvironment(self, renderer))
-  {
-    iso.environment_light = 0.0f;
-    iso.background = false;
-  }
-  this->Background = iso.background;
-  if (!vtkFerroVolumeCall(
-        "use the isosurface settings", error, [&] { renderer.set_isosurface(iso); }))
-  {
-    return Result::Failed;
-  }
-  return Result::Ready;
 }

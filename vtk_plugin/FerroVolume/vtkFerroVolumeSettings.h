@@ -8,20 +8,21 @@
 
 #include "ferrovol.hpp"
 
-#include <set>
 #include <string>
 
 class vtkFerroVolumeInputHelper;
 class vtkFerroVolumeMapper;
+class vtkFerroVolumeReport;
 class vtkRenderer;
 class vtkVolume;
+class vtkVolumeProperty;
 
 class vtkFerroVolumeSettings
 {
 public:
   // The mapper's blend mode (or path tracing) in ferrovol's terms; false with the reason
   // when ferrovol has no such mode.
-  bool SelectBlendMode(vtkFerroVolumeMapper* self, std::string& error);
+  bool SelectBlendMode(vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report);
   // The blend mode SelectBlendMode chose (an FvBlendMode).
   uint32_t GetBlend() const { return this->Blend; }
 
@@ -33,17 +34,18 @@ public:
   };
   // Gives the renderer the frame's parameters (and the isosurfaces, path tracing settings
   // and environment in those modes), and warns about the mapper's settings ferrovol does not
-  // support. `input`: the image and scalars rendered (LockSampleDistanceToInputSpacing reads
-  // the spacing and extent; ClippedVoxelIntensity the type and ranges). `traceBudget`: seconds a progressive render's path tracing may
-  // take, 0 when the render is not progressive. `warned`: the warnings said once per mapper.
+  // support (once per mapper, in `report`). `input`: the image and scalars rendered
+  // (LockSampleDistanceToInputSpacing reads the spacing and extent; ClippedVoxelIntensity
+  // the type and ranges). `traceBudget`: seconds a progressive render's path tracing may
+  // take, 0 when the render is not progressive.
   Result Apply(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
     const vtkFerroVolumeInputHelper& input, ferrovol::Renderer& renderer, double traceBudget,
-    std::set<std::string>& warned, std::string& error);
+    vtkFerroVolumeReport& report);
 
   // Gives the renderer the camera VTK draws the opaque geometry with (for a vw × vh
   // viewport) and the renderer's lights.
   bool ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw, int vh,
-    ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+    ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   // Paths per pixel below which the path-traced image shown is denoised as a preview:
   // PathTracingDenoiseUntil, never past SamplesPerPixel (a converged image is unfiltered).
@@ -64,7 +66,33 @@ private:
   // Warns, once per mapper and setting, about each vtkGPUVolumeRayCastMapper setting in
   // effect that ferrovol does not honour (`vol`: its shader property).
   void WarnUnsupported(
-    vtkFerroVolumeMapper* self, vtkVolume* vol, std::set<std::string>& warned) const;
+    vtkFerroVolumeMapper* self, vtkVolume* vol, vtkFerroVolumeReport& report) const;
+  // Apply's parts, by concern, each filling its fields of Params.
+  // SLICE_BLEND: the property's SliceFunction, a vtkPlane (an error otherwise).
+  bool SetUpSlicePlane(vtkVolume* vol, vtkFerroVolumeReport& report);
+  // The property's InterpolationType (cubic: the mapper's CubicInterpolation).
+  void SetUpInterpolation(
+    vtkFerroVolumeMapper* self, vtkVolumeProperty* prop, vtkFerroVolumeReport& report);
+  // The step along the rays: SampleDistance, LockSampleDistanceToInputSpacing or
+  // AutoAdjustSampleDistances (an error for a SampleDistance that is not positive).
+  bool SetUpSampling(vtkFerroVolumeMapper* self, vtkVolume* vol,
+    const vtkFerroVolumeInputHelper& input, vtkFerroVolumeReport& report);
+  // Jittering, shading (Shade, the material, normals from the opacity), volumetric
+  // scattering, and the warnings about what ferrovol does not honour.
+  void SetUpShading(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
+    const vtkFerroVolumeInputHelper& input, vtkFerroVolumeReport& report);
+  // Cropping regions, clipping planes and ClippedVoxelIntensity.
+  void SetUpCroppingAndClipping(vtkFerroVolumeMapper* self, vtkVolumeProperty* prop,
+    const vtkFerroVolumeInputHelper& input, vtkFerroVolumeReport& report);
+  // The blend modes' options: the average's range, empty space skipping, the extremum's
+  // depth, pre-integration, and the coarser preview of interactive renders.
+  void SetUpRayOptions(vtkFerroVolumeMapper* self, vtkRenderer* ren);
+  // WholeExtent: the whole dataset's box in the piece's index space.
+  void SetUpWholeExtent(vtkFerroVolumeMapper* self, const vtkFerroVolumeInputHelper& input);
+  // MidpointQuadrature and AdaptiveSampling (after SetUpWholeExtent: not for pieces).
+  void SetUpQuadrature(vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report);
+  // The modes (vtkFerroVolumeSettingsModes.cxx): the environment light, path tracing and
+  // the isosurfaces.
   bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
   // AutoAdjustSampleDistances: the factor (1, 1/2, 1/5 or 1/10) the smallest world spacing
   // is divided by to make the step, from the time the last render took against the time
@@ -72,9 +100,9 @@ private:
   // DesiredUpdateRate), as vtkOpenGLGPUVolumeRayCastMapper::ComputeReductionFactor sets it.
   double UpdateReductionFactor(vtkFerroVolumeMapper* self, double allocatedTime);
   bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
-    ferrovol::Renderer& renderer, double traceBudget, std::string& error);
+    ferrovol::Renderer& renderer, double traceBudget, vtkFerroVolumeReport& report);
   Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol, int components,
-    ferrovol::Renderer& renderer, std::set<std::string>& warned, std::string& error);
+    ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   uint32_t Blend = FV_BLEND_MODE_COMPOSITE;
   FvRenderParams Params{};

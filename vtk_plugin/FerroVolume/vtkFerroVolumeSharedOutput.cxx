@@ -2,6 +2,7 @@
 
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeDepthReader.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderWindow.h"
@@ -133,13 +134,13 @@ std::unique_ptr<vtkFerroVolumeSharedOutput> vtkFerroVolumeSharedOutput::Create(
   {
     return nullptr;
   }
-  std::string error;
-  if (!vtkFerroVolumeCall("share its output", error,
+  vtkFerroVolumeReport report;
+  if (!vtkFerroVolumeCall("share its output", report,
         [&] { renderer.set_output_path(FV_OUTPUT_PATH_SHARED); }))
   {
     // Everything said it would work: a failure here is worth a warning in any case.
     choice.Shared = false;
-    choice.Reason = error;
+    choice.Reason = report.GetError();
     choice.Warn = true;
     return nullptr;
   }
@@ -152,7 +153,7 @@ vtkFerroVolumeSharedOutput::~vtkFerroVolumeSharedOutput()
 }
 
 bool vtkFerroVolumeSharedOutput::Render(ferrovol::Renderer& renderer,
-  const vtkFerroVolumeFrameRequest& req, std::string& error, std::string& warning)
+  const vtkFerroVolumeFrameRequest& req, vtkFerroVolumeReport& report, std::string& warning)
 {
   const uint32_t w = static_cast<uint32_t>(req.RenderW), h = static_cast<uint32_t>(req.RenderH);
   // OpenGL must be done with the images of the last frame before ferrovol overwrites them.
@@ -161,25 +162,25 @@ bool vtkFerroVolumeSharedOutput::Render(ferrovol::Renderer& renderer,
   // may land after OpenGL wrote the depth input below (zero depth, an empty frame; seen in
   // some first frames under load). Nothing else is in flight here, so the wait is free
   // otherwise.
-  if (!vtkFerroVolumeCall("allocate the shared images", error,
+  if (!vtkFerroVolumeCall("allocate the shared images", report,
         [&] { renderer.prepare_targets(w, h); }) ||
     !vtkFerroVolumeCall(
-      "finish allocating the shared images", error, [&] { renderer.finish(); }) ||
-    !this->Import(renderer, req.Window, error))
+      "finish allocating the shared images", report, [&] { renderer.finish(); }) ||
+    !this->Import(renderer, req.Window, report))
   {
     return false;
   }
   if (req.UseDepth)
   {
-    if (!this->WriteDepthInput(req, error))
+    if (!this->WriteDepthInput(req, report))
     {
-      warning = "the volume ignores opaque geometry in this frame: " + error;
-      error.clear();
+      warning = "the volume ignores opaque geometry in this frame: " + report.GetError();
+      report.ClearError();
       this->ClearDepthInput();
     }
     glFinish(); // ferrovol reads the depth input next
   }
-  return vtkFerroVolumeCall("render the frame", error,
+  return vtkFerroVolumeCall("render the frame", report,
            [&] {
              if (req.UseDepth)
              {
@@ -190,7 +191,7 @@ bool vtkFerroVolumeSharedOutput::Render(ferrovol::Renderer& renderer,
                renderer.render(w, h);
              }
            }) &&
-    vtkFerroVolumeCall("finish the frame", error, [&] { renderer.finish(); });
+    vtkFerroVolumeCall("finish the frame", report, [&] { renderer.finish(); });
 }
 
 vtkTextureObject* vtkFerroVolumeSharedOutput::ColorTexture()
@@ -232,14 +233,14 @@ void vtkFerroVolumeSharedOutput::ReleaseGraphicsResources(vtkWindow* window)
 
 // Imports the three images again whenever ferrovol reallocated them.
 bool vtkFerroVolumeSharedOutput::Import(
-  ferrovol::Renderer& renderer, vtkOpenGLRenderWindow* win, std::string& error)
+  ferrovol::Renderer& renderer, vtkOpenGLRenderWindow* win, vtkFerroVolumeReport& report)
 {
   // (descriptors not handed over to OpenGL are closed when `img` goes)
   std::array<ferrovol::SharedImage, 3> img;
   for (uint32_t i = 0; i < 3; ++i)
   {
     if (!vtkFerroVolumeCall(
-          "export a shared image", error, [&] { img[i] = renderer.shared_image(i); }))
+          "export a shared image", report, [&] { img[i] = renderer.shared_image(i); }))
     {
       return false;
     }
@@ -266,7 +267,7 @@ bool vtkFerroVolumeSharedOutput::Import(
     glImportMemoryFdEXT(im.Memory, info.size, GL_HANDLE_TYPE_OPAQUE_FD_EXT, info.fd);
     if (glGetError() != GL_NO_ERROR)
     {
-      error = "OpenGL could not import ferrovol's shared memory (glImportMemoryFdEXT)";
+      report.Fail("OpenGL could not import ferrovol's shared memory (glImportMemoryFdEXT)");
       ok = false;
       break;
     }
@@ -278,8 +279,8 @@ bool vtkFerroVolumeSharedOutput::Import(
       static_cast<GLsizei>(info.width), static_cast<GLsizei>(info.height), im.Memory, 0);
     if (glGetError() != GL_NO_ERROR)
     {
-      error = "OpenGL could not make a texture of ferrovol's shared memory "
-              "(glTexStorageMem2DEXT)";
+      report.Fail("OpenGL could not make a texture of ferrovol's shared memory "
+                  "(glTexStorageMem2DEXT)");
       ok = false;
       break;
     }
@@ -311,7 +312,7 @@ bool vtkFerroVolumeSharedOutput::Import(
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(oldDraw));
   if (status != GL_FRAMEBUFFER_COMPLETE)
   {
-    error = "ferrovol's shared depth input image cannot be drawn into";
+    report.Fail("ferrovol's shared depth input image cannot be drawn into");
     this->DeleteImports();
     return false;
   }
@@ -321,7 +322,7 @@ bool vtkFerroVolumeSharedOutput::Import(
 // VTK's depth (the viewport of the framebuffer being drawn) → CopyTex (a blit, which also
 // resolves multisampling) → the depth input image (one pass, scaled to the render size).
 bool vtkFerroVolumeSharedOutput::WriteDepthInput(
-  const vtkFerroVolumeFrameRequest& req, std::string& error)
+  const vtkFerroVolumeFrameRequest& req, vtkFerroVolumeReport& report)
 {
   vtkOpenGLRenderWindow* win = req.Window;
   vtkOpenGLState* ostate = win->GetState();
@@ -332,8 +333,7 @@ bool vtkFerroVolumeSharedOutput::WriteDepthInput(
   const GLenum format = vtkFerroVolumeDepthReader::DepthFormatOf(readFbo);
   if (format == GL_NONE)
   {
-    error = "the framebuffer's depth attachment has an unknown format";
-    return false;
+    return report.Fail("the framebuffer's depth attachment has an unknown format");
   }
   const int vw = req.ViewportW, vh = req.ViewportH;
   if (!this->CopyTex || this->CopyFormat != format || this->CopyW != vw || this->CopyH != vh)
@@ -377,8 +377,7 @@ bool vtkFerroVolumeSharedOutput::WriteDepthInput(
   }
   if (glGetError() != GL_NO_ERROR)
   {
-    error = "copying the depth buffer failed";
-    return false;
+    return report.Fail("copying the depth buffer failed");
   }
 
   if (!this->Quad)
@@ -387,8 +386,7 @@ bool vtkFerroVolumeSharedOutput::WriteDepthInput(
   }
   if (!this->Quad->Program)
   {
-    error = "could not compile the depth copy shader";
-    return false;
+    return report.Fail("could not compile the depth copy shader");
   }
   win->GetShaderCache()->ReadyShaderProgram(this->Quad->Program);
   {
@@ -419,8 +417,7 @@ bool vtkFerroVolumeSharedOutput::WriteDepthInput(
   }
   if (glGetError() != GL_NO_ERROR)
   {
-    error = "writing ferrovol's depth input failed";
-    return false;
+    return report.Fail("writing ferrovol's depth input failed");
   }
   return true;
 }

@@ -17,6 +17,8 @@
 #include <memory>
 #include <string>
 
+class vtkFerroVolumeReport;
+
 class vtkFerroVolumeSharedOutput : public vtkFerroVolumeFramePath
 {
 public:
@@ -30,7 +32,7 @@ public:
 
   const char* Name() const override { return "shared"; }
   bool Render(ferrovol::Renderer& renderer, const vtkFerroVolumeFrameRequest& req,
-    std::string& error, std::string& warning) override;
+    vtkFerroVolumeReport& report, std::string& warning) override;
   vtkTextureObject* ColorTexture() override;
   vtkTextureObject* DepthTexture() override;
   void ReleaseGraphicsResources(vtkWindow* window) override;
@@ -44,8 +46,9 @@ private:
   };
 
   vtkFerroVolumeSharedOutput() = default;
-  bool Import(ferrovol::Renderer& renderer, vtkOpenGLRenderWindow* win, std::string& error);
-  bool WriteDepthInput(const vtkFerroVolumeFrameRequest& req, std::string& error);
+  bool Import(
+    ferrovol::Renderer& renderer, vtkOpenGLRenderWindow* win, vtkFerroVolumeReport& report);
+  bool WriteDepthInput(const vtkFerroVolumeFrameRequest& req, vtkFerroVolumeReport& report);
   void ClearDepthInput();
   void DeleteImports();
   void Forget();
