@@ -15,7 +15,8 @@ pub enum FvStatus {
     NullArgument = 1,
     /// An argument is out of range or inconsistent (the message names it).
     InvalidArgument = 2,
-    /// The device or this build cannot do what was asked (e.g. no shared-memory export).
+    /// The device or this build cannot do what was asked (e.g. no shared-memory export), or
+    /// the settings combine what ray casting does not draw (docs/REFUSALS.md lists them).
     Unsupported = 3,
     /// A GPU or host allocation failed.
     OutOfMemory = 4,

@@ -513,6 +513,126 @@ mod tests {
         assert_eq!(drawn, expected);
     }
 
+    /// When each refusal happens, as docs/REFUSALS.md says it, and its place in the order
+    /// `select` checks them.
+    fn when(r: DvrRefusal) -> (u8, &'static str) {
+        use DvrRefusal as R;
+        match r {
+            R::StreamingVolumetric => (0, "volumetric shadows on a streamed frame (the bricks in view exceed the volume's memory budget)"),
+            R::StreamingCubic => (1, "cubic interpolation on a streamed frame"),
+            R::StreamingSlice => (2, "the slice blend mode on a streamed frame"),
+            R::MidpointIntermix(_) => (3, "the midpoint or adaptive quadrature with intermixed volumes"),
+            R::RectilinearVolumetric => (4, "volumetric shadows on a rectilinear grid"),
+            R::RectilinearClippedVoxel => (5, "a clipped voxel value (with shading or gradient opacity) on a rectilinear grid"),
+            R::Tables2dBlend(_) => (6, "2D transfer functions in another blend mode than composite"),
+            R::Tables2dDependent => (7, "2D transfer functions on dependent components"),
+            R::OpacityNormalDependent(_) => (8, "normals from the opacity gradient on dependent components"),
+            R::OpacityNormalGradientOpacityBricked => (9, "normals from the opacity gradient with gradient opacity on a bricked volume"),
+            R::Intermix(_) => (10, "intermixed volumes with what they do not combine with"),
+        }
+    }
+
+    /// Messages that differ in one part, as one: their common start and end around the
+    /// parts (`start [a / b] end`).
+    fn merged(messages: &std::collections::BTreeSet<String>) -> String {
+        let all: Vec<&str> = messages.iter().map(String::as_str).collect();
+        if all.len() == 1 {
+            return all[0].to_string();
+        }
+        let common = |f: &dyn Fn(&str) -> Vec<char>| {
+            let seqs: Vec<Vec<char>> = all.iter().map(|m| f(m)).collect();
+            (0..seqs[0].len())
+                .take_while(|&i| seqs.iter().all(|q| q.get(i) == seqs[0].get(i)))
+                .count()
+        };
+        let chars: Vec<Vec<char>> = all.iter().map(|m| m.chars().collect()).collect();
+        // (whole words only)
+        let mut head = common(&|m| m.chars().collect());
+        while head > 0 && chars[0][head - 1] != ' ' {
+            head -= 1;
+        }
+        let mut tail = common(&|m| m.chars().rev().collect());
+        let shortest = chars.iter().map(Vec::len).min().unwrap_or(0);
+        tail = tail.min(shortest - head);
+        while tail > 0 && !matches!(chars[0][chars[0].len() - tail], ' ' | ':' | ',') {
+            tail -= 1;
+        }
+        let parts: Vec<String> = chars
+            .iter()
+            .map(|c| c[head..c.len() - tail].iter().collect())
+            .collect();
+        let start: String = chars[0][..head].iter().collect();
+        let end: String = chars[0][chars[0].len() - tail..].iter().collect();
+        format!("{start}[{}]{end}", parts.join(" / "))
+    }
+
+    /// docs/REFUSALS.md: every refusal of the matrix, its condition and the messages it
+    /// gives, in the order `select` checks them.
+    fn refusals_doc() -> String {
+        let mut rows = std::collections::BTreeMap::new();
+        matrix(|x| {
+            if let Err(r) = select(x) {
+                let Error::Unsupported(m) = Error::from(r) else {
+                    panic!("{r:?} is not Unsupported")
+                };
+                rows.entry(when(r))
+                    .or_insert_with(std::collections::BTreeSet::new)
+                    .insert(m);
+            }
+        });
+        let mut doc = String::from(
+            "<!-- Generated from core/src/passes/dvr_variant.rs by its tests: \
+             FERROVOL_UPDATE_DOCS=1 cargo test -p ferrovol-core --lib refusals -->\n\
+             # What ray casting refuses\n\n\
+             The combinations of settings the ray-casting pass does not draw, each with the \
+             error it gives: `Error::Unsupported` in Rust, FV_STATUS_UNSUPPORTED and the \
+             message from the C ABI, vtkErrorMacro in VTK and ParaView, an error from the \
+             CLI. Each message names the way out. The list is written once, in the code; \
+             this page is generated from it, and a test keeps it current.\n\n\
+             | when | the error says |\n| --- | --- |\n",
+        );
+        for ((_, when), messages) in &rows {
+            doc.push_str(&format!(
+                "| {when} | {} |\n",
+                merged(messages).replace('|', "\\|")
+            ));
+        }
+        doc
+    }
+
+    /// The refusal list is written once (here) and generated into docs/REFUSALS.md; the
+    /// READMEs and the C header send their readers there.
+    #[test]
+    fn refusals_doc_is_current_and_linked() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        if !root.join("docs").is_dir() {
+            // (the crate packaged alone has no docs/)
+            return;
+        }
+        let path = root.join("docs/REFUSALS.md");
+        let doc = refusals_doc();
+        if std::env::var_os("FERROVOL_UPDATE_DOCS").is_some() {
+            std::fs::write(&path, &doc).expect("docs/REFUSALS.md written");
+        }
+        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            on_disk == doc,
+            "docs/REFUSALS.md is not what the code refuses: regenerate it with \
+             FERROVOL_UPDATE_DOCS=1 cargo test -p ferrovol-core --lib refusals"
+        );
+        for file in [
+            "README.md",
+            "vtk_plugin/README.md",
+            "ffi/include/ferrovol.h",
+        ] {
+            let text = std::fs::read_to_string(root.join(file)).expect(file);
+            assert!(
+                text.contains("docs/REFUSALS.md"),
+                "{file} does not link docs/REFUSALS.md"
+            );
+        }
+    }
+
     #[test]
     fn the_first_refusal_in_order_wins_and_says_what_to_do() {
         let x = DvrFacts {
