@@ -566,38 +566,60 @@ mod tests {
         format!("{start}[{}]{end}", parts.join(" / "))
     }
 
-    /// docs/REFUSALS.md: every refusal of the matrix, its condition and the messages it
-    /// gives, in the order `select` checks them.
+    /// A table of refusals: each condition (in the order they are checked) and the messages
+    /// its refusals give, merged.
+    fn table(
+        rows: &std::collections::BTreeMap<(u8, &str), std::collections::BTreeSet<String>>,
+    ) -> String {
+        let mut out = String::from("| when | the error says |\n| --- | --- |\n");
+        for ((_, when), messages) in rows {
+            out.push_str(&format!(
+                "| {when} | {} |\n",
+                merged(messages).replace('|', "\\|")
+            ));
+        }
+        out
+    }
+
+    /// docs/REFUSALS.md: every refusal of the ray-casting and isosurface matrices, its
+    /// condition and the messages it gives, in the order the passes check them.
     fn refusals_doc() -> String {
-        let mut rows = std::collections::BTreeMap::new();
+        let mut dvr = std::collections::BTreeMap::new();
         matrix(|x| {
             if let Err(r) = select(x) {
                 let Error::Unsupported(m) = Error::from(r) else {
                     panic!("{r:?} is not Unsupported")
                 };
-                rows.entry(when(r))
+                dvr.entry(when(r))
                     .or_insert_with(std::collections::BTreeSet::new)
                     .insert(m);
             }
         });
-        let mut doc = String::from(
-            "<!-- Generated from core/src/passes/dvr_variant.rs by its tests: \
-             FERROVOL_UPDATE_DOCS=1 cargo test -p ferrovol-core --lib refusals -->\n\
-             # What ray casting refuses\n\n\
-             The combinations of settings the ray-casting pass does not draw, each with the \
-             error it gives: `Error::Unsupported` in Rust, FV_STATUS_UNSUPPORTED and the \
-             message from the C ABI, vtkErrorMacro in VTK and ParaView, an error from the \
-             CLI. Each message names the way out. The list is written once, in the code; \
-             this page is generated from it, and a test keeps it current.\n\n\
-             | when | the error says |\n| --- | --- |\n",
-        );
-        for ((_, when), messages) in &rows {
-            doc.push_str(&format!(
-                "| {when} | {} |\n",
-                merged(messages).replace('|', "\\|")
-            ));
-        }
-        doc
+        let mut iso = std::collections::BTreeMap::new();
+        crate::passes::iso_variant::tests::matrix(|x| {
+            if let Err(r) = crate::passes::iso_variant::select(x) {
+                let Error::Unsupported(m) = Error::from(r) else {
+                    panic!("{r:?} is not Unsupported")
+                };
+                iso.entry(crate::passes::iso_variant::tests::when(r))
+                    .or_insert_with(std::collections::BTreeSet::new)
+                    .insert(m);
+            }
+        });
+        format!(
+            "<!-- Generated from core/src/passes/dvr_variant.rs and iso_variant.rs by their \
+             tests: FERROVOL_UPDATE_DOCS=1 cargo test -p ferrovol-core --lib refusals -->\n\
+             # What ray casting and isosurfaces refuse\n\n\
+             The combinations of settings the ray-casting and isosurface passes do not draw, \
+             each with the error it gives: `Error::Unsupported` in Rust, \
+             FV_STATUS_UNSUPPORTED and the message from the C ABI, vtkErrorMacro in VTK and \
+             ParaView, an error from the CLI. Each message names the way out. The list is \
+             written once, in the code (each pass's variant selection, a pure function of \
+             the frame's facts); this page is generated from it, and a test keeps it \
+             current.\n\n## Ray casting\n\n{}\n## Isosurfaces\n\n{}",
+            table(&dvr),
+            table(&iso)
+        )
     }
 
     /// The refusal list is written once (here) and generated into docs/REFUSALS.md; the

@@ -22,25 +22,23 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
-use super::frame::{
-    self, bricks_in_view, groups, visibility_order, FrameInput, SKIP_MAX_OCCUPANCY,
-};
+use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput};
+use super::iso_variant::{self, DeferredVariant, FirstHitVariant, IsoFacts};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::{pipeline_variant, PipelineCache};
+use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::readback::{read_buffer, read_texture_layer};
 use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
-use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND, MASK_BINARY, MASK_NONE};
+use crate::gpu::uniforms::{mat, IsoUniforms, ISO_FLAG_BACKGROUND};
 use crate::gpu::Context;
 use crate::params::downsample::Reduction;
 use crate::params::iso::MAX_SPECULAR_SAMPLES;
 use crate::params::{
-    BlendMode, GBuffer, Interpolation, IsoParams, IsoScatterMode, MaskKind, RenderParams, Shading,
-    Shininess, TransferFunction,
+    BlendMode, GBuffer, IsoParams, RenderParams, Shading, Shininess, TransferFunction,
 };
 use crate::resources::environment::texel_solid_angle;
 use crate::resources::levels::LevelDemand;
@@ -51,44 +49,6 @@ use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, 
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
-
-pipeline_variant! {
-    /// The pipeline constants of one specialisation of the first-hit pass.
-    struct FirstHitVariant {
-        skip: bool => "SKIP",
-        crop: bool => "CROP",
-        single_brick: bool => "SINGLE_BRICK",
-        streaming: bool => "STREAMING",
-        /// The component the isosurfaces are of (iso_component).
-        component: u32 => "ISO_COMP",
-        /// MASK_BINARY: samples whose nearest point the mask holds 0 at are left out.
-        mask: u32 => "MASK",
-        /// VTK's blanking: blanked samples are left out as masked ones are.
-        blanking: bool => "BLANKING",
-        /// A rectilinear grid: samples mapped to its index space (lib/rectilinear.wgsl).
-        rectilinear: bool => "RECTILINEAR",
-        /// The surfaces of the cubic B-spline (Interpolation::Cubic).
-        cubic: bool => "CUBIC",
-    }
-}
-
-pipeline_variant! {
-    /// The pipeline constants of one specialisation of the deferred pass.
-    struct DeferredVariant {
-        lights: u32 => "NUM_LIGHTS",
-        positional_lights: bool => "POSITIONAL_LIGHTS",
-        /// 0 none, 1 preview, 2 traced (IsoScattering).
-        scatter: u32 => "SCATTER",
-        single_brick: bool => "SINGLE_BRICK",
-        component: u32 => "ISO_COMP",
-        /// MASK_BINARY: the medium between the surfaces is empty where the mask holds 0.
-        mask: u32 => "MASK",
-        /// VTK's blanking: the medium between the surfaces is empty where blanked.
-        blanking: bool => "BLANKING",
-        /// A rectilinear grid (lib/rectilinear.wgsl).
-        rectilinear: bool => "RECTILINEAR",
-    }
-}
 
 /// The component whose isosurfaces are drawn, as vtkGPUVolumeRayCastMapper chooses it:
 /// with independent components the one of the largest weight (the first of equal ones),
@@ -431,13 +391,6 @@ impl IsoPass {
         iso.validate()?;
         frame::check_light_count(view)?;
         let rectilinear = res.volume()?.grid_lookup.is_some();
-        if rectilinear && params.interpolation == Interpolation::Cubic {
-            return Err(Error::Unsupported(
-                "cubic isosurfaces are found on uniform grids, and this volume is rectilinear \
-                 (per-axis coordinates): interpolate linearly or resample the grid"
-                    .into(),
-            ));
-        }
         res.ensure_environment(ctx)?;
         let step = res.sample_distance(params)?;
         if iso.scattering.is_some() {
@@ -498,9 +451,6 @@ impl IsoPass {
                 }
             }
         };
-        if plan.is_some() {
-            check_streamable(res, params, iso, step)?;
-        }
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
@@ -529,46 +479,27 @@ impl IsoPass {
             .map_or(1.0, |tf| tf.component(component as usize).unit_distance);
         let full = [0, 0, view.width, view.height];
         let occupied = self.occupancy.as_ref().map_or(1.0, |o| o.fraction);
-        let mask = if res.mask_kind() == Some(MaskKind::Binary) {
-            MASK_BINARY
-        } else {
-            MASK_NONE
+        let step_voxels = match plan {
+            Some(_) => step_in_voxels(res, params, step)?,
+            None => 0.0,
         };
-        // (blocks and their exits are in the grid's index space, which rays on a rectilinear
-        // grid do not march)
-        let fh = FirstHitVariant {
-            skip: params.empty_space_skipping && !rectilinear && occupied < SKIP_MAX_OCCUPANCY,
-            crop: params.cropping.is_some(),
+        let (fh, df) = iso_variant::select(&IsoFacts {
+            interpolation: params.interpolation,
+            empty_space_skipping: params.empty_space_skipping,
+            cropping: params.cropping.is_some(),
             single_brick,
-            streaming: plan.is_some(),
-            component,
-            mask,
-            blanking: res.blanking.is_some(),
             rectilinear,
-            cubic: params.interpolation == Interpolation::Cubic,
-        };
-        if fh.cubic && fh.streaming {
-            return Err(Error::Unsupported(
-                "cubic interpolation reads two points around each sample, beyond what a \
-                 streamed brick keeps around it, and the bricks in view exceed the volume's \
-                 memory budget: raise the budget or interpolate linearly"
-                    .into(),
-            ));
-        }
-        let df = DeferredVariant {
+            component,
+            mask: res.mask_kind(),
+            blanking: res.blanking.is_some(),
+            occupied,
             lights: f.lights(),
             positional_lights: f.positional_lights(),
-            scatter: match iso.scattering.map(|s| s.mode) {
-                None => 0,
-                Some(IsoScatterMode::Preview) => 1,
-                Some(IsoScatterMode::Traced) => 2,
-            },
-            single_brick,
-            component,
-            mask,
-            blanking: res.blanking.is_some(),
-            rectilinear,
-        };
+            scattering: iso.scattering.map(|s| s.mode),
+            ambient_occlusion: iso.ambient_occlusion.is_some_and(|a| a.samples > 0),
+            streaming: plan.is_some(),
+            step_voxels,
+        })?;
         let firsthit = self.firsthit.get(ctx, fh)?;
         let deferred = self.deferred.get(ctx, df)?;
         // With scattering the surfaces are interfaces: the first-hit pass keeps the first two
@@ -796,23 +727,9 @@ impl IsoPass {
     }
 }
 
-/// Whether an isosurface frame can stream its bricks: the first hit's samples and their
-/// refinement stay within one voxel of the brick serving them only with a sample distance
-/// of at most one voxel along every direction (the spectral norm of world → index), and
-/// ambient-occlusion rays reach beyond the bricks the surfaces lie in.
-fn check_streamable(
-    res: &Resources,
-    params: &RenderParams,
-    iso: &IsoParams,
-    step: f64,
-) -> Result<()> {
-    let over = "the bricks the isosurfaces lie in exceed the volume's memory budget";
-    if iso.ambient_occlusion.is_some_and(|a| a.samples > 0) {
-        return Err(Error::Unsupported(format!(
-            "{over}, and ambient occlusion reads around them: raise the budget or turn \
-             ambient occlusion off"
-        )));
-    }
+/// The sample distance `step` in voxels along the direction the volume's grid is stretched
+/// most (the spectral norm of world → index).
+fn step_in_voxels(res: &Resources, params: &RenderParams, step: f64) -> Result<f64> {
     let vol = res.volume()?;
     let m = (params.volume_matrix * vol.index_to_data).inverse();
     let a = glam::DMat3::from_mat4(m);
@@ -822,13 +739,5 @@ fn check_streamable(
     for _ in 0..64 {
         v = (ata * v).normalize_or_zero();
     }
-    let stretch = (ata * v).length().sqrt();
-    if step * stretch > 1.0 + 1e-9 {
-        return Err(Error::Unsupported(format!(
-            "{over}, and streaming them needs a sample distance of at most one voxel (this one \
-             is {:.3} voxels): raise the budget or lower the sample distance",
-            step * stretch
-        )));
-    }
-    Ok(())
+    Ok(step * (ata * v).length().sqrt())
 }

@@ -8,6 +8,7 @@ pub(crate) mod dvr;
 pub(crate) mod dvr_variant;
 pub(crate) mod frame;
 pub(crate) mod iso;
+pub(crate) mod iso_variant;
 pub(crate) mod medium;
 pub(crate) mod pathtrace;
 pub(crate) mod scatter_check;
