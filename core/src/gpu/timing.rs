@@ -34,8 +34,8 @@ struct Observed {
     done: Arc<Mutex<Option<Instant>>>,
 }
 
-/// The device time per unit of work of the newest submission measured, read a frame or more
-/// after the submission: [`GpuTimer::pass_writes`] for the timed compute pass,
+/// The device time per unit of work of the newest submission measured, and its work, read a
+/// frame or more after the submission: [`GpuTimer::pass_writes`] for the timed compute pass,
 /// [`GpuTimer::resolve`] after it in the same encoder, [`GpuTimer::submitted`] after the
 /// submission, [`GpuTimer::seconds_per_unit`] at a later frame.
 pub(crate) struct GpuTimer {
@@ -43,8 +43,8 @@ pub(crate) struct GpuTimer {
     observed: VecDeque<Observed>,
     /// The ring slot the encoder being recorded writes.
     recording: Option<usize>,
-    /// The newest measurement.
-    latest: Option<f64>,
+    /// The newest measurement: seconds per unit, units.
+    latest: Option<(f64, u64)>,
 }
 
 impl GpuTimer {
@@ -128,11 +128,11 @@ impl GpuTimer {
     }
 
     /// Device seconds per unit of work of the newest timed submission that has come back
-    /// (polling the device, never waiting), or of the one before if none has since; None
-    /// before any.
-    pub(crate) fn seconds_per_unit(&mut self, ctx: &Context) -> Result<Option<f64>> {
+    /// (polling the device, never waiting), or of the one before if none has since, with
+    /// the units it did; None before any.
+    pub(crate) fn seconds_per_unit(&mut self, ctx: &Context) -> Result<Option<(f64, u64)>> {
         ctx.poll("reading the device's timestamps")?;
-        let rate = |seconds: f64, work: u64| (work > 0).then(|| seconds / work as f64);
+        let rate = |seconds: f64, work: u64| (work > 0).then(|| (seconds / work as f64, work));
         match self.timestamps.as_mut() {
             Some(ts) => {
                 if let Some((work, bytes)) = ts.ring.take_latest() {
@@ -186,7 +186,10 @@ mod tests {
             ctx.wait_idle().unwrap();
             let rate = timer.seconds_per_unit(&ctx).unwrap();
             println!("timestamps {timestamps}: {rate:?} s per unit");
-            assert!(rate.is_some_and(|r| r >= 0.0 && r.is_finite()), "{rate:?}");
+            assert!(
+                rate.is_some_and(|(r, work)| r >= 0.0 && r.is_finite() && work == 4),
+                "{rate:?}"
+            );
         }
     }
 }

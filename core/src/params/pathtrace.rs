@@ -119,8 +119,9 @@ pub struct PathTraceParams {
     /// traced yet show a traced neighbour), at least one sixteenth and at most
     /// `samples_per_frame` paths per pixel. The time per sixteenth is measured on the
     /// device (GPU timestamps) and read back a frame or more later, so that no frame waits
-    /// for it: a frame plans from an earlier frame's rate (one sixteenth before any came
-    /// back), and the device time it takes follows the budget as the rate holds.
+    /// for it: a frame plans from an earlier frame's rate, at most twice the sixteenths that
+    /// rate was measured on (one sixteenth before any came back), and the device time it
+    /// takes follows the budget as the rate holds.
     pub time_budget: f32,
     /// Secondary rays per primary ray, 1 to [`MAX_SAMPLES_PER_FRAME`] (the lecture's ray
     /// budget P × S: each group of S consecutive paths of a pixel shares its jittered

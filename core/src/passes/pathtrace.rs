@@ -564,7 +564,8 @@ impl PathTracePass {
         let brick = res.volume()?.bind_group(nearest);
         // Sixteenths this frame traces: all that are wanted without a budget, else as many
         // as the budget holds at the rate measured on the device at an earlier frame (read
-        // without waiting), one before any measurement came back, at least one. (Every
+        // without waiting; at most twice the sixteenths measured), one before any
+        // measurement came back, at least one. (Every
         // frame is timed and takes what came back, so the rate is fresh when a budget
         // comes.)
         let rate = self.timer.seconds_per_unit(ctx)?;
@@ -776,13 +777,15 @@ impl Dispatch {
 }
 
 /// Sixteenths a frame with a time budget of `budget` seconds traces, of `wanted`: as many
-/// as fit at `rate` seconds each (the last measured), one while no rate is known, at least
-/// one.
-fn budget_units(budget: f64, rate: Option<f64>, wanted: u64) -> u64 {
+/// as fit at the last measured `rate` (seconds per sixteenth, and the sixteenths it was
+/// measured on), but at most twice as many as that measurement (a rate holds near the work
+/// it was measured on: one too low would otherwise send several frames in flight far over
+/// the budget before it is corrected); one while no rate is known, at least one.
+fn budget_units(budget: f64, rate: Option<(f64, u64)>, wanted: u64) -> u64 {
     let fit = match rate {
         None => 1,
-        Some(t) if t > 0.0 => (budget / t).floor() as u64,
-        Some(_) => wanted,
+        Some((t, work)) if t > 0.0 => ((budget / t).floor() as u64).min(2 * work),
+        Some((_, work)) => 2 * work,
     };
     fit.clamp(1, wanted.max(1))
 }
@@ -816,10 +819,12 @@ mod tests {
     #[test]
     fn budgets_plan_from_the_last_rate() {
         // no rate yet: one sixteenth; then what fits, at least one, at most what is wanted
+        // and twice the work the rate was measured on
         assert_eq!(budget_units(0.1, None, 48), 1);
-        assert_eq!(budget_units(0.1, Some(0.01), 48), 10);
-        assert_eq!(budget_units(0.1, Some(0.3), 48), 1);
-        assert_eq!(budget_units(100.0, Some(0.01), 48), 48);
-        assert_eq!(budget_units(0.1, Some(0.0), 48), 48);
+        assert_eq!(budget_units(0.1, Some((0.01, 16)), 48), 10);
+        assert_eq!(budget_units(0.1, Some((0.01, 2)), 48), 4);
+        assert_eq!(budget_units(0.1, Some((0.3, 16)), 48), 1);
+        assert_eq!(budget_units(100.0, Some((0.01, 32)), 48), 48);
+        assert_eq!(budget_units(0.1, Some((0.0, 8)), 48), 16);
     }
 }
