@@ -565,9 +565,8 @@ impl PathTracePass {
         // Sixteenths this frame traces: all that are wanted without a budget, else as many
         // as the budget holds at the rate measured on the device at an earlier frame (read
         // without waiting; at most twice the sixteenths measured), one before any
-        // measurement came back, at least one. (Every
-        // frame is timed and takes what came back, so the rate is fresh when a budget
-        // comes.)
+        // measurement came back, at least one. (Every frame is timed and takes what came
+        // back, so the rate is fresh when a budget comes.)
         let rate = self.timer.seconds_per_unit(ctx)?;
         let n = if pp.time_budget > 0.0 {
             budget_units(pp.time_budget as f64, rate, wanted)

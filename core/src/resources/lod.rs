@@ -107,7 +107,6 @@ impl Resources {
         let Some(host) = vol.host.clone() else {
             return Ok(false);
         };
-
         let needed = volume::needed_bricks(vol, flags, Some(in_view));
         let count = needed.iter().filter(|&&n| n).count() as u32;
         let capacity = volume::capacity(vol);
