@@ -94,6 +94,8 @@ pub struct Context {
     pub(crate) shaders: std::sync::Arc<ShaderStore>,
     /// The latest submission to the queue ([`Context::submit`]).
     last_submission: std::sync::Arc<Mutex<Option<wgpu::SubmissionIndex>>>,
+    /// Times the host waited for the device ([`Context::device_waits`]).
+    waits: std::sync::Arc<std::sync::atomic::AtomicU64>,
 }
 
 /// The backend sets to try, in order. Without FERROVOL_BACKEND: the native APIs first and
@@ -230,6 +232,7 @@ impl Context {
             memory_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
             shaders: Default::default(),
             last_submission: Default::default(),
+            waits: Default::default(),
         })
     }
 
@@ -293,6 +296,8 @@ impl Context {
         submission: Option<wgpu::SubmissionIndex>,
         what: &str,
     ) -> Result<()> {
+        self.waits
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let polled = self.device.poll(wgpu::PollType::Wait {
             submission_index: submission,
             timeout: None,
@@ -301,6 +306,27 @@ impl Context {
         polled
             .map(|_| ())
             .map_err(|e| Error::Gpu(format!("{what}: {e}")))
+    }
+
+    /// Runs the callbacks of the work the device has finished (mapped readbacks), without
+    /// waiting for any; `what` names the poll in errors.
+    pub(crate) fn poll(&self, what: &str) -> Result<()> {
+        let polled = self.device.poll(wgpu::PollType::Poll);
+        self.check_lost(what)?;
+        polled
+            .map(|_| ())
+            .map_err(|e| Error::Gpu(format!("{what}: {e}")))
+    }
+
+    /// How many times the host has waited for the device on this context and its clones
+    /// (every renderer on it together). Frames wait only where a caller asks for pixels or
+    /// results ([`crate::Renderer::read_image`], [`crate::Renderer::finish`],
+    /// [`crate::Renderer::wait_for_previous_frame`], the accumulation and its convergence),
+    /// and a path-traced frame with a host's depth input (to restart in that frame); besides,
+    /// building an environment and allocating the shared output wait once. The count lets
+    /// a host or a test see that nothing else did.
+    pub fn device_waits(&self) -> u64 {
+        self.waits.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// The buffers, textures and device memory the context holds now.

@@ -117,8 +117,11 @@ pub struct PathTraceParams {
     /// paths per pixel). With a budget a frame adds as many sixteenths of a path per pixel
     /// as fit (16 interleaved subsets of the pixels; during the first pass the pixels not
     /// traced yet show a traced neighbour), at least one sixteenth and at most
-    /// `samples_per_frame` paths per pixel; the time per sixteenth is measured as frames
-    /// go.
+    /// `samples_per_frame` paths per pixel. The time per sixteenth is measured on the
+    /// device (GPU timestamps) and read back a frame or more later, so that no frame waits
+    /// for it: a frame plans from an earlier frame's rate, at most twice the sixteenths that
+    /// rate was measured on (one sixteenth before any came back), and the device time it
+    /// takes follows the budget as the rate holds.
     pub time_budget: f32,
     /// Secondary rays per primary ray, 1 to [`MAX_SAMPLES_PER_FRAME`] (the lecture's ray
     /// budget P × S: each group of S consecutive paths of a pixel shares its jittered

@@ -58,7 +58,10 @@ impl DepthCheck {
 
     /// Compares `depth_in` (width × height) with the depth seen last time and keeps it;
     /// true when any pixel differs, or nothing was seen at this size yet. Waits for the
-    /// device.
+    /// device: the one wait inside a frame, since the accumulation must restart in the
+    /// frame whose depth changed (paths against the new depth added to sums against the old
+    /// would show a wrong image), and the restart decides on the host what the frame
+    /// traces.
     pub fn changed(&mut self, ctx: &Context, depth_in: &wgpu::Texture) -> Result<bool> {
         let (width, height) = (depth_in.width(), depth_in.height());
         let fresh = !self

@@ -16,7 +16,8 @@
 //! Frames accumulate: each [`Renderer::render`](crate::Renderer::render) adds
 //! [`PathTraceParams::samples_per_frame`] paths per pixel to the sums of the frames before
 //! (or, with a [`PathTraceParams::time_budget`], as many sixteenths of a path per pixel as
-//! the budget holds: the pixels in 16 interleaved subsets, timed as they go), until anything
+//! the budget holds at the rate an earlier frame's paths took on the device: the pixels in
+//! 16 interleaved subsets, one submission a frame, timed without waiting), until anything
 //! that changes the image changes (camera, lights, size, render or path tracing parameters
 //! but the paths per frame, the budget and the preview, volume, transfer function,
 //! environment), or until [`PathTraceParams::max_samples`]; the count is
@@ -43,6 +44,7 @@ use crate::gpu::pipeline::{
 use crate::gpu::readback::read_buffer;
 use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
+use crate::gpu::timing::GpuTimer;
 use crate::gpu::uniforms::{
     flag_bits, PathTraceUniforms, ShowUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE,
     PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, UNIFORM_STRIDE,
@@ -61,7 +63,6 @@ use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, 
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
-use std::time::Instant;
 
 /// Subsets of a pass: the pixels of each 4×4 cell in Bayer order (every 4th pixel first,
 /// then the rest of every 2nd, ...), as (x, y) offsets in the cell.
@@ -140,8 +141,8 @@ pub(crate) struct PathTracePass {
     key: String,
     /// Sixteenths of a path per pixel accumulated (passes × 16 + subsets of the next).
     units: u64,
-    /// Seconds one sixteenth took when last measured (frames with a time budget).
-    unit_seconds: Option<f64>,
+    /// The device time of the frames' paths, per sixteenth (read a frame or more later).
+    timer: GpuTimer,
     /// The pixels the accumulation covers (x0, y0, x1, y1).
     rect: [u32; 4],
 }
@@ -228,7 +229,7 @@ impl PathTracePass {
             intermix_binding: IntermixBinding::new(ctx),
             key: String::new(),
             units: 0,
-            unit_seconds: None,
+            timer: GpuTimer::new(ctx, ctx.info.timestamps),
             rect: [0; 4],
         })
     }
@@ -568,86 +569,62 @@ impl PathTracePass {
             .collect::<Vec<_>>(),
         });
         let brick = res.volume()?.bind_group(nearest);
-        let budget = pp.time_budget as f64;
-        let start = Instant::now();
-        let mut added = 0;
-        while added < wanted {
-            // Sixteenths this submission traces: all that are wanted without a budget, else
-            // as many as half the time left holds at the last measured rate, or one where
-            // only one fits (at least one a frame): a machine that gets busier mid-frame
-            // then overshoots by a fraction of what is left, not of the whole budget.
-            let n = match (budget > 0.0, self.unit_seconds) {
-                (false, _) => wanted - added,
-                (true, None) => 1,
-                (true, Some(t)) => {
-                    let left = (budget - start.elapsed().as_secs_f64()) / t;
-                    let fit = if left >= 2.0 {
-                        (0.5 * left).floor() as u64
-                    } else {
-                        u64::from(left >= 1.0)
-                    };
-                    fit.max(u64::from(added == 0)).min(wanted - added)
-                }
-            };
-            if n == 0 {
-                break;
-            }
-            let mut enc = ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("path-traced frame"),
-                });
-            if before + added == 0 {
-                // A new accumulation: no pixel has paths (the shown image reads the counts).
-                enc.clear_buffer(&acc.moments, 0, None);
-                if guided {
-                    enc.clear_buffer(&acc.guide, 0, None);
-                }
-            }
-            let dispatches = plan_dispatches(before + added, n);
-            let mut blocks = vec![0u8; UNIFORM_STRIDE as usize * dispatches.len()];
-            for (i, d) in dispatches.iter().enumerate() {
-                u.counts[1] = d.pass;
-                u.options[3] = d.lattice();
-                let at = UNIFORM_STRIDE as usize * i;
-                blocks[at..at + std::mem::size_of::<PathTraceUniforms>()]
-                    .copy_from_slice(bytemuck::bytes_of(&u));
-            }
-            q.write_buffer(&self.uniforms, 0, &blocks);
-            if rect[2] > rect[0] && rect[3] > rect[1] {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("path tracing"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(1, brick, &[]);
-                for (i, d) in dispatches.iter().enumerate() {
-                    pass.set_bind_group(0, &bg, &[(UNIFORM_STRIDE * i as u64) as u32]);
-                    let gr = d.groups(rect);
-                    pass.dispatch_workgroups(gr[0], gr[1], 1);
-                }
-            }
-            let timed = Instant::now();
-            ctx.checked("rendering the path-traced frame", || {
-                ctx.submit([enc.finish()]);
-            })?;
-            added += n;
-            if budget > 0.0 {
-                ctx.wait_idle()?;
-                self.unit_seconds = Some(timed.elapsed().as_secs_f64() / n as f64);
-            }
-        }
-        self.units = before + added;
-        self.rect = rect;
+        // Sixteenths this frame traces: all that are wanted without a budget, else as many
+        // as the budget holds at the rate measured on the device at an earlier frame (read
+        // without waiting; at most twice the sixteenths measured), one before any
+        // measurement came back, at least one. (Every frame is timed and takes what came
+        // back, so the rate is fresh when a budget comes.)
+        let rate = self.timer.seconds_per_unit(ctx)?;
+        let n = if pp.time_budget > 0.0 {
+            budget_units(pp.time_budget as f64, rate, wanted)
+        } else {
+            wanted
+        };
+        // One submission: the paths, then the image shown.
         let mut enc = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("path-traced image"),
+                label: Some("path-traced frame"),
             });
+        if before == 0 {
+            // A new accumulation: no pixel has paths (the shown image reads the counts).
+            enc.clear_buffer(&acc.moments, 0, None);
+            if guided {
+                enc.clear_buffer(&acc.guide, 0, None);
+            }
+        }
+        let dispatches = plan_dispatches(before, n);
+        let mut blocks = vec![0u8; UNIFORM_STRIDE as usize * dispatches.len()];
+        for (i, d) in dispatches.iter().enumerate() {
+            u.counts[1] = d.pass;
+            u.options[3] = d.lattice();
+            let at = UNIFORM_STRIDE as usize * i;
+            blocks[at..at + std::mem::size_of::<PathTraceUniforms>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        q.write_buffer(&self.uniforms, 0, &blocks);
+        let traced = rect[2] > rect[0] && rect[3] > rect[1];
+        if traced {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("path tracing"),
+                timestamp_writes: self.timer.pass_writes(),
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(1, brick, &[]);
+            for (i, d) in dispatches.iter().enumerate() {
+                pass.set_bind_group(0, &bg, &[(UNIFORM_STRIDE * i as u64) as u32]);
+                let gr = d.groups(rect);
+                pass.dispatch_workgroups(gr[0], gr[1], 1);
+            }
+            drop(pass);
+            self.timer.resolve(&mut enc);
+        }
+        self.units = before + n;
+        self.rect = rect;
         if rect != full {
             clear_outputs(&mut enc, &color_view, &depth_view);
         }
-        if rect[2] > rect[0] && rect[3] > rect[1] {
+        if traced {
             let (show_bgl, show_pipeline, show_uniforms) = &self.show;
             let su = ShowUniforms {
                 rect,
@@ -689,9 +666,12 @@ impl PathTracePass {
                 );
             }
         }
-        ctx.checked("showing the path-traced frame", || {
+        ctx.checked("rendering the path-traced frame", || {
             ctx.submit([enc.finish()]);
         })?;
+        if traced {
+            self.timer.submitted(ctx, n);
+        }
         res.stats.frames += 1;
         Ok(())
     }
@@ -802,6 +782,20 @@ impl Dispatch {
     }
 }
 
+/// Sixteenths a frame with a time budget of `budget` seconds traces, of `wanted`: as many
+/// as fit at the last measured `rate` (seconds per sixteenth, and the sixteenths it was
+/// measured on), but at most twice as many as that measurement (a rate holds near the work
+/// it was measured on: one too low would otherwise send several frames in flight far over
+/// the budget before it is corrected); one while no rate is known, at least one.
+fn budget_units(budget: f64, rate: Option<(f64, u64)>, wanted: u64) -> u64 {
+    let fit = match rate {
+        None => 1,
+        Some((t, work)) if t > 0.0 => ((budget / t).floor() as u64).min(2 * work),
+        Some((_, work)) => 2 * work,
+    };
+    fit.clamp(1, wanted.max(1))
+}
+
 /// The dispatches that trace sixteenths `from .. from + n` of the accumulation: whole passes
 /// where a pass starts and ends inside the range, single subsets elsewhere.
 fn plan_dispatches(from: u64, n: u64) -> Vec<Dispatch> {
@@ -822,4 +816,21 @@ fn plan_dispatches(from: u64, n: u64) -> Vec<Dispatch> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::budget_units;
+
+    #[test]
+    fn budgets_plan_from_the_last_rate() {
+        // no rate yet: one sixteenth; then what fits, at least one, at most what is wanted
+        // and twice the work the rate was measured on
+        assert_eq!(budget_units(0.1, None, 48), 1);
+        assert_eq!(budget_units(0.1, Some((0.01, 16)), 48), 10);
+        assert_eq!(budget_units(0.1, Some((0.01, 2)), 48), 4);
+        assert_eq!(budget_units(0.1, Some((0.3, 16)), 48), 1);
+        assert_eq!(budget_units(100.0, Some((0.01, 32)), 48), 48);
+        assert_eq!(budget_units(0.1, Some((0.0, 8)), 48), 16);
+    }
 }

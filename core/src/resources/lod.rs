@@ -2,7 +2,9 @@
 //! ([`crate::params::RenderParams::preview_level`]): when the bricks in view exceed the memory
 //! budget, the bricks of a coarser level stand in, in the same pool, for the fine bricks not
 //! resident, so that the frame draws in one pass with whatever fine bricks it has. Rays mark
-//! in the request buffer the bricks they read, from a stand-in or not; the next preview frame
+//! in the request buffer the bricks they read, from a stand-in or not; the frame copies it
+//! into a readback ring, and the next preview frame takes the newest copy the device has
+//! finished (without waiting: the last frame's when it is done, else an earlier one's),
 //! keeps the bricks they read and brings some of those they read from a stand-in (nearest
 //! first, a share of the pool per frame), evicting the least recently used. Frames of a
 //! still camera thus converge to the fine image, and the bricks no ray reaches (behind
@@ -10,17 +12,48 @@
 
 use super::bricks::{BrickGrid, FrontToBack};
 use super::residency::NOT_LATER;
-use super::volume::{self, Lod, Needed};
+use super::volume::{self, BrickReads, GpuVolume, Lod, Needed};
 use super::Resources;
 use crate::error::Result;
-use crate::gpu::readback::read_buffer;
-use crate::gpu::uniforms::PAGE_EMPTY;
+use crate::gpu::context::lock;
+use crate::gpu::readback::ReadbackRing;
+use crate::gpu::uniforms::{PAGE_EMPTY, READ_STAND_IN};
 use crate::gpu::Context;
 use crate::params::downsample::{coarse_points, Reduction};
 use std::sync::Arc;
 
 /// A preview frame brings at most 1/UPLOAD_SHARE of the pool's slots of fine bricks.
 const UPLOAD_SHARE: u32 = 4;
+/// Preview frames whose requests can be on their way back at once (a frame finding every
+/// copy still in flight reads none back).
+const REQUEST_COPIES: usize = 3;
+
+impl BrickReads {
+    /// Takes the newest copy the device has finished, if any (the caller polled).
+    fn update(&mut self) {
+        if let Some((_, bytes)) = self.ring.as_mut().and_then(ReadbackRing::take_latest) {
+            self.latest = bytemuck::cast_slice(&bytes).to_vec();
+        }
+    }
+
+    /// Whether the newest frame read back read fine brick `i`.
+    fn read(&self, i: usize) -> bool {
+        self.latest.get(i).is_some_and(|&r| r != 0)
+    }
+}
+
+impl GpuVolume {
+    /// Fine bricks the newest preview frame whose requests came back read from a stand-in
+    /// (0: no stand-in is in the pool, or that frame drew the volume itself).
+    pub fn stand_ins_read(&self) -> u32 {
+        if !self.lod.as_ref().is_some_and(|l| l.active) {
+            return 0;
+        }
+        let mut reads = lock(&self.reads);
+        reads.update();
+        reads.latest.iter().filter(|&&r| r == READ_STAND_IN).count() as u32
+    }
+}
 
 /// Of `grid`'s bricks, the one of the level 2^`shift` times coarser (`coarse`) holding fine
 /// brick `i`.
@@ -85,10 +118,11 @@ impl Resources {
         // The level: the finest whose bricks standing in for every needed brick fit the
         // pool, or a coarser one where that leaves room for every needed brick the last
         // frame read beside the stand-ins of the rest (the frames can then complete).
-        let read: Vec<bool> = match vol.lod.as_ref() {
-            Some(l) => (0..fine).map(|i| needed[i] && l.reads[i] != 0).collect(),
-            None => vec![false; fine],
-        };
+        // (the requests of the newest preview frame the device has finished)
+        ctx.poll("reading back the brick requests")?;
+        let reads = vol.reads.get_mut().unwrap_or_else(|e| e.into_inner());
+        reads.update();
+        let read: Vec<bool> = (0..fine).map(|i| needed[i] && reads.read(i)).collect();
         let reads = read.iter().filter(|&&r| r).count() as u32;
         let stand_ins = |shift: u32, coarse: &BrickGrid, except: &[bool]| {
             let mut s: Vec<usize> = (0..fine)
@@ -127,10 +161,7 @@ impl Resources {
             // (the last level's stand-ins leave first, and with them the page entries)
             self.leave_lod();
             let vol = self.volume.as_mut().expect("a volume");
-            let (reads, mut built) = match vol.lod.take() {
-                Some(l) => (l.reads, l.built),
-                None => (vec![0; fine], Vec::new()),
-            };
+            let mut built = vol.lod.take().map_or_else(Vec::new, |l| l.built);
             let data = match built.iter().find(|(k, _)| *k == (shift, reduction)) {
                 Some((_, data)) => data.clone(),
                 None => {
@@ -145,7 +176,6 @@ impl Resources {
                 grid: coarse,
                 host: data,
                 active: false,
-                reads,
                 built,
             });
         }
@@ -167,11 +197,7 @@ impl Resources {
         let mut free = capacity - children.iter().filter(|&&c| c > 0).count() as u32;
         let mut uploads = (capacity / UPLOAD_SHARE).max(1);
         let mut wanted = Vec::new();
-        for &b in front
-            .order
-            .iter()
-            .filter(|&&b| needed[b] && lod.reads[b] != 0)
-        {
+        for &b in front.order.iter().filter(|&&b| read[b]) {
             let resident = vol.slots.slot_of(b).is_some();
             if free == 0 || (!resident && uploads == 0) {
                 continue;
@@ -207,13 +233,26 @@ impl Resources {
         Ok(true)
     }
 
-    /// After a preview frame [`Resources::enter_lod`] prepared: what its rays read.
+    /// After a preview frame [`Resources::enter_lod`] prepared was submitted: copies what
+    /// its rays read into the readback ring, for a later preview frame to take once the
+    /// device has finished it (never waiting: with every copy still in flight, this frame's
+    /// is skipped).
     pub fn read_lod_requests(&mut self, ctx: &Context) -> Result<()> {
-        let vol = self.volume.as_mut().expect("a volume");
-        let bytes = read_buffer(ctx, &vol.requests)?;
-        if let Some(lod) = vol.lod.as_mut() {
-            lod.reads = bytemuck::cast_slice(&bytes).to_vec();
-        }
+        let vol = self.volume.as_mut().ok_or_else(super::no_volume)?;
+        let size = vol.requests.size();
+        let reads = vol.reads.get_mut().unwrap_or_else(|e| e.into_inner());
+        let ring = reads.ring.get_or_insert_with(|| {
+            ReadbackRing::new(ctx, "brick requests readback", size, REQUEST_COPIES)
+        });
+        let Some(slot) = ring.record() else {
+            return Ok(());
+        };
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&vol.requests, 0, ring.buffer(slot), 0, size);
+        ctx.checked("reading back the brick requests", || {
+            ctx.submit([enc.finish()]);
+        })?;
+        ring.submitted(slot, 0);
         Ok(())
     }
 

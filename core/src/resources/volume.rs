@@ -12,14 +12,15 @@ use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{bind, sampled_texture_entry};
 use crate::gpu::buffers::{buffer, uniform_buffer};
+use crate::gpu::readback::ReadbackRing;
 use crate::gpu::slots;
 use crate::gpu::texture::{block_grid, block_grid_texture, upload_region, upload_texture};
-use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS, READ_STAND_IN};
+use crate::gpu::uniforms::{PoolUniforms, PAGE_EMPTY, PAGE_MISSING, PAGE_SLOT_BITS};
 use crate::gpu::Context;
 use crate::params::downsample::Reduction;
 use crate::params::{MaskKind, Residency, UploadOptions, VolumeData};
 use glam::DMat4;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// A rectilinear grid's lookup's layout entry (lib/rectilinear.wgsl).
 pub(crate) fn grid_lookup_layout_entry() -> wgpu::BindGroupLayoutEntry {
@@ -125,12 +126,25 @@ pub(crate) struct GpuVolume {
     pub(super) requests: wgpu::Buffer,
     /// The coarser level whose bricks stand in for missing ones in preview frames.
     pub(super) lod: Option<Lod>,
+    /// What preview frames' rays read, as their requests come back (lod.rs; a lock:
+    /// [`GpuVolume::residency`] takes what came back).
+    pub(super) reads: Mutex<BrickReads>,
     constants: wgpu::Texture,
     uniform: wgpu::Buffer,
     /// Bind groups through the linear and the nearest sampler, once the pool exists.
     pub(super) groups: Option<[wgpu::BindGroup; 2]>,
     /// What the volume was uploaded with (its coarser levels are uploaded alike).
     pub opts: UploadOptions,
+}
+
+/// What preview frames' rays read, as it comes back from the device (lod.rs).
+#[derive(Default)]
+pub(crate) struct BrickReads {
+    /// Copies of the request buffer on their way back (made at the first preview frame).
+    pub(super) ring: Option<ReadbackRing>,
+    /// Per fine brick, what the rays of the newest preview frame whose copy came back read
+    /// there (0: nothing; empty before any came back).
+    pub(super) latest: Vec<u32>,
 }
 
 /// A coarser level of the volume whose bricks stand in for fine ones in preview frames
@@ -147,22 +161,9 @@ pub(crate) struct Lod {
     pub host: Arc<VolumeData>,
     /// The level's bricks are in the slots, by ids after the volume's bricks.
     pub active: bool,
-    /// Per fine brick, what the last preview frame's rays read there (0: nothing).
-    pub reads: Vec<u32>,
     /// The levels built so far, by shift and reduction (kept: the level a preview takes
     /// follows what its rays read, and building one reads the whole volume).
     pub built: Vec<((u32, Reduction), Arc<VolumeData>)>,
-}
-
-impl Lod {
-    /// Fine bricks the last preview frame read from a stand-in (0: it drew the volume).
-    pub fn stand_ins_read(&self) -> u32 {
-        if self.active {
-            self.reads.iter().filter(|&&r| r == READ_STAND_IN).count() as u32
-        } else {
-            0
-        }
-    }
 }
 
 impl GpuVolume {
@@ -198,7 +199,7 @@ impl GpuVolume {
             dense_bytes: bytes(self.data_dims),
             level: 1,
             level_dims: self.data_dims,
-            stand_ins: self.lod.as_ref().map_or(0, |l| l.stand_ins_read()),
+            stand_ins: self.stand_ins_read(),
         }
     }
 }
@@ -333,6 +334,7 @@ pub(super) fn new_volume(
         page_table,
         requests,
         lod: None,
+        reads: Default::default(),
         constants,
         uniform,
         groups: None,
