@@ -45,6 +45,8 @@ pub(crate) struct GpuTimer {
     recording: Option<usize>,
     /// The newest measurement: seconds per unit, units.
     latest: Option<(f64, u64)>,
+    /// The measurements' running mean (seconds per unit; each new one weighs a quarter).
+    mean: Option<f64>,
 }
 
 impl GpuTimer {
@@ -71,6 +73,7 @@ impl GpuTimer {
             observed: VecDeque::new(),
             recording: None,
             latest: None,
+            mean: None,
         }
     }
 
@@ -127,18 +130,22 @@ impl GpuTimer {
         }
     }
 
-    /// Device seconds per unit of work of the newest timed submission that has come back
-    /// (polling the device, never waiting), or of the one before if none has since, with
-    /// the units it did; None before any.
+    /// Device seconds per unit of work that a budget should plan with, and the units of the
+    /// newest timed submission that has come back (polling the device, never waiting), or
+    /// of the one before if none has since; None before any. The rate is the newest
+    /// measurement's or the running mean's, whichever is slower: one measurement that came
+    /// out fast (lavapipe's vary by a factor of two from frame to frame) would otherwise
+    /// send the next frames over their budget.
     pub(crate) fn seconds_per_unit(&mut self, ctx: &Context) -> Result<Option<(f64, u64)>> {
         ctx.poll("reading the device's timestamps")?;
         let rate = |seconds: f64, work: u64| (work > 0).then(|| (seconds / work as f64, work));
+        let mut measured = Vec::new();
         match self.timestamps.as_mut() {
             Some(ts) => {
                 if let Some((work, bytes)) = ts.ring.take_latest() {
                     let t: &[u64] = bytemuck::cast_slice(&bytes);
                     let ticks = t[1].saturating_sub(t[0]) as f64;
-                    self.latest = rate(ticks * ts.period * 1e-9, work).or(self.latest);
+                    measured.extend(rate(ticks * ts.period * 1e-9, work));
                 }
             }
             None => {
@@ -146,12 +153,18 @@ impl GpuTimer {
                     let done = *o.done.lock().unwrap_or_else(|e| e.into_inner());
                     let Some(done) = done else { break };
                     let seconds = done.duration_since(o.submitted).as_secs_f64();
-                    self.latest = rate(seconds, o.work).or(self.latest);
+                    measured.extend(rate(seconds, o.work));
                     self.observed.pop_front();
                 }
             }
         }
-        Ok(self.latest)
+        for (r, work) in measured {
+            self.mean = Some(self.mean.map_or(r, |m| m + 0.25 * (r - m)));
+            self.latest = Some((r, work));
+        }
+        Ok(self
+            .latest
+            .map(|(r, work)| (r.max(self.mean.unwrap_or(r)), work)))
     }
 }
 
