@@ -65,8 +65,7 @@ typedef enum FvStatus {
   FV_STATUS_INVALID_ARGUMENT = 2,
   /**
    * The device or this build cannot do what was asked (e.g. no shared-memory export), or
-   * the settings combine what ray casting or isosurfaces do not draw (docs/REFUSALS.md
-   * lists them).
+   * the settings combine what a pass does not draw (docs/REFUSALS.md lists them).
    */
   FV_STATUS_UNSUPPORTED = 3,
   /**

@@ -16,8 +16,7 @@ pub enum FvStatus {
     /// An argument is out of range or inconsistent (the message names it).
     InvalidArgument = 2,
     /// The device or this build cannot do what was asked (e.g. no shared-memory export), or
-    /// the settings combine what ray casting or isosurfaces do not draw (docs/REFUSALS.md
-    /// lists them).
+    /// the settings combine what a pass does not draw (docs/REFUSALS.md lists them).
     Unsupported = 3,
     /// A GPU or host allocation failed.
     OutOfMemory = 4,

@@ -581,44 +581,61 @@ mod tests {
         out
     }
 
-    /// docs/REFUSALS.md: every refusal of the ray-casting and isosurface matrices, its
-    /// condition and the messages it gives, in the order the passes check them.
-    fn refusals_doc() -> String {
-        let mut dvr = std::collections::BTreeMap::new();
-        matrix(|x| {
+    /// The messages of the refusals `select` gives over a matrix of frames (`walk` calls
+    /// its argument on each), by when they happen.
+    fn rows<X, V, R>(
+        walk: impl FnOnce(&mut dyn FnMut(&X)),
+        select: fn(&X) -> Result<V, R>,
+        when: fn(R) -> (u8, &'static str),
+    ) -> std::collections::BTreeMap<(u8, &'static str), std::collections::BTreeSet<String>>
+    where
+        R: Copy + std::fmt::Debug,
+        Error: From<R>,
+    {
+        let mut rows = std::collections::BTreeMap::new();
+        walk(&mut |x: &X| {
             if let Err(r) = select(x) {
                 let Error::Unsupported(m) = Error::from(r) else {
                     panic!("{r:?} is not Unsupported")
                 };
-                dvr.entry(when(r))
+                rows.entry(when(r))
                     .or_insert_with(std::collections::BTreeSet::new)
                     .insert(m);
             }
         });
-        let mut iso = std::collections::BTreeMap::new();
-        crate::passes::iso_variant::tests::matrix(|x| {
-            if let Err(r) = crate::passes::iso_variant::select(x) {
-                let Error::Unsupported(m) = Error::from(r) else {
-                    panic!("{r:?} is not Unsupported")
-                };
-                iso.entry(crate::passes::iso_variant::tests::when(r))
-                    .or_insert_with(std::collections::BTreeSet::new)
-                    .insert(m);
-            }
-        });
+        rows
+    }
+
+    /// docs/REFUSALS.md: every refusal of the ray-casting, isosurface and path-tracing
+    /// matrices, its condition and the messages it gives, in the order the passes check them.
+    fn refusals_doc() -> String {
+        use crate::passes::{iso_variant, pathtrace_variant};
+        let dvr = rows(|each| matrix(each), select, when);
+        let iso = rows(
+            |each| iso_variant::tests::matrix(each),
+            iso_variant::select,
+            iso_variant::tests::when,
+        );
+        let pt = rows(
+            |each| pathtrace_variant::tests::matrix(each),
+            pathtrace_variant::select,
+            pathtrace_variant::tests::when,
+        );
         format!(
-            "<!-- Generated from core/src/passes/dvr_variant.rs and iso_variant.rs by their \
-             tests: FERROVOL_UPDATE_DOCS=1 cargo test -p ferrovol-core --lib refusals -->\n\
-             # What ray casting and isosurfaces refuse\n\n\
-             The combinations of settings the ray-casting and isosurface passes do not draw, \
-             each with the error it gives: `Error::Unsupported` in Rust, \
+            "<!-- Generated from core/src/passes/dvr_variant.rs, iso_variant.rs and \
+             pathtrace_variant.rs by their tests: FERROVOL_UPDATE_DOCS=1 cargo test -p \
+             ferrovol-core --lib refusals -->\n\
+             # What the passes refuse\n\n\
+             The combinations of settings the ray-casting, isosurface and path-tracing passes \
+             do not draw, each with the error it gives: `Error::Unsupported` in Rust, \
              FV_STATUS_UNSUPPORTED and the message from the C ABI, vtkErrorMacro in VTK and \
              ParaView, an error from the CLI. Each message names the way out. The list is \
              written once, in the code (each pass's variant selection, a pure function of \
              the frame's facts); this page is generated from it, and a test keeps it \
-             current.\n\n## Ray casting\n\n{}\n## Isosurfaces\n\n{}",
+             current.\n\n## Ray casting\n\n{}\n## Isosurfaces\n\n{}\n## Path tracing\n\n{}",
             table(&dvr),
-            table(&iso)
+            table(&iso),
+            table(&pt)
         )
     }
 

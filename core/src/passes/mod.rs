@@ -11,6 +11,7 @@ pub(crate) mod iso;
 pub(crate) mod iso_variant;
 pub(crate) mod medium;
 pub(crate) mod pathtrace;
+pub(crate) mod pathtrace_variant;
 pub(crate) mod scatter_check;
 
 #[cfg(test)]

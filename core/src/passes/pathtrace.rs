@@ -32,28 +32,27 @@ use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::depth_check::DepthCheck;
 use super::frame::{self, groups, FrameInput};
 use super::medium;
+use super::pathtrace_variant::{self, PathTraceFacts, PathTraceVariant};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, bind_block, buffer_entry, dynamic_uniform_entry, sampled_texture_entry, sampler_entry,
     storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::{
-    encode_single_group, pipeline_variant, single_group_pipeline, PipelineCache,
-};
+use crate::gpu::pipeline::{encode_single_group, single_group_pipeline, PipelineCache};
 use crate::gpu::readback::read_buffer;
 use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::uniforms::{
-    flag_bits, PathTraceUniforms, ShowUniforms, MASK_BINARY, MASK_LABELS, MASK_NONE,
-    PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND, PT_FLAG_GUIDE, UNIFORM_STRIDE,
+    flag_bits, PathTraceUniforms, ShowUniforms, PT_FLAG_ATTENUATION, PT_FLAG_BACKGROUND,
+    PT_FLAG_GUIDE, UNIFORM_STRIDE,
 };
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, Convergence, GradientMethod, Interpolation, MaskKind, PathTraceParams, RenderParams,
-    ScatterRegions, Shading, TransferFunction,
+    BlendMode, Convergence, PathTraceParams, RenderParams, ScatterRegions, Shading,
+    TransferFunction,
 };
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{empty_distances, tables_2d_layout_entry, Tables};
@@ -276,36 +275,6 @@ impl PathTracePass {
     }
 }
 
-pipeline_variant! {
-    /// The pipeline constants of one specialisation of the path tracer.
-    struct PathTraceVariant {
-        /// Nearest table lookups.
-        nearest: bool => "NEAREST",
-        /// The BSDF and the scattering regions (anything but Henyey–Greenstein everywhere).
-        hybrid: bool => "HYBRID",
-        /// The denoiser's guide.
-        guide: bool => "GUIDE",
-        /// Forward-difference gradients (FORWARD_DIFF in lib/volume.wgsl).
-        forward_diff: bool => "FORWARD_DIFF",
-        /// The volume is one brick (lib/volume.wgsl).
-        single_brick: bool => "SINGLE_BRICK",
-        /// Cropping regions.
-        crop: bool => "CROP",
-        /// What the mask does (MASK_NONE, MASK_BINARY or MASK_LABELS).
-        mask: u32 => "MASK",
-        /// VTK's blanking (lib/blanking.wgsl): the medium is empty at blanked samples.
-        blanking: bool => "BLANKING",
-        /// A rectilinear grid (lib/rectilinear.wgsl).
-        rectilinear: bool => "RECTILINEAR",
-        /// 1: the medium's colour and opacity from the 2D table (lib/table2d.wgsl).
-        tables_2d: u32 => "TF2D",
-        /// Number of volumes intermixed with the main one.
-        intermix: u32 => "INTERMIX",
-        /// The intermixed volumes' atlas is read through a linear sampler.
-        intermix_filtered: bool => "INTERMIX_FILTERED",
-    }
-}
-
 impl PathTracePass {
     /// Starts the accumulation over at the next path-traced frame.
     pub fn reset_accumulation(&mut self) {
@@ -349,35 +318,28 @@ impl PathTracePass {
         let pp = *pp;
         pp.validate()?;
         let vol = res.volume()?;
-        if params.interpolation == Interpolation::Cubic {
-            return Err(Error::Unsupported(
-                "path tracing samples the trilinear field: cubic interpolation is for ray \
-                 casting"
-                    .into(),
-            ));
-        }
-        if vol.components != 1 {
-            return Err(Error::Unsupported(format!(
-                "path tracing renders one-component volumes (this one has {} components): \
-                 extract one (vtkImageExtractComponents) or use ray casting",
-                vol.components
-            )));
-        }
         let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
-        let rectilinear = vol.grid_lookup.is_some();
-        if intermix > 0
-            && (params.cropping.is_some()
-                || res.mask.is_some()
-                || res.blanking.is_some()
-                || rectilinear)
-        {
-            return Err(Error::Unsupported(
-                "intermixed volumes are path traced with a uniform main volume without \
-                 cropping, a mask or blanking: clear the intermixed volumes or turn those off"
-                    .into(),
-            ));
-        }
-        let single_brick = vol.single_brick();
+        let table_2d = res.tf.as_ref().is_some_and(TransferFunction::has_2d);
+        let guided = pp.denoise || pp.denoise_until > 0;
+        let variant = pathtrace_variant::select(&PathTraceFacts {
+            interpolation: params.interpolation,
+            gradient: params.gradient,
+            components: vol.components,
+            single_brick: vol.single_brick(),
+            rectilinear: vol.grid_lookup.is_some(),
+            cropping: params.cropping.is_some(),
+            mask: res.mask_kind(),
+            labels_apply: params.mask_blend > 0.0
+                && res.tf.as_ref().is_some_and(|tf| tf.max_label() > 0),
+            blanking: res.blanking.is_some(),
+            tables_2d: table_2d,
+            hybrid: pp.gradient_threshold.is_finite()
+                || pp.stochastic_blend > 0.0
+                || pp.scatter != ScatterRegions::Everywhere,
+            guided,
+            intermix,
+            float32_filterable: ctx.info.float32_filterable,
+        })?;
         frame::check_light_count(view)?;
         let unit = res
             .tf
@@ -385,7 +347,6 @@ impl PathTracePass {
             .map_or(1.0, |tf| tf.component(0).unit_distance);
         let step = res.sample_distance(params)?;
         res.ensure_tables(ctx, step)?;
-        let table_2d = res.tf.as_ref().is_some_and(TransferFunction::has_2d);
         if table_2d {
             res.ensure_tables_2d(ctx)?;
         }
@@ -431,32 +392,6 @@ impl PathTracePass {
             res.generation,
             (res.mask_generation, res.intermix_generation)
         );
-        let nearest = params.interpolation == Interpolation::Nearest;
-        let guided = pp.denoise || pp.denoise_until > 0;
-        let variant = PathTraceVariant {
-            nearest,
-            hybrid: pp.gradient_threshold.is_finite()
-                || pp.stochastic_blend > 0.0
-                || pp.scatter != ScatterRegions::Everywhere,
-            guide: guided,
-            forward_diff: params.gradient == GradientMethod::Forward,
-            single_brick,
-            crop: params.cropping.is_some(),
-            mask: match res.mask_kind() {
-                Some(MaskKind::Binary) => MASK_BINARY,
-                Some(MaskKind::LabelMap)
-                    if params.mask_blend > 0.0 && res.transfer_function()?.max_label() > 0 =>
-                {
-                    MASK_LABELS
-                }
-                _ => MASK_NONE,
-            },
-            blanking: res.blanking.is_some(),
-            rectilinear,
-            tables_2d: u32::from(table_2d),
-            intermix,
-            intermix_filtered: intermix > 0 && ctx.info.float32_filterable,
-        };
         let pipeline = self.pipelines.get(ctx, variant)?;
         self.ensure_accum(ctx, view.width, view.height)?;
         if guided && self.denoise.is_none() {
@@ -568,7 +503,7 @@ impl PathTracePass {
             .chain(self.intermix_binding.entries(res.intermix.as_ref()))
             .collect::<Vec<_>>(),
         });
-        let brick = res.volume()?.bind_group(nearest);
+        let brick = res.volume()?.bind_group(variant.nearest);
         // Sixteenths this frame traces: all that are wanted without a budget, else as many
         // as the budget holds at the rate measured on the device at an earlier frame (read
         // without waiting; at most twice the sixteenths measured), one before any
