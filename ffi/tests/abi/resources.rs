@@ -215,6 +215,25 @@ fn path_tracing_past_the_budget_reports_its_level() {
     assert!(res.stand_ins > 0 && res.level == 1, "{res:?}");
 }
 
+/// The device-memory tests' scene on `s`: a 16³ f32 ramp along x (0 to 15), then
+/// [`small_scene_view`].
+fn small_scene(s: &mut Session) {
+    let n = 16usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
+    small_scene_view(s);
+}
+
+/// White to orange over the ramp, opacity rising to 1, seen from +z: what a renderer made
+/// again for `small_scene`'s volume needs to draw it the same.
+fn small_scene_view(s: &mut Session) {
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
+        &[0.0, 0.0, 15.0, 1.0],
+    );
+    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+}
+
 /// The context's device memory counters: a renderer's frames allocate once (repeated
 /// frames hold the same buffers and textures), and a renderer freed and made again holds no
 /// more than the first one did.
@@ -222,8 +241,6 @@ fn path_tracing_past_the_budget_reports_its_level() {
 fn device_memory_stays_flat_over_frames_and_renderers() {
     type Memory = unsafe extern "C" fn(H, *mut ferrovol::FvDeviceMemory) -> FvStatus;
     let lib = Lib::open();
-    let n = 16usize;
-    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
     let mut s = Session::new(&lib);
     let memory = lib.f::<Memory>("fv_context_device_memory");
     let read = |s: &Session| {
@@ -234,12 +251,7 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
     };
     // SAFETY: a NULL out-pointer is refused, not written.
     unsafe { lib.expect(memory(s.ctx, null_mut()), Null, "memory") };
-    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
-    s.set_transfer_function(
-        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-        &[0.0, 0.0, 15.0, 1.0],
-    );
-    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    small_scene(&mut s);
     s.frame(24, 24);
     let first = read(&s);
     for _ in 0..5 {
@@ -264,11 +276,7 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
             lib.ok(lib.f::<NewRenderer>("fv_renderer_new")(s.ctx, &mut s.r));
             lib.ok(lib.f::<SetH>("fv_renderer_set_volume")(s.r, s.volume));
         }
-        s.set_transfer_function(
-            &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-            &[0.0, 0.0, 15.0, 1.0],
-        );
-        s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+        small_scene_view(&mut s);
         s.frame(24, 24);
         s.frame(24, 24);
     }
@@ -286,15 +294,8 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
 #[test]
 fn out_of_memory_is_reported_and_the_renderer_recovers() {
     let lib = Lib::open();
-    let n = 16usize;
-    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
     let mut s = Session::new(&lib);
-    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
-    s.set_transfer_function(
-        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-        &[0.0, 0.0, 15.0, 1.0],
-    );
-    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    small_scene(&mut s);
     let before = s.frame(24, 24).to_vec();
     assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
     type Limit = unsafe extern "C" fn(H, u64) -> FvStatus;
@@ -330,18 +331,8 @@ fn out_of_memory_is_reported_and_the_renderer_recovers() {
 #[test]
 fn device_loss_is_reported_and_a_new_context_draws() {
     let lib = Lib::open();
-    let n = 16usize;
-    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
-    let scene = |s: &mut Session| {
-        s.set_volume([16, 16, 16], FvScalarType::F32, &data);
-        s.set_transfer_function(
-            &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-            &[0.0, 0.0, 15.0, 1.0],
-        );
-        s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
-    };
     let mut s = Session::new(&lib);
-    scene(&mut s);
+    small_scene(&mut s);
     let before = s.frame(24, 24).to_vec();
     assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
     let render = lib.f::<Render>("fv_renderer_render");
@@ -357,7 +348,7 @@ fn device_loss_is_reported_and_a_new_context_draws() {
     }
     drop(s);
     let mut fresh = Session::new(&lib);
-    scene(&mut fresh);
+    small_scene(&mut fresh);
     assert_eq!(
         fresh.frame(24, 24),
         &before[..],
