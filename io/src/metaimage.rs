@@ -274,28 +274,19 @@ fn plan(bytes: &[u8]) -> Result<Plan, ReadError> {
     let (_, file_value) = h
         .get(&["ElementDataFile"])
         .ok_or_else(|| bad("no ElementDataFile line"))?;
-    if file_value.eq_ignore_ascii_case("LOCAL") {
-        return Ok(Plan {
-            layout,
-            geometry,
-            binary,
-            big_endian,
-            compressed,
-            header_size,
-            file: None,
-            data_start,
-        });
-    }
-    if file_value.eq_ignore_ascii_case("LIST") || file_value.contains('%') {
+    let file = if file_value.eq_ignore_ascii_case("LOCAL") {
+        None
+    } else if file_value.eq_ignore_ascii_case("LIST") || file_value.contains('%') {
         return Err(ReadError::unsupported(format!(
             "ElementDataFile = {file_value}: data split over several files; merge the slices into one volume (e.g. save it again as .mha)"
         )));
-    }
-    if file_value.is_empty() {
+    } else if file_value.is_empty() {
         return Err(bad(
             "ElementDataFile is empty; it must be LOCAL or a file name",
         ));
-    }
+    } else {
+        Some(file_value.to_string())
+    };
     Ok(Plan {
         layout,
         geometry,
@@ -303,7 +294,7 @@ fn plan(bytes: &[u8]) -> Result<Plan, ReadError> {
         big_endian,
         compressed,
         header_size,
-        file: Some(file_value.to_string()),
+        file,
         data_start,
     })
 }
