@@ -1,4 +1,4 @@
-"""The VTK set-up the Python examples share: a vtkVolumeProperty from transfer-function
+"""The VTK set-up the Python examples share: transfer functions and a vtkVolumeProperty from
 points, an off-screen window and its PNG. The examples import it from their own folder
 (Python puts a script's folder on its path), so run them where they stand:
 
@@ -9,17 +9,27 @@ bench/multi_volume.py and the VTK module's tests (vtk_plugin/tests/fvtest.py) us
 import vtk
 
 
+def color_function(points):
+    """A vtkColorTransferFunction through (value, r, g, b) points."""
+    color = vtk.vtkColorTransferFunction()
+    for x, r, g, b in points:
+        color.AddRGBPoint(x, r, g, b)
+    return color
+
+
+def opacity_function(points):
+    """A vtkPiecewiseFunction through (value, y) points."""
+    function = vtk.vtkPiecewiseFunction()
+    for x, y in points:
+        function.AddPoint(x, y)
+    return function
+
+
 def volume_property(colors, opacities):
     """A vtkVolumeProperty from (value, r, g, b) colour points and (value, opacity) points."""
-    color = vtk.vtkColorTransferFunction()
-    for x, r, g, b in colors:
-        color.AddRGBPoint(x, r, g, b)
-    opacity = vtk.vtkPiecewiseFunction()
-    for x, a in opacities:
-        opacity.AddPoint(x, a)
     prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
+    prop.SetColor(color_function(colors))
+    prop.SetScalarOpacity(opacity_function(opacities))
     return prop
 
 

@@ -22,7 +22,8 @@ from ferrovol_testing.metrics import (  # noqa: E402,F401  (re-exported for the 
     coverage, difference_image, luminance, psnr, ssim)
 from ferrovol_testing.png import write_png  # noqa: E402
 sys.path.append(os.path.join(ROOT, "vtk_plugin", "examples"))
-from volume_scene import volume_property  # noqa: E402
+from volume_scene import (  # noqa: E402,F401  (the function helpers re-exported for the suites)
+    color_function, opacity_function, volume_property)
 # The VTK under test: (major, minor), for the thresholds that differ between VTK versions.
 VTK_VERSION = (vtk.vtkVersion.GetVTKMajorVersion(), vtk.vtkVersion.GetVTKMinorVersion())
 OUTPUT = os.environ.get("FERROVOL_TEST_OUTPUT", os.path.join(ROOT, "build", "vtk", "test-images"))

@@ -772,14 +772,8 @@ class Settings(unittest.TestCase):
 
     def test_gray_transfer_function(self):
         p = vtk.vtkVolumeProperty()
-        gray = vtk.vtkPiecewiseFunction()
-        gray.AddPoint(37.0, 0.0)
-        gray.AddPoint(277.0, 1.0)
-        otf = vtk.vtkPiecewiseFunction()
-        otf.AddPoint(37.0, 0.0)
-        otf.AddPoint(277.0, 0.8)
-        p.SetColor(gray)
-        p.SetScalarOpacity(otf)
+        p.SetColor(fvtest.opacity_function([(37.0, 0.0), (277.0, 1.0)]))
+        p.SetScalarOpacity(fvtest.opacity_function([(37.0, 0.0), (277.0, 0.8)]))
         self.assertEqual(p.GetColorChannels(), 1)
         img, _ = self.render(prop=p)
         lit = img.max(axis=2) > 8
