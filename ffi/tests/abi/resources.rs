@@ -224,6 +224,14 @@ fn small_scene(s: &mut Session) {
     small_scene_view(s);
 }
 
+/// [`small_scene`] on `s` and its 24 × 24 frame, checked to show the volume.
+fn small_scene_frame(s: &mut Session) -> Vec<u8> {
+    small_scene(s);
+    let frame = s.frame(24, 24).to_vec();
+    assert!(frame.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    frame
+}
+
 /// White to orange over the ramp, opacity rising to 1, seen from +z: what a renderer made
 /// again for `small_scene`'s volume needs to draw it the same.
 fn small_scene_view(s: &mut Session) {
@@ -295,9 +303,7 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
 fn out_of_memory_is_reported_and_the_renderer_recovers() {
     let lib = Lib::open();
     let mut s = Session::new(&lib);
-    small_scene(&mut s);
-    let before = s.frame(24, 24).to_vec();
-    assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    let before = small_scene_frame(&mut s);
     type Limit = unsafe extern "C" fn(H, u64) -> FvStatus;
     let limit = lib.f::<Limit>("fv_context_limit_device_memory");
     let render = lib.f::<Render>("fv_renderer_render");
@@ -332,9 +338,7 @@ fn out_of_memory_is_reported_and_the_renderer_recovers() {
 fn device_loss_is_reported_and_a_new_context_draws() {
     let lib = Lib::open();
     let mut s = Session::new(&lib);
-    small_scene(&mut s);
-    let before = s.frame(24, 24).to_vec();
-    assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    let before = small_scene_frame(&mut s);
     let render = lib.f::<Render>("fv_renderer_render");
     // SAFETY: a valid context (NULL is ignored) and renderer.
     unsafe {
