@@ -13,6 +13,7 @@ ratio to VTK's.
 Needs `. build/env.sh` (the ferrovol Python module) and an X display (scripts/with-xvfb.sh).
 """
 import argparse
+import os
 import statistics
 import sys
 import time
@@ -20,17 +21,13 @@ import time
 import vtk
 import ferrovol
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "vtk_plugin",
+                                "examples"))
+from volume_scene import offscreen_window, volume_property  # noqa: E402
+
 
 def prop(colors, opacities, unit_distance, shade):
-    color = vtk.vtkColorTransferFunction()
-    for x, r, g, b in colors:
-        color.AddRGBPoint(x, r, g, b)
-    opacity = vtk.vtkPiecewiseFunction()
-    for x, a in opacities:
-        opacity.AddPoint(x, a)
-    p = vtk.vtkVolumeProperty()
-    p.SetColor(color)
-    p.SetScalarOpacity(opacity)
+    p = volume_property(colors, opacities)
     p.SetScalarOpacityUnitDistance(unit_distance)
     p.SetInterpolationTypeToLinear()
     p.SetShade(shade)
@@ -67,10 +64,7 @@ class Scene:
             self.keep += [src, vol]
         self.ren = vtk.vtkRenderer()
         self.ren.AddVolume(self.multi)
-        self.win = vtk.vtkRenderWindow()
-        self.win.SetOffScreenRendering(1)
-        self.win.SetSize(size, size)
-        self.win.AddRenderer(self.ren)
+        self.win = offscreen_window(self.ren, size)
         self.ren.ResetCamera()
         cam = self.ren.GetActiveCamera()
         cam.Azimuth(30.0)

@@ -18,7 +18,7 @@ use common::gpu::{renderer, trace};
 use common::images::save_rgb;
 use common::metrics::{self, srgb8};
 use common::pathtracer::{reference, Hybrid, Intermixed, Reference, Scene};
-use common::scenes::volume;
+use common::scenes::{oblique, volume};
 
 /// Voxels per edge of the volume.
 const DIMS: usize = 20;
@@ -56,15 +56,11 @@ fn bump_scene(r: &mut Renderer, size: u32, zoom: f64, p: &PathTraceParams) -> (V
     let mut env = Environment::hemisphere(above, below);
     env.up = DVec3::new(0.3, 1.0, -0.2).normalize();
     r.set_environment(&env).unwrap();
-    // An oblique perspective view; the headlight dimmed and a strong warm light from the
-    // left and a little behind (a bright rim where forward scattering carries it).
-    let bounds = vol.bounds();
-    let mut view = View::fit(bounds, size, size);
-    view.camera.azimuth(30.0);
-    view.camera.elevation(20.0);
-    view.camera.orthogonalize_view_up();
+    // An oblique perspective view, zoomed (the view angle only: the clipping range stays);
+    // the headlight dimmed and a strong warm light from the left and a little behind (a
+    // bright rim where forward scattering carries it).
+    let mut view = oblique(&vol, size);
     view.camera.zoom(zoom);
-    view.camera.reset_clipping_range(bounds);
     view.lights[0].intensity = 0.5;
     let mut sun = Light::directional(DVec3::new(-100.0, 50.0, -20.0), DVec3::ZERO, 5.0);
     sun.diffuse = [1.0, 0.8, 0.55];

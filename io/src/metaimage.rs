@@ -113,29 +113,20 @@ pub fn parse(
     bytes: &[u8],
     data_file: impl FnOnce(&str) -> Result<Vec<u8>, ReadError>,
 ) -> Result<VolumeData, ReadError> {
-    let Plan {
-        layout,
-        geometry,
-        binary,
-        big_endian,
-        compressed,
-        header_size,
-        file,
-        data_start,
-    } = plan(bytes)?;
-    let Some(file_value) = file else {
-        let data = bytes.get(data_start..).unwrap_or(&[]);
-        let scalars = decode(data, layout, binary, big_endian, compressed)?;
-        return layout.volume(geometry, scalars);
+    let p = plan(bytes)?;
+    let Some(file_value) = p.file.as_deref() else {
+        let data = bytes.get(p.data_start..).unwrap_or(&[]);
+        let scalars = decode(data, p.layout, p.binary, p.big_endian, p.compressed)?;
+        return p.layout.volume(p.geometry, scalars);
     };
-    let file_value = file_value.as_str();
     let external = data_file(file_value)?;
     let in_data_file = |e: ReadError| e.in_file(Path::new(file_value));
+    let header_size = p.header_size;
     let skipped = match usize::try_from(header_size) {
         Ok(skip) => skip,
         // -1: the data is at the end of the file.
-        Err(_) if header_size == -1 && !compressed && binary => {
-            external.len().saturating_sub(layout.nbytes)
+        Err(_) if header_size == -1 && !p.compressed && p.binary => {
+            external.len().saturating_sub(p.layout.nbytes)
         }
         Err(_) => {
             return Err(bad(format!(
@@ -153,8 +144,9 @@ pub fn parse(
             )
         })
         .map_err(in_data_file)?;
-    let scalars = decode(data, layout, binary, big_endian, compressed).map_err(in_data_file)?;
-    layout.volume(geometry, scalars)
+    let scalars =
+        decode(data, p.layout, p.binary, p.big_endian, p.compressed).map_err(in_data_file)?;
+    p.layout.volume(p.geometry, scalars)
 }
 
 /// Where uncompressed binary data lies, for reading it in place (`header`: any prefix of
@@ -274,28 +266,19 @@ fn plan(bytes: &[u8]) -> Result<Plan, ReadError> {
     let (_, file_value) = h
         .get(&["ElementDataFile"])
         .ok_or_else(|| bad("no ElementDataFile line"))?;
-    if file_value.eq_ignore_ascii_case("LOCAL") {
-        return Ok(Plan {
-            layout,
-            geometry,
-            binary,
-            big_endian,
-            compressed,
-            header_size,
-            file: None,
-            data_start,
-        });
-    }
-    if file_value.eq_ignore_ascii_case("LIST") || file_value.contains('%') {
+    let file = if file_value.eq_ignore_ascii_case("LOCAL") {
+        None
+    } else if file_value.eq_ignore_ascii_case("LIST") || file_value.contains('%') {
         return Err(ReadError::unsupported(format!(
             "ElementDataFile = {file_value}: data split over several files; merge the slices into one volume (e.g. save it again as .mha)"
         )));
-    }
-    if file_value.is_empty() {
+    } else if file_value.is_empty() {
         return Err(bad(
             "ElementDataFile is empty; it must be LOCAL or a file name",
         ));
-    }
+    } else {
+        Some(file_value.to_string())
+    };
     Ok(Plan {
         layout,
         geometry,
@@ -303,7 +286,7 @@ fn plan(bytes: &[u8]) -> Result<Plan, ReadError> {
         big_endian,
         compressed,
         header_size,
-        file: Some(file_value.to_string()),
+        file,
         data_start,
     })
 }

@@ -141,9 +141,7 @@ def path_trace(view, disp, tag):
     again: each rank traces its piece alone, so light stops at the cut (measured)."""
     disp.FerrovolRenderMode = "Path Trace"
     disp.FerrovolSamplesPerPixel = PATH_SPP
-    T.set_camera(view, BOUNDS, direction=CAMERAS[GI_CAMERA])
-    Render(view)
-    img, _, _ = T.screenshot(view, "mpi-%s-pathtrace-%s" % (tag, GI_CAMERA))
+    img, _, _ = shot(view, "mpi-%s-pathtrace" % tag, GI_CAMERA)
     disp.FerrovolRenderMode = "Ray Cast"
     return img
 
@@ -194,6 +192,21 @@ def show_tf2d(view, disp):
     disp.UseTransfer2D = 0
     disp.Representation = "Ferrovol Volume"
     return imgs
+
+
+def shot(view, name, camera):
+    """T.screenshot of the view from CAMERAS[camera] (over BOUNDS), written as
+    <name>-<camera>."""
+    T.set_camera(view, BOUNDS, direction=CAMERAS[camera])
+    Render(view)
+    return T.screenshot(view, "%s-%s" % (name, camera))
+
+
+def serial_image(name):
+    """On rank 0, the serial run's image mpi-serial-<name>.png where that run wrote it;
+    None otherwise."""
+    path = os.path.join(T.OUT_DIR, "mpi-serial-%s.png" % name)
+    return T.read_png(path) if T.rank() == 0 and os.path.exists(path) else None
 
 
 def ref_path(cam, blend=None):
@@ -248,9 +261,7 @@ def serial():
             T.log("  serial reference %-17s %-8s %s" % (blend or "Composite", cam, path))
     disp.FerrovolBlendMode = "Follow Blend Mode"
     set_gi(disp, True)
-    T.set_camera(view, bounds, direction=CAMERAS[GI_CAMERA])
-    Render(view)
-    T.screenshot(view, "mpi-serial-volumetric-%s" % GI_CAMERA)
+    shot(view, "mpi-serial-volumetric", GI_CAMERA)
     set_gi(disp, False)
     path_trace(view, disp, "serial")
     failures = []
@@ -263,9 +274,7 @@ def serial():
     # The label map: the labels' colours where they are; Mask Blend Factor 0 is the
     # unlabelled image; a binary mask of the same array draws less.
     calc, ldisp = show_labels(view, src)
-    T.set_camera(view, bounds, direction=CAMERAS[LABEL_CAMERA])
-    Render(view)
-    img, path, _ = T.screenshot(view, "mpi-serial-labels-%s" % LABEL_CAMERA)
+    img, path, _ = shot(view, "mpi-serial-labels", LABEL_CAMERA)
     rgb = img[..., :3].astype(float)
     # (the colour map has no green: the unlabelled image has no such pixel)
     green = int((rgb[..., 1] - np.maximum(rgb[..., 0], rgb[..., 2]) > 15).sum())
@@ -378,17 +387,14 @@ def distributed():
                           img, ref, min_ssim, min_psnr, failures)
     disp.FerrovolBlendMode = "Follow Blend Mode"
     set_gi(disp, True)
-    T.set_camera(view, bounds, direction=CAMERAS[GI_CAMERA])
-    Render(view)
-    img, _, _ = T.screenshot(view, "mpi-n%d-volumetric-%s" % (T.nranks(), GI_CAMERA))
-    gi_ref = os.path.join(T.OUT_DIR, "mpi-serial-volumetric-%s.png" % GI_CAMERA)
-    if T.rank() == 0 and os.path.exists(gi_ref):
-        T.compare("mpi -n %d volumetric shadows (measured)" % T.nranks(), img,
-                  T.read_png(gi_ref))
+    img, _, _ = shot(view, "mpi-n%d-volumetric" % T.nranks(), GI_CAMERA)
+    gi_ref = serial_image("volumetric-%s" % GI_CAMERA)
+    if gi_ref is not None:
+        T.compare("mpi -n %d volumetric shadows (measured)" % T.nranks(), img, gi_ref)
     set_gi(disp, False)
     img = path_trace(view, disp, "n%d" % T.nranks())
-    pt_ref = os.path.join(T.OUT_DIR, "mpi-serial-pathtrace-%s.png" % GI_CAMERA)
-    if T.rank() == 0 and os.path.exists(pt_ref):
+    pt_ref = serial_image("pathtrace-%s" % GI_CAMERA)
+    if pt_ref is not None:
         # (the ranks' paths differ from the serial ones: 4x4 means leave the bias, not noise)
         def means(a):
             h, w = (a.shape[0] // 4) * 4, (a.shape[1] // 4) * 4
@@ -396,7 +402,7 @@ def distributed():
             return np.round(b).astype(np.uint8)
 
         T.compare("mpi -n %d path tracing, 4x4 means (measured)" % T.nranks(), means(img),
-                  means(T.read_png(pt_ref)))
+                  means(pt_ref))
     T.set_camera(view, bounds, direction=CAMERAS[TF2D_CAMERA])
     imgs = show_tf2d(view, disp)
     tf2d_ref = os.path.join(T.OUT_DIR, "mpi-serial-tf2d-ferrovol.png")
@@ -407,13 +413,11 @@ def distributed():
                   % T.nranks(), imgs["Volume"], T.read_png(tf2d_ref.replace("ferrovol", "vtk")))
     Hide(src, view)
     show_labels(view, src)
-    T.set_camera(view, bounds, direction=CAMERAS[LABEL_CAMERA])
-    Render(view)
-    img, _, _ = T.screenshot(view, "mpi-n%d-labels-%s" % (T.nranks(), LABEL_CAMERA))
-    labels_ref = os.path.join(T.OUT_DIR, "mpi-serial-labels-%s.png" % LABEL_CAMERA)
-    if T.rank() == 0 and os.path.exists(labels_ref):
-        T.compare("mpi -n %d label map vs serial" % T.nranks(), img, T.read_png(labels_ref),
-                  MIN_SSIM, MIN_PSNR, failures)
+    img, _, _ = shot(view, "mpi-n%d-labels" % T.nranks(), LABEL_CAMERA)
+    labels_ref = serial_image("labels-%s" % LABEL_CAMERA)
+    if labels_ref is not None:
+        T.compare("mpi -n %d label map vs serial" % T.nranks(), img, labels_ref, MIN_SSIM,
+                  MIN_PSNR, failures)
     empty_pieces(view, failures)
     # Rank-local failures are printed by their ranks; rank 0 decides the exit status.
     if failures and T.rank() != 0:

@@ -349,26 +349,12 @@ FROG_LABELS = {3: ((0.9, 0.2, 0.2), 0.35), 9: ((0.2, 0.8, 0.3), 0.35),
 
 def frog_tf(shade=False):
     def make():
-        ctf = vtk.vtkColorTransferFunction()
-        ctf.AddRGBPoint(0.0, 0.0, 0.0, 0.0)
-        ctf.AddRGBPoint(29.0, 0.7, 0.7, 0.7)
-        otf = vtk.vtkPiecewiseFunction()
-        otf.AddPoint(0.49, 0.0)
-        otf.AddPoint(0.51, 0.02)
-        otf.AddPoint(29.0, 0.02)
-        p = vtk.vtkVolumeProperty()
-        p.SetColor(ctf)
-        p.SetScalarOpacity(otf)
+        p = fvtest.volume_property([(0.0, 0.0, 0.0, 0.0), (29.0, 0.7, 0.7, 0.7)],
+                                   [(0.49, 0.0), (0.51, 0.02), (29.0, 0.02)])
         p.SetInterpolationTypeToNearest()
         for label, (rgb, alpha) in FROG_LABELS.items():
-            c = vtk.vtkColorTransferFunction()
-            c.AddRGBPoint(0.0, *rgb)
-            c.AddRGBPoint(29.0, *rgb)
-            p.SetLabelColor(label, c)
-            o = vtk.vtkPiecewiseFunction()
-            o.AddPoint(0.0, alpha)
-            o.AddPoint(29.0, alpha)
-            p.SetLabelScalarOpacity(label, o)
+            p.SetLabelColor(label, fvtest.color_function([(0.0, *rgb), (29.0, *rgb)]))
+            p.SetLabelScalarOpacity(label, fvtest.opacity_function([(0.0, alpha), (29.0, alpha)]))
         if shade:
             p.ShadeOn()
         return p

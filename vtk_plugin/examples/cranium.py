@@ -17,25 +17,12 @@ import time
 
 import vtk
 import ferrovol
+from volume_scene import offscreen_window, volume_property, write_png
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_INPUT = os.path.join(
     os.environ.get("FERROVOL_DATA_DIR", os.path.join(HERE, "..", "..", "build", "data")),
     "cranium.vti")
-
-
-def volume_property(colors, opacities):
-    """A vtkVolumeProperty from (value, r, g, b) colour points and (value, opacity) points."""
-    color = vtk.vtkColorTransferFunction()
-    for x, r, g, b in colors:
-        color.AddRGBPoint(x, r, g, b)
-    opacity = vtk.vtkPiecewiseFunction()
-    for x, a in opacities:
-        opacity.AddPoint(x, a)
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
-    return prop
 
 
 def ct_bone_property(spacing):
@@ -69,10 +56,7 @@ def render(mapper, port, prop, have_ct, size, out):
     ren = vtk.vtkRenderer()
     ren.AddVolume(volume)
     ren.SetBackground(0.1, 0.1, 0.12)
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
-    win.SetSize(size, size)
-    win.AddRenderer(ren)
+    win = offscreen_window(ren, size)
     ren.ResetCamera()
     cam = ren.GetActiveCamera()
     if have_ct:
@@ -88,14 +72,7 @@ def render(mapper, port, prop, have_ct, size, out):
     t0 = time.perf_counter()
     win.Render()
     ms = 1000.0 * (time.perf_counter() - t0)
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(win)
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    writer = vtk.vtkPNGWriter()
-    writer.SetFileName(out)
-    writer.SetInputConnection(grab.GetOutputPort())
-    writer.Write()
+    write_png(win, out)
     return ms
 
 

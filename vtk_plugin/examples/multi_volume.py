@@ -16,19 +16,13 @@ import argparse
 
 import vtk
 import ferrovol
+import volume_scene
+from volume_scene import offscreen_window, write_png
 
 
 def volume_property(colors, opacities, unit_distance):
-    """A vtkVolumeProperty from (value, r, g, b) colour points and (value, opacity) points."""
-    color = vtk.vtkColorTransferFunction()
-    for x, r, g, b in colors:
-        color.AddRGBPoint(x, r, g, b)
-    opacity = vtk.vtkPiecewiseFunction()
-    for x, a in opacities:
-        opacity.AddPoint(x, a)
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
+    """volume_scene.volume_property, linear, with its opacity's unit distance."""
+    prop = volume_scene.volume_property(colors, opacities)
     prop.SetScalarOpacityUnitDistance(unit_distance)
     prop.SetInterpolationTypeToLinear()
     return prop
@@ -69,10 +63,7 @@ def render(mapper, size, out):
 
     ren = vtk.vtkRenderer()
     ren.AddVolume(multi)
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
-    win.SetSize(size, size)
-    win.AddRenderer(ren)
+    win = offscreen_window(ren, size)
     ren.ResetCamera()
     cam = ren.GetActiveCamera()
     cam.Azimuth(30.0)
@@ -80,14 +71,7 @@ def render(mapper, size, out):
     cam.OrthogonalizeViewUp()
     ren.ResetCameraClippingRange()
     win.Render()
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(win)
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    writer = vtk.vtkPNGWriter()
-    writer.SetFileName(out)
-    writer.SetInputConnection(grab.GetOutputPort())
-    writer.Write()
+    write_png(win, out)
     win.Finalize()
     print("wrote", out)
 

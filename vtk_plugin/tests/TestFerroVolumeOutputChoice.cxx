@@ -29,18 +29,26 @@ vtkFerroVolumeUuid Uuid(uint8_t first)
   return u;
 }
 
+// Vulkan and OpenGL (with GL_EXT_memory_object_fd) on one device and driver: the device
+// UUID Uuid(device), the driver UUID Uuid(driver).
+vtkFerroVolumeOutputFacts OneDevice(
+  const char* adapter, const char* glRenderer, uint8_t device, uint8_t driver)
+{
+  vtkFerroVolumeOutputFacts f;
+  f.AdapterName = adapter;
+  f.GLRenderer = glRenderer;
+  f.GLHasMemoryObjectFd = true;
+  f.VulkanDevice = Uuid(device);
+  f.VulkanDriver = Uuid(driver);
+  f.GLDevices = { Uuid(device) };
+  f.GLDriver = Uuid(driver);
+  return f;
+}
+
 // Vulkan and OpenGL on one device and driver, as NVIDIA's drivers report them.
 vtkFerroVolumeOutputFacts Nvidia()
 {
-  vtkFerroVolumeOutputFacts f;
-  f.AdapterName = "NVIDIA H200";
-  f.GLRenderer = "NVIDIA H200/PCIe/SSE2";
-  f.GLHasMemoryObjectFd = true;
-  f.VulkanDevice = Uuid(0x10);
-  f.VulkanDriver = Uuid(0x80);
-  f.GLDevices = { Uuid(0x10) };
-  f.GLDriver = Uuid(0x80);
-  return f;
+  return OneDevice("NVIDIA H200", "NVIDIA H200/PCIe/SSE2", 0x10, 0x80);
 }
 
 bool Contains(const std::string& text, const std::string& part)
@@ -90,14 +98,8 @@ int main()
       Contains(otherDriver.Reason, "90919293-9495-9697-9899-9a9b9c9d9e9f"),
     "the reason names both driver UUIDs: %s", otherDriver.Reason.c_str());
 
-  vtkFerroVolumeOutputFacts cpuFacts;
-  cpuFacts.AdapterName = "llvmpipe (LLVM 15.0.6, 256 bits)";
-  cpuFacts.GLRenderer = "llvmpipe (LLVM 15.0.6, 256 bits)";
-  cpuFacts.GLHasMemoryObjectFd = true;
-  cpuFacts.VulkanDevice = Uuid(0x6c);
-  cpuFacts.VulkanDriver = Uuid(0x4d);
-  cpuFacts.GLDevices = { Uuid(0x6c) };
-  cpuFacts.GLDriver = Uuid(0x4d);
+  const vtkFerroVolumeOutputFacts cpuFacts = OneDevice(
+    "llvmpipe (LLVM 15.0.6, 256 bits)", "llvmpipe (LLVM 15.0.6, 256 bits)", 0x6c, 0x4d);
   const vtkFerroVolumeOutputChoice cpu = Choose("lavapipe + llvmpipe", cpuFacts);
   CHECK(cpu.Shared && !cpu.Warn, "a CPU device whose UUIDs match shares");
 

@@ -21,6 +21,9 @@ sys.path.insert(0, os.path.join(ROOT, "tests"))
 from ferrovol_testing.metrics import (  # noqa: E402,F401  (re-exported for the suites)
     coverage, difference_image, luminance, psnr, ssim)
 from ferrovol_testing.png import write_png  # noqa: E402
+sys.path.append(os.path.join(ROOT, "vtk_plugin", "examples"))
+from volume_scene import (  # noqa: E402,F401  (the function helpers re-exported for the suites)
+    color_function, opacity_function, volume_property)
 # The VTK under test: (major, minor), for the thresholds that differ between VTK versions.
 VTK_VERSION = (vtk.vtkVersion.GetVTKMajorVersion(), vtk.vtkVersion.GetVTKMinorVersion())
 OUTPUT = os.environ.get("FERROVOL_TEST_OUTPUT", os.path.join(ROOT, "build", "vtk", "test-images"))
@@ -75,15 +78,7 @@ def image_from_array(arr, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), name=
 
 
 def tf_property(color=WAVELET_COLOR, opacity=WAVELET_OPACITY, interpolation="nearest"):
-    ctf = vtk.vtkColorTransferFunction()
-    for x, r, g, b in color:
-        ctf.AddRGBPoint(x, r, g, b)
-    otf = vtk.vtkPiecewiseFunction()
-    for x, a in opacity:
-        otf.AddPoint(x, a)
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(ctf)
-    prop.SetScalarOpacity(otf)
+    prop = volume_property(color, opacity)
     if interpolation == "linear":
         prop.SetInterpolationTypeToLinear()
     return prop

@@ -58,19 +58,9 @@ def make_mask(inside=255):
 def make_property():
     """Shaded; colour and opacity functions over a part of the data range (so the NATIVE
     range types change the image), a gradient opacity function and an iso-value."""
-    ctf = vtk.vtkColorTransferFunction()
-    ctf.AddRGBPoint(100, 0.1, 0.2, 0.9)
-    ctf.AddRGBPoint(200, 1.0, 0.8, 0.1)
-    otf = vtk.vtkPiecewiseFunction()
-    otf.AddPoint(60, 0.0)
-    otf.AddPoint(280, 0.6)
-    gof = vtk.vtkPiecewiseFunction()
-    gof.AddPoint(0, 0.2)
-    gof.AddPoint(12, 1.0)
-    p = vtk.vtkVolumeProperty()
-    p.SetColor(ctf)
-    p.SetScalarOpacity(otf)
-    p.SetGradientOpacity(gof)
+    p = fvtest.volume_property([(100, 0.1, 0.2, 0.9), (200, 1.0, 0.8, 0.1)],
+                               [(60, 0.0), (280, 0.6)])
+    p.SetGradientOpacity(fvtest.opacity_function([(0, 0.2), (12, 1.0)]))
     p.SetInterpolationTypeToLinear()
     p.ShadeOn()
     p.GetIsoSurfaceValues().SetValue(0, 160.0)

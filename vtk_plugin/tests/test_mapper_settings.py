@@ -33,6 +33,16 @@ def parallel_camera(focal, distance, scale, clipping):
     return camera
 
 
+def memory_budget(max_bytes, fraction, progress):
+    """A render() configure hook: a budget of max_bytes x fraction (MaxMemoryInBytes,
+    MaxMemoryFraction), each progress event's value appended to the list progress."""
+    def configure(m):
+        m.SetMaxMemoryInBytes(max_bytes)
+        m.SetMaxMemoryFraction(fraction)
+        m.AddObserver(vtk.vtkCommand.ProgressEvent, lambda o, e: progress.append(o.GetProgress()))
+    return configure
+
+
 class Settings(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -474,13 +484,7 @@ class Settings(unittest.TestCase):
         # MaxMemoryFraction) bricks the volume and streams the bricks in several passes
         full, _ = self.render()
         progress = []
-
-        def configure(m):
-            m.SetMaxMemoryInBytes(48 ** 3 * 4 // 2)
-            m.SetMaxMemoryFraction(0.5)
-            m.AddObserver(vtk.vtkCommand.ProgressEvent,
-                          lambda o, e: progress.append(o.GetProgress()))
-        streamed, mapper = self.render(configure)
+        streamed, mapper = self.render(memory_budget(48 ** 3 * 4 // 2, 0.5, progress))
         save("settings-memory-budget", full, streamed)
         d = float(np.abs(streamed - full).max())
         print("memory budget 108 KiB: max |difference| to unlimited %.1f levels; progress "
@@ -498,13 +502,7 @@ class Settings(unittest.TestCase):
         # update reports those two); the still render after it streams the volume itself.
         full, _ = self.render()
         progress = []
-
-        def configure(m):
-            m.SetMaxMemoryInBytes(48 ** 3 * 4 // 4)
-            m.SetMaxMemoryFraction(1.0)
-            m.AddObserver(vtk.vtkCommand.ProgressEvent,
-                          lambda o, e: progress.append(o.GetProgress()))
-        preview, _ = self.render(configure,
+        preview, _ = self.render(memory_budget(48 ** 3 * 4 // 4, 1.0, progress),
                                  scene_hook=lambda s: s.window.SetDesiredUpdateRate(15.0))
         passes = [p for p in progress if 0.0 < p < 1.0]
         progress.clear()
@@ -774,14 +772,8 @@ class Settings(unittest.TestCase):
 
     def test_gray_transfer_function(self):
         p = vtk.vtkVolumeProperty()
-        gray = vtk.vtkPiecewiseFunction()
-        gray.AddPoint(37.0, 0.0)
-        gray.AddPoint(277.0, 1.0)
-        otf = vtk.vtkPiecewiseFunction()
-        otf.AddPoint(37.0, 0.0)
-        otf.AddPoint(277.0, 0.8)
-        p.SetColor(gray)
-        p.SetScalarOpacity(otf)
+        p.SetColor(fvtest.opacity_function([(37.0, 0.0), (277.0, 1.0)]))
+        p.SetScalarOpacity(fvtest.opacity_function([(37.0, 0.0), (277.0, 0.8)]))
         self.assertEqual(p.GetColorChannels(), 1)
         img, _ = self.render(prop=p)
         lit = img.max(axis=2) > 8

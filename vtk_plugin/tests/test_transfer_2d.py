@@ -42,14 +42,8 @@ def property_2d(image, gradient=True, shade=False, components=1):
     p = vtk.vtkVolumeProperty()
     p.SetInterpolationTypeToLinear()
     for c in range(components):
-        ctf = vtk.vtkColorTransferFunction()
-        ctf.AddRGBPoint(37.0, 0.0, 0.0, 0.0)
-        ctf.AddRGBPoint(277.0, 1.0, 1.0, 1.0)
-        otf = vtk.vtkPiecewiseFunction()
-        otf.AddPoint(37.0, 0.0)
-        otf.AddPoint(277.0, 0.5)
-        p.SetColor(c, ctf)
-        p.SetScalarOpacity(c, otf)
+        p.SetColor(c, fvtest.color_function([(37.0, 0.0, 0.0, 0.0), (277.0, 1.0, 1.0, 1.0)]))
+        p.SetScalarOpacity(c, fvtest.opacity_function([(37.0, 0.0), (277.0, 0.5)]))
         p.SetTransferFunction2D(c, image[c] if isinstance(image, list) else image)
         if gradient:
             p.SetGradientOpacity(c, gradient_ramp(30.0))
@@ -146,14 +140,8 @@ class Transfer2D(unittest.TestCase):
             p = vtk.vtkVolumeProperty()
             p.SetInterpolationTypeToLinear()
             for c, rgb in enumerate(colors):
-                ctf = vtk.vtkColorTransferFunction()
-                ctf.AddRGBPoint(37.0, *rgb)
-                ctf.AddRGBPoint(277.0, *rgb)
-                otf = vtk.vtkPiecewiseFunction()
-                otf.AddPoint(37.0, 0.0)
-                otf.AddPoint(277.0, 0.5)
-                p.SetColor(c, ctf)
-                p.SetScalarOpacity(c, otf)
+                p.SetColor(c, fvtest.color_function([(37.0, *rgb), (277.0, *rgb)]))
+                p.SetScalarOpacity(c, fvtest.opacity_function([(37.0, 0.0), (277.0, 0.5)]))
                 if two_d:
                     p.SetTransferFunction2D(c, flat(rgb))
             if two_d:

@@ -100,6 +100,14 @@ pub fn blob_transfer() -> ComponentTransfer {
     )
 }
 
+/// Default frames in another blend mode.
+pub fn blended(blend: BlendMode) -> RenderParams {
+    RenderParams {
+        blend,
+        ..RenderParams::default()
+    }
+}
+
 /// Composite frames with shading on.
 pub fn shaded() -> RenderParams {
     RenderParams {

@@ -5,7 +5,7 @@ use crate::common::gpu::{assert_error, renderer, trace};
 use crate::common::images::save_enlarged;
 use crate::common::metrics::{alpha, channel_sums, footprint, image_diff};
 use crate::common::raycast::to_pixel;
-use crate::common::scenes::{blob_transfer, blob_volume, shaded, volume, white};
+use crate::common::scenes::{blended, blob_transfer, blob_volume, shaded, volume, white};
 use ferrovol_core::*;
 use glam::DVec3;
 
@@ -43,27 +43,9 @@ fn uniform_coordinates_draw_the_plain_volume() {
     for (name, p) in [
         ("composite", RenderParams::default()),
         ("shaded", shaded()),
-        (
-            "mip",
-            RenderParams {
-                blend: BlendMode::Maximum,
-                ..Default::default()
-            },
-        ),
-        (
-            "average",
-            RenderParams {
-                blend: BlendMode::Average,
-                ..Default::default()
-            },
-        ),
-        (
-            "isosurface",
-            RenderParams {
-                blend: BlendMode::Isosurface,
-                ..Default::default()
-            },
-        ),
+        ("mip", blended(BlendMode::Maximum)),
+        ("average", blended(BlendMode::Average)),
+        ("isosurface", blended(BlendMode::Isosurface)),
     ] {
         r.set_volume(&plain).unwrap();
         let a = r.render_image(&view, &p).unwrap();

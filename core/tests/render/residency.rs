@@ -4,7 +4,7 @@
 use super::bricks::assert_content;
 use crate::common::gpu::{renderer, set_bricked};
 use crate::common::metrics::{footprint, image_diff};
-use crate::common::scenes::{blob_transfer, blob_volume, component_transfer, shaded};
+use crate::common::scenes::{blended, blob_transfer, blob_volume, component_transfer, shaded};
 use ferrovol_core::*;
 
 /// The blob's colours, transparent below `from` and rising to 0.8 at 1.
@@ -70,10 +70,7 @@ fn only_visible_bricks_are_resident() {
         "a wider transfer function uploads only the bricks it adds"
     );
     // Maximum intensity reads every value: every brick comes in.
-    let mip = RenderParams {
-        blend: BlendMode::Maximum,
-        ..Default::default()
-    };
+    let mip = blended(BlendMode::Maximum);
     r.render_image(&view, &mip).unwrap();
     let all = r.residency();
     println!(
@@ -110,27 +107,9 @@ fn streamed_frames_equal_in_core_ones() {
     let modes = [
         ("composite", RenderParams::default()),
         ("shaded", shaded()),
-        (
-            "maximum",
-            RenderParams {
-                blend: BlendMode::Maximum,
-                ..Default::default()
-            },
-        ),
-        (
-            "average",
-            RenderParams {
-                blend: BlendMode::Average,
-                ..Default::default()
-            },
-        ),
-        (
-            "additive",
-            RenderParams {
-                blend: BlendMode::Additive,
-                ..Default::default()
-            },
-        ),
+        ("maximum", blended(BlendMode::Maximum)),
+        ("average", blended(BlendMode::Average)),
+        ("additive", blended(BlendMode::Additive)),
     ];
     let told = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let log = told.clone();
@@ -173,10 +152,7 @@ fn streamed_frames_equal_in_core_ones() {
     // Isosurfaces stream too (the first hit's state carried between passes) and give the
     // in-core hits; with ambient occlusion, whose rays reach around the surfaces' bricks,
     // the budget is reported.
-    let iso_params = RenderParams {
-        blend: BlendMode::Isosurface,
-        ..Default::default()
-    };
+    let iso_params = blended(BlendMode::Isosurface);
     let surfaces = |ao: Option<AmbientOcclusion>| IsoParams {
         values: vec![
             IsoValue::new(0.3, [0.4, 0.6, 1.0], 0.4),

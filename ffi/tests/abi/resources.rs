@@ -3,6 +3,26 @@
 
 use super::*;
 
+type Residency = unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus;
+
+/// An n³ u8 volume of `value(x, y, z)`, x fastest.
+fn cube_u8(n: usize, value: impl Fn(usize, usize, usize) -> u8) -> Vec<u8> {
+    (0..n * n * n)
+        .map(|i| value(i % n, (i / n) % n, i / (n * n)))
+        .collect()
+}
+
+/// A session whose renderer bricks volumes (fv_renderer_set_max_brick_points), and
+/// fv_renderer_residency.
+fn bricked_session(lib: &Lib, max_brick_points: u32) -> (Session<'_>, Residency) {
+    let s = Session::new(lib);
+    let set_bricks =
+        lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_max_brick_points");
+    // SAFETY: a valid handle.
+    unsafe { lib.ok(set_bricks(s.r, max_brick_points)) };
+    (s, *lib.f::<Residency>("fv_renderer_residency"))
+}
+
 /// A bricked volume keeps only the bricks something visible lies in, reports it through
 /// fv_renderer_residency, and keeps rendering after the caller frees its FvVolume (the
 /// renderer shares the data it reads bricks from).
@@ -11,28 +31,17 @@ fn bricked_volume_residency_outlives_the_volume() {
     let lib = Lib::open();
     let n = 24usize;
     // a bright ball in one corner of a dark volume
-    let data: Vec<u8> = (0..n * n * n)
-        .map(|i| {
-            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
-            let r2 = (x as f32 - 5.0).powi(2) + (y as f32 - 5.0).powi(2) + (z as f32 - 5.0).powi(2);
-            if r2 < 16.0 {
-                200
-            } else {
-                0
-            }
-        })
-        .collect();
-    let mut s = Session::new(&lib);
-    let set_bricks =
-        lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_max_brick_points");
-    let residency = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus>(
-        "fv_renderer_residency",
-    );
+    let data = cube_u8(n, |x, y, z| {
+        let r2 = (x as f32 - 5.0).powi(2) + (y as f32 - 5.0).powi(2) + (z as f32 - 5.0).powi(2);
+        if r2 < 16.0 {
+            200
+        } else {
+            0
+        }
+    });
+    let (mut s, residency) = bricked_session(&lib, 10);
     // SAFETY: a valid handle; the residency out-pointer is checked for NULL.
-    unsafe {
-        lib.ok(set_bricks(s.r, 10));
-        lib.expect(residency(s.r, null_mut()), Null, "residency");
-    }
+    unsafe { lib.expect(residency(s.r, null_mut()), Null, "residency") };
     s.set_volume([24, 24, 24], FvScalarType::U8, &data);
     s.set_transfer_function(
         &[0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0],
@@ -70,20 +79,8 @@ fn bricked_volume_residency_outlives_the_volume() {
 fn brick_pool_shrinks_to_what_is_shown() {
     let lib = Lib::open();
     let n = 24usize;
-    let data: Vec<u8> = (0..n * n * n)
-        .map(|i| {
-            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
-            ((x + y + z) * 255 / (3 * (n - 1))) as u8
-        })
-        .collect();
-    let mut s = Session::new(&lib);
-    let set_bricks =
-        lib.f::<unsafe extern "C" fn(H, u32) -> FvStatus>("fv_renderer_set_max_brick_points");
-    let residency = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus>(
-        "fv_renderer_residency",
-    );
-    // SAFETY: a valid handle.
-    unsafe { lib.ok(set_bricks(s.r, 8)) };
+    let data = cube_u8(n, |x, y, z| ((x + y + z) * 255 / (3 * (n - 1))) as u8);
+    let (mut s, residency) = bricked_session(&lib, 8);
     s.set_volume([24, 24, 24], FvScalarType::U8, &data);
     s.set_camera(&camera([11.5, 11.5, 80.0], [11.5; 3], [1.0, 200.0]));
     let white = [0.0, 1.0, 1.0, 1.0, 255.0, 1.0, 1.0, 1.0];
@@ -171,9 +168,7 @@ fn path_tracing_past_the_budget_reports_its_level() {
     let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
     let mut s = Session::new(&lib);
     let budget = lib.f::<unsafe extern "C" fn(H, u64) -> FvStatus>("fv_renderer_set_memory_budget");
-    let residency = lib.f::<unsafe extern "C" fn(H, *mut ferrovol::FvResidency) -> FvStatus>(
-        "fv_renderer_residency",
-    );
+    let residency = lib.f::<Residency>("fv_renderer_residency");
     let read = |s: &Session| {
         let mut res = ferrovol::FvResidency::default();
         // SAFETY: a valid handle and out-pointer.
@@ -215,6 +210,34 @@ fn path_tracing_past_the_budget_reports_its_level() {
     assert!(res.stand_ins > 0 && res.level == 1, "{res:?}");
 }
 
+/// The device-memory tests' scene on `s`: a 16³ f32 ramp along x (0 to 15), then
+/// [`small_scene_view`].
+fn small_scene(s: &mut Session) {
+    let n = 16usize;
+    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
+    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
+    small_scene_view(s);
+}
+
+/// A session showing [`small_scene`] and its 24 × 24 frame, checked to show the volume.
+fn small_scene_session(lib: &Lib) -> (Session<'_>, Vec<u8>) {
+    let mut s = Session::new(lib);
+    small_scene(&mut s);
+    let frame = s.frame(24, 24).to_vec();
+    assert!(frame.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    (s, frame)
+}
+
+/// White to orange over the ramp, opacity rising to 1, seen from +z: what a renderer made
+/// again for `small_scene`'s volume needs to draw it the same.
+fn small_scene_view(s: &mut Session) {
+    s.set_transfer_function(
+        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
+        &[0.0, 0.0, 15.0, 1.0],
+    );
+    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+}
+
 /// The context's device memory counters: a renderer's frames allocate once (repeated
 /// frames hold the same buffers and textures), and a renderer freed and made again holds no
 /// more than the first one did.
@@ -222,8 +245,6 @@ fn path_tracing_past_the_budget_reports_its_level() {
 fn device_memory_stays_flat_over_frames_and_renderers() {
     type Memory = unsafe extern "C" fn(H, *mut ferrovol::FvDeviceMemory) -> FvStatus;
     let lib = Lib::open();
-    let n = 16usize;
-    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
     let mut s = Session::new(&lib);
     let memory = lib.f::<Memory>("fv_context_device_memory");
     let read = |s: &Session| {
@@ -234,12 +255,7 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
     };
     // SAFETY: a NULL out-pointer is refused, not written.
     unsafe { lib.expect(memory(s.ctx, null_mut()), Null, "memory") };
-    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
-    s.set_transfer_function(
-        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-        &[0.0, 0.0, 15.0, 1.0],
-    );
-    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+    small_scene(&mut s);
     s.frame(24, 24);
     let first = read(&s);
     for _ in 0..5 {
@@ -264,11 +280,7 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
             lib.ok(lib.f::<NewRenderer>("fv_renderer_new")(s.ctx, &mut s.r));
             lib.ok(lib.f::<SetH>("fv_renderer_set_volume")(s.r, s.volume));
         }
-        s.set_transfer_function(
-            &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-            &[0.0, 0.0, 15.0, 1.0],
-        );
-        s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
+        small_scene_view(&mut s);
         s.frame(24, 24);
         s.frame(24, 24);
     }
@@ -286,17 +298,7 @@ fn device_memory_stays_flat_over_frames_and_renderers() {
 #[test]
 fn out_of_memory_is_reported_and_the_renderer_recovers() {
     let lib = Lib::open();
-    let n = 16usize;
-    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
-    let mut s = Session::new(&lib);
-    s.set_volume([16, 16, 16], FvScalarType::F32, &data);
-    s.set_transfer_function(
-        &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-        &[0.0, 0.0, 15.0, 1.0],
-    );
-    s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
-    let before = s.frame(24, 24).to_vec();
-    assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    let (mut s, before) = small_scene_session(&lib);
     type Limit = unsafe extern "C" fn(H, u64) -> FvStatus;
     let limit = lib.f::<Limit>("fv_context_limit_device_memory");
     let render = lib.f::<Render>("fv_renderer_render");
@@ -330,20 +332,7 @@ fn out_of_memory_is_reported_and_the_renderer_recovers() {
 #[test]
 fn device_loss_is_reported_and_a_new_context_draws() {
     let lib = Lib::open();
-    let n = 16usize;
-    let data: Vec<f32> = (0..n * n * n).map(|i| (i % n) as f32).collect();
-    let scene = |s: &mut Session| {
-        s.set_volume([16, 16, 16], FvScalarType::F32, &data);
-        s.set_transfer_function(
-            &[0.0, 1.0, 1.0, 1.0, 15.0, 1.0, 0.5, 0.0],
-            &[0.0, 0.0, 15.0, 1.0],
-        );
-        s.set_camera(&camera([7.5, 7.5, 60.0], [7.5; 3], [1.0, 200.0]));
-    };
-    let mut s = Session::new(&lib);
-    scene(&mut s);
-    let before = s.frame(24, 24).to_vec();
-    assert!(before.chunks(4).any(|p| p[3] > 100), "the volume is drawn");
+    let (s, before) = small_scene_session(&lib);
     let render = lib.f::<Render>("fv_renderer_render");
     // SAFETY: a valid context (NULL is ignored) and renderer.
     unsafe {
@@ -356,11 +345,6 @@ fn device_loss_is_reported_and_a_new_context_draws() {
         );
     }
     drop(s);
-    let mut fresh = Session::new(&lib);
-    scene(&mut fresh);
-    assert_eq!(
-        fresh.frame(24, 24),
-        &before[..],
-        "a new context draws the same frame"
-    );
+    let (_fresh, after) = small_scene_session(&lib);
+    assert_eq!(after, before, "a new context draws the same frame");
 }
