@@ -3,7 +3,7 @@
 use super::frame::groups;
 use crate::error::Result;
 use crate::gpu::binding::{
-    bind, bind_block, buffer_entry, dynamic_uniform_entry, storage_texture_entry,
+    bind, bind_block, bind_view, buffer_entry, dynamic_uniform_entry, storage_texture_entry,
 };
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::single_group_pipeline;
@@ -110,7 +110,7 @@ impl DenoisePass {
                     bind(2, dst.as_entire_binding()),
                     bind(3, out.guide.as_entire_binding()),
                     bind(4, out.accum.as_entire_binding()),
-                    bind(5, wgpu::BindingResource::TextureView(out.color)),
+                    bind_view(5, out.color),
                 ],
             })
         };

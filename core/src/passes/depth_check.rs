@@ -4,7 +4,7 @@
 
 use super::frame::groups;
 use crate::error::Result;
-use crate::gpu::binding::{bind, buffer_entry, texture_entry};
+use crate::gpu::binding::{bind, bind_view, buffer_entry, texture_entry};
 use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::{encode_single_group, single_group_pipeline};
 use crate::gpu::readback::read_buffer;
@@ -100,7 +100,7 @@ impl DepthCheck {
             (&self.bgl, &self.pipeline),
             &[
                 bind(0, self.uniforms.as_entire_binding()),
-                bind(1, wgpu::BindingResource::TextureView(&view)),
+                bind_view(1, &view),
                 bind(2, seen.as_entire_binding()),
                 bind(3, self.flag.as_entire_binding()),
             ],

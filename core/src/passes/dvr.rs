@@ -9,7 +9,8 @@ use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput};
 
 use crate::error::Result;
 use crate::gpu::binding::{
-    bind, buffer_entry, sampled_texture_entry, storage_texture_entry, texture_entry,
+    bind, bind_view, buffer_entry, group_layout, sampled_texture_entry, storage_texture_entry,
+    texture_entry,
 };
 use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::slots;
@@ -68,12 +69,8 @@ impl DvrPass {
     }
 
     pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<DvrPass> {
-        let bgl = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("dvr frame"),
-                entries: &Self::layout_entries(ctx.info.float32_filterable),
-            });
+        let entries = Self::layout_entries(ctx.info.float32_filterable);
+        let bgl = group_layout(&ctx.device, "dvr frame", &entries);
         let pipelines = PipelineCache::new(ctx, "dvr.wgsl", "dvr", &[&bgl, brick_bgl])?;
         let no_blanking = block_grid(ctx, "no blanking", [1; 3], &[0u8]);
         Ok(DvrPass {
@@ -211,40 +208,16 @@ impl DvrPass {
             layout: &self.bgl,
             entries: &[
                 bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind(
-                    slots::TABLES,
-                    wgpu::BindingResource::TextureView(&tables.view),
-                ),
-                bind(
-                    slots::BLOCK_RANGE,
-                    wgpu::BindingResource::TextureView(&vol.ranges),
-                ),
-                bind(
-                    slots::OCCUPANCY,
-                    wgpu::BindingResource::TextureView(occupancy),
-                ),
-                bind(
-                    slots::DEPTH_IN,
-                    wgpu::BindingResource::TextureView(&depth_in_view),
-                ),
-                bind(
-                    slots::DEPTH_NEAR,
-                    wgpu::BindingResource::TextureView(&depth_near_view),
-                ),
-                bind(
-                    slots::OUT_COLOR,
-                    wgpu::BindingResource::TextureView(&color_view),
-                ),
-                bind(
-                    slots::OUT_DEPTH,
-                    wgpu::BindingResource::TextureView(&depth_view),
-                ),
+                bind_view(slots::TABLES, &tables.view),
+                bind_view(slots::BLOCK_RANGE, &vol.ranges),
+                bind_view(slots::OCCUPANCY, occupancy),
+                bind_view(slots::DEPTH_IN, &depth_in_view),
+                bind_view(slots::DEPTH_NEAR, &depth_near_view),
+                bind_view(slots::OUT_COLOR, &color_view),
+                bind_view(slots::OUT_DEPTH, &depth_view),
                 bind(slots::RAY_STATE, t.state.as_entire_binding()),
                 res.blanking_entry(&self.no_blanking),
-                bind(
-                    slots::PREINT_TABLES,
-                    wgpu::BindingResource::TextureView(&preintegrated.view),
-                ),
+                bind_view(slots::PREINT_TABLES, &preintegrated.view),
                 bind(
                     slots::MASK,
                     wgpu::BindingResource::TextureView(

@@ -26,7 +26,8 @@ use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput};
 use super::iso_variant::{self, DeferredVariant, FirstHitVariant, IsoFacts};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
-    bind, buffer_entry, sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
+    bind, bind_view, buffer_entry, group_layout, sampled_texture_entry, sampler_entry,
+    storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::PipelineCache;
@@ -210,14 +211,8 @@ impl IsoPass {
 
     pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<IsoPass> {
         let d = &ctx.device;
-        let firsthit_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("first hit"),
-            entries: &Self::firsthit_layout_entries(),
-        });
-        let deferred_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("deferred"),
-            entries: &Self::deferred_layout_entries(),
-        });
+        let firsthit_bgl = group_layout(d, "first hit", &Self::firsthit_layout_entries());
+        let deferred_bgl = group_layout(d, "deferred", &Self::deferred_layout_entries());
         let firsthit = PipelineCache::new(
             ctx,
             "firsthit.wgsl",
@@ -610,18 +605,12 @@ impl IsoPass {
             entries: &[
                 bind(slots::FRAME, res.frame_buf.as_entire_binding()),
                 bind(2, t.state.as_entire_binding()),
-                bind(
-                    slots::OCCUPANCY,
-                    wgpu::BindingResource::TextureView(occupancy),
-                ),
-                bind(
-                    slots::DEPTH_IN,
-                    wgpu::BindingResource::TextureView(&depth_in_view),
-                ),
+                bind_view(slots::OCCUPANCY, occupancy),
+                bind_view(slots::DEPTH_IN, &depth_in_view),
                 bind(slots::ISO, self.iso_buf.as_entire_binding()),
-                bind(8, wgpu::BindingResource::TextureView(&gp)),
-                bind(9, wgpu::BindingResource::TextureView(&gn)),
-                bind(10, wgpu::BindingResource::TextureView(&ge)),
+                bind_view(8, &gp),
+                bind_view(9, &gn),
+                bind_view(10, &ge),
                 bind(11, wgpu::BindingResource::Sampler(&res.nearest)),
                 bind(
                     12,
@@ -639,20 +628,14 @@ impl IsoPass {
             entries: &[
                 bind(slots::FRAME, res.frame_buf.as_entire_binding()),
                 bind(2, t.state.as_entire_binding()),
-                bind(
-                    slots::OUT_COLOR,
-                    wgpu::BindingResource::TextureView(&color_view),
-                ),
-                bind(
-                    slots::OUT_DEPTH,
-                    wgpu::BindingResource::TextureView(&depth_view),
-                ),
+                bind_view(slots::OUT_COLOR, &color_view),
+                bind_view(slots::OUT_DEPTH, &depth_view),
                 bind(slots::ISO, self.iso_buf.as_entire_binding()),
-                bind(8, wgpu::BindingResource::TextureView(&gp)),
-                bind(9, wgpu::BindingResource::TextureView(&gn)),
-                bind(10, wgpu::BindingResource::TextureView(&ge)),
-                bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
-                bind(12, wgpu::BindingResource::TextureView(&env.irradiance_view)),
+                bind_view(8, &gp),
+                bind_view(9, &gn),
+                bind_view(10, &ge),
+                bind_view(11, &env.cube_view),
+                bind_view(12, &env.irradiance_view),
                 bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
                 bind(14, self.lobe_dirs.as_entire_binding()),
                 bind(
@@ -661,10 +644,7 @@ impl IsoPass {
                         res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
                     ),
                 ),
-                bind(
-                    slots::TABLES,
-                    wgpu::BindingResource::TextureView(&tables.view),
-                ),
+                bind_view(slots::TABLES, &tables.view),
                 res.blanking_entry(&self.no_mask),
                 res.grid_lookup_entry(&self.no_grid_lookup)?,
             ],

@@ -35,8 +35,8 @@ use super::medium;
 use super::pathtrace_variant::{self, PathTraceFacts, PathTraceVariant};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
-    bind, bind_block, buffer_entry, dynamic_uniform_entry, sampled_texture_entry, sampler_entry,
-    storage_texture_entry, texture_entry,
+    bind, bind_block, bind_view, buffer_entry, dynamic_uniform_entry, group_layout,
+    sampled_texture_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::{encode_single_group, single_group_pipeline, PipelineCache};
@@ -192,12 +192,8 @@ impl PathTracePass {
     }
 
     pub fn new(ctx: &Context, brick_bgl: &wgpu::BindGroupLayout) -> Result<PathTracePass> {
-        let bgl = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("path tracing"),
-                entries: &Self::layout_entries(ctx.info.float32_filterable),
-            });
+        let entries = Self::layout_entries(ctx.info.float32_filterable);
+        let bgl = group_layout(&ctx.device, "path tracing", &entries);
         let pipelines =
             PipelineCache::new(ctx, "pathtrace.wgsl", "path tracing", &[&bgl, brick_bgl])?;
         let uniforms = uniform_buffer(
@@ -473,21 +469,15 @@ impl PathTracePass {
             layout: &self.bgl,
             entries: &[
                 bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind(
-                    slots::TABLES,
-                    wgpu::BindingResource::TextureView(&tables.view),
-                ),
+                bind_view(slots::TABLES, &tables.view),
                 bind(2, acc.sums.as_entire_binding()),
-                bind(
-                    slots::DEPTH_IN,
-                    wgpu::BindingResource::TextureView(&depth_in_view),
-                ),
+                bind_view(slots::DEPTH_IN, &depth_in_view),
                 bind(5, acc.moments.as_entire_binding()),
                 bind_block::<PathTraceUniforms>(7, &self.uniforms),
-                bind(11, wgpu::BindingResource::TextureView(&env.cube_view)),
+                bind_view(11, &env.cube_view),
                 bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
                 bind(14, dist.as_entire_binding()),
-                bind(15, wgpu::BindingResource::TextureView(majorant_buf)),
+                bind_view(15, majorant_buf),
                 bind(16, acc.guide.as_entire_binding()),
                 bind(
                     17,
@@ -576,8 +566,8 @@ impl PathTracePass {
                     bind(1, acc.sums.as_entire_binding()),
                     bind(2, acc.moments.as_entire_binding()),
                     bind(3, acc.images[0].as_entire_binding()),
-                    bind(4, wgpu::BindingResource::TextureView(&color_view)),
-                    bind(5, wgpu::BindingResource::TextureView(&depth_view)),
+                    bind_view(4, &color_view),
+                    bind_view(5, &depth_view),
                 ],
                 {
                     let [x, y] = groups(rect);

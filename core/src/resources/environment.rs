@@ -4,7 +4,7 @@
 use super::Resources;
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
-    bind, buffer_entry, sampler_entry, storage_texture_entry, texture_entry,
+    bind, bind_view, buffer_entry, sampler_entry, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::{compute_pipeline, encode_single_group, pipeline_layout};
@@ -286,9 +286,9 @@ impl GpuEnvironment {
                     (&p.build_bgl, &p.build),
                     &[
                         bind(0, ub.as_entire_binding()),
-                        bind(1, wgpu::BindingResource::TextureView(&src_view)),
+                        bind_view(1, &src_view),
                         bind(2, wgpu::BindingResource::Sampler(&p.equirect_sampler)),
-                        bind(3, wgpu::BindingResource::TextureView(&dst)),
+                        bind_view(3, &dst),
                     ],
                     [groups(size), groups(size), 6],
                 );
@@ -309,8 +309,8 @@ impl GpuEnvironment {
                 (&p.downsample_bgl, &p.downsample),
                 &[
                     bind(0, ub.as_entire_binding()),
-                    bind(3, wgpu::BindingResource::TextureView(&dst)),
-                    bind(4, wgpu::BindingResource::TextureView(&src)),
+                    bind_view(3, &dst),
+                    bind_view(4, &src),
                 ],
                 [groups(s), groups(s), 6],
             );
@@ -332,8 +332,8 @@ impl GpuEnvironment {
             (&p.irradiance_bgl, &p.irradiance),
             &[
                 bind(0, ub.as_entire_binding()),
-                bind(3, wgpu::BindingResource::TextureView(&dst)),
-                bind(5, wgpu::BindingResource::TextureView(&cube_view)),
+                bind_view(3, &dst),
+                bind_view(5, &cube_view),
                 bind(6, wgpu::BindingResource::Sampler(&p.cube_sampler)),
             ],
             [groups(IRRADIANCE_SIZE), groups(IRRADIANCE_SIZE), 6],

@@ -3,7 +3,7 @@
 //! [`UploadOptions::precompute_gradients`](crate::UploadOptions::precompute_gradients).
 
 use crate::error::Result;
-use crate::gpu::binding::{bind, buffer_entry, storage_texture_entry, texture_entry};
+use crate::gpu::binding::{bind, bind_view, buffer_entry, storage_texture_entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::pipeline::{encode_single_group, single_group_pipeline};
 use crate::gpu::Context;
@@ -72,8 +72,8 @@ impl GradientPass {
             (&self.bgl, &self.pipeline),
             &[
                 bind(0, uniforms.as_entire_binding()),
-                bind(1, wgpu::BindingResource::TextureView(volume)),
-                bind(2, wgpu::BindingResource::TextureView(&out)),
+                bind_view(1, volume),
+                bind_view(2, &out),
             ],
             [
                 size.width.div_ceil(4),

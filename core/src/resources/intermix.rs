@@ -4,7 +4,7 @@
 
 use super::tables::Tables;
 use crate::error::{Error, Result};
-use crate::gpu::binding::{bind, buffer_entry, entry, texture_entry};
+use crate::gpu::binding::{bind, bind_view, buffer_entry, entry, texture_entry};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::slots;
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
@@ -230,14 +230,8 @@ impl IntermixBinding {
         };
         [
             bind(slots::INTERMIX, uniforms.as_entire_binding()),
-            bind(
-                slots::INTERMIX_ATLAS,
-                wgpu::BindingResource::TextureView(atlas),
-            ),
-            bind(
-                slots::INTERMIX_TABLES,
-                wgpu::BindingResource::TextureView(tables),
-            ),
+            bind_view(slots::INTERMIX_ATLAS, atlas),
+            bind_view(slots::INTERMIX_TABLES, tables),
             bind(
                 slots::INTERMIX_SAMPLER,
                 wgpu::BindingResource::Sampler(&self.sampler),

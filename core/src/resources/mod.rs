@@ -14,7 +14,9 @@ pub(crate) mod targets;
 pub(crate) mod volume;
 
 use crate::error::{Error, Result};
-use crate::gpu::binding::{buffer_entry, entry, sampled_texture_entry, texture_entry};
+use crate::gpu::binding::{
+    buffer_entry, entry, group_layout, sampled_texture_entry, texture_entry,
+};
 use crate::gpu::buffers::uniform_buffer;
 use crate::gpu::interop::OutputPath;
 use crate::gpu::slots;
@@ -102,10 +104,7 @@ pub(crate) fn brick_layout_entries() -> [wgpu::BindGroupLayoutEntry; 7] {
 impl Resources {
     pub fn new(ctx: &Context) -> Resources {
         let d = &ctx.device;
-        let brick_bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("brick"),
-            entries: &brick_layout_entries(),
-        });
+        let brick_bgl = group_layout(d, "brick", &brick_layout_entries());
         let sampler = |f: wgpu::FilterMode| {
             d.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("volume"),

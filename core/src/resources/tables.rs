@@ -3,7 +3,7 @@
 use super::bricks::BLOCK_SIZE;
 use super::Resources;
 use crate::error::{Error, Result};
-use crate::gpu::binding::{bind, texture_entry};
+use crate::gpu::binding::{bind_view, texture_entry};
 use crate::gpu::slots;
 use crate::gpu::texture::{block_grid, texture_2d, upload_texture};
 use crate::gpu::uniforms::TABLE_SIZE;
@@ -247,7 +247,7 @@ impl Resources {
             Some((_, t)) if used => &t.view,
             _ => &none.view,
         };
-        bind(slots::TABLES_2D, wgpu::BindingResource::TextureView(view))
+        bind_view(slots::TABLES_2D, view)
     }
 
     /// Builds the 2D tables for the transfer function, unless they are current (a transfer

@@ -10,7 +10,7 @@ use super::gradients::GradientPass;
 use super::residency::{self, Slots, NOT_LATER};
 use super::Resources;
 use crate::error::{Error, Result};
-use crate::gpu::binding::{bind, sampled_texture_entry};
+use crate::gpu::binding::{bind, bind_view, sampled_texture_entry};
 use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::readback::ReadbackRing;
 use crate::gpu::slots;
@@ -630,20 +630,14 @@ impl Resources {
                 layout: &self.brick_bgl,
                 entries: &[
                     bind(slots::POOL, vol.uniform.as_entire_binding()),
-                    bind(slots::VOLUME, wgpu::BindingResource::TextureView(&view)),
+                    bind_view(slots::VOLUME, &view),
                     bind(slots::VOLUME_SAMPLER, wgpu::BindingResource::Sampler(s)),
                     bind(
                         slots::GRADIENTS,
                         wgpu::BindingResource::TextureView(gradient_view.as_ref().unwrap_or(&view)),
                     ),
-                    bind(
-                        slots::PAGE_TABLE,
-                        wgpu::BindingResource::TextureView(&page_view),
-                    ),
-                    bind(
-                        slots::BRICK_CONSTANTS,
-                        wgpu::BindingResource::TextureView(&constants_view),
-                    ),
+                    bind_view(slots::PAGE_TABLE, &page_view),
+                    bind_view(slots::BRICK_CONSTANTS, &constants_view),
                     bind(slots::BRICK_REQUESTS, vol.requests.as_entire_binding()),
                 ],
             })

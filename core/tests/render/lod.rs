@@ -116,16 +116,9 @@ fn previews_draw_coarser_bricks_where_fine_ones_are_missing() {
     assert_eq!(r.residency().stand_ins, 0);
 }
 
-/// A box whose top slab (toward the camera) is opaque over a translucent inside: every brick
-/// is visible and in view, too many for the budget, but the rays stop in the top layer of
-/// bricks. Preview frames of a still camera bring the bricks the rays read, a share of the
-/// pool per frame, until none is read from a stand-in: then the frame equals the in-core
-/// image, and the bricks below the slab were never brought.
-#[test]
-fn previews_converge_to_the_fine_image_and_bring_only_what_rays_read() {
-    let mut r = renderer();
-    let n = 96u32;
-    // (a pattern in the slab, finer than the stand-ins' points)
+/// An n³ volume whose opaque slab in its top 7 layers holds a pattern finer than the
+/// stand-ins' points, over a faint body, and its transfer function set on `r`.
+pub(crate) fn slab_scene(r: &mut Renderer, n: u32) -> VolumeData {
     let vol = volume([n; 3], |x, y, z| match z >= (n - 7) as f64 {
         true => 0.8 + 0.2 * (x / 1.5).sin() * (y / 2.0).sin(),
         false => 0.3,
@@ -140,6 +133,19 @@ fn previews_converge_to_the_fine_image_and_bring_only_what_rays_read() {
         1.0,
     )))
     .unwrap();
+    vol
+}
+
+/// A box whose top slab (toward the camera) is opaque over a translucent inside: every brick
+/// is visible and in view, too many for the budget, but the rays stop in the top layer of
+/// bricks. Preview frames of a still camera bring the bricks the rays read, a share of the
+/// pool per frame, until none is read from a stand-in: then the frame equals the in-core
+/// image, and the bricks below the slab were never brought.
+#[test]
+fn previews_converge_to_the_fine_image_and_bring_only_what_rays_read() {
+    let mut r = renderer();
+    let n = 96u32;
+    let vol = slab_scene(&mut r, n);
     let view = View::fit(vol.bounds(), 64, 64);
     let (_, preview, in_core) = in_core(&mut r, &vol, &view, BlendMode::Composite);
     let dense = (n as u64).pow(3) * 4;

@@ -7,7 +7,7 @@
 
 use crate::common::gpu::{pt_params, renderer};
 use crate::common::metrics::image_diff;
-use crate::common::scenes::{ball, blob_transfer, blob_volume, component_transfer, shaded, volume};
+use crate::common::scenes::{ball, blob_transfer, blob_volume, component_transfer, shaded};
 use ferrovol_core::*;
 use std::time::Instant;
 
@@ -27,19 +27,31 @@ fn heavy_scene(r: &mut Renderer) -> (View, RenderParams) {
     (view, params)
 }
 
-#[test]
-fn render_returns_before_the_device_finishes_the_frame() {
-    let mut r = renderer();
-    let (view, params) = heavy_scene(&mut r);
-    r.render_image(&view, &params).unwrap();
+/// Renders a frame, and says after how many seconds `render` returned and whether the
+/// device had finished it then (polled, not waited for).
+fn render_and_poll(
+    r: &mut Renderer,
+    view: &View,
+    params: &RenderParams,
+) -> (f64, wgpu::PollStatus) {
     let t0 = Instant::now();
-    r.render(&view, &params, None).unwrap();
+    r.render(view, params, None).unwrap();
     let returned = t0.elapsed().as_secs_f64();
     let status = r
         .context()
         .device
         .poll(wgpu::PollType::Poll)
         .expect("polling the device");
+    (returned, status)
+}
+
+#[test]
+fn render_returns_before_the_device_finishes_the_frame() {
+    let mut r = renderer();
+    let (view, params) = heavy_scene(&mut r);
+    r.render_image(&view, &params).unwrap();
+    let t0 = Instant::now();
+    let (returned, status) = render_and_poll(&mut r, &view, &params);
     r.finish().unwrap();
     let finished = t0.elapsed().as_secs_f64();
     println!(
@@ -121,13 +133,7 @@ fn budgeted_path_tracing_frames_do_not_wait() {
     r.reset_accumulation();
     let waits = r.context().device_waits();
     let t0 = Instant::now();
-    r.render(&view, &pt_params(), None).unwrap();
-    let returned = t0.elapsed().as_secs_f64();
-    let status = r
-        .context()
-        .device
-        .poll(wgpu::PollType::Poll)
-        .expect("polling the device");
+    let (returned, status) = render_and_poll(&mut r, &view, &pt_params());
     assert_eq!(r.context().device_waits(), waits, "the frame waited");
     r.finish().unwrap();
     let finished = t0.elapsed().as_secs_f64();
@@ -188,16 +194,7 @@ fn budgeted_path_tracing_frames_do_not_wait() {
 fn preview_frames_do_not_wait_and_converge() {
     let mut r = renderer();
     let n = 96u32;
-    let vol = volume([n; 3], |x, y, z| match z >= (n - 7) as f64 {
-        true => 0.8 + 0.2 * (x / 1.5).sin() * (y / 2.0).sin(),
-        false => 0.3,
-    });
-    r.set_transfer_function(&TransferFunction::single(component_transfer(
-        &[(0.0, [0.2, 0.3, 0.9]), (1.0, [1.0, 0.8, 0.3])],
-        &[(0.0, 0.0), (0.3, 0.05), (0.55, 1.0), (1.0, 1.0)],
-        1.0,
-    )))
-    .unwrap();
+    let vol = super::lod::slab_scene(&mut r, n);
     let view = View::fit(vol.bounds(), 64, 64);
     let still = RenderParams {
         sample_distance: Some(1.0),
