@@ -275,7 +275,7 @@ fn check_coordinates(dims: [u32; 3], coordinates: &[Vec<f64>; 3]) -> Result<()> 
 
 /// The largest world coordinate (and extent) a volume's bounds may reach: the GPU
 /// computes positions in 32-bit floats.
-const MAX_COORDINATE: f64 = f32::MAX as f64;
+pub(crate) const MAX_COORDINATE: f64 = f32::MAX as f64;
 
 impl VolumeData {
     /// A volume with unit spacing, zero origin and identity direction. Validated.
