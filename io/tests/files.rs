@@ -88,3 +88,36 @@ fn the_byte_api_reads_what_the_path_api_reads() {
     assert_eq!(from_file.dims, from_bytes.dims);
     assert_eq!(from_file.scalars, from_bytes.scalars);
 }
+
+#[test]
+fn vtu_files_are_read_as_meshes() {
+    use common::vtu::{hex_grid, write, Enc, Opts};
+    let dir = TempDir::new("vtu");
+    let bytes = write(&[hex_grid(2)], &Opts::with(Enc::AppendedRaw));
+    let p = dir.write("grid.VTU", &bytes);
+    let mesh = ferrovol_io::read_unstructured(&p).unwrap();
+    assert_eq!(mesh, ferrovol_io::vtu::parse(&bytes).unwrap());
+    assert_eq!((mesh.points.len(), mesh.num_cells()), (27, 8));
+    // read_volume points to read_unstructured.
+    let m = read_volume(&p).unwrap_err().to_string();
+    assert!(
+        m.starts_with(&format!(
+            "{}: not supported: this is an unstructured grid",
+            p.display()
+        )) && m.contains("read_unstructured"),
+        "{m}"
+    );
+    // Errors name the file.
+    let p = dir.write("bad.vtu", b"<VTKFile type=\"UnstructuredGrid\"/>");
+    let m = ferrovol_io::read_unstructured(&p).unwrap_err().to_string();
+    assert!(
+        m.starts_with(&format!(
+            "{}: bad VTK UnstructuredGrid (.vtu) header",
+            p.display()
+        )),
+        "{m}"
+    );
+    let p = dir.0.join("nothere.vtu");
+    let m = ferrovol_io::read_unstructured(&p).unwrap_err().to_string();
+    assert!(m.contains("cannot read the file"), "{m}");
+}

@@ -28,7 +28,7 @@
 
 use std::collections::HashMap;
 
-use super::volume::{ScalarType, Scalars, MAX_COORDINATE};
+use super::volume::{beyond_f32, ScalarType, Scalars};
 use crate::error::{Error, Result};
 
 /// A cell type the renderer takes, with its VTK code as discriminant.
@@ -365,18 +365,8 @@ impl UnstructuredVolume {
                 "point {i} is {p:?} (NaN and infinite coordinates are not renderable)"
             )));
         }
-        let b = self.bounds();
-        for axis in 0..3 {
-            let [lo, hi] = [b[2 * axis], b[2 * axis + 1]];
-            if !(lo.abs() <= MAX_COORDINATE
-                && hi.abs() <= MAX_COORDINATE
-                && hi - lo <= MAX_COORDINATE)
-            {
-                return Err(invalid(format!(
-                    "the mesh's bounds along {} are [{lo:e}, {hi:e}], beyond the 32-bit float range (±{MAX_COORDINATE:.1e}) the GPU computes in",
-                    ["x", "y", "z"][axis]
-                )));
-            }
+        if let Some(beyond) = beyond_f32(self.bounds()) {
+            return Err(invalid(format!("the mesh's {beyond}")));
         }
         self.check_cell_array()?;
         let np = self.points.len();
