@@ -24,18 +24,17 @@ use ferrovol_core::{ScalarType, VolumeData};
 use crate::decode::{lookup_type, numbers, Geometry, Layout, TypeNames};
 use crate::vtkxml::{
     appended_array, appended_encoding, appended_section, check_vtkfile, get, parse_xml, xml_part,
-    ArrayDesc, Arrays, Binary, Encoding,
+    ArrayDesc, Arrays, Binary, Encoding, SUPPORTED_TYPES,
 };
 use crate::ReadError;
 
 const FORMAT: &str = "VTK ImageData (.vti)";
-const SUPPORTED_TYPES: &str =
-    "Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32 and Float64 (also the legacy names char, unsigned_char, short, unsigned_short, int, unsigned_int, float, double)";
 
 fn bad(message: impl Into<String>) -> ReadError {
     ReadError::bad_header(FORMAT, message)
 }
 
+/// Whether the array is point or cell data.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Which {
     Point,

@@ -17,6 +17,10 @@ use crate::base64::{Base64, TakeError};
 use crate::decode::{decode_binary, inflate, parse_ascii};
 use crate::ReadError;
 
+/// The scalar types of data arrays, as VTK XML names them (for messages).
+pub(crate) const SUPPORTED_TYPES: &str =
+    "Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32 and Float64 (also the legacy names char, unsigned_char, short, unsigned_short, int, unsigned_int, float, double)";
+
 /// A `<DataArray>`, with its inline text.
 #[derive(Debug, Default)]
 pub(crate) struct ArrayDesc {

@@ -28,12 +28,11 @@ use crate::decode::{lookup_type, TypeNames};
 use crate::error::Problem;
 use crate::vtkxml::{
     appended_encoding, check_vtkfile, get, parse_xml, xml_part, ArrayDesc, Arrays, Piece,
+    SUPPORTED_TYPES,
 };
 use crate::ReadError;
 
 const FORMAT: &str = "VTK UnstructuredGrid (.vtu)";
-const SUPPORTED_TYPES: &str =
-    "Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32 and Float64 (also the legacy names char, unsigned_char, short, unsigned_short, int, unsigned_int, float, double)";
 
 fn bad(message: impl Into<String>) -> ReadError {
     ReadError::bad_header(FORMAT, message)
