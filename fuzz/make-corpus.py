@@ -29,6 +29,19 @@ def put(target, name, data):
         f.write(data)
 
 
+def with_ramp(data, n, components, vtk_type, cells):
+    """`data` with scalars "scalars" on its `n` cells or points: value i is 7 i mod 120."""
+    dtype = numpy_support.get_vtk_to_numpy_typemap()[vtk_type]
+    values = (np.arange(n * components) * 7 % 120).astype(dtype).reshape(n, components)
+    array = numpy_support.numpy_to_vtk(values, deep=True, array_type=vtk_type)
+    array.SetName("scalars")
+    if cells:
+        data.GetCellData().SetScalars(array)
+    else:
+        data.GetPointData().SetScalars(array)
+    return data
+
+
 def image(dims=(3, 2, 2), vtk_type=vtk.VTK_UNSIGNED_SHORT, components=1, cells=False,
           extent_min=(0, 0, 0)):
     """A small vtkImageData with a ramp of values."""
@@ -39,15 +52,7 @@ def image(dims=(3, 2, 2), vtk_type=vtk.VTK_UNSIGNED_SHORT, components=1, cells=F
     img.SetSpacing(0.5, 1.0, 2.0)
     img.SetOrigin(1.0, -2.0, 3.0)
     n = dims[0] * dims[1] * dims[2]
-    dtype = numpy_support.get_vtk_to_numpy_typemap()[vtk_type]
-    values = (np.arange(n * components) * 7 % 120).astype(dtype).reshape(n, components)
-    array = numpy_support.numpy_to_vtk(values, deep=True, array_type=vtk_type)
-    array.SetName("scalars")
-    if cells:
-        img.GetCellData().SetScalars(array)
-    else:
-        img.GetPointData().SetScalars(array)
-    return img
+    return with_ramp(img, n, components, vtk_type, cells)
 
 
 def written(writer, ext):
@@ -154,15 +159,7 @@ def mesh(cells=False, components=1, vtk_type=vtk.VTK_FLOAT, quadratic=False, eac
             grid.InsertNextCell(cell_type, len(ids), [base + i for i in ids])
     grid.SetPoints(points)
     n = grid.GetNumberOfCells() if cells else grid.GetNumberOfPoints()
-    dtype = numpy_support.get_vtk_to_numpy_typemap()[vtk_type]
-    values = (np.arange(n * components) * 7 % 120).astype(dtype).reshape(n, components)
-    array = numpy_support.numpy_to_vtk(values, deep=True, array_type=vtk_type)
-    array.SetName("scalars")
-    if cells:
-        grid.GetCellData().SetScalars(array)
-    else:
-        grid.GetPointData().SetScalars(array)
-    return grid
+    return with_ramp(grid, n, components, vtk_type, cells)
 
 
 def vtu():
