@@ -44,13 +44,7 @@ enum Which {
 /// Parses a `.vti` file from its bytes.
 pub fn parse(bytes: &[u8]) -> Result<VolumeData, ReadError> {
     let h = describe(bytes)?;
-    let arrays = Arrays {
-        format: FORMAT,
-        bytes,
-        binary: h.binary,
-        appended_encoding: h.appended_encoding,
-        xml_end: h.xml_end,
-    };
+    let arrays = Arrays::new(FORMAT, bytes, h.binary, h.appended_encoding, h.xml_end);
     let scalars = arrays.values(&h.array, &h.what, h.ty, h.layout.count)?;
     h.layout.volume(h.geometry, scalars)
 }

@@ -10,6 +10,8 @@
 //! Sizes come from the caller (what the dataset's header calls for) and are checked
 //! against the data present before anything is allocated for them.
 
+use std::cell::OnceCell;
+
 use ferrovol_core::{ScalarType, Scalars};
 use quick_xml::events::{BytesStart, Event};
 
@@ -320,9 +322,38 @@ pub(crate) struct Arrays<'a> {
     pub appended_encoding: Option<Encoding>,
     /// The end of the XML part.
     pub xml_end: usize,
+    /// The appended section, found once: finding its end scans it, and a file may have
+    /// many arrays there.
+    appended: OnceCell<&'a [u8]>,
 }
 
-impl Arrays<'_> {
+impl<'a> Arrays<'a> {
+    pub fn new(
+        format: &'static str,
+        bytes: &'a [u8],
+        binary: Binary,
+        appended_encoding: Option<Encoding>,
+        xml_end: usize,
+    ) -> Arrays<'a> {
+        Arrays {
+            format,
+            bytes,
+            binary,
+            appended_encoding,
+            xml_end,
+            appended: OnceCell::new(),
+        }
+    }
+
+    /// The appended section ([`appended_section`]).
+    fn appended(&self) -> Result<&'a [u8], ReadError> {
+        if let Some(&data) = self.appended.get() {
+            return Ok(data);
+        }
+        let data = appended_section(self.format, self.bytes, self.xml_end)?;
+        Ok(self.appended.get_or_init(|| data))
+    }
+
     /// Exactly `nbytes` bytes of a binary or appended array's data (decompressed);
     /// `what` names the array ("DataArray 'name'").
     pub fn bytes(
@@ -340,7 +371,7 @@ impl Arrays<'_> {
             "appended" => {
                 let (encoding, offset) =
                     appended_array(self.format, what, array, self.appended_encoding)?;
-                let data = appended_section(self.format, self.bytes, self.xml_end)?;
+                let data = self.appended()?;
                 let what = format!("appended data of {what}");
                 let rest = data.get(offset..).ok_or_else(|| {
                     ReadError::truncated(&what, offset.saturating_add(1), data.len())

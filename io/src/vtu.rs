@@ -49,13 +49,13 @@ pub fn parse(bytes: &[u8]) -> Result<UnstructuredVolume, ReadError> {
         ".vtu",
         "save the mesh as an unstructured grid (.vtu), e.g. after ParaView's Merge Blocks or Append Datasets",
     )?;
-    let arrays = Arrays {
-        format: FORMAT,
+    let arrays = Arrays::new(
+        FORMAT,
         bytes,
         binary,
-        appended_encoding: appended_encoding(FORMAT, &h)?,
+        appended_encoding(FORMAT, &h)?,
         xml_end,
-    };
+    );
     if h.pieces.is_empty() {
         return Err(bad("<UnstructuredGrid> has no <Piece> element"));
     }

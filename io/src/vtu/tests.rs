@@ -185,3 +185,18 @@ fn readers_vtu_never_panics_on_damaged_files() {
     never_panics(parse, &write(&[one_tetra()], &o), &[0, b'9', 0xff, b'<']);
     never_panics(parse, &write(&[one_tetra()], &Opts::ASCII), b"09\"");
 }
+
+#[test]
+fn readers_vtu_many_pieces_take_linear_time() {
+    // 20 000 tetra pieces in raw appended data (about 3 MB): each array is found in the
+    // appended section without scanning the section again.
+    let pieces = vec![one_tetra(); 20_000];
+    let mut file = write(&pieces, &Opts::with(Enc::AppendedRaw));
+    // Without its closing tags, as in a cut file, the section runs to the end.
+    file.truncate(file.len() - b"\n</AppendedData>\n</VTKFile>\n".len());
+    let start = std::time::Instant::now();
+    let v = parse(&file).unwrap();
+    assert_eq!(v.num_cells(), 20_000);
+    let took = start.elapsed();
+    assert!(took < std::time::Duration::from_secs(3), "took {took:?}");
+}
