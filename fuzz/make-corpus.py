@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes the fuzz targets' seed corpus, fuzz/corpus/<target>/: small valid files of every
 encoding each reader knows. VTK's own writers (VTK 9.2, /usr/bin/python3) make the .vti,
-MetaImage and NIfTI files; the NRRD files, NIfTI-2 variants VTK does not write and the
+.vtu, MetaImage and NIfTI files; the NRRD files, NIfTI-2 variants VTK does not write and the
 transfer functions are written here. Run it again after changing a format's reader:
     /usr/bin/python3 fuzz/make-corpus.py
 """
@@ -29,6 +29,19 @@ def put(target, name, data):
         f.write(data)
 
 
+def with_ramp(data, n, components, vtk_type, cells):
+    """`data` with scalars "scalars" on its `n` cells or points: value i is 7 i mod 120."""
+    dtype = numpy_support.get_vtk_to_numpy_typemap()[vtk_type]
+    values = (np.arange(n * components) * 7 % 120).astype(dtype).reshape(n, components)
+    array = numpy_support.numpy_to_vtk(values, deep=True, array_type=vtk_type)
+    array.SetName("scalars")
+    if cells:
+        data.GetCellData().SetScalars(array)
+    else:
+        data.GetPointData().SetScalars(array)
+    return data
+
+
 def image(dims=(3, 2, 2), vtk_type=vtk.VTK_UNSIGNED_SHORT, components=1, cells=False,
           extent_min=(0, 0, 0)):
     """A small vtkImageData with a ramp of values."""
@@ -39,15 +52,7 @@ def image(dims=(3, 2, 2), vtk_type=vtk.VTK_UNSIGNED_SHORT, components=1, cells=F
     img.SetSpacing(0.5, 1.0, 2.0)
     img.SetOrigin(1.0, -2.0, 3.0)
     n = dims[0] * dims[1] * dims[2]
-    dtype = numpy_support.get_vtk_to_numpy_typemap()[vtk_type]
-    values = (np.arange(n * components) * 7 % 120).astype(dtype).reshape(n, components)
-    array = numpy_support.numpy_to_vtk(values, deep=True, array_type=vtk_type)
-    array.SetName("scalars")
-    if cells:
-        img.GetCellData().SetScalars(array)
-    else:
-        img.GetPointData().SetScalars(array)
-    return img
+    return with_ramp(img, n, components, vtk_type, cells)
 
 
 def written(writer, ext):
@@ -64,6 +69,29 @@ def written(writer, ext):
         return files
     finally:
         shutil.rmtree(d)
+
+
+def configured(w, opts):
+    """A VTK XML writer set to write as `opts` say: mode (ascii, binary, appended), raw
+    (appended data not base64), zlib with its block size, uint64 headers."""
+    if opts["mode"] == "ascii":
+        w.SetDataModeToAscii()
+    elif opts["mode"] == "binary":
+        w.SetDataModeToBinary()
+    else:
+        w.SetDataModeToAppended()
+        w.SetEncodeAppendedData(0 if opts.get("raw") else 1)
+    if opts.get("zlib"):
+        w.SetCompressorTypeToZLib()
+        if "block" in opts:
+            w.SetBlockSize(opts["block"])  # several blocks, the last one short
+    else:
+        w.SetCompressorTypeToNone()
+    if opts.get("uint64"):
+        w.SetHeaderTypeToUInt64()
+    else:
+        w.SetHeaderTypeToUInt32()
+    return w
 
 
 def vti():
@@ -84,25 +112,8 @@ def vti():
                                        components=4), dict(mode="binary", uint64=True)),
     ]
     for name, img, opts in cases:
-        w = vtk.vtkXMLImageDataWriter()
+        w = configured(vtk.vtkXMLImageDataWriter(), opts)
         w.SetInputData(img)
-        if opts["mode"] == "ascii":
-            w.SetDataModeToAscii()
-        elif opts["mode"] == "binary":
-            w.SetDataModeToBinary()
-        else:
-            w.SetDataModeToAppended()
-            w.SetEncodeAppendedData(0 if opts.get("raw") else 1)
-        if opts.get("zlib"):
-            w.SetCompressorTypeToZLib()
-            if "block" in opts:
-                w.SetBlockSize(opts["block"])  # several blocks, the last one short
-        else:
-            w.SetCompressorTypeToNone()
-        if opts.get("uint64"):
-            w.SetHeaderTypeToUInt64()
-        else:
-            w.SetHeaderTypeToUInt32()
         put("vti", name, written(w, ".vti")["seed.vti"])
     # Big-endian binary data, written by hand (VTK writes the machine's byte order).
     values = struct.pack(">6h", *[-300, -2, 0, 1, 250, 32000])
@@ -120,6 +131,59 @@ def vti():
         '</InformationKey></DataArray>\n'
         '</PointData>\n<CellData></CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n'
     ).encode())
+
+
+def mesh(cells=False, components=1, vtk_type=vtk.VTK_FLOAT, quadratic=False, each=False):
+    """A small vtkUnstructuredGrid: a hexahedron with a pyramid on top, one cell of each
+    linear 3D type the reader takes (`each`, each on its own 9 points, 2 apart along x),
+    or a quadratic tetra, with a ramp of point or cell values."""
+    cube = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1),
+            (0, 1, 1), (0.5, 0.5, 2)]
+    cells_of = [[(vtk.VTK_HEXAHEDRON, list(range(8))), (vtk.VTK_PYRAMID, [4, 5, 6, 7, 8])]]
+    if each:
+        cells_of = [[(vtk.VTK_TETRA, [0, 1, 3, 4])], [(vtk.VTK_VOXEL, [0, 1, 3, 2, 4, 5, 7, 6])],
+                    [(vtk.VTK_HEXAHEDRON, list(range(8)))], [(vtk.VTK_WEDGE, [0, 1, 3, 4, 5, 7])],
+                    [(vtk.VTK_PYRAMID, [4, 5, 6, 7, 8])]]
+    if quadratic:
+        cube += [(0.5, 0, 0), (0.5, 0.5, 0), (0, 0.5, 0), (0, 0, 0.5), (0.5, 0, 0.5),
+                 (0, 0.5, 0.5)]
+        cells_of = [[(vtk.VTK_QUADRATIC_TETRA, [0, 1, 3, 4] + list(range(9, 15)))]]
+    grid = vtk.vtkUnstructuredGrid()
+    points = vtk.vtkPoints()
+    # Each group of cells on its own copy of the points, 2 apart along x.
+    for k, group in enumerate(cells_of):
+        base = points.GetNumberOfPoints()
+        for x, y, z in cube:
+            points.InsertNextPoint(x + 2 * k, y, z)
+        for cell_type, ids in group:
+            grid.InsertNextCell(cell_type, len(ids), [base + i for i in ids])
+    grid.SetPoints(points)
+    n = grid.GetNumberOfCells() if cells else grid.GetNumberOfPoints()
+    return with_ramp(grid, n, components, vtk_type, cells)
+
+
+def vtu():
+    """vtkXMLUnstructuredGridWriter in every mode; io/src/vtu/tests.rs reads these."""
+    cases = [
+        ("ascii-float32-each-type.vtu", mesh(each=True), dict(mode="ascii")),
+        ("binary-uint8-cells.vtu", mesh(cells=True, vtk_type=vtk.VTK_UNSIGNED_CHAR),
+         dict(mode="binary")),
+        ("binary-zlib-int16-2c.vtu", mesh(components=2, vtk_type=vtk.VTK_SHORT),
+         dict(mode="binary", zlib=True, block=64)),
+        ("appended-raw-float64.vtu", mesh(vtk_type=vtk.VTK_DOUBLE),
+         dict(mode="appended", raw=True)),
+        ("appended-raw-zlib-uint16-bigheader-pieces.vtu", mesh(vtk_type=vtk.VTK_UNSIGNED_SHORT),
+         dict(mode="appended", raw=True, zlib=True, uint64=True, block=64, pieces=2)),
+        ("appended-base64-int32-cells-4c.vtu",
+         mesh(cells=True, components=4, vtk_type=vtk.VTK_INT), dict(mode="appended")),
+        ("ascii-quadratic-tetra.vtu", mesh(quadratic=True), dict(mode="ascii")),
+    ]
+    for name, grid, opts in cases:
+        w = configured(vtk.vtkXMLUnstructuredGridWriter(), opts)
+        w.SetInputData(grid)
+        # An input not split into pieces is written whole into each piece.
+        w.SetNumberOfPieces(opts.get("pieces", 1))
+        put("vtu", name, written(w, ".vtu")["seed.vtu"])
 
 
 def metaimage():
@@ -264,6 +328,7 @@ def transfer():
 if __name__ == "__main__":
     shutil.rmtree(ROOT, ignore_errors=True)
     vti()
+    vtu()
     metaimage()
     nifti()
     nrrd()

@@ -6,11 +6,11 @@
 #   scripts/fuzz.sh smoke [SECONDS]       every target on its committed corpus for
 #                                         SECONDS (default 20) each; fails on a crash or hang
 #   scripts/fuzz.sh stats                 executions, paths and findings per target
-# Targets: vti nifti metaimage nrrd transfer. A finding replays with the target's binary:
+# Targets: vti vtu nifti metaimage nrrd transfer. A finding replays with the target's binary:
 #   $CARGO_TARGET_DIR/fuzz/release/TARGET build/fuzz/TARGET/default/crashes/id:...
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-TARGETS=(vti nifti metaimage nrrd transfer)
+TARGETS=(vti vtu nifti metaimage nrrd transfer)
 # Its own target folder: the coverage flags would otherwise rebuild the main workspace's.
 FUZZ_TARGET=${CARGO_TARGET_DIR:-$ROOT/target}/fuzz
 BIN=$FUZZ_TARGET/release

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 
-use ferrovol_core::VolumeData;
+use ferrovol_core::{UnstructuredVolume, VolumeData};
 use ferrovol_io::ReadError;
 
 // AFL++'s runtime, afl-compiler-rt.o, which scripts/fuzz.sh links in. Under afl-fuzz it
@@ -179,12 +179,35 @@ pub fn check_volume(result: &Result<VolumeData, ReadError>) -> String {
                 v.scalars.scalar_type().name()
             )
         }
-        Err(e) => {
-            let message = e.to_string();
-            assert!(!message.is_empty(), "an error without a message: {e:?}");
-            format!("error: {message}")
-        }
+        Err(e) => error_line(e),
     }
+}
+
+/// [`check_volume`] for a mesh reader: the mesh must pass validation; an error must
+/// have a message.
+pub fn check_mesh(result: &Result<UnstructuredVolume, ReadError>) -> String {
+    match result {
+        Ok(m) => {
+            if let Err(e) = m.validate() {
+                panic!("a reader returned a mesh that fails validation: {e}");
+            }
+            format!(
+                "mesh of {} points and {} cells, {} component(s) of {}",
+                m.points.len(),
+                m.num_cells(),
+                m.components,
+                m.scalar_type().name()
+            )
+        }
+        Err(e) => error_line(e),
+    }
+}
+
+/// The line for an error, which must have a message.
+fn error_line(e: &ReadError) -> String {
+    let message = e.to_string();
+    assert!(!message.is_empty(), "an error without a message: {e:?}");
+    format!("error: {message}")
 }
 
 /// Separates the bytes of a header from those of its detached data file: an input holds

@@ -1,9 +1,16 @@
 //! ferrovol-io: the file formats around ferrovol's renderer.
 //!
 //! Volume readers for VTK XML ImageData (`.vti`), NIfTI-1/2 (`.nii`, `.nii.gz`),
-//! MetaImage (`.mha`, `.mhd` + data file) and NRRD (`.nrrd`, `.nhdr` + data file), the
-//! JSON transfer-function format ([`transfer`]), and image files: environment maps in,
+//! MetaImage (`.mha`, `.mhd` + data file) and NRRD (`.nrrd`, `.nhdr` + data file), a
+//! mesh reader for VTK XML UnstructuredGrid (`.vtu`, [`vtu`]), the JSON
+//! transfer-function format ([`transfer`]), and image files: environment maps in,
 //! rendered frames out ([`image`]).
+//!
+//! Meshes are not volumes: [`read_unstructured`] (and [`vtu::parse`]) return a validated
+//! [`ferrovol_core::UnstructuredVolume`], not a [`VolumeData`], so `.vtu` is not a
+//! [`Format`] and [`read_volume`] refuses it with a message that names
+//! [`read_unstructured`]. The VTK XML machinery (DataArray encodings, appended data,
+//! zlib blocks) is shared by the `.vti` and `.vtu` readers.
 //!
 //! Every reader has a byte-slice API beside the path API: [`read_volume`] reads a file
 //! and its detached data file from disk; [`Format::parse`] (or each format module's
@@ -13,7 +20,7 @@
 //!
 //! Every reader keeps the scalar type stored in the file (no conversion to float, except
 //! NIfTI data with a non-trivial `scl_slope`/`scl_inter`), returns a validated
-//! [`VolumeData`], and reports every problem as a [`ReadError`] whose message names the
+//! [`VolumeData`] (or mesh), and reports every problem as a [`ReadError`] whose message names the
 //! file (when there is one), the field or section that was wrong and what to do about
 //! it. Nothing in a file's content can make a reader panic, and no reader allocates more
 //! than its input can fill: sizes are checked (with overflow checks) against the data
@@ -24,7 +31,7 @@
 
 use std::path::{Path, PathBuf};
 
-use ferrovol_core::VolumeData;
+use ferrovol_core::{UnstructuredVolume, VolumeData};
 
 mod base64;
 mod decode;
@@ -36,6 +43,8 @@ pub mod nrrd;
 mod raw;
 pub mod transfer;
 pub mod vti;
+mod vtkxml;
+pub mod vtu;
 
 pub use error::{Problem, ReadError};
 pub use raw::RawFileSource;
@@ -108,6 +117,12 @@ pub fn no_data_file(name: &str) -> Result<Vec<u8>, ReadError> {
 /// detached data file is read relative to the header's folder. Every error message starts
 /// with the path of the file it is about. The result has passed [`VolumeData::validate`].
 pub fn read_volume(path: &Path) -> Result<VolumeData, ReadError> {
+    if is_vtu(path) {
+        return Err(ReadError::unsupported(
+            "this is an unstructured grid (.vtu), not a volume: read it with read_unstructured",
+        )
+        .in_file(path));
+    }
     let format = Format::from_path(path).ok_or_else(|| ReadError::UnknownFormat {
         path: path.to_path_buf(),
     })?;
@@ -119,6 +134,19 @@ pub fn read_volume(path: &Path) -> Result<VolumeData, ReadError> {
                 file.map_or_else(|| path.to_path_buf(), |name| data_file_path(path, name))
             })
         })
+}
+
+/// Whether a file name ends in `.vtu` (case-insensitive).
+fn is_vtu(path: &Path) -> bool {
+    path.file_name()
+        .is_some_and(|n| n.to_string_lossy().to_ascii_lowercase().ends_with(".vtu"))
+}
+
+/// Reads a VTK XML UnstructuredGrid file (`.vtu`, [`vtu`]) into a validated mesh. Every
+/// error message starts with the path.
+pub fn read_unstructured(path: &Path) -> Result<UnstructuredVolume, ReadError> {
+    let bytes = read_file(path)?;
+    vtu::parse(&bytes).map_err(|e| e.in_file(path))
 }
 
 /// Opens a volume file as [`read_volume`] reads it, but leaves uncompressed binary data
@@ -185,9 +213,24 @@ fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
 
 #[cfg(test)]
 mod test_util {
-    use ferrovol_core::VolumeData;
+    use ferrovol_core::{UnstructuredVolume, VolumeData};
 
     use crate::ReadError;
+
+    /// What a reader returns: a volume or a mesh, which validates.
+    pub trait Valid: std::fmt::Debug {
+        fn check(&self);
+    }
+    impl Valid for VolumeData {
+        fn check(&self) {
+            self.validate().unwrap();
+        }
+    }
+    impl Valid for UnstructuredVolume {
+        fn check(&self) {
+            self.validate().unwrap();
+        }
+    }
 
     pub fn zlib(data: &[u8]) -> Vec<u8> {
         use std::io::Write;
@@ -218,8 +261,8 @@ mod test_util {
 
     /// Checks that parsing each case's bytes fails with a message containing the case's
     /// words.
-    pub fn check_errors(
-        parse: impl Fn(&[u8]) -> Result<VolumeData, ReadError>,
+    pub fn check_errors<T: Valid>(
+        parse: impl Fn(&[u8]) -> Result<T, ReadError>,
         cases: &[(&str, Vec<u8>, &str)],
     ) {
         for (name, bytes, want) in cases {
@@ -231,8 +274,8 @@ mod test_util {
 
     /// Parses every prefix of `file` and `file` with each byte replaced by each of
     /// `replacements`: every parse must return an error or a valid volume, never panic.
-    pub fn never_panics(
-        parse: impl Fn(&[u8]) -> Result<VolumeData, ReadError>,
+    pub fn never_panics<T: Valid>(
+        parse: impl Fn(&[u8]) -> Result<T, ReadError>,
         file: &[u8],
         replacements: &[u8],
     ) {
@@ -245,7 +288,7 @@ mod test_util {
             for &x in replacements {
                 f[i] = x;
                 if let Ok(v) = parse(&f) {
-                    v.validate().unwrap();
+                    v.check();
                 }
             }
             f[i] = keep;

@@ -8,8 +8,9 @@ use std::cell::Cell;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
-use ferrovol_core::VolumeData;
 use ferrovol_io::{no_data_file, Format, ReadError};
+
+mod common;
 
 thread_local! {
     static LIVE: Cell<usize> = const { Cell::new(0) };
@@ -81,25 +82,30 @@ type Claim = (&'static str, Vec<u8>, Option<Vec<u8>>, &'static str);
 /// Parses each claim and checks that it fails with its words, within 1 s, under
 /// [`claim_bound`].
 fn check(format: Format, cases: &[Claim]) {
+    check_parse(&format!("{format:?}"), cases, |input, data| {
+        format.parse(input, |n| match data {
+            Some(d) => Ok(d.clone()),
+            None => no_data_file(n),
+        })
+    })
+}
+
+/// [`check`] for any reader: `parse` takes the input and the data file.
+fn check_parse<T>(
+    label: &str,
+    cases: &[Claim],
+    parse: impl Fn(&[u8], &Option<Vec<u8>>) -> Result<T, ReadError>,
+) {
     for (name, input, data, want) in cases {
-        let parse = || -> Result<VolumeData, ReadError> {
-            format.parse(input, |n| match data {
-                Some(d) => Ok(d.clone()),
-                None => no_data_file(n),
-            })
-        };
-        let (result, peak, took) = measure(parse);
+        let (result, peak, took) = measure(|| parse(input, data));
         let message = match result {
-            Ok(v) => panic!(
-                "{name}: a {:?} volume from a header claiming 10^12 voxels",
-                v.dims
-            ),
+            Ok(_) => panic!("{label} {name}: a result from a header claiming 10^12 values"),
             Err(e) => e.to_string(),
         };
         let len = input.len() + data.as_ref().map_or(0, Vec::len);
         let bound = claim_bound(len);
         println!(
-            "{format:?} {name}: {len} input bytes, peak heap {peak} bytes (bound {bound}), {:.2} ms: {message}",
+            "{label} {name}: {len} input bytes, peak heap {peak} bytes (bound {bound}), {:.2} ms: {message}",
             took.as_secs_f64() * 1e3
         );
         assert!(
@@ -210,6 +216,64 @@ fn vti_claims_fail_without_allocating() {
             ),
         ],
     );
+}
+
+#[test]
+fn vtu_claims_fail_without_allocating() {
+    use common::vtu::{one_tetra, write, Enc, Opts};
+    // The tetra file with `attr` (NumberOfPoints="4" or NumberOfCells="1") claiming more.
+    let file = |o: Opts, attr: &str, claim: &str| {
+        let mut bytes = write(&[one_tetra()], &o);
+        let n = if attr == "NumberOfPoints" { 4 } else { 1 };
+        let from = format!("{attr}=\"{n}\"").into_bytes();
+        let at = bytes
+            .windows(from.len())
+            .position(|w| w == from)
+            .expect("the attribute");
+        bytes.splice(
+            at..at + from.len(),
+            format!("{attr}=\"{claim}\"").into_bytes(),
+        );
+        bytes
+    };
+    let twelve = "1000000000000";
+    let mut cases: Vec<Claim> = vec![
+        (
+            "ascii points",
+            file(Opts::ASCII, "NumberOfPoints", twelve),
+            None,
+            "found 12 values, expected 3000000000000",
+        ),
+        (
+            "ascii cells",
+            file(Opts::ASCII, "NumberOfCells", twelve),
+            None,
+            "found 1 values, expected 1000000000000",
+        ),
+    ];
+    for (name, enc) in [
+        ("binary points", Enc::Binary),
+        ("appended raw points", Enc::AppendedRaw),
+        ("appended base64 points", Enc::AppendedBase64),
+    ] {
+        cases.push((
+            name,
+            file(Opts::with(enc), "NumberOfPoints", twelve),
+            None,
+            "call for 24000000000000",
+        ));
+        let zlib = Opts {
+            zlib: Some(64),
+            ..Opts::with(enc)
+        };
+        cases.push((
+            name,
+            file(zlib, "NumberOfPoints", twelve),
+            None,
+            "24000000000000",
+        ));
+    }
+    check_parse("Vtu", &cases, |input, _| ferrovol_io::vtu::parse(input));
 }
 
 /// A NIfTI header of `version` (1 or 2) for uint8 voxels of `dims`, data at byte 352

@@ -12,6 +12,7 @@ pub mod light;
 pub mod pathtrace;
 pub mod render;
 pub mod transfer;
+pub mod unstructured;
 pub mod view;
 pub mod volume;
 
@@ -33,6 +34,7 @@ pub use transfer::{
     ComponentTransfer, LabelTransfer, Piecewise, Table2D, TransferFunction, MAX_TRANSFER_POSITION,
     TABLE_SIZE,
 };
+pub use unstructured::{vtk_cell_type_name, CellType, ScalarLocation, UnstructuredVolume};
 pub use view::{Image, Residency, Stats, StreamProgress, UploadOptions, View};
 pub use volume::{
     Direction, MaskKind, ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION,

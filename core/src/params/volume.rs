@@ -277,6 +277,23 @@ fn check_coordinates(dims: [u32; 3], coordinates: &[Vec<f64>; 3]) -> Result<()> 
 /// computes positions in 32-bit floats.
 const MAX_COORDINATE: f64 = f32::MAX as f64;
 
+/// For bounds (`[xmin, xmax, ymin, …]`) beyond [`MAX_COORDINATE`] along an axis, the
+/// message's start: "bounds along x are [lo, hi], beyond the 32-bit float range …".
+pub(crate) fn beyond_f32(b: [f64; 6]) -> Option<String> {
+    (0..3).find_map(|axis| {
+        let [lo, hi] = [b[2 * axis], b[2 * axis + 1]];
+        let within =
+            lo.abs() <= MAX_COORDINATE && hi.abs() <= MAX_COORDINATE && hi - lo <= MAX_COORDINATE;
+        (!within).then(|| {
+            format!(
+                "bounds along {} are [{lo:e}, {hi:e}], beyond the 32-bit float range \
+                 (±{MAX_COORDINATE:.1e}) the GPU computes in",
+                ["x", "y", "z"][axis]
+            )
+        })
+    })
+}
+
 impl VolumeData {
     /// A volume with unit spacing, zero origin and identity direction. Validated.
     pub fn new(dims: [u32; 3], components: u32, scalars: Scalars) -> Result<Self> {
@@ -392,25 +409,11 @@ impl VolumeData {
                 "direction matrix {d:?} is singular (determinant {det})"
             )));
         }
-        let b = self.bounds();
-        for axis in 0..3 {
-            let [lo, hi] = [b[2 * axis], b[2 * axis + 1]];
-            if !(lo.abs() <= MAX_COORDINATE
-                && hi.abs() <= MAX_COORDINATE
-                && hi - lo <= MAX_COORDINATE)
-            {
-                return Err(Error::InvalidVolume(format!(
-                    "the volume's bounds along {} are [{lo:e}, {hi:e}], beyond the 32-bit float \
-                     range (±{MAX_COORDINATE:.1e}) the GPU computes in: origin {:?}, spacing {:?}, \
-                     dimensions {}x{}x{}",
-                    ["x", "y", "z"][axis],
-                    self.origin,
-                    self.spacing,
-                    self.dims[0],
-                    self.dims[1],
-                    self.dims[2]
-                )));
-            }
+        if let Some(beyond) = beyond_f32(self.bounds()) {
+            return Err(Error::InvalidVolume(format!(
+                "the volume's {beyond}: origin {:?}, spacing {:?}, dimensions {}x{}x{}",
+                self.origin, self.spacing, self.dims[0], self.dims[1], self.dims[2]
+            )));
         }
         if let Some(c) = &self.coordinates {
             check_coordinates(self.dims, c)?;
