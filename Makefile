@@ -179,9 +179,16 @@ lint-fuzz:
 	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
 	$(CARGO) clippy --locked --manifest-path fuzz/Cargo.toml --all-targets -- -D warnings
 # The library crates as crates.io would take them: packaged alone (the shaders inside
-# ferrovol-core) and built from the package.
+# ferrovol-core) and built from the package, in a target folder of their own. Cargo
+# verifies ferrovol-io against the ferrovol-core it just packaged, through a local registry
+# whose crates it takes as immutable: it reuses an unpacked copy, or a build, of a version
+# it has seen (the same 0.2.0 with older code). Those copies and builds go first.
+PUBLISH_TARGET := target/publish
 lint-publish:
-	$(CARGO) publish --dry-run --locked --allow-dirty -p ferrovol-core -p ferrovol-io
+	rm -rf $${CARGO_HOME:-$$HOME/.cargo}/registry/src/-*/ferrovol-* \
+	  $(PUBLISH_TARGET)/debug/deps/*ferrovol_* $(PUBLISH_TARGET)/debug/.fingerprint/ferrovol-*
+	CARGO_TARGET_DIR=$(PUBLISH_TARGET) $(CARGO) publish --dry-run --locked --allow-dirty \
+	  -p ferrovol-core -p ferrovol-io
 
 # Everything CI runs (scripts/test.sh: the builds, then the suites in two lanes, each
 # suite's log in build/test-logs and its wall time; `scripts/test.sh NAME...` runs some).
