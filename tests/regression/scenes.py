@@ -1,6 +1,9 @@
 """The regression matrix: every scene is rendered in the same VTK window setup by
 vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper (a second
-opinion, where it supports the scene) and vtkFerroVolumeMapper.
+opinion, where it supports the scene) and vtkFerroVolumeMapper; an unstructured-grid scene
+(`unstructured=True`, the meshes of meshes.py) by vtkUnstructuredGridVolumeRayCastMapper
+(the reference), vtkUnstructuredGridVolumeZSweepMapper and vtkProjectedTetrahedraMapper
+(second opinions) and ferrovol's vtkFerroUnstructuredVolumeMapper.
 
 A scene is data + volume property + blend mode + mapper settings + camera (+ actors, volume
 matrix, viewports). Its thresholds live in thresholds.toml under the same name. Scenes with
