@@ -140,7 +140,7 @@ def render(scene, kind):
     data = S.DATA[scene.data]()
     if scene.unstructured and kind != "ferrovol":
         data = S.meshes.tetrahedralised(data)   # VTK's unstructured mappers: tetrahedra only
-    if make_mapper(kind, scene.unstructured) is None:
+    if kind == "ferrovol" and scene.unstructured and not hasattr(ferrovol, UGRID_FERROVOL):
         return None, {"ms": None, "errors": [], "warnings": [], "drew": False,
                       "missing": "the module ferrovol has no %s yet" % UGRID_FERROVOL}
     w, h = scene.size
