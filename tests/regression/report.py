@@ -66,14 +66,15 @@ reference), by <b>vtkFerroVolumeMapper</b> and, where it supports the scene, by
 Unstructured grids (<code>ugrid-*</code>) have <b>vtkUnstructuredGridVolumeRayCastMapper</b>
 as the reference, <b>vtkUnstructuredGridVolumeZSweepMapper</b> and
 <b>vtkProjectedTetrahedraMapper</b> as second opinions, and ferrovol's
-vtkFerroUnstructuredVolumeMapper (<a href="../../tests/regression/UNSTRUCTURED.md">UNSTRUCTURED.md</a>).
+vtkFerroUnstructuredVolumeMapper
+(<a href="../../tests/regression/UNSTRUCTURED.md">UNSTRUCTURED.md</a>).
 Figures against the reference: SSIM (luminance, 11×11 Gaussian window), PSNR over RGB, mean
 <a href="https://research.nvidia.com/publication/2020-07_FLIP">FLIP</a> (Andersson et al.,
 HPG 2020; 67 pixels per degree) and ΔRGB, the mean absolute colour difference in 8-bit levels
 inside the volume's footprint (pixels where either image is not background). ferrovol's
 figures are held against <code>tests/regression/thresholds.toml</code> (each with its reason);
-the second opinions' figures are shown, not judged. Difference images are |image − reference| × 4;
-FLIP maps are black (no visible difference) to light yellow (1).
+the second opinions' figures are shown, not judged. Difference images are
+|image − reference| × 4; FLIP maps are black (no visible difference) to light yellow (1).
 <br><b>Sample placement</b>: ferrovol samples where VTK 9.2 does: the first sample one
 full step inside the volume's box (<code>g_rayOrigin += g_dirStep</code> when jittering is
 off), always taken, the exit-face sample kept, and up to one step past opaque depth and

@@ -80,6 +80,7 @@ import vtk  # noqa: E402
 
 import ferrovol  # noqa: E402
 import fvtest  # noqa: E402
+import meshes  # noqa: E402
 import scenes as S  # noqa: E402
 from ferrovol_testing import flip  # noqa: E402
 from ferrovol_testing.metrics import (  # noqa: E402
@@ -139,7 +140,7 @@ def render(scene, kind):
     (None, info) where there is no such mapper yet."""
     data = S.DATA[scene.data]()
     if scene.unstructured and kind != "ferrovol":
-        data = S.meshes.tetrahedralised(data)   # VTK's unstructured mappers: tetrahedra only
+        data = meshes.tetrahedralised(data)   # VTK's unstructured mappers: tetrahedra only
     if kind == "ferrovol" and scene.unstructured and not hasattr(ferrovol, UGRID_FERROVOL):
         return None, {"ms": None, "errors": [], "warnings": [], "drew": False,
                       "missing": "the module ferrovol has no %s yet" % UGRID_FERROVOL}

@@ -17,7 +17,6 @@ import numpy as np
 import vtk
 
 import fvtest  # vtk_plugin/tests/fvtest.py: windows, TF helpers, image_from_array, spheres
-import meshes  # tests/regression/meshes.py: the unstructured grids
 from fvtest import WAVELET_OPACITY, tf_property
 
 # ---------------------------------------------------------------------------------------
@@ -207,57 +206,9 @@ def wavelet_rectilinear_cells():
     return _rectilinear(cells=True)
 
 
-# Unstructured grids (tests/regression/meshes.py, made in memory): VTK's unstructured
-# mappers take tetrahedra only, and get the mixed mesh through vtkDataSetTriangleFilter
-# (run.py's vtk_input); ferrovol gets each mesh as it is.
-
-
-@_cached
-def ugrid_wavelet():
-    """VTK's wavelet on -10..10 (wavelet21's points), 5 tetrahedra per voxel: 40 000
-    tetrahedra, point scalars RTData."""
-    return meshes.tet_wavelet(10)
-
-
-@_cached
-def ugrid_wavelet_cells():
-    """ugrid_wavelet with cell scalars instead: each tetrahedron the mean of its 4 points."""
-    f = vtk.vtkPointDataToCellData()
-    f.SetInputData(ugrid_wavelet())
-    f.Update()
-    ug = vtk.vtkUnstructuredGrid()
-    ug.ShallowCopy(f.GetOutput())
-    ug.GetPointData().Initialize()
-    ug.GetCellData().SetActiveScalars("RTData")
-    return ug
-
-
-@_cached
-def ugrid_mixed():
-    """meshes.mixed(): 768 hexahedra, 1152 wedges, 800 pyramids and 3008 tetrahedra,
-    distorted, over [-10, 10]^3, point scalars."""
-    return meshes.mixed()
-
-
-@_cached
-def ugrid_mixed_tets():
-    """ugrid_mixed split into tetrahedra by vtkDataSetTriangleFilter (what VTK's mappers
-    draw of it), for every mapper: matched interpolation."""
-    return meshes.tetrahedralised(ugrid_mixed())
-
-
-@_cached
-def ugrid_torus():
-    """meshes.torus(): a torus about z (major radius 6.5) with a hollow tube (radii 1.5 to
-    3.5), 36 864 tetrahedra, point scalars."""
-    return meshes.torus()
-
-
 DATA = {f.__name__: f for f in (wavelet128, wavelet128_blanked, wavelet21, marschner_lobb,
                                  cranium, colin27, heart, labels, frog,
-                                 wavelet_rectilinear_points, wavelet_rectilinear_cells,
-                                 ugrid_wavelet, ugrid_wavelet_cells, ugrid_mixed,
-                                 ugrid_mixed_tets, ugrid_torus)}
+                                 wavelet_rectilinear_points, wavelet_rectilinear_cells)}
 
 # ---------------------------------------------------------------------------------------
 # Volume properties
@@ -631,15 +582,6 @@ def ml_intermixed(shade=False):
     return make
 
 
-def ray_integrator(name):
-    """The unstructured ray integrator vtkUnstructuredGrid<name> on the mappers that take one
-    (the ray caster and the Z-sweep mapper; projected tetrahedra has none)."""
-    def f(m):
-        if hasattr(m, "SetRayIntegrator"):
-            m.SetRayIntegrator(getattr(vtk, "vtkUnstructuredGrid" + name)())
-    return f
-
-
 def rotate_scale(vol):
     vol.SetPosition(15.0, -5.0, 0.0)
     vol.RotateZ(30.0)
@@ -700,15 +642,6 @@ OUTLINE_NOTE = ("Outline: VTK rasterises its proxy box into the 8x multisampled 
 SAMPLING_NOTE = ("Sample placement: ferrovol samples on VTK 9.2's lattice (first sample one "
                  "step inside the box, the exit-face sample kept), adopted after this suite "
                  "found the difference; what remains is listed in SAMPLING.md.")
-
-UGRID_NOTE = ("Reference: vtkUnstructuredGridVolumeRayCastMapper (Bunyk et al.'s cell-to-cell "
-              "ray caster, one ray per pixel: ImageSampleDistance 1, no auto-adjustment) with "
-              "its default integrator for one-component point scalars, "
-              "vtkUnstructuredGridPreIntegration (a 128 x 128 x 256 table of "
-              "vtkUnstructuredGridPartialPreIntegration), unless the title names another. "
-              "VTK's unstructured mappers read the transfer function's opacity as an "
-              "attenuation coefficient per ScalarOpacityUnitDistance (exp(-length x opacity / "
-              "unit distance)), not as the opacity of a unit step (UNSTRUCTURED.md).")
 
 SCENES = [
     # --- wavelet 128^3: blend modes
@@ -949,45 +882,16 @@ SCENES = [
           "property turns it on for both, as VTK)", "wavelet128", wavelet_tf("linear", True),
           intermix=lambda: [("marschner_lobb", ml_intermixed(True), ml_in_wavelet)],
           views=one(camera=orbit(30, 20, 1.1)), fixed=False),
-    # --- unstructured grids (issue 40): pending until ferrovol has an unstructured mapper
-    Scene("ugrid-wavelet", "wavelet 21^3 as 40 000 tetrahedra (vtkDataSetTriangleFilter), "
-          "point scalars, composite, default integrator (pre-integration table)",
-          "ugrid_wavelet", wavelet_tf("linear"), unstructured=True, note=UGRID_NOTE),
-    Scene("ugrid-wavelet-linear-integrator", "wavelet 21^3 as 40 000 tetrahedra, point "
-          "scalars, composite, vtkUnstructuredGridLinearRayIntegrator (exact for a "
-          "piecewise-linear transfer function: splits segments at its control points)",
-          "ugrid_wavelet", wavelet_tf("linear"),
-          configure=ray_integrator("LinearRayIntegrator"), unstructured=True,
-          note=UGRID_NOTE + " Projected tetrahedra has no integrator to choose."),
-    Scene("ugrid-wavelet-cells", "wavelet 21^3 as 40 000 tetrahedra, cell scalars (each the "
-          "mean of its points), composite (VTK's homogeneous integrator: constant colour and "
-          "attenuation per cell)", "ugrid_wavelet_cells", wavelet_tf("linear"),
-          unstructured=True, note=UGRID_NOTE),
-    Scene("ugrid-mixed", "mixed mesh: 768 hexahedra, 1152 wedges, 800 pyramids, 3008 "
-          "tetrahedra, distorted (non-planar faces), point scalars, composite; VTK draws it "
-          "split into tetrahedra, ferrovol as it is", "ugrid_mixed", wavelet_tf("linear"),
-          views=one(camera=orbit(35, 25)), unstructured=True,
-          note=UGRID_NOTE + " VTK's unstructured mappers draw tetrahedra only (the ray "
-          "caster skips other cells with a warning, projected tetrahedra stops with an "
-          "error): they get vtkDataSetTriangleFilter's split of the mesh, whose linear "
-          "tetrahedra differ from a hexahedron's trilinear field (ugrid-mixed-tets is the "
-          "matched control)."),
-    Scene("ugrid-mixed-tets", "control: the mixed mesh split into tetrahedra by "
-          "vtkDataSetTriangleFilter for every mapper (matched interpolation)",
-          "ugrid_mixed_tets", wavelet_tf("linear"), views=one(camera=orbit(35, 25)),
-          unstructured=True, note=UGRID_NOTE),
-    Scene("ugrid-torus", "hollow torus (annular tube), 36 864 tetrahedra, seen at 60 degrees "
-          "from its axis: rays leave and re-enter the mesh", "ugrid_torus",
-          wavelet_tf("linear", unit_distance=4.0), views=one(camera=orbit(30, 60)),
-          unstructured=True,
-          note=UGRID_NOTE),
-    Scene("ugrid-torus-edge", "hollow torus seen nearly edge-on (80 degrees from its axis): "
-          "rays cross up to four walls, where projected tetrahedra's cell-centre depth sort "
-          "shows", "ugrid_torus", wavelet_tf("linear", unit_distance=4.0),
-          views=one(camera=orbit(20, 80, 1.2)), unstructured=True, note=UGRID_NOTE),
     Scene("labels-composite", "label map 128x128x108 uint8 (skull CT in 4 tissues), "
           "categorical TF, nearest", "labels", label_tf, quick=True,
           views=one(camera=ct_front(30, 10))),
 ]
+
+# The unstructured grids' data and scenes (ugrid_scenes.py builds them from the pieces above;
+# import this module, not that one, first).
+import ugrid_scenes  # noqa: E402
+
+DATA.update(ugrid_scenes.DATA)
+SCENES += ugrid_scenes.SCENES
 
 BY_NAME = {s.name: s for s in SCENES}
