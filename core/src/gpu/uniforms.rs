@@ -96,6 +96,16 @@ pub struct PoolUniforms {
 /// Per-pixel ray state (PixelState in WGSL), 48 bytes.
 pub const PIXEL_STATE_BYTES: u64 = 48;
 
+/// An unstructured volume's uniforms (`Mesh` in shaders/unstructured.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct MeshUniforms {
+    /// Tetrahedra, boundary triangles, hierarchy nodes, the most steps a ray takes.
+    pub counts: [u32; 4],
+    /// x: 1 / the scalar opacity unit distance (attenuation = opacity · x).
+    pub unit: [f32; 4],
+}
+
 /// The isosurface uniforms (`Iso` in shaders/lib/iso.wgsl), read by the first-hit and
 /// deferred passes.
 #[repr(C)]
@@ -512,6 +522,8 @@ mod layout_tests {
             PathTraceUniforms,
             [env_rotation, medium, surface, lobe, counts, options, rect]
         );
+        let m = module("unstructured.wgsl");
+        check!(m, "Mesh", MeshUniforms, [counts, unit]);
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
         let m = module("pathtrace_show.wgsl");

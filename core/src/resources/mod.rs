@@ -8,6 +8,7 @@ pub(crate) mod gradients;
 pub(crate) mod intermix;
 pub(crate) mod levels;
 pub(crate) mod lod;
+pub(crate) mod mesh;
 pub(crate) mod residency;
 pub(crate) mod tables;
 pub(crate) mod targets;
@@ -41,6 +42,8 @@ pub(crate) struct Resources {
     /// The frame uniforms (lib/common.wgsl's Frame), written by each pass.
     pub frame_buf: wgpu::Buffer,
     pub volume: Option<GpuVolume>,
+    /// An unstructured volume, drawn instead of `volume` while it is set.
+    pub mesh: Option<mesh::gpu::GpuMesh>,
     /// A coarser level of a bricked volume, built when a path-traced frame's bricks exceed
     /// the memory budget (levels.rs).
     pub level: Option<levels::Level>,
@@ -127,6 +130,7 @@ impl Resources {
             nearest: sampler(wgpu::FilterMode::Nearest),
             frame_buf,
             volume: None,
+            mesh: None,
             level: None,
             drawn_level: 1,
             tf: None,

@@ -215,6 +215,7 @@ impl Resources {
     ) -> Result<()> {
         let (volume, whole) = new_volume(ctx, host, opts)?;
         self.volume = Some(volume);
+        self.mesh = None;
         self.level = None;
         self.occupancy = None;
         self.blanking = None;
