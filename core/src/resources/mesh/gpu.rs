@@ -14,8 +14,8 @@ use crate::gpu::Context;
 use crate::params::{ScalarLocation, UnstructuredVolume};
 use crate::resources::Resources;
 
-/// Bytes per tetrahedron of the tetrahedra and neighbours buffers.
-pub(crate) const TET_BYTES: u64 = 32;
+/// Bytes per tetrahedron of the tetrahedra and neighbours buffers (16 each).
+pub(crate) const TET_BYTES: u64 = 16;
 
 pub(crate) struct GpuMesh {
     pub points: wgpu::Buffer,
@@ -33,20 +33,26 @@ pub(crate) struct GpuMesh {
     pub bounds: [f64; 6],
 }
 
+/// An error when the mesh's `label` of `size` bytes exceed `max`, the most one storage
+/// buffer binding holds on the device.
+pub(crate) fn check_binding_size(label: &str, size: u64, max: u64) -> Result<()> {
+    if size > max {
+        return Err(Error::OutOfMemory(format!(
+            "the mesh's {label} take {size} bytes, but this device binds at most {max} bytes \
+             in one storage buffer (max_storage_buffer_binding_size): the mesh is too large \
+             for it; decimate or split it (the tetrahedra and their neighbours take \
+             {TET_BYTES} bytes per tetrahedron)"
+        )));
+    }
+    Ok(())
+}
+
 /// A storage buffer holding `data` (at least 4 bytes), refused with the sizes when it exceeds
 /// what one binding can hold.
 fn storage(ctx: &Context, label: &str, data: &[u8]) -> Result<wgpu::Buffer> {
     use wgpu::util::DeviceExt;
     let max = ctx.info.limits.max_storage_buffer_binding_size;
-    let size = data.len() as u64;
-    if size > max {
-        return Err(Error::OutOfMemory(format!(
-            "the mesh's {label} take {size} bytes, but this device binds at most {max} bytes \
-             in one storage buffer (max_storage_buffer_binding_size): the mesh is too large \
-             for it; decimate or split it (about {TET_BYTES} bytes per tetrahedron in the \
-             largest buffers)"
-        )));
-    }
+    check_binding_size(label, data.len() as u64, max)?;
     let padded;
     let contents = if data.len() < 4 {
         padded = [0u8; 4];

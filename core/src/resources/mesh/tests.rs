@@ -132,3 +132,29 @@ fn flat_tetrahedra_are_left_out_and_flat_cells_refused() {
     let t = tetrahedralize(&w).unwrap();
     assert!(t.flat > 0 && t.tets.len() + t.flat == 14, "{} flat", t.flat);
 }
+
+#[test]
+fn the_mixed_mesh_splits_into_its_whole_volume() {
+    // n³ unit cubes whose boundary points stay in place: hexahedra, wedges, pyramids and
+    // tetrahedra, distorted inside, fill the n³ box exactly
+    let t = tetrahedralize(&synth::mixed_cells(3, ScalarLocation::Cells)).unwrap();
+    let total: f64 = t
+        .tets
+        .iter()
+        .map(|q| signed_volume6(q.map(|i| t.points[i as usize])) / 6.0)
+        .sum();
+    assert!((total - 27.0).abs() < 1e-9, "{total}");
+    assert_eq!(t.flat, 0);
+}
+
+#[test]
+fn a_mesh_past_the_binding_size_is_refused_with_the_sizes() {
+    let e = gpu::check_binding_size("tetrahedra", 200, 128)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("200 bytes") && e.contains("at most 128 bytes"),
+        "{e}"
+    );
+    assert!(gpu::check_binding_size("tetrahedra", 128, 128).is_ok());
+}
