@@ -20,6 +20,8 @@ override CELL_SCALARS: bool = false;
 struct Mesh {
     counts: vec4<u32>,  // tetrahedra, boundary triangles, hierarchy nodes, most steps
     unit: vec4<f32>,    // x: 1 / unit distance
+    split: vec4<u32>,   // x: knots, or MESH_EVERY_ENTRY (pieces end at every table entry)
+    knots: array<vec4<f32>, MESH_KNOTS / 4>, // table coordinates where pieces end, ascending
 }
 
 struct BvhNode {
@@ -29,7 +31,9 @@ struct BvhNode {
     count: u32,         // triangles of a leaf, 0 for an inner node
 }
 
-@group(0) @binding(SLOT_MESH) var<uniform> mesh: Mesh;
+@group(0) @binding(SLOT_MESH) var<uniform> mesh_ubo: Mesh;
+// (read once into private memory, as `frame`: lavapipe gathers uniforms read in loops)
+var<private> mesh: Mesh;
 @group(0) @binding(SLOT_MESH_POINTS) var<storage, read> points: array<vec4<f32>>;
 @group(0) @binding(SLOT_MESH_TETS) var<storage, read> tets: array<vec4<u32>>;
 // across face f of tetrahedron t (opposite its point f): 4 · neighbour + its face, or
@@ -171,34 +175,114 @@ fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> 
     return best;
 }
 
-// The ray's exit from tetrahedron t entered through face f_in at t_in: the nearest plane of
-// the other faces that the ray leaves through (at t_in at the earliest). tf NO_HIT when no
-// face is left through (a ray grazing a face).
-fn exit_of(o: vec3<f32>, d: vec3<f32>, t: u32, f_in: u32, t_in: f32) -> Hit {
-    var best: Hit;
-    best.t = 3.0e38;
-    best.tf = NO_HIT;
-    var fc_best: Face;
-    for (var f = 0u; f < 4u; f = f + 1u) {
-        if (f == f_in) {
-            continue;
-        }
-        let fc = face_of(t, f);
-        let den = dot(fc.n, d);
-        if (den > 0.0) {
-            let th = dot(fc.n, fc.a - o) / den;
-            if (th < best.t) {
-                best.t = th;
-                best.tf = 4u * t + f;
-                fc_best = fc;
-            }
-        }
+// A tetrahedron in registers: its point indices and its points (xyz, w the point scalar).
+struct Tet {
+    ids: vec4<u32>,
+    p0: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+    p3: vec4<f32>,
+}
+
+fn load_tet(t: u32) -> Tet {
+    var out: Tet;
+    out.ids = tets[t];
+    out.p0 = points[out.ids.x];
+    out.p1 = points[out.ids.y];
+    out.p2 = points[out.ids.z];
+    out.p3 = points[out.ids.w];
+    return out;
+}
+
+// The point of `old` whose index is id (one of them).
+fn shared_point(old: Tet, id: u32) -> vec4<f32> {
+    var p = old.p3;
+    p = select(p, old.p2, old.ids.z == id);
+    p = select(p, old.p1, old.ids.y == id);
+    return select(p, old.p0, old.ids.x == id);
+}
+
+// Tetrahedron t entered through its face f from `old` (whose exit face it shares): three
+// of its points are old's, one load brings the fourth.
+fn next_tet(old: Tet, t: u32, f: u32) -> Tet {
+    var out: Tet;
+    out.ids = tets[t];
+    let fresh = points[out.ids[f]];
+    out.p0 = select(shared_point(old, out.ids.x), fresh, f == 0u);
+    out.p1 = select(shared_point(old, out.ids.y), fresh, f == 1u);
+    out.p2 = select(shared_point(old, out.ids.z), fresh, f == 2u);
+    out.p3 = select(shared_point(old, out.ids.w), fresh, f == 3u);
+    return out;
+}
+
+// Where the ray leaves through the plane of face (a, b, c) opposite q: its distance, or
+// +∞ where the ray does not leave through it (entering or parallel).
+fn leaves_at(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, q: vec3<f32>) -> f32 {
+    var n = cross(b - a, c - a);
+    n = select(n, -n, dot(n, q - a) > 0.0);
+    let den = dot(n, d);
+    return select(3.0e38, dot(n, a - o) / den, den > 0.0);
+}
+
+// The ray's exit from tetrahedron k (index t) entered through face f_in at t_in: the
+// nearest plane of the other faces that the ray leaves through (at t_in at the earliest).
+// tf NO_HIT when no face is left through (a ray grazing a face).
+fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> Hit {
+    let q0 = k.p0.xyz;
+    let q1 = k.p1.xyz;
+    let q2 = k.p2.xyz;
+    let q3 = k.p3.xyz;
+    var ts = vec4<f32>(
+        leaves_at(o, d, q1, q2, q3, q0),
+        leaves_at(o, d, q2, q3, q0, q1),
+        leaves_at(o, d, q3, q0, q1, q2),
+        leaves_at(o, d, q0, q1, q2, q3),
+    );
+    ts = select(ts, vec4<f32>(3.0e38), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in));
+    // the nearest, and its face's points (f + 1, f + 2, f + 3) mod 4
+    var best = ts.x;
+    var f = 0u;
+    var pa = k.p1;
+    var pb = k.p2;
+    var pc = k.p3;
+    if (ts.y < best) {
+        best = ts.y;
+        f = 1u;
+        pa = k.p2;
+        pb = k.p3;
+        pc = k.p0;
     }
-    if (best.tf != NO_HIT) {
-        best.t = max(best.t, t_in);
-        best.s = face_scalar(fc_best, o + best.t * d, t);
+    if (ts.z < best) {
+        best = ts.z;
+        f = 2u;
+        pa = k.p3;
+        pb = k.p0;
+        pc = k.p1;
     }
-    return best;
+    if (ts.w < best) {
+        best = ts.w;
+        f = 3u;
+        pa = k.p0;
+        pb = k.p1;
+        pc = k.p2;
+    }
+    var out: Hit;
+    out.tf = NO_HIT;
+    if (best >= 3.0e38) {
+        return out;
+    }
+    out.t = max(best, t_in);
+    out.tf = 4u * t + f;
+    var fc: Face;
+    fc.a = pa.xyz;
+    fc.b = pb.xyz;
+    fc.c = pc.xyz;
+    fc.sa = pa.w;
+    fc.sb = pb.w;
+    fc.sc = pc.w;
+    fc.n = cross(fc.b - fc.a, fc.c - fc.a);
+    out.s = face_scalar(fc, o + out.t * d, t);
+    return out;
 }
 
 // ---- integration ----
@@ -300,6 +384,37 @@ fn projection_at(x: f32) -> f32 {
     return row_lookup(tables, 1, u, false).x * u;
 }
 
+// Where the piece from table coordinate xa toward x1 (up: increasing) ends: the next knot
+// strictly beyond xa, or x1.
+fn next_cut(xa: f32, x1: f32, up: bool) -> f32 {
+    let n = mesh.split.x;
+    if (n == MESH_EVERY_ENTRY) {
+        let last = f32(TABLE_N - 1u);
+        if (up && xa < last) {
+            return min(select(floor(xa) + 1.0, 0.0, xa < 0.0), x1);
+        } else if (!up && xa > 0.0) {
+            return max(select(ceil(xa) - 1.0, last, xa > last), x1);
+        }
+        return x1;
+    }
+    if (up) {
+        for (var i = 0u; i < n; i = i + 1u) {
+            let k = mesh.knots[i / 4u][i % 4u];
+            if (k > xa) {
+                return min(k, x1);
+            }
+        }
+    } else {
+        for (var i = n; i > 0u; i = i - 1u) {
+            let k = mesh.knots[(i - 1u) / 4u][(i - 1u) % 4u];
+            if (k < xa) {
+                return max(k, x1);
+            }
+        }
+    }
+    return x1;
+}
+
 // One segment [t0, t0 + len] along which the scalar runs linearly from s0 to s1.
 fn integrate(r: Ray, s0: f32, s1: f32, t0: f32, len: f32) {
     if (BLEND == BLEND_MAXIMUM) {
@@ -317,22 +432,16 @@ fn integrate(r: Ray, s0: f32, s1: f32, t0: f32, len: f32) {
     if (len <= 0.0) {
         return;
     }
-    // the pieces between the table entries the segment crosses: within each, colour,
-    // attenuation and the normalised scalar are linear in t
+    // the pieces between the knots (or table entries) the segment crosses: within each,
+    // colour, attenuation and the normalised scalar are linear in t
     let x0 = entry_of(s0);
     let x1 = entry_of(s1);
-    let last = f32(TABLE_N - 1u);
     let up = x1 > x0;
     var xa = x0;
     var ua = 0.0;
     var ca = colour_tau(xa);
     for (var i = 0u; i <= TABLE_N + 1u; i = i + 1u) {
-        var xb = x1;
-        if (up && xa < last) {
-            xb = min(select(floor(xa) + 1.0, 0.0, xa < 0.0), x1);
-        } else if (!up && xa > 0.0) {
-            xb = max(select(ceil(xa) - 1.0, last, xa > last), x1);
-        }
+        let xb = next_cut(xa, x1, up);
         let ub = select((xb - x0) / (x1 - x0), 1.0, xb == x1);
         let plen = (ub - ua) * len;
         let cb = colour_tau(xb);
@@ -385,6 +494,7 @@ fn done() -> bool {
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
+    mesh = mesh_ubo;
     let px = gid.xy + frame.rect.xy;
     if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
         return;
@@ -398,17 +508,24 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // (from the line's first boundary crossing, behind the camera too: a near plane
         // inside the mesh starts its rays inside, where they are integrated from seg.x)
         var hit = next_entry(o, d, -3.0e38, seg.y, NO_HIT);
+        var k: Tet;
+        if (hit.tf != NO_HIT) {
+            k = load_tet(hit.tf >> 2u);
+        }
         var steps = 0u;
         loop {
             if (hit.tf == NO_HIT || steps >= mesh.counts.w) {
                 break;
             }
             let t = hit.tf >> 2u;
-            let ex = exit_of(o, d, t, hit.tf & 3u, hit.t);
+            let ex = exit_of(o, d, k, t, hit.tf & 3u, hit.t);
             steps = steps + 1u;
             if (ex.tf == NO_HIT) {
                 // (a ray along a face: leave this tetrahedron where it entered)
                 hit = next_entry(o, d, hit.t, seg.y, hit.tf);
+                if (hit.tf != NO_HIT) {
+                    k = load_tet(hit.tf >> 2u);
+                }
                 continue;
             }
             integrate_within(ray, seg, hit.t, ex.t, hit.s, ex.s);
@@ -418,10 +535,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             let nb = neighbours[t][ex.tf & 3u];
             if (nb == NO_NEIGHBOUR) {
                 hit = next_entry(o, d, ex.t, seg.y, ex.tf);
+                if (hit.tf != NO_HIT) {
+                    k = load_tet(hit.tf >> 2u);
+                }
             } else {
                 hit.t = ex.t;
                 hit.tf = nb;
                 hit.s = select(ex.s, cell_scalars[nb >> 2u], CELL_SCALARS);
+                k = next_tet(k, nb >> 2u, nb & 3u);
             }
         }
     }

@@ -311,3 +311,28 @@ fn opaque_depth_and_clipping_planes_end_rays() {
     println!("pixels drawn: full {f}, clipped {h}");
     assert!(h < f * 3 / 4 && h > f / 4);
 }
+
+#[test]
+fn a_transfer_function_of_many_points_splits_segments_at_every_table_entry() {
+    // more points than the knots the pass holds (64): the pieces end at every entry
+    let v = synth::tet_wavelet(8);
+    let (lo, hi) = range(&v);
+    let n = 100;
+    let at = |i: usize| lo + (hi - lo) * i as f64 / (n - 1) as f64;
+    let opacity = Piecewise::new(
+        (0..n)
+            .map(|i| (at(i), [if i % 2 == 0 { 0.1 } else { 0.6 }]))
+            .collect(),
+    )
+    .unwrap();
+    let color = Piecewise::new(vec![(lo, [0.2, 0.4, 1.0]), (hi, [1.0, 0.6, 0.2])]).unwrap();
+    let t = TransferFunction::single(ComponentTransfer::new(color, opacity));
+    let (mean, psnr, max) = compare(
+        "many_points",
+        &v,
+        &t,
+        &view_of(&v, 48),
+        &params(BlendMode::Composite),
+    );
+    assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
+}

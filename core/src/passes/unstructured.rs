@@ -17,9 +17,10 @@ use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::slots;
 use crate::gpu::uniforms::{
     flag_bits, mat, FrameUniforms, MeshUniforms, FLAG_DEPTH_INPUT, FLAG_EXTREMUM_DEPTH,
+    MESH_EVERY_ENTRY, MESH_KNOTS,
 };
 use crate::gpu::Context;
-use crate::params::ScalarLocation;
+use crate::params::{ComponentTransfer, ScalarLocation, TABLE_SIZE};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -95,6 +96,7 @@ impl UnstructuredPass {
         let mesh = res.mesh.as_ref().expect("checked above");
         let mut mu = mesh.uniforms;
         mu.unit[0] = (1.0 / ct.unit_distance) as f32;
+        set_knots(&mut mu, ct);
         res.ensure_tables(ctx, 1.0)?;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
@@ -151,6 +153,44 @@ impl UnstructuredPass {
         ctx.submit([enc.finish()]);
         res.stats.frames += 1;
         Ok(())
+    }
+}
+
+/// The table coordinates where a segment's pieces end (the colour's and opacity's points,
+/// where the opacity crosses 0 or 1, which the tables clamp it to, and the tables' ends),
+/// or every entry when there are more than [`MESH_KNOTS`].
+fn set_knots(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
+    let [lo, hi] = ct.table_range();
+    let last = (TABLE_SIZE - 1) as f64;
+    let op = &ct.opacity.points;
+    let crossings = op.windows(2).flat_map(|w| {
+        let ((x0, [a0]), (x1, [a1])) = (w[0], w[1]);
+        [0.0, 1.0].into_iter().filter_map(move |l: f64| {
+            let (a0, a1) = (a0 as f64, a1 as f64);
+            ((a0 - l) * (a1 - l) < 0.0).then(|| x0 + (l - a0) / (a1 - a0) * (x1 - x0))
+        })
+    });
+    let mut knots: Vec<f32> = ct
+        .color
+        .points
+        .iter()
+        .map(|p| p.0)
+        .chain(op.iter().map(|p| p.0))
+        .chain(crossings)
+        .map(|s| (s - lo) / (hi - lo) * last)
+        .filter(|x| *x > 0.0 && *x < last)
+        .chain([0.0, last])
+        .map(|x| x as f32)
+        .collect();
+    knots.sort_by(f32::total_cmp);
+    knots.dedup();
+    if knots.len() > MESH_KNOTS {
+        mu.split[0] = MESH_EVERY_ENTRY;
+        return;
+    }
+    mu.split[0] = knots.len() as u32;
+    for (i, k) in knots.into_iter().enumerate() {
+        mu.knots[i / 4][i % 4] = k;
     }
 }
 

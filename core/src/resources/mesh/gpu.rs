@@ -9,7 +9,7 @@
 use super::bvh::BvhNode;
 use super::TetMesh;
 use crate::error::{Error, Result};
-use crate::gpu::uniforms::MeshUniforms;
+use crate::gpu::uniforms::{MeshUniforms, MESH_EVERY_ENTRY, MESH_KNOTS};
 use crate::gpu::Context;
 use crate::params::{ScalarLocation, UnstructuredVolume};
 use crate::resources::Resources;
@@ -96,6 +96,8 @@ impl GpuMesh {
                 max_steps,
             ],
             unit: [1.0, 0.0, 0.0, 0.0],
+            split: [MESH_EVERY_ENTRY, 0, 0, 0],
+            knots: [[0.0; 4]; MESH_KNOTS / 4],
         };
         Ok(GpuMesh {
             points,
