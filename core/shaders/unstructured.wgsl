@@ -55,7 +55,7 @@ struct Hit {
     s: f32,
 }
 
-// The face f of tetrahedron t as a triangle (a, b, c) with its outward normal n.
+// A triangle (a, b, c) with its point scalars and a normal n (face_of: the outward one).
 struct Face {
     a: vec3<f32>,
     b: vec3<f32>,
@@ -72,6 +72,13 @@ fn face_of(t: u32, f: u32) -> Face {
     let pb = points[ids[(f + 2u) % 4u]];
     let pc = points[ids[(f + 3u) % 4u]];
     let q = points[ids[f]].xyz;
+    var out = make_face(pa, pb, pc);
+    out.n = select(out.n, -out.n, dot(out.n, q - out.a) > 0.0);
+    return out;
+}
+
+// The triangle of points (xyz, w the scalar) a, b, c, its normal cross(b − a, c − a).
+fn make_face(pa: vec4<f32>, pb: vec4<f32>, pc: vec4<f32>) -> Face {
     var out: Face;
     out.a = pa.xyz;
     out.b = pb.xyz;
@@ -79,8 +86,7 @@ fn face_of(t: u32, f: u32) -> Face {
     out.sa = pa.w;
     out.sb = pb.w;
     out.sc = pc.w;
-    let n = cross(pb.xyz - pa.xyz, pc.xyz - pa.xyz);
-    out.n = select(n, -n, dot(n, q - pa.xyz) > 0.0);
+    out.n = cross(out.b - out.a, out.c - out.a);
     return out;
 }
 
@@ -215,6 +221,13 @@ fn next_tet(old: Tet, t: u32, f: u32) -> Tet {
     return out;
 }
 
+// Point i mod 4 of tetrahedron k (selects: a local array indexed at run time would live in
+// memory).
+fn corner(k: Tet, i: u32) -> vec4<f32> {
+    let j = i % 4u;
+    return select(select(select(k.p3, k.p2, j == 2u), k.p1, j == 1u), k.p0, j == 0u);
+}
+
 // Where the ray leaves through the plane of face (a, b, c) opposite q: its distance, or
 // +∞ where the ray does not leave through it (entering or parallel).
 fn leaves_at(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, q: vec3<f32>) -> f32 {
@@ -240,32 +253,11 @@ fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> 
     );
     ts = select(ts, vec4<f32>(3.0e38), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in));
     // the nearest, and its face's points (f + 1, f + 2, f + 3) mod 4
-    var best = ts.x;
-    var f = 0u;
-    var pa = k.p1;
-    var pb = k.p2;
-    var pc = k.p3;
-    if (ts.y < best) {
-        best = ts.y;
-        f = 1u;
-        pa = k.p2;
-        pb = k.p3;
-        pc = k.p0;
-    }
-    if (ts.z < best) {
-        best = ts.z;
-        f = 2u;
-        pa = k.p3;
-        pb = k.p0;
-        pc = k.p1;
-    }
-    if (ts.w < best) {
-        best = ts.w;
-        f = 3u;
-        pa = k.p0;
-        pb = k.p1;
-        pc = k.p2;
-    }
+    let best = min(min(ts.x, ts.y), min(ts.z, ts.w));
+    let f = select(select(select(3u, 2u, ts.z == best), 1u, ts.y == best), 0u, ts.x == best);
+    let pa = corner(k, f + 1u);
+    let pb = corner(k, f + 2u);
+    let pc = corner(k, f + 3u);
     var out: Hit;
     out.tf = NO_HIT;
     if (best >= 3.0e38) {
@@ -273,15 +265,7 @@ fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> 
     }
     out.t = max(best, t_in);
     out.tf = 4u * t + f;
-    var fc: Face;
-    fc.a = pa.xyz;
-    fc.b = pb.xyz;
-    fc.c = pc.xyz;
-    fc.sa = pa.w;
-    fc.sb = pb.w;
-    fc.sc = pc.w;
-    fc.n = cross(fc.b - fc.a, fc.c - fc.a);
-    out.s = face_scalar(fc, o + out.t * d, t);
+    out.s = face_scalar(make_face(pa, pb, pc), o + out.t * d, t);
     return out;
 }
 

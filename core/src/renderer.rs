@@ -104,8 +104,9 @@ impl Renderer {
     }
 
     /// Uploads an unstructured volume (replacing any previous volume, image or mesh): cells
-    /// split into tetrahedra, their neighbours and a hierarchy over the boundary (the rules
-    /// in `resources/mesh`). [`Renderer::render`] and [`Renderer::render_image`] then draw
+    /// split into tetrahedra ([`crate::tetrahedralize`]), their neighbours and a hierarchy
+    /// over the boundary; a triangle shared by more than two tetrahedra is an error naming
+    /// their cells. Drawn from its first scalar component. [`Renderer::render`] and [`Renderer::render_image`] then draw
     /// it with the same view, parameters and transfer function as an image volume;
     /// [`Renderer::set_volume`] goes back to an image. A mesh whose buffers exceed the
     /// device's storage-buffer binding size is refused with the sizes (about 35 bytes per

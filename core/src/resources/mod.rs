@@ -153,6 +153,17 @@ impl Resources {
         }
     }
 
+    /// Forgets what belonged to the volume before a new one (image or mesh): its coarser
+    /// level, occupancy, blanking and mask; counts the upload.
+    pub fn new_volume_state(&mut self) {
+        self.level = None;
+        self.occupancy = None;
+        self.blanking = None;
+        self.mask = None;
+        self.mask_generation += 1;
+        self.stats.volume_uploads += 1;
+    }
+
     /// The volume, or the error every pass gives without one.
     pub fn volume(&self) -> Result<&GpuVolume> {
         self.volume.as_ref().ok_or_else(no_volume)

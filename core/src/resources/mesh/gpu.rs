@@ -123,12 +123,7 @@ impl Resources {
         let mesh = GpuMesh::upload(ctx, &prepared)?;
         self.mesh = Some(mesh);
         self.volume = None;
-        self.level = None;
-        self.occupancy = None;
-        self.blanking = None;
-        self.mask = None;
-        self.mask_generation += 1;
-        self.stats.volume_uploads += 1;
+        self.new_volume_state();
         Ok(())
     }
 }

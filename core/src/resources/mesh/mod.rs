@@ -154,8 +154,8 @@ fn is_flat(p: [[f64; 3]; 4]) -> bool {
 /// The points of face i of a tetrahedron (opposite its point i).
 pub(crate) const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
 
-/// An unstructured volume split into tetrahedra by the module's rules, in the mesh's own
-/// coordinates (what [`TetMesh`] uploads, and what a CPU reference needs).
+/// An unstructured volume split into tetrahedra ([`tetrahedralize`]), in the mesh's own
+/// coordinates: what the renderer uploads, and what a CPU reference needs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tetrahedra {
     /// The mesh's points, then one centroid per hexahedron or voxel.
@@ -170,8 +170,15 @@ pub struct Tetrahedra {
     pub flat: usize,
 }
 
-/// Splits a mesh into tetrahedra (see the rules of this module): an error for a mesh that
-/// does not validate or has a flat cell.
+/// Splits a mesh into tetrahedra as the renderer does. Each quad face is split along its
+/// diagonal through its smallest point index (neighbours' triangles match); a tetra stays
+/// itself, a pyramid becomes 2 tetrahedra, a wedge 3, a hexahedron or voxel 12 around a
+/// point added at its centroid (its point scalars the corners' mean), so scalars are
+/// linear per tetrahedron: exact for tetrahedra, an approximation of the other cells'
+/// interpolants that agrees at their corners. Tetrahedra with a volume of at most 1e-7
+/// times the cube of their longest edge are left out ([`Tetrahedra::flat`] counts them);
+/// every tetrahedron is positively oriented. An error for a mesh that does not validate,
+/// or has a cell with no tetrahedron left (a flat cell), naming the cell.
 pub fn tetrahedralize(v: &UnstructuredVolume) -> Result<Tetrahedra> {
     v.validate()?;
     let nc = v.components as usize;
