@@ -31,8 +31,12 @@ enum Command {
     Render(Box<RenderArgs>),
     /// Time VTK's GPU ray cast benchmark scene (wavelet 256³, 900×900), shaded and unshaded.
     Bench(bench::BenchArgs),
-    /// Print the GPU adapter, backend and limits ferrovol would use.
-    Info,
+    /// Print the GPU adapter, backend and limits ferrovol would use; with a .vtu mesh, what
+    /// the renderer makes of it.
+    Info {
+        /// An unstructured grid (.vtu) to describe instead.
+        mesh: Option<PathBuf>,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -689,7 +693,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(a) => render(*a),
         Command::Bench(a) => bench::run(a),
-        Command::Info => Context::new()
+        Command::Info { mesh: Some(p) } => mesh::info(&p),
+        Command::Info { mesh: None } => Context::new()
             .map(|c| println!("{}", c.info))
             .map_err(CliError::from),
     };

@@ -3,7 +3,10 @@
 
 use crate::presets;
 use crate::{render_params, spinner, view_of, CliError, RenderArgs};
-use ferrovol_core::{Context, Renderer, UnstructuredVolume};
+use ferrovol_core::{
+    tetrahedralize, vtk_cell_type_name, Context, Renderer, ScalarLocation, UnstructuredVolume,
+};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Whether a file name ends in `.vtu` (case-insensitive): a mesh, not a volume.
@@ -85,5 +88,59 @@ pub fn render(a: &RenderArgs, path: &Path) -> Result<(), CliError> {
             a.repeat - 1
         );
     }
+    Ok(())
+}
+
+/// `ferrovol info mesh.vtu`: the mesh as read, and the tetrahedra the renderer splits it
+/// into (with the device bytes they take).
+pub fn info(path: &Path) -> Result<(), CliError> {
+    if !is_vtu(path) {
+        return Err(CliError::Usage(format!(
+            "{}: `ferrovol info` describes .vtu meshes (or, without a file, the GPU)",
+            path.display()
+        )));
+    }
+    let m = ferrovol_io::read_unstructured(path)?;
+    let mut types = BTreeMap::new();
+    for &t in &m.cell_types {
+        *types.entry(t).or_insert(0usize) += 1;
+    }
+    let b = m.bounds();
+    println!("{}", path.display());
+    println!("points:     {}", m.points.len());
+    println!("cells:      {}", m.num_cells());
+    for (t, n) in types {
+        println!("  {n} {}", vtk_cell_type_name(t));
+    }
+    println!(
+        "bounds:     [{}, {}] x [{}, {}] x [{}, {}]",
+        b[0], b[1], b[2], b[3], b[4], b[5]
+    );
+    let [lo, hi] = range(&m);
+    let location = match m.location {
+        ScalarLocation::Points => "point",
+        ScalarLocation::Cells => "cell",
+    };
+    println!(
+        "scalars:    {} per {location}, {} component(s); the first spans [{lo}, {hi}]",
+        m.scalar_type().name(),
+        m.components
+    );
+    let t = tetrahedralize(&m)?;
+    // points 16 bytes, tetrahedra and neighbours 16 each (cell scalars 4 more)
+    let cell = if m.location == ScalarLocation::Cells {
+        4
+    } else {
+        0
+    };
+    let bytes = 16 * t.points.len() + (32 + cell) * t.tets.len();
+    println!(
+        "tetrahedra: {} ({} flat ones left out), {} points with the added centroids; \
+         {:.1} MiB on the device before the boundary hierarchy",
+        t.tets.len(),
+        t.flat,
+        t.points.len(),
+        bytes as f64 / (1u64 << 20) as f64
+    );
     Ok(())
 }

@@ -234,7 +234,7 @@ const HOUSE_VTU: &str = r#"<?xml version="1.0"?>
 "#;
 
 #[test]
-fn a_vtu_mesh_renders_and_refuses_what_meshes_do_not_draw() {
+fn a_vtu_mesh_renders_is_described_and_refuses_what_meshes_do_not_draw() {
     let vtu = std::env::temp_dir().join("ferrovol-cli-test-house.vtu");
     std::fs::write(&vtu, HOUSE_VTU).unwrap();
     let path = vtu.to_str().unwrap();
@@ -243,6 +243,12 @@ fn a_vtu_mesh_renders_and_refuses_what_meshes_do_not_draw() {
     let img = image::open(&png).unwrap().to_rgb8();
     let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
     assert!(lit > 100, "{lit} pixels drawn");
+    let (code, out, _) = ferrovol(&["info", path]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("1 VTK_HEXAHEDRON (12)") && out.contains("tetrahedra: 14"),
+        "{out}"
+    );
     let (code, _, err) = ferrovol(&[
         "render", path, "--mode", "iso", "--iso", "1", "--size", "8x8",
     ]);
