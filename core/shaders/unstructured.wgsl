@@ -110,7 +110,7 @@ fn face_scalar(fc: Face, p: vec3<f32>, t: u32) -> f32 {
 }
 
 // The ray's entry into the mesh: the nearest boundary triangle facing the ray at a
-// distance ≥ t_min, other than `skip` (the face the ray just left through).
+// distance ≥ t_min, not of tetrahedron `skip` (the one the ray just left).
 fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> Hit {
     var best: Hit;
     best.t = t_max;
@@ -131,7 +131,7 @@ fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> 
         if (visit && nd.count > 0u) {
             for (var i = nd.a; i < nd.a + nd.count; i = i + 1u) {
                 let tf = boundary[i];
-                if (tf == skip) {
+                if ((tf >> 2u) == skip) {
                     continue;
                 }
                 let fc = face_of(tf >> 2u, tf & 3u);
@@ -506,7 +506,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             steps = steps + 1u;
             if (ex.tf == NO_HIT) {
                 // (a ray along a face: leave this tetrahedron where it entered)
-                hit = next_entry(o, d, hit.t, seg.y, hit.tf);
+                hit = next_entry(o, d, hit.t, seg.y, t);
                 if (hit.tf != NO_HIT) {
                     k = load_tet(hit.tf >> 2u);
                 }
@@ -518,7 +518,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let nb = neighbours[t][ex.tf & 3u];
             if (nb == NO_NEIGHBOUR) {
-                hit = next_entry(o, d, ex.t, seg.y, ex.tf);
+                // the next boundary triangle facing the ray: further on in a non-convex
+                // mesh, or right there where a face does not conform (the triangles on
+                // both sides differ), found a rounding error back at the latest
+                hit = next_entry(o, d, ex.t - 1e-5 * (abs(ex.t) + length(o)), seg.y, t);
                 if (hit.tf != NO_HIT) {
                     k = load_tet(hit.tf >> 2u);
                 }

@@ -339,3 +339,32 @@ fn a_transfer_function_of_many_points_splits_segments_at_every_table_entry() {
     );
     assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
 }
+
+#[test]
+fn a_non_conforming_face_is_crossed_without_a_gap() {
+    // the house's cube on two tetrahedra that split its bottom quad along the other
+    // diagonal (1–3, where the cube splits it along 0–2): the triangles do not match, so
+    // both sides are boundary, and rays leave the cube and enter the tetrahedra there
+    let mut points = synth::HOUSE_POINTS[..8].to_vec();
+    points.push([0.5, 0.5, -1.0]);
+    let v = UnstructuredVolume {
+        points,
+        connectivity: vec![0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 3, 8, 1, 2, 3, 8],
+        offsets: vec![0, 8, 12, 16],
+        cell_types: vec![12, 10, 10],
+        location: ScalarLocation::Points,
+        components: 1,
+        scalars: Scalars::F32(vec![0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 2.0]),
+    };
+    let mut view = View::fit(v.bounds(), 48, 48);
+    view.camera.elevation(70.0);
+    view.camera.reset_clipping_range(v.bounds());
+    let (mean, psnr, max) = compare(
+        "non_conforming",
+        &v,
+        &tf(0.0, 2.0, 1.0),
+        &view,
+        &params(BlendMode::Composite),
+    );
+    assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
+}

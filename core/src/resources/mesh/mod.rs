@@ -16,8 +16,9 @@
 //!   approximation of the trilinear (hexahedron) and the wedge's and pyramid's own
 //!   interpolants that agrees with them at the corners (and, for hexahedra, at the centre).
 //! * **Degenerate tetrahedra.** A tetrahedron whose volume is at most [`FLAT`] times the
-//!   cube of its longest edge is left out and counted ([`TetMesh::flat`]); its faces become
-//!   boundary faces, which rays leave and re-enter through the boundary hierarchy. A cell
+//!   cube of its longest edge is left out and counted ([`Tetrahedra::flat`]); its faces
+//!   become boundary faces, which rays leave and re-enter through the boundary hierarchy
+//!   (so do faces that do not conform, a quad against two triangles split the other way). A cell
 //!   all of whose tetrahedra are left out (a flat cell) is refused, naming the cell.
 //! * **Non-manifold faces.** A triangle shared by more than two tetrahedra is refused,
 //!   naming the cells they come from.
