@@ -368,3 +368,40 @@ fn a_non_conforming_face_is_crossed_without_a_gap() {
     );
     assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
 }
+
+#[test]
+fn composite_depth_is_where_the_ray_first_gathers_opacity() {
+    // the depth threshold 0: where the opacity first exceeds 0, the entry into the mesh
+    // wherever the entry's scalar has opacity
+    let v = synth::tet_wavelet(8);
+    let (lo, hi) = range(&v);
+    let t = tf(lo, hi, 0.5);
+    let mut view = view_of(&v, 32);
+    view.camera.reset_clipping_range(v.bounds());
+    let mut r = renderer();
+    r.set_unstructured(&v).unwrap();
+    r.set_transfer_function(&t).unwrap();
+    let img = r
+        .render_image(&view, &params(BlendMode::Composite))
+        .unwrap();
+    let segs = mesh::Tets::of(&v).segments(&view);
+    let table = mesh::Table::of(&t);
+    let vp = view.camera.view_projection(view.aspect());
+    let (mut checked, mut worst) = (0, 0.0f64);
+    for (i, s) in segs.iter().enumerate() {
+        let Some(first) = s.first() else {
+            assert_eq!(img.depth[i], 1.0, "pixel {i}: no mesh, far depth");
+            continue;
+        };
+        if table.at(first.s0)[3] < 0.01 {
+            continue;
+        }
+        let ray = common::raycast::pixel_ray(&view, i as u32 % 32, i as u32 / 32);
+        let c = vp * (ray.origin + first.t0 * ray.dir).extend(1.0);
+        let expected = 0.5 * c.z / c.w + 0.5;
+        worst = worst.max((img.depth[i] as f64 - expected).abs());
+        checked += 1;
+    }
+    println!("{checked} pixels: depth off by {worst:.2e} at most");
+    assert!(checked > 300 && worst < 1e-4);
+}
