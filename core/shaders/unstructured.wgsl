@@ -46,7 +46,6 @@ var<private> mesh: Mesh;
 
 const NO_NEIGHBOUR: u32 = 0xffffffffu;
 const NO_HIT: u32 = 0xffffffffu;
-const STACK: u32 = 64u;
 
 // Where a ray crosses a face: distance, the face as 4 · tet + face, the scalar there.
 struct Hit {
@@ -115,7 +114,7 @@ fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> 
     var best: Hit;
     best.t = t_max;
     best.tf = NO_HIT;
-    var stack: array<u32, STACK>;
+    var stack: array<u32, MESH_BVH_STACK>;
     var sp = 0u;
     var node = 0u;
     let inv = 1.0 / d;
@@ -166,7 +165,7 @@ fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> 
                 }
             }
         }
-        if (visit && nd.count == 0u && sp < STACK) {
+        if (visit && nd.count == 0u && sp < MESH_BVH_STACK) {
             stack[sp] = nd.a;
             sp = sp + 1u;
             node = node + 1u;

@@ -116,6 +116,9 @@ pub struct MeshUniforms {
 pub const MESH_KNOTS: usize = 64;
 /// A transfer function of more knots: segments split at every table entry.
 pub const MESH_EVERY_ENTRY: u32 = u32::MAX;
+/// The deepest boundary hierarchy a ray's search holds on its stack (median splits of 2^32
+/// triangles go 31 deep).
+pub const MESH_BVH_STACK: usize = 64;
 
 /// The isosurface uniforms (`Iso` in shaders/lib/iso.wgsl), read by the first-hit and
 /// deferred passes.
@@ -347,6 +350,7 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("MAX_CLIP", Wgsl::U32(MAX_CLIP_PLANES as u32)),
     ("MESH_KNOTS", Wgsl::U32(MESH_KNOTS as u32)),
     ("MESH_EVERY_ENTRY", Wgsl::U32(MESH_EVERY_ENTRY)),
+    ("MESH_BVH_STACK", Wgsl::U32(MESH_BVH_STACK as u32)),
     ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
     ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),
     ("SPECULAR_CONE", Wgsl::U32(SPECULAR_CONE)),

@@ -9,7 +9,7 @@
 use super::bvh::BvhNode;
 use super::TetMesh;
 use crate::error::{Error, Result};
-use crate::gpu::uniforms::{MeshUniforms, MESH_EVERY_ENTRY, MESH_KNOTS};
+use crate::gpu::uniforms::{MeshUniforms, MESH_BVH_STACK, MESH_EVERY_ENTRY, MESH_KNOTS};
 use crate::gpu::Context;
 use crate::params::{ScalarLocation, UnstructuredVolume};
 use crate::resources::Resources;
@@ -72,6 +72,13 @@ fn storage(ctx: &Context, label: &str, data: &[u8]) -> Result<wgpu::Buffer> {
 
 impl GpuMesh {
     pub fn upload(ctx: &Context, m: &TetMesh) -> Result<GpuMesh> {
+        if m.bvh.depth > MESH_BVH_STACK {
+            return Err(Error::Unsupported(format!(
+                "the mesh's boundary hierarchy is {} levels deep; rays search at most {} \
+                 (split the mesh)",
+                m.bvh.depth, MESH_BVH_STACK
+            )));
+        }
         use bytemuck::cast_slice as cast;
         let cells: &[f32] = match m.location {
             ScalarLocation::Cells => &m.cell_scalars,

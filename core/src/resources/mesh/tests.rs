@@ -71,6 +71,11 @@ fn neighbours_agree_and_the_boundary_is_closed() {
             }
         }
         assert!(seen.iter().all(|&c| c == 1));
+        let leaves = m.boundary.len().div_ceil(bvh::LEAF) as f64;
+        assert!(
+            m.bvh.depth <= leaves.log2().ceil() as usize + 2,
+            "median splits"
+        );
     }
 }
 
