@@ -2,6 +2,7 @@
 
 mod bench;
 mod iso;
+mod mesh;
 mod presets;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -30,8 +31,12 @@ enum Command {
     Render(Box<RenderArgs>),
     /// Time VTK's GPU ray cast benchmark scene (wavelet 256³, 900×900), shaded and unshaded.
     Bench(bench::BenchArgs),
-    /// Print the GPU adapter, backend and limits ferrovol would use.
-    Info,
+    /// Print the GPU adapter, backend and limits ferrovol would use; with a .vtu mesh, what
+    /// the renderer makes of it.
+    Info {
+        /// An unstructured grid (.vtu) to describe instead.
+        mesh: Option<PathBuf>,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
@@ -88,7 +93,8 @@ enum GradArg {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// Volume file: .vti, .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr. Without it, a built-in volume.
+    /// Volume file: .vti, .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr; or an unstructured grid,
+    /// .vtu (composite, mip, minip, average, additive). Without it, a built-in volume.
     input: Option<PathBuf>,
     /// Built-in volume to render when no input file is given.
     #[arg(long, value_enum, default_value = "wavelet")]
@@ -414,7 +420,94 @@ fn demo_volume(d: Demo) -> VolumeData {
     }
 }
 
+/// The camera of `render`'s flags around `bounds` (world coordinates).
+fn view_of(a: &RenderArgs, bounds: [f64; 6]) -> Result<View, CliError> {
+    let (w, h) = a.size;
+    let mut view = View::fit(bounds, w, h);
+    view.camera.parallel = a.parallel;
+    view.camera.azimuth(a.azimuth);
+    view.camera.elevation(a.elevation);
+    if let Some(up) = a.view_up {
+        let up = glam::DVec3::from_array(up);
+        let dir = view.camera.focal_point - view.camera.position;
+        if up.cross(dir).length() <= 1e-9 * dir.length() {
+            return Err(CliError::Usage(format!(
+                "--view-up {up}: that axis is parallel to the view direction {dir} after \
+                 --azimuth/--elevation; choose another axis or turn the camera first"
+            )));
+        }
+        view.camera.view_up = up;
+    }
+    view.camera.orthogonalize_view_up();
+    view.camera.roll(a.roll);
+    view.camera.zoom(a.zoom);
+    view.camera.reset_clipping_range(bounds);
+    Ok(view)
+}
+
+/// The render parameters of `render`'s flags for a volume or mesh within `bounds`.
+fn render_params(a: &RenderArgs, bounds: [f64; 6]) -> RenderParams {
+    let mut params = RenderParams {
+        blend: match a.mode {
+            Mode::Composite => BlendMode::Composite,
+            Mode::Mip => BlendMode::Maximum,
+            Mode::Minip => BlendMode::Minimum,
+            Mode::Average => BlendMode::Average,
+            Mode::Additive => BlendMode::Additive,
+            Mode::Iso => BlendMode::Isosurface,
+            Mode::Pathtrace => BlendMode::PathTrace,
+            Mode::Slice => BlendMode::Slice,
+        },
+        interpolation: match a.interpolation {
+            InterpArg::Nearest => Interpolation::Nearest,
+            InterpArg::Linear => Interpolation::Linear,
+            InterpArg::Cubic => Interpolation::Cubic,
+        },
+        gradient: if a.gradient == GradArg::Forward {
+            GradientMethod::Forward
+        } else {
+            GradientMethod::Central
+        },
+        sample_distance: a.sample_distance,
+        jitter: a.jitter,
+        empty_space_skipping: !a.no_skip,
+        preintegration: a.preintegration,
+        preview_level: a.preview_level,
+        quadrature: if a.adaptive {
+            Quadrature::Adaptive
+        } else if a.midpoint {
+            Quadrature::Midpoint
+        } else {
+            Quadrature::Vtk
+        },
+        slice_plane: (a.mode == Mode::Slice).then(|| {
+            let b = bounds;
+            let p = a.slice_plane.unwrap_or([
+                0.5 * (b[0] + b[1]),
+                0.5 * (b[2] + b[3]),
+                0.5 * (b[4] + b[5]),
+                0.0,
+                0.0,
+                1.0,
+            ]);
+            ClipPlane {
+                origin: glam::DVec3::new(p[0], p[1], p[2]),
+                normal: glam::DVec3::new(p[3], p[4], p[5]),
+            }
+        }),
+        ..Default::default()
+    };
+    params.shading.enabled = a.shade;
+    params.shading.volumetric_blending = a.volumetric;
+    params.shading.global_illumination_reach = a.reach;
+    params.shading.scattering_anisotropy = a.pt.anisotropy;
+    params
+}
+
 fn render(a: RenderArgs) -> Result<(), CliError> {
+    if let Some(p) = a.input.as_ref().filter(|p| mesh::is_vtu(p)) {
+        return mesh::render(&a, p);
+    }
     let pb = spinner("loading volume");
     let (vol, default_tf) = match (&a.input, a.demo_size) {
         (Some(p), _) => (ferrovol_io::open_volume(p)?, "auto"),
@@ -481,79 +574,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         r.set_environment(env)?;
     }
     let (w, h) = a.size;
-    let mut view = View::fit(vol.bounds(), w, h);
-    view.camera.parallel = a.parallel;
-    view.camera.azimuth(a.azimuth);
-    view.camera.elevation(a.elevation);
-    if let Some(up) = a.view_up {
-        let up = glam::DVec3::from_array(up);
-        let dir = view.camera.focal_point - view.camera.position;
-        if up.cross(dir).length() <= 1e-9 * dir.length() {
-            return Err(CliError::Usage(format!(
-                "--view-up {up}: that axis is parallel to the view direction {dir} after \
-                 --azimuth/--elevation; choose another axis or turn the camera first"
-            )));
-        }
-        view.camera.view_up = up;
-    }
-    view.camera.orthogonalize_view_up();
-    view.camera.roll(a.roll);
-    view.camera.zoom(a.zoom);
-    view.camera.reset_clipping_range(vol.bounds());
-    let mut params = RenderParams {
-        blend: match a.mode {
-            Mode::Composite => BlendMode::Composite,
-            Mode::Mip => BlendMode::Maximum,
-            Mode::Minip => BlendMode::Minimum,
-            Mode::Average => BlendMode::Average,
-            Mode::Additive => BlendMode::Additive,
-            Mode::Iso => BlendMode::Isosurface,
-            Mode::Pathtrace => BlendMode::PathTrace,
-            Mode::Slice => BlendMode::Slice,
-        },
-        interpolation: match a.interpolation {
-            InterpArg::Nearest => Interpolation::Nearest,
-            InterpArg::Linear => Interpolation::Linear,
-            InterpArg::Cubic => Interpolation::Cubic,
-        },
-        gradient: if a.gradient == GradArg::Forward {
-            GradientMethod::Forward
-        } else {
-            GradientMethod::Central
-        },
-        sample_distance: a.sample_distance,
-        jitter: a.jitter,
-        empty_space_skipping: !a.no_skip,
-        preintegration: a.preintegration,
-        preview_level: a.preview_level,
-        quadrature: if a.adaptive {
-            Quadrature::Adaptive
-        } else if a.midpoint {
-            Quadrature::Midpoint
-        } else {
-            Quadrature::Vtk
-        },
-        slice_plane: (a.mode == Mode::Slice).then(|| {
-            let b = vol.bounds();
-            let p = a.slice_plane.unwrap_or([
-                0.5 * (b[0] + b[1]),
-                0.5 * (b[2] + b[3]),
-                0.5 * (b[4] + b[5]),
-                0.0,
-                0.0,
-                1.0,
-            ]);
-            ClipPlane {
-                origin: glam::DVec3::new(p[0], p[1], p[2]),
-                normal: glam::DVec3::new(p[3], p[4], p[5]),
-            }
-        }),
-        ..Default::default()
-    };
-    params.shading.enabled = a.shade;
-    params.shading.volumetric_blending = a.volumetric;
-    params.shading.global_illumination_reach = a.reach;
-    params.shading.scattering_anisotropy = a.pt.anisotropy;
+    let mut view = view_of(&a, vol.bounds())?;
+    let params = render_params(&a, vol.bounds());
     if a.iso.no_lights {
         view.lights.clear();
     }
@@ -671,7 +693,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(a) => render(*a),
         Command::Bench(a) => bench::run(a),
-        Command::Info => Context::new()
+        Command::Info { mesh: Some(p) } => mesh::info(&p),
+        Command::Info { mesh: None } => Context::new()
             .map(|c| println!("{}", c.info))
             .map_err(CliError::from),
     };

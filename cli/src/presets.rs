@@ -35,11 +35,24 @@ fn tf(color: &[(f64, [f32; 3])], opacity: &[(f64, f32)]) -> TransferFunction {
     TransferFunction::single(ComponentTransfer::new(c, o))
 }
 
-/// A preset by name, or a JSON file.
+/// A preset by name, or a JSON file, for a volume.
 pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunction, CliError> {
-    // Only the presets placed by the data range read it (a pass over the whole volume).
+    // Preset opacities are per voxel: the unit distance is the mean spacing (as ParaView
+    // derives ScalarOpacityUnitDistance from the data), so a preset looks alike at any scale.
+    let unit = vol.spacing.iter().sum::<f64>() / 3.0;
+    preset(name, || Ok(vol.try_range(0)?), unit)
+}
+
+/// A preset by name, or a JSON file, for data whose first component's range `range` gives
+/// (read only by the presets placed by it: a pass over the whole data), the presets' unit
+/// distance `unit`.
+pub fn preset(
+    name: &str,
+    range: impl FnOnce() -> Result<[f64; 2], CliError>,
+    unit: f64,
+) -> Result<TransferFunction, CliError> {
     let [lo, hi] = if matches!(name, "mri" | "grey" | "auto") {
-        vol.try_range(0)?
+        range()?
     } else {
         [0.0, 1.0]
     };
@@ -110,9 +123,7 @@ pub fn transfer_function(name: &str, vol: &VolumeData) -> Result<TransferFunctio
             return from_json(p);
         }
     };
-    // Preset opacities are per voxel: the unit distance is the mean spacing (as ParaView
-    // derives ScalarOpacityUnitDistance from the data), so a preset looks alike at any scale.
-    t.components[0].unit_distance = vol.spacing.iter().sum::<f64>() / 3.0;
+    t.components[0].unit_distance = unit;
     Ok(t)
 }
 

@@ -209,3 +209,52 @@ fn pathtrace_render_accumulates_paths() {
     let (_, _, err) = render_ok("pathtrace", &[&pt[..], &args].concat());
     assert!(err.contains("8 paths per pixel"), "{err}");
 }
+
+/// The house (a hexahedron with a pyramid roof) as an ASCII VTK XML UnstructuredGrid.
+const HOUSE_VTU: &str = r#"<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="9" NumberOfCells="2">
+      <PointData Scalars="height">
+        <DataArray type="Float32" Name="height" format="ascii">0 0 0 0 1 1 1 1 2</DataArray>
+      </PointData>
+      <Points>
+        <DataArray type="Float64" NumberOfComponents="3" format="ascii">
+          0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1  0.5 0.5 2
+        </DataArray>
+      </Points>
+      <Cells>
+        <DataArray type="Int64" Name="connectivity" format="ascii">0 1 2 3 4 5 6 7 4 5 6 7 8</DataArray>
+        <DataArray type="Int64" Name="offsets" format="ascii">8 13</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">12 14</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+"#;
+
+#[test]
+fn a_vtu_mesh_renders_is_described_and_refuses_what_meshes_do_not_draw() {
+    let vtu = std::env::temp_dir().join("ferrovol-cli-test-house.vtu");
+    std::fs::write(&vtu, HOUSE_VTU).unwrap();
+    let path = vtu.to_str().unwrap();
+    let (png, stdout, _) = render_ok("house", &[path, "--mode", "mip", "--size", "32x32"]);
+    assert!(stdout.contains("9 points, 2 cells"), "{stdout}");
+    let img = image::open(&png).unwrap().to_rgb8();
+    let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
+    assert!(lit > 100, "{lit} pixels drawn");
+    let (code, out, _) = ferrovol(&["info", path]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("1 VTK_HEXAHEDRON (12)") && out.contains("tetrahedra: 14"),
+        "{out}"
+    );
+    let (code, _, err) = ferrovol(&[
+        "render", path, "--mode", "iso", "--iso", "1", "--size", "8x8",
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("unstructured volumes are drawn in the composite"),
+        "{err}"
+    );
+}

@@ -29,3 +29,4 @@ pub use gpu::{Context, DeviceInfo, DeviceMemory};
 pub use params::environment::{cube_direction, cube_face_coords, FACE_NAMES};
 pub use params::*;
 pub use renderer::Renderer;
+pub use resources::mesh::{tetrahedralize, Tetrahedra};

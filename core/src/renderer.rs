@@ -8,13 +8,14 @@ use crate::gpu::Context;
 use crate::params::{
     BlendMode, BsdfParams, Convergence, CubeImage, Environment, GBuffer, Image, IntermixedVolume,
     IsoParams, MaskKind, PathTraceParams, RenderParams, Residency, Stats, StreamProgress,
-    TransferFunction, UploadOptions, View, VolumeData,
+    TransferFunction, UnstructuredVolume, UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
 use crate::passes::frame::{self, FrameInput};
 use crate::passes::iso::{self, IsoPass};
 use crate::passes::pathtrace::PathTracePass;
 use crate::passes::scatter_check;
+use crate::passes::unstructured::UnstructuredPass;
 use crate::resources::intermix::Intermix;
 use crate::resources::levels::LevelDemand;
 use crate::resources::targets::DepthSource;
@@ -29,6 +30,7 @@ pub struct Renderer {
     /// The passes of the other modes, created on first use.
     iso: Option<Box<IsoPass>>,
     pt: Option<Box<PathTracePass>>,
+    unstructured: Option<Box<UnstructuredPass>>,
     iso_params: Option<IsoParams>,
     pt_params: PathTraceParams,
     /// The submissions that end the last frame and the one before it
@@ -56,6 +58,7 @@ impl Renderer {
             dvr,
             iso: None,
             pt: None,
+            unstructured: None,
             iso_params: None,
             pt_params: Default::default(),
             last_frame: None,
@@ -98,6 +101,18 @@ impl Renderer {
     /// bricks from `v` without a copy.
     pub fn set_shared_volume(&mut self, v: Arc<VolumeData>, opts: UploadOptions) -> Result<()> {
         self.res.set_volume(&self.ctx, HostVolume::Shared(v), opts)
+    }
+
+    /// Uploads an unstructured volume (replacing any previous volume, image or mesh): cells
+    /// split into tetrahedra ([`crate::tetrahedralize`]), their neighbours and a hierarchy
+    /// over the boundary; a triangle shared by more than two tetrahedra is an error naming
+    /// their cells. Drawn from its first scalar component. [`Renderer::render`] and [`Renderer::render_image`] then draw
+    /// it with the same view, parameters and transfer function as an image volume;
+    /// [`Renderer::set_volume`] goes back to an image. A mesh whose buffers exceed the
+    /// device's storage-buffer binding size is refused with the sizes (about 35 bytes per
+    /// tetrahedron).
+    pub fn set_unstructured(&mut self, v: &UnstructuredVolume) -> Result<()> {
+        self.res.set_mesh(&self.ctx, v)
     }
 
     /// Blanks points of the current volume's grid (VTK's ghost arrays and vtkUniformGrid
@@ -385,6 +400,23 @@ impl Renderer {
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
         let (ctx, res) = (&self.ctx, &mut self.res);
+        if res.mesh.is_some() {
+            let pass = ensure(&mut self.unstructured, || {
+                Ok(Box::new(UnstructuredPass::new(ctx)?))
+            })?;
+            let done = pass.render(FrameInput {
+                ctx,
+                res,
+                view,
+                params,
+                depth,
+            });
+            if done.is_ok() {
+                self.previous_frame =
+                    std::mem::replace(&mut self.last_frame, ctx.last_submission());
+            }
+            return done;
+        }
         // Rays that go anywhere cannot stream: past the budget such a frame draws a coarser
         // level of the volume.
         let anywhere = match params.blend {

@@ -65,6 +65,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../shaders/lib/classify.wgsl"),
     ),
     ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
+    (
+        "unstructured.wgsl",
+        include_str!("../../shaders/unstructured.wgsl"),
+    ),
     ("firsthit.wgsl", include_str!("../../shaders/firsthit.wgsl")),
     ("deferred.wgsl", include_str!("../../shaders/deferred.wgsl")),
     (
@@ -95,6 +99,7 @@ pub const FILES: &[(&str, &str)] = &[
 #[cfg(test)]
 pub const PASSES: &[&str] = &[
     "dvr.wgsl",
+    "unstructured.wgsl",
     "firsthit.wgsl",
     "deferred.wgsl",
     "environment.wgsl",

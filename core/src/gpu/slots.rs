@@ -26,6 +26,15 @@ pub const ISO: u32 = 7;
 /// The pre-integration tables and the mask (lib/classify.wgsl).
 pub const PREINT_TABLES: u32 = 9;
 pub const MASK: u32 = 10;
+/// An unstructured volume (unstructured.wgsl): its uniforms, points, tetrahedra,
+/// neighbours, cell scalars, boundary hierarchy and boundary triangles.
+pub const MESH: u32 = 11;
+pub const MESH_POINTS: u32 = 12;
+pub const MESH_TETS: u32 = 13;
+pub const MESH_NEIGHBOURS: u32 = 14;
+pub const MESH_CELL_SCALARS: u32 = 15;
+pub const MESH_NODES: u32 = 16;
+pub const MESH_BOUNDARY: u32 = 17;
 /// The intermixed volumes (lib/intermix.wgsl).
 pub const INTERMIX: u32 = 18;
 pub const INTERMIX_ATLAS: u32 = 19;
@@ -64,6 +73,13 @@ pub const WGSL_SLOTS: &[(&str, u32)] = &[
     ("SLOT_ISO", ISO),
     ("SLOT_PREINT_TABLES", PREINT_TABLES),
     ("SLOT_MASK", MASK),
+    ("SLOT_MESH", MESH),
+    ("SLOT_MESH_POINTS", MESH_POINTS),
+    ("SLOT_MESH_TETS", MESH_TETS),
+    ("SLOT_MESH_NEIGHBOURS", MESH_NEIGHBOURS),
+    ("SLOT_MESH_CELL_SCALARS", MESH_CELL_SCALARS),
+    ("SLOT_MESH_NODES", MESH_NODES),
+    ("SLOT_MESH_BOUNDARY", MESH_BOUNDARY),
     ("SLOT_INTERMIX", INTERMIX),
     ("SLOT_INTERMIX_ATLAS", INTERMIX_ATLAS),
     ("SLOT_INTERMIX_TABLES", INTERMIX_TABLES),

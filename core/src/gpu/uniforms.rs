@@ -96,6 +96,30 @@ pub struct PoolUniforms {
 /// Per-pixel ray state (PixelState in WGSL), 48 bytes.
 pub const PIXEL_STATE_BYTES: u64 = 48;
 
+/// An unstructured volume's uniforms (`Mesh` in shaders/unstructured.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct MeshUniforms {
+    /// Tetrahedra, boundary triangles, hierarchy nodes, the most steps a ray takes.
+    pub counts: [u32; 4],
+    /// x: 1 / the scalar opacity unit distance (attenuation = opacity · x).
+    pub unit: [f32; 4],
+    /// x: the number of `knots`, or [`MESH_EVERY_ENTRY`].
+    pub split: [u32; 4],
+    /// Where a segment's pieces end besides its own ends (table coordinates, ascending):
+    /// the transfer functions' points and the tables' ends, between which colour and
+    /// opacity are linear.
+    pub knots: [[f32; 4]; MESH_KNOTS / 4],
+}
+
+/// The most knots [`MeshUniforms`] holds.
+pub const MESH_KNOTS: usize = 64;
+/// A transfer function of more knots: segments split at every table entry.
+pub const MESH_EVERY_ENTRY: u32 = u32::MAX;
+/// The deepest boundary hierarchy a ray's search holds on its stack (median splits of 2^32
+/// triangles go 31 deep).
+pub const MESH_BVH_STACK: usize = 64;
+
 /// The isosurface uniforms (`Iso` in shaders/lib/iso.wgsl), read by the first-hit and
 /// deferred passes.
 #[repr(C)]
@@ -324,6 +348,9 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("READ_STAND_IN", Wgsl::U32(READ_STAND_IN)),
     ("READ_FINE", Wgsl::U32(READ_FINE)),
     ("MAX_CLIP", Wgsl::U32(MAX_CLIP_PLANES as u32)),
+    ("MESH_KNOTS", Wgsl::U32(MESH_KNOTS as u32)),
+    ("MESH_EVERY_ENTRY", Wgsl::U32(MESH_EVERY_ENTRY)),
+    ("MESH_BVH_STACK", Wgsl::U32(MESH_BVH_STACK as u32)),
     ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
     ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),
     ("SPECULAR_CONE", Wgsl::U32(SPECULAR_CONE)),
@@ -512,6 +539,8 @@ mod layout_tests {
             PathTraceUniforms,
             [env_rotation, medium, surface, lobe, counts, options, rect]
         );
+        let m = module("unstructured.wgsl");
+        check!(m, "Mesh", MeshUniforms, [counts, unit, split, knots]);
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
         let m = module("pathtrace_show.wgsl");

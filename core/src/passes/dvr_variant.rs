@@ -609,7 +609,7 @@ mod tests {
     /// docs/REFUSALS.md: every refusal of the ray-casting, isosurface and path-tracing
     /// matrices, its condition and the messages it gives, in the order the passes check them.
     fn refusals_doc() -> String {
-        use crate::passes::{iso_variant, pathtrace_variant};
+        use crate::passes::{iso_variant, pathtrace_variant, unstructured_variant};
         let dvr = rows(|each| matrix(each), select, when);
         let iso = rows(
             |each| iso_variant::tests::matrix(each),
@@ -621,21 +621,28 @@ mod tests {
             pathtrace_variant::select,
             pathtrace_variant::tests::when,
         );
+        let mesh = rows(
+            |each| unstructured_variant::tests::matrix(each),
+            unstructured_variant::select,
+            unstructured_variant::tests::when,
+        );
         format!(
-            "<!-- Generated from core/src/passes/dvr_variant.rs, iso_variant.rs and \
-             pathtrace_variant.rs by their tests: FERROVOL_UPDATE_DOCS=1 cargo test -p \
+            "<!-- Generated from core/src/passes/dvr_variant.rs, iso_variant.rs, \
+             pathtrace_variant.rs and unstructured_variant.rs by their tests: FERROVOL_UPDATE_DOCS=1 cargo test -p \
              ferrovol-core --lib refusals -->\n\
              # What the passes refuse\n\n\
-             The combinations of settings the ray-casting, isosurface and path-tracing passes \
-             do not draw, each with the error it gives: `Error::Unsupported` in Rust, \
+             The combinations of settings the ray-casting, isosurface, path-tracing and \
+             unstructured passes do not draw, each with the error it gives: `Error::Unsupported` in Rust, \
              FV_STATUS_UNSUPPORTED and the message from the C ABI, vtkErrorMacro in VTK and \
              ParaView, an error from the CLI. Each message names the way out. The list is \
              written once, in the code (each pass's variant selection, a pure function of \
              the frame's facts); this page is generated from it, and a test keeps it \
-             current.\n\n## Ray casting\n\n{}\n## Isosurfaces\n\n{}\n## Path tracing\n\n{}",
+             current.\n\n## Ray casting\n\n{}\n## Isosurfaces\n\n{}\n## Path tracing\n\n{}\n\
+             ## Unstructured volumes\n\n{}",
             table(&dvr),
             table(&iso),
-            table(&pt)
+            table(&pt),
+            table(&mesh)
         )
     }
 

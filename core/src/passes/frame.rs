@@ -195,7 +195,7 @@ pub(crate) fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
 
 /// A world plane in index space as (n_i, w): dot(n_i, p) + w is the world distance to the
 /// plane of the point p (index coordinates), for any invertible index → world matrix.
-fn index_plane(index_to_world: DMat4, p: &ClipPlane) -> [f32; 4] {
+pub(crate) fn index_plane(index_to_world: DMat4, p: &ClipPlane) -> [f32; 4] {
     let n = p.normal.normalize();
     let ni = index_to_world.transpose().transform_vector3(n);
     let w = n.dot(index_to_world.transform_point3(DVec3::ZERO) - p.origin);

@@ -4,7 +4,7 @@
 
 use super::{
     denoise::DenoisePass, depth_check::DepthCheck, dvr::DvrPass, iso::IsoPass,
-    pathtrace::PathTracePass, scatter_check,
+    pathtrace::PathTracePass, scatter_check, unstructured::UnstructuredPass,
 };
 use crate::gpu::shaders;
 use crate::resources::{brick_layout_entries, environment::EnvPipelines, gradients::GradientPass};
@@ -192,6 +192,11 @@ fn every_pass_binds_what_its_wgsl_declares() {
         "deferred.wgsl",
         "main",
         &[IsoPass::deferred_layout_entries(), brick],
+    );
+    check(
+        "unstructured.wgsl",
+        "main",
+        &[UnstructuredPass::layout_entries()],
     );
     check(
         "pathtrace_show.wgsl",

@@ -13,6 +13,8 @@ pub(crate) mod medium;
 pub(crate) mod pathtrace;
 pub(crate) mod pathtrace_variant;
 pub(crate) mod scatter_check;
+pub(crate) mod unstructured;
+pub(crate) mod unstructured_variant;
 
 #[cfg(test)]
 mod layout_tests;

@@ -8,6 +8,7 @@ pub(crate) mod gradients;
 pub(crate) mod intermix;
 pub(crate) mod levels;
 pub(crate) mod lod;
+pub(crate) mod mesh;
 pub(crate) mod residency;
 pub(crate) mod tables;
 pub(crate) mod targets;
@@ -41,6 +42,8 @@ pub(crate) struct Resources {
     /// The frame uniforms (lib/common.wgsl's Frame), written by each pass.
     pub frame_buf: wgpu::Buffer,
     pub volume: Option<GpuVolume>,
+    /// An unstructured volume, drawn instead of `volume` while it is set.
+    pub mesh: Option<mesh::gpu::GpuMesh>,
     /// A coarser level of a bricked volume, built when a path-traced frame's bricks exceed
     /// the memory budget (levels.rs).
     pub level: Option<levels::Level>,
@@ -127,6 +130,7 @@ impl Resources {
             nearest: sampler(wgpu::FilterMode::Nearest),
             frame_buf,
             volume: None,
+            mesh: None,
             level: None,
             drawn_level: 1,
             tf: None,
@@ -147,6 +151,17 @@ impl Resources {
             intermix: None,
             intermix_generation: 0,
         }
+    }
+
+    /// Forgets what belonged to the volume before a new one (image or mesh): its coarser
+    /// level, occupancy, blanking and mask; counts the upload.
+    pub fn new_volume_state(&mut self) {
+        self.level = None;
+        self.occupancy = None;
+        self.blanking = None;
+        self.mask = None;
+        self.mask_generation += 1;
+        self.stats.volume_uploads += 1;
     }
 
     /// The volume, or the error every pass gives without one.

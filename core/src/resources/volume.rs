@@ -215,12 +215,8 @@ impl Resources {
     ) -> Result<()> {
         let (volume, whole) = new_volume(ctx, host, opts)?;
         self.volume = Some(volume);
-        self.level = None;
-        self.occupancy = None;
-        self.blanking = None;
-        self.mask = None;
-        self.mask_generation += 1;
-        self.stats.volume_uploads += 1;
+        self.mesh = None;
+        self.new_volume_state();
         let uploaded = match whole {
             Some(texels) => self.upload_whole(ctx, &texels),
             None => Ok(()),

@@ -9,6 +9,7 @@
 
 pub mod gpu;
 pub mod images;
+pub mod mesh;
 pub mod metrics;
 pub mod pathtracer;
 pub mod raycast;

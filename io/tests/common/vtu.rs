@@ -258,19 +258,10 @@ pub fn write(pieces: &[Piece], o: &Opts) -> Vec<u8> {
     out
 }
 
-/// A unit cube's corners in VTK hexahedron order and an apex above it.
+/// A unit cube's corners in VTK hexahedron order and an apex above it (the house of
+/// ferrovol_core::synth).
 pub fn cube_points() -> Vec<[f64; 3]> {
-    vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 0.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [0.0, 1.0, 1.0],
-        [0.5, 0.5, 2.0],
-    ]
+    ferrovol_core::synth::HOUSE_POINTS.to_vec()
 }
 
 /// One tetra with a Float32 point scalar.

@@ -1,19 +1,9 @@
 use super::*;
 
 /// A unit cube's 8 corners in VTK hexahedron order, and one more point (the apex of a
-/// pyramid on top).
+/// pyramid on top): the house of [`crate::synth`].
 fn points() -> Vec<[f64; 3]> {
-    vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 0.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [0.0, 1.0, 1.0],
-        [0.5, 0.5, 2.0],
-    ]
+    crate::synth::HOUSE_POINTS.to_vec()
 }
 
 /// One tetra with point scalars.

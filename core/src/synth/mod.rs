@@ -1,8 +1,12 @@
 //! Analytic test volumes: VTK's wavelet (`vtkRTAnalyticSource`), the Marschner–Lobb
-//! signal, and a sphere signed distance field.
+//! signal, and a sphere signed distance field; generated unstructured volumes (meshes.rs:
+//! [`tet_wavelet`], [`mixed_cells`], [`hollow_cylinder`], [`house`]).
 //!
-//! All generators return single-component `float32` volumes with identity direction;
+//! All image generators return single-component `float32` volumes with identity direction;
 //! [`wavelet_generated`] also gives `uint16`, computed in runs as the renderer reads it.
+
+mod meshes;
+pub use meshes::{hollow_cylinder, house, mixed_cells, tet_wavelet, HOUSE_POINTS};
 
 use crate::error::{Error, Result};
 use crate::params::{ScalarSource, ScalarType, Scalars, VolumeData, IDENTITY_DIRECTION};

@@ -1,0 +1,536 @@
+// Ray casting an unstructured volume (core/src/passes/unstructured.rs): one thread per
+// pixel. A ray enters the mesh where it first meets a boundary triangle facing it (a
+// bounding volume hierarchy over the boundary triangles), walks from tetrahedron to
+// tetrahedron across shared faces, each tetrahedron's exit the nearest of its other faces'
+// planes the ray leaves through, and where it leaves the mesh looks for the next boundary
+// triangle facing it beyond (non-convex meshes). Along a tetrahedron the scalar is linear
+// (barycentric on the entry and exit faces; cell scalars constant), and each segment is
+// integrated exactly for the transfer tables (linear between entries): split at the
+// entries it crosses, each piece with linear colour and linear attenuation
+// τ = opacity / unit distance, emission colour · τ (VTK's unstructured integrators).
+// "Index space" is the mesh's own coordinates relative to its centre; t is world distance.
+// Only the part of each ray within the near and far planes, the host's depth and the
+// clipping planes is integrated.
+#include "lib/output.wgsl"
+#include "lib/march.wgsl"
+
+override BLEND: u32 = BLEND_COMPOSITE;
+override CELL_SCALARS: bool = false;
+
+struct Mesh {
+    counts: vec4<u32>,  // tetrahedra, boundary triangles, hierarchy nodes, most steps
+    unit: vec4<f32>,    // x: 1 / unit distance
+    split: vec4<u32>,   // x: knots, or MESH_EVERY_ENTRY (pieces end at every table entry)
+    knots: array<vec4<f32>, MESH_KNOTS / 4>, // table coordinates where pieces end, ascending
+}
+
+struct BvhNode {
+    lo: vec3<f32>,
+    a: u32,             // leaf: first triangle; inner: second child
+    hi: vec3<f32>,
+    count: u32,         // triangles of a leaf, 0 for an inner node
+}
+
+@group(0) @binding(SLOT_MESH) var<uniform> mesh_ubo: Mesh;
+// (read once into private memory, as `frame`: lavapipe gathers uniforms read in loops)
+var<private> mesh: Mesh;
+@group(0) @binding(SLOT_MESH_POINTS) var<storage, read> points: array<vec4<f32>>;
+@group(0) @binding(SLOT_MESH_TETS) var<storage, read> tets: array<vec4<u32>>;
+// across face f of tetrahedron t (opposite its point f): 4 · neighbour + its face, or
+// NO_NEIGHBOUR on the boundary
+@group(0) @binding(SLOT_MESH_NEIGHBOURS) var<storage, read> neighbours: array<vec4<u32>>;
+@group(0) @binding(SLOT_MESH_CELL_SCALARS) var<storage, read> cell_scalars: array<f32>;
+@group(0) @binding(SLOT_MESH_NODES) var<storage, read> nodes: array<BvhNode>;
+// boundary triangles as 4 · tetrahedron + face, in the hierarchy's leaf order
+@group(0) @binding(SLOT_MESH_BOUNDARY) var<storage, read> boundary: array<u32>;
+
+const NO_NEIGHBOUR: u32 = 0xffffffffu;
+const NO_HIT: u32 = 0xffffffffu;
+
+// Where a ray crosses a face: distance, the face as 4 · tet + face, the scalar there.
+struct Hit {
+    t: f32,
+    tf: u32,
+    s: f32,
+}
+
+// A triangle (a, b, c) with its point scalars and a normal n (face_of: the outward one).
+struct Face {
+    a: vec3<f32>,
+    b: vec3<f32>,
+    c: vec3<f32>,
+    n: vec3<f32>,
+    sa: f32,
+    sb: f32,
+    sc: f32,
+}
+
+fn face_of(t: u32, f: u32) -> Face {
+    let ids = tets[t];
+    let pa = points[ids[(f + 1u) % 4u]];
+    let pb = points[ids[(f + 2u) % 4u]];
+    let pc = points[ids[(f + 3u) % 4u]];
+    let q = points[ids[f]].xyz;
+    var out = make_face(pa, pb, pc);
+    out.n = select(out.n, -out.n, dot(out.n, q - out.a) > 0.0);
+    return out;
+}
+
+// The triangle of points (xyz, w the scalar) a, b, c, its normal cross(b − a, c − a).
+fn make_face(pa: vec4<f32>, pb: vec4<f32>, pc: vec4<f32>) -> Face {
+    var out: Face;
+    out.a = pa.xyz;
+    out.b = pb.xyz;
+    out.c = pc.xyz;
+    out.sa = pa.w;
+    out.sb = pb.w;
+    out.sc = pc.w;
+    out.n = cross(out.b - out.a, out.c - out.a);
+    return out;
+}
+
+// The point scalar at p on face fc (barycentric, clamped to the triangle), or the cell's.
+fn face_scalar(fc: Face, p: vec3<f32>, t: u32) -> f32 {
+    if (CELL_SCALARS) {
+        return cell_scalars[t];
+    }
+    // (signed areas, positive inside for either orientation of the normal)
+    var w = vec3<f32>(
+        dot(fc.n, cross(fc.b - p, fc.c - p)),
+        dot(fc.n, cross(fc.c - p, fc.a - p)),
+        dot(fc.n, cross(fc.a - p, fc.b - p)),
+    );
+    w = max(w * sign(dot(fc.n, cross(fc.b - fc.a, fc.c - fc.a))), vec3<f32>(0.0));
+    let sum = w.x + w.y + w.z;
+    if (sum <= 0.0) {
+        return (fc.sa + fc.sb + fc.sc) / 3.0;
+    }
+    return dot(w, vec3<f32>(fc.sa, fc.sb, fc.sc)) / sum;
+}
+
+// The ray's entry into the mesh: the nearest boundary triangle facing the ray at a
+// distance ≥ t_min, not of tetrahedron `skip` (the one the ray just left).
+fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> Hit {
+    var best: Hit;
+    best.t = t_max;
+    best.tf = NO_HIT;
+    var stack: array<u32, MESH_BVH_STACK>;
+    var sp = 0u;
+    var node = 0u;
+    let inv = 1.0 / d;
+    loop {
+        let nd = nodes[node];
+        let t0 = (nd.lo - o) * inv;
+        let t1 = (nd.hi - o) * inv;
+        let near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), t_min));
+        let far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), best.t));
+        // (widened for rounding: flat boxes hold the faces of flat boundaries; written so
+        // that a NaN, from a ray in a slab's plane, culls nothing)
+        let visit = !(near - far > 1e-6 * (abs(near) + abs(far)) + 1e-6);
+        if (visit && nd.count > 0u) {
+            for (var i = nd.a; i < nd.a + nd.count; i = i + 1u) {
+                let tf = boundary[i];
+                if ((tf >> 2u) == skip) {
+                    continue;
+                }
+                let fc = face_of(tf >> 2u, tf & 3u);
+                if (dot(fc.n, d) >= 0.0) {
+                    continue; // faces away: the ray would leave through it
+                }
+                // Möller–Trumbore, edges widened a little so that rays through an edge
+                // enter by one of the triangles that share it
+                let e1 = fc.b - fc.a;
+                let e2 = fc.c - fc.a;
+                let pv = cross(d, e2);
+                let det = dot(e1, pv);
+                if (abs(det) < 1e-30) {
+                    continue;
+                }
+                let inv_det = 1.0 / det;
+                let tv = o - fc.a;
+                let u = dot(tv, pv) * inv_det;
+                let qv = cross(tv, e1);
+                let v = dot(d, qv) * inv_det;
+                let th = dot(e2, qv) * inv_det;
+                let eps = 1e-5;
+                if (u >= -eps && v >= -eps && u + v <= 1.0 + eps && th >= t_min && th < best.t) {
+                    best.t = th;
+                    best.tf = tf;
+                    if (CELL_SCALARS) {
+                        best.s = cell_scalars[tf >> 2u];
+                    } else {
+                        let w = clamp(vec3<f32>(1.0 - u - v, u, v), vec3<f32>(0.0), vec3<f32>(1.0));
+                        best.s = dot(w, vec3<f32>(fc.sa, fc.sb, fc.sc)) / max(w.x + w.y + w.z, 1e-30);
+                    }
+                }
+            }
+        }
+        if (visit && nd.count == 0u && sp < MESH_BVH_STACK) {
+            stack[sp] = nd.a;
+            sp = sp + 1u;
+            node = node + 1u;
+            continue;
+        }
+        if (sp == 0u) {
+            break;
+        }
+        sp = sp - 1u;
+        node = stack[sp];
+    }
+    return best;
+}
+
+// A tetrahedron in registers: its point indices and its points (xyz, w the point scalar).
+struct Tet {
+    ids: vec4<u32>,
+    p0: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+    p3: vec4<f32>,
+}
+
+fn load_tet(t: u32) -> Tet {
+    var out: Tet;
+    out.ids = tets[t];
+    out.p0 = points[out.ids.x];
+    out.p1 = points[out.ids.y];
+    out.p2 = points[out.ids.z];
+    out.p3 = points[out.ids.w];
+    return out;
+}
+
+// The point of `old` whose index is id (one of them).
+fn shared_point(old: Tet, id: u32) -> vec4<f32> {
+    var p = old.p3;
+    p = select(p, old.p2, old.ids.z == id);
+    p = select(p, old.p1, old.ids.y == id);
+    return select(p, old.p0, old.ids.x == id);
+}
+
+// Tetrahedron t entered through its face f from `old` (whose exit face it shares): three
+// of its points are old's, one load brings the fourth.
+fn next_tet(old: Tet, t: u32, f: u32) -> Tet {
+    var out: Tet;
+    out.ids = tets[t];
+    let fresh = points[out.ids[f]];
+    out.p0 = select(shared_point(old, out.ids.x), fresh, f == 0u);
+    out.p1 = select(shared_point(old, out.ids.y), fresh, f == 1u);
+    out.p2 = select(shared_point(old, out.ids.z), fresh, f == 2u);
+    out.p3 = select(shared_point(old, out.ids.w), fresh, f == 3u);
+    return out;
+}
+
+// Point i mod 4 of tetrahedron k (selects: a local array indexed at run time would live in
+// memory).
+fn corner(k: Tet, i: u32) -> vec4<f32> {
+    let j = i % 4u;
+    return select(select(select(k.p3, k.p2, j == 2u), k.p1, j == 1u), k.p0, j == 0u);
+}
+
+// Where the ray leaves through the plane of face (a, b, c) opposite q: its distance, or
+// +∞ where the ray does not leave through it (entering or parallel).
+fn leaves_at(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, q: vec3<f32>) -> f32 {
+    var n = cross(b - a, c - a);
+    n = select(n, -n, dot(n, q - a) > 0.0);
+    let den = dot(n, d);
+    return select(3.0e38, dot(n, a - o) / den, den > 0.0);
+}
+
+// The ray's exit from tetrahedron k (index t) entered through face f_in at t_in: the
+// nearest plane of the other faces that the ray leaves through (at t_in at the earliest).
+// tf NO_HIT when no face is left through (a ray grazing a face).
+fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> Hit {
+    let q0 = k.p0.xyz;
+    let q1 = k.p1.xyz;
+    let q2 = k.p2.xyz;
+    let q3 = k.p3.xyz;
+    var ts = vec4<f32>(
+        leaves_at(o, d, q1, q2, q3, q0),
+        leaves_at(o, d, q2, q3, q0, q1),
+        leaves_at(o, d, q3, q0, q1, q2),
+        leaves_at(o, d, q0, q1, q2, q3),
+    );
+    ts = select(ts, vec4<f32>(3.0e38), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in));
+    // the nearest, and its face's points (f + 1, f + 2, f + 3) mod 4
+    let best = min(min(ts.x, ts.y), min(ts.z, ts.w));
+    let f = select(select(select(3u, 2u, ts.z == best), 1u, ts.y == best), 0u, ts.x == best);
+    let pa = corner(k, f + 1u);
+    let pb = corner(k, f + 2u);
+    let pc = corner(k, f + 3u);
+    var out: Hit;
+    out.tf = NO_HIT;
+    if (best >= 3.0e38) {
+        return out;
+    }
+    out.t = max(best, t_in);
+    out.tf = 4u * t + f;
+    out.s = face_scalar(make_face(pa, pb, pc), o + out.t * d, t);
+    return out;
+}
+
+// ---- integration ----
+
+// The table coordinate (entries, 0 … TABLE_N − 1, unclamped) of scalar s.
+fn entry_of(s: f32) -> f32 {
+    return scalar_coord(0u, s) * f32(TABLE_N - 1u);
+}
+
+// Colour (rgb) and attenuation τ (a) at table coordinate x, linear between entries.
+fn colour_tau(x: f32) -> vec4<f32> {
+    let u = x / f32(TABLE_N - 1u);
+    let c = row_lookup(tables, 0, u, false);
+    let a = row_lookup(tables, 1, u, false).x;
+    return vec4<f32>(c.rgb, a * mesh.unit.x);
+}
+
+// e^(x²) erfc(x) for x ≥ 0 (the Chebyshev fit of Numerical Recipes, relative error
+// below 1.2e-7).
+fn erfcx(x: f32) -> f32 {
+    let t = 1.0 / (1.0 + 0.5 * x);
+    let p = -1.26551223 + t * (1.00002368 + t * (0.37409196 + t * (0.09678418 +
+        t * (-0.18628806 + t * (0.27886807 + t * (-1.13520398 + t * (1.48851587 +
+        t * (-0.82215223 + t * 0.17087277))))))));
+    return t * exp(p);
+}
+
+// Dawson's integral F(x) = e^(−x²) ∫₀ˣ e^(y²) dy for x ≥ 0: its series near 0, Rybicki's
+// sum (h = 0.4, twelve terms) up to 10, the asymptotic series beyond.
+fn dawson(x: f32) -> f32 {
+    let x2 = x * x;
+    if (x < 0.2) {
+        return x * (1.0 - 2.0 / 3.0 * x2 * (1.0 - 2.0 / 5.0 * x2 * (1.0 - 2.0 / 7.0 * x2)));
+    }
+    if (x > 10.0) {
+        let r = 1.0 / x2;
+        return 0.5 / x * (1.0 + r * (0.5 + r * (0.75 + r * 1.875)));
+    }
+    let h = 0.4;
+    let n0 = 2.0 * round(0.5 * x / h);
+    let xp = x - n0 * h;
+    var sum = 0.0;
+    for (var k = -11; k <= 11; k = k + 2) {
+        let kh = f32(k) * h;
+        sum = sum + exp(-(xp - kh) * (xp - kh)) / (n0 + f32(k));
+    }
+    return sum * 0.5641895835; // 1 / √π
+}
+
+// The mean over u in [0, 1] of exp(−a·u − b·u²), a ≥ 0, a + 2b ≥ 0: the mean
+// transmittance over a piece of optical depth a·u + b·u² at u.
+fn psi(a: f32, b: f32) -> f32 {
+    if (a + abs(b) < 1.0) {
+        // Gauss–Legendre, four points: the exponent is small, the error far below f32's
+        let x = vec4<f32>(0.0694318442, 0.3300094782, 0.6699905218, 0.9305681558);
+        let w = vec4<f32>(0.1739274226, 0.3260725774, 0.3260725774, 0.1739274226);
+        return dot(w, exp(-a * x - b * x * x));
+    }
+    if (abs(b) < 1e-6 * a) {
+        return (1.0 - exp(-a)) / a;
+    }
+    if (b > 0.0) {
+        let s = sqrt(b);
+        let x0 = 0.5 * a / s;
+        return 0.8862269255 / s * (erfcx(x0) - exp(-(a + b)) * erfcx(x0 + s));
+    }
+    let s = sqrt(-b);
+    let zeta = exp(-(a + b));
+    return (dawson(0.5 * a / s) - zeta * dawson(0.5 * (a + 2.0 * b) / s)) / s;
+}
+
+// The ray's state: premultiplied colour, the projections' value and length, the depth.
+var<private> st: PixelState;
+
+// Composites a piece of length len whose colour and attenuation run linearly from cf to cb
+// (rgb colour, a attenuation), starting at distance t0.
+fn composite_piece(r: Ray, cf: vec4<f32>, cb: vec4<f32>, len: f32, t0: f32) {
+    let a = cf.a * len;
+    let b = 0.5 * (cb.a - cf.a) * len;
+    if (a + b <= 0.0 && a <= 0.0) {
+        return;
+    }
+    let zeta = exp(-(a + b));
+    let p = psi(a, b);
+    let emitted = cb.rgb * (1.0 - zeta) + (cf.rgb - cb.rgb) * (1.0 - p);
+    let before = st.color.a;
+    let keep = 1.0 - before;
+    st.color = st.color + keep * vec4<f32>(emitted, 1.0 - zeta);
+    if (st.misc.z == 0.0 && st.color.a > frame.depth_threshold) {
+        let f = clamp((frame.depth_threshold - before) / max(st.color.a - before, 1e-30), 0.0, 1.0);
+        st.misc.y = distance_to_depth(r, t0 + f * len);
+        st.misc.z = 1.0;
+    }
+}
+
+// Opacity × normalised scalar at table coordinate x (average and additive).
+fn projection_at(x: f32) -> f32 {
+    let u = clamp(x / f32(TABLE_N - 1u), 0.0, 1.0);
+    return row_lookup(tables, 1, u, false).x * u;
+}
+
+// Where the piece from table coordinate xa toward x1 (up: increasing) ends: the next knot
+// strictly beyond xa, or x1.
+fn next_cut(xa: f32, x1: f32, up: bool) -> f32 {
+    let n = mesh.split.x;
+    if (n == MESH_EVERY_ENTRY) {
+        let last = f32(TABLE_N - 1u);
+        if (up && xa < last) {
+            return min(select(floor(xa) + 1.0, 0.0, xa < 0.0), x1);
+        } else if (!up && xa > 0.0) {
+            return max(select(ceil(xa) - 1.0, last, xa > last), x1);
+        }
+        return x1;
+    }
+    if (up) {
+        for (var i = 0u; i < n; i = i + 1u) {
+            let k = mesh.knots[i / 4u][i % 4u];
+            if (k > xa) {
+                return min(k, x1);
+            }
+        }
+    } else {
+        for (var i = n; i > 0u; i = i - 1u) {
+            let k = mesh.knots[(i - 1u) / 4u][(i - 1u) % 4u];
+            if (k < xa) {
+                return max(k, x1);
+            }
+        }
+    }
+    return x1;
+}
+
+// One segment [t0, t0 + len] along which the scalar runs linearly from s0 to s1.
+fn integrate(r: Ray, s0: f32, s1: f32, t0: f32, len: f32) {
+    if (BLEND == BLEND_MAXIMUM) {
+        let m = max(s0, s1);
+        st.value.x = select(max(st.value.x, m), m, st.misc.x == 0.0);
+        st.misc.x = st.misc.x + 1.0;
+        return;
+    }
+    if (BLEND == BLEND_MINIMUM) {
+        let m = min(s0, s1);
+        st.value.x = select(min(st.value.x, m), m, st.misc.x == 0.0);
+        st.misc.x = st.misc.x + 1.0;
+        return;
+    }
+    if (len <= 0.0) {
+        return;
+    }
+    // the pieces between the knots (or table entries) the segment crosses: within each,
+    // colour, attenuation and the normalised scalar are linear in t
+    let x0 = entry_of(s0);
+    let x1 = entry_of(s1);
+    let up = x1 > x0;
+    var xa = x0;
+    var ua = 0.0;
+    var ca = colour_tau(xa);
+    for (var i = 0u; i <= TABLE_N + 1u; i = i + 1u) {
+        let xb = next_cut(xa, x1, up);
+        let ub = select((xb - x0) / (x1 - x0), 1.0, xb == x1);
+        let plen = (ub - ua) * len;
+        let cb = colour_tau(xb);
+        if (BLEND == BLEND_COMPOSITE) {
+            composite_piece(r, ca, cb, plen, t0 + ua * len);
+            if (st.color.a >= frame.termination) {
+                return;
+            }
+        } else {
+            // the product of two linear functions: Simpson's rule is exact
+            let mid = projection_at(0.5 * (xa + xb));
+            let term = plen / 6.0 * (projection_at(xa) + 4.0 * mid + projection_at(xb));
+            st.value.x = st.value.x + term * select(1.0, mesh.unit.x, BLEND == BLEND_ADDITIVE);
+        }
+        if (xb == x1) {
+            break;
+        }
+        xa = xb;
+        ua = ub;
+        ca = cb;
+    }
+    if (BLEND == BLEND_AVERAGE) {
+        st.misc.x = st.misc.x + len;
+    } else if (BLEND == BLEND_ADDITIVE) {
+        st.misc.x = st.misc.x + 1.0;
+    }
+}
+
+// The part of segment [ta, tb] (scalars sa, sb) within [seg.x, seg.y], integrated.
+fn integrate_within(r: Ray, seg: vec2<f32>, ta: f32, tb: f32, sa: f32, sb: f32) {
+    let lo = max(ta, seg.x);
+    let hi = min(tb, seg.y);
+    if (hi < lo || (hi == lo && BLEND != BLEND_MAXIMUM && BLEND != BLEND_MINIMUM)) {
+        return;
+    }
+    let span = tb - ta;
+    var s0 = sa;
+    var s1 = sb;
+    if (span > 0.0) {
+        s0 = mix(sa, sb, (lo - ta) / span);
+        s1 = mix(sa, sb, (hi - ta) / span);
+    }
+    integrate(r, s0, s1, lo, hi - lo);
+}
+
+fn done() -> bool {
+    return BLEND == BLEND_COMPOSITE && st.color.a >= frame.termination;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    frame = frame_ubo;
+    mesh = mesh_ubo;
+    let px = gid.xy + frame.rect.xy;
+    if (px.x >= frame.rect.z || px.y >= frame.rect.w) {
+        return;
+    }
+    let ray = make_ray(px);
+    // near and far planes, the host's opaque geometry, the clipping planes
+    let seg = segment_within(ray, px, vec2<f32>(0.0, ray.far));
+    let o = ray.index_origin;
+    let d = ray.index_dir;
+    if (seg.x < seg.y || (seg.x == seg.y && BLEND != BLEND_COMPOSITE)) {
+        // (from the line's first boundary crossing, behind the camera too: a near plane
+        // inside the mesh starts its rays inside, where they are integrated from seg.x)
+        var hit = next_entry(o, d, -3.0e38, seg.y, NO_HIT);
+        var k: Tet;
+        if (hit.tf != NO_HIT) {
+            k = load_tet(hit.tf >> 2u);
+        }
+        var steps = 0u;
+        loop {
+            if (hit.tf == NO_HIT || steps >= mesh.counts.w) {
+                break;
+            }
+            let t = hit.tf >> 2u;
+            let ex = exit_of(o, d, k, t, hit.tf & 3u, hit.t);
+            steps = steps + 1u;
+            if (ex.tf == NO_HIT) {
+                // (a ray along a face: leave this tetrahedron where it entered)
+                hit = next_entry(o, d, hit.t, seg.y, t);
+                if (hit.tf != NO_HIT) {
+                    k = load_tet(hit.tf >> 2u);
+                }
+                continue;
+            }
+            integrate_within(ray, seg, hit.t, ex.t, hit.s, ex.s);
+            if (done() || ex.t >= seg.y) {
+                break;
+            }
+            let nb = neighbours[t][ex.tf & 3u];
+            if (nb == NO_NEIGHBOUR) {
+                // the next boundary triangle facing the ray: further on in a non-convex
+                // mesh, or right there where a face does not conform (the triangles on
+                // both sides differ), found a rounding error back at the latest
+                hit = next_entry(o, d, ex.t - 1e-5 * (abs(ex.t) + length(o)), seg.y, t);
+                if (hit.tf != NO_HIT) {
+                    k = load_tet(hit.tf >> 2u);
+                }
+            } else {
+                hit.t = ex.t;
+                hit.tf = nb;
+                hit.s = select(ex.s, cell_scalars[nb >> 2u], CELL_SCALARS);
+                k = next_tet(k, nb >> 2u, nb & 3u);
+            }
+        }
+    }
+    write_pixel(px, st);
+}

@@ -1,0 +1,251 @@
+//! Ray casting an unstructured volume (shaders/unstructured.wgsl): one dispatch, one ray per
+//! pixel traversing the tetrahedra from face to face (resources/mesh). Composite integrates
+//! each segment exactly for the transfer tables as VTK's unstructured ray caster's
+//! integrators model it (colour · attenuation emitted, attenuation = opacity / unit
+//! distance); MIP and MinIP take the exact extrema of the linear segments, average and
+//! additive the exact integrals of opacity × normalised scalar.
+
+use super::frame::{groups, index_plane, screen_rect, FrameInput};
+use super::unstructured_variant::{select, UnstructuredFacts, UnstructuredVariant};
+
+use crate::error::{Error, Result};
+use crate::gpu::binding::{
+    bind, bind_view, buffer_entry, group_layout, storage_texture_entry, texture_entry,
+};
+use crate::gpu::buffers::uniform_buffer;
+use crate::gpu::pipeline::PipelineCache;
+use crate::gpu::slots;
+use crate::gpu::uniforms::{
+    flag_bits, mat, FrameUniforms, MeshUniforms, FLAG_DEPTH_INPUT, FLAG_EXTREMUM_DEPTH,
+    MESH_EVERY_ENTRY, MESH_KNOTS,
+};
+use crate::gpu::Context;
+use crate::params::{ComponentTransfer, ScalarLocation, TABLE_SIZE};
+use crate::resources::targets::{clear_outputs, DepthSource};
+use crate::resources::Resources;
+use bytemuck::Zeroable;
+use glam::{DMat4, DVec3};
+
+/// The unstructured pass: its pipelines (one per variant) and its uniforms.
+pub(crate) struct UnstructuredPass {
+    bgl: wgpu::BindGroupLayout,
+    pipelines: PipelineCache<UnstructuredVariant>,
+    mesh_buf: wgpu::Buffer,
+}
+
+impl UnstructuredPass {
+    /// The bind group of unstructured.wgsl.
+    pub fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        let read = B::Storage { read_only: true };
+        vec![
+            buffer_entry(slots::FRAME, B::Uniform),
+            texture_entry(slots::TABLES, false, V::D2),
+            texture_entry(slots::DEPTH_IN, false, V::D2),
+            storage_texture_entry(slots::OUT_COLOR, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(slots::OUT_DEPTH, wgpu::TextureFormat::R32Float, V::D2),
+            buffer_entry(slots::MESH, B::Uniform),
+            buffer_entry(slots::MESH_POINTS, read),
+            buffer_entry(slots::MESH_TETS, read),
+            buffer_entry(slots::MESH_NEIGHBOURS, read),
+            buffer_entry(slots::MESH_CELL_SCALARS, read),
+            buffer_entry(slots::MESH_NODES, read),
+            buffer_entry(slots::MESH_BOUNDARY, read),
+        ]
+    }
+
+    pub fn new(ctx: &Context) -> Result<UnstructuredPass> {
+        let bgl = group_layout(&ctx.device, "unstructured", &Self::layout_entries());
+        let pipelines = PipelineCache::new(ctx, "unstructured.wgsl", "unstructured", &[&bgl])?;
+        let mesh_buf = uniform_buffer(
+            ctx,
+            "mesh uniforms",
+            std::mem::size_of::<MeshUniforms>() as u64,
+        );
+        Ok(UnstructuredPass {
+            bgl,
+            pipelines,
+            mesh_buf,
+        })
+    }
+
+    /// One frame of the renderer's mesh.
+    pub fn render(&mut self, input: FrameInput<'_>) -> Result<()> {
+        let (ctx, res, view, params, depth) = input.parts();
+        params.validate()?;
+        let tf = res.transfer_function()?.clone();
+        let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
+        let ct = tf.component(0);
+        let variant = select(&UnstructuredFacts {
+            blend: params.blend,
+            components: mesh.components,
+            cell_scalars: mesh.location == ScalarLocation::Cells,
+            shade: params.shading.enabled,
+            gradient_opacity: ct.gradient_opacity.is_some(),
+            tables_2d: ct.table_2d.is_some(),
+            cropping: params.cropping.is_some(),
+            average_range: params.average_range.is_some(),
+            whole_box: params.whole_box.is_some(),
+            volumetric: params.shading.volumetric_blending > 0.0 && params.shading.enabled,
+            depth_range: matches!(depth, DepthSource::Range(..)),
+            intermix: res.intermix.is_some(),
+        })
+        .map_err(Error::from)?;
+        let u = frame_uniforms(res, view, params, !matches!(depth, DepthSource::None))?;
+        let mesh = res.mesh.as_ref().expect("checked above");
+        let mut mu = mesh.uniforms;
+        mu.unit[0] = (1.0 / ct.unit_distance) as f32;
+        set_knots(&mut mu, ct);
+        res.ensure_tables(ctx, 1.0)?;
+        res.ensure_targets(ctx, view.width, view.height)?;
+        res.write_depth_input(ctx, view, depth)?;
+        let pipeline = self.pipelines.get(ctx, variant)?;
+        let mesh = res.mesh.as_ref().expect("checked above");
+        let t = res.targets.as_ref().expect("targets allocated above");
+        let (_, tables) = res.tables.as_ref().expect("tables built above");
+        let q = &ctx.queue;
+        q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
+        q.write_buffer(&self.mesh_buf, 0, bytemuck::bytes_of(&mu));
+        let depth_in_view = t.depth_in.create_view(&Default::default());
+        let color_view = t.color.create_view(&Default::default());
+        let depth_view = t.depth.create_view(&Default::default());
+        let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("unstructured"),
+            layout: &self.bgl,
+            entries: &[
+                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
+                bind_view(slots::TABLES, &tables.view),
+                bind_view(slots::DEPTH_IN, &depth_in_view),
+                bind_view(slots::OUT_COLOR, &color_view),
+                bind_view(slots::OUT_DEPTH, &depth_view),
+                bind(slots::MESH, self.mesh_buf.as_entire_binding()),
+                bind(slots::MESH_POINTS, mesh.points.as_entire_binding()),
+                bind(slots::MESH_TETS, mesh.tets.as_entire_binding()),
+                bind(slots::MESH_NEIGHBOURS, mesh.neighbours.as_entire_binding()),
+                bind(
+                    slots::MESH_CELL_SCALARS,
+                    mesh.cell_scalars.as_entire_binding(),
+                ),
+                bind(slots::MESH_NODES, mesh.nodes.as_entire_binding()),
+                bind(slots::MESH_BOUNDARY, mesh.boundary.as_entire_binding()),
+            ],
+        });
+        let rect = u.rect;
+        let gr = groups(rect);
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("unstructured frame"),
+            });
+        if rect != [0, 0, view.width, view.height] {
+            clear_outputs(&mut enc, &color_view, &depth_view);
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("unstructured"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(gr[0], gr[1], 1);
+        }
+        ctx.submit([enc.finish()]);
+        res.stats.frames += 1;
+        Ok(())
+    }
+}
+
+/// The table coordinates where a segment's pieces end (the colour's and opacity's points,
+/// where the opacity crosses 0 or 1, which the tables clamp it to, and the tables' ends),
+/// or every entry when there are more than [`MESH_KNOTS`].
+fn set_knots(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
+    let [lo, hi] = ct.table_range();
+    let last = (TABLE_SIZE - 1) as f64;
+    let op = &ct.opacity.points;
+    let crossings = op.windows(2).flat_map(|w| {
+        let ((x0, [a0]), (x1, [a1])) = (w[0], w[1]);
+        [0.0, 1.0].into_iter().filter_map(move |l: f64| {
+            let (a0, a1) = (a0 as f64, a1 as f64);
+            ((a0 - l) * (a1 - l) < 0.0).then(|| x0 + (l - a0) / (a1 - a0) * (x1 - x0))
+        })
+    });
+    let mut knots: Vec<f32> = ct
+        .color
+        .points
+        .iter()
+        .map(|p| p.0)
+        .chain(op.iter().map(|p| p.0))
+        .chain(crossings)
+        .map(|s| (s - lo) / (hi - lo) * last)
+        .filter(|x| *x > 0.0 && *x < last)
+        .chain([0.0, last])
+        .map(|x| x as f32)
+        .collect();
+    knots.sort_by(f32::total_cmp);
+    knots.dedup();
+    if knots.len() > MESH_KNOTS {
+        mu.split[0] = MESH_EVERY_ENTRY;
+        return;
+    }
+    mu.split[0] = knots.len() as u32;
+    for (i, k) in knots.into_iter().enumerate() {
+        mu.knots[i / 4][i % 4] = k;
+    }
+}
+
+/// The frame uniforms of a frame of the renderer's mesh: the camera, the mesh's coordinates
+/// (relative to its centre) as the index space, the first component's table range, the
+/// clipping planes and the pixels the mesh's box covers.
+fn frame_uniforms(
+    res: &Resources,
+    view: &crate::params::View,
+    params: &crate::params::RenderParams,
+    depth_input: bool,
+) -> Result<FrameUniforms> {
+    let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
+    let tf = res.transfer_function()?;
+    let vp = view.camera.view_projection(view.aspect());
+    if !vp.is_finite() || vp.determinant().abs() < 1e-300 {
+        return Err(Error::InvalidParameter("the camera gives a singular projection (check position, focal point, view up and clipping range)".into()));
+    }
+    let index_to_world = params.volume_matrix * DMat4::from_translation(DVec3::from(mesh.origin));
+    let world_to_index = index_to_world.inverse();
+    let mut u = FrameUniforms::zeroed();
+    u.camera = [mat(vp.inverse()), mat(vp)];
+    u.world_to_index = mat(world_to_index);
+    u.index_to_data = mat(DMat4::from_translation(DVec3::from(mesh.origin)));
+    u.gradient_to_world = mat(world_to_index.transpose());
+    u.dims = [1.0, 1.0, 1.0, 1.0];
+    u.scalar_scale = [1.0; 4];
+    let ct = tf.component(0);
+    let [lo, hi] = ct.table_range();
+    u.tf_lo[0] = lo as f32;
+    u.tf_inv_width[0] = (1.0 / (hi - lo)) as f32;
+    u.weights[0] = ct.weight;
+    u.termination = params.termination_threshold;
+    u.depth_threshold = params.depth_threshold;
+    for (i, p) in params.clip_planes.iter().enumerate() {
+        u.clip[i] = index_plane(index_to_world, p);
+    }
+    u.width = view.width;
+    u.height = view.height;
+    let b = mesh.bounds;
+    let o = mesh.origin;
+    u.rect = screen_rect(
+        vp,
+        index_to_world,
+        [b[0] - o[0], b[2] - o[1], b[4] - o[2]],
+        [b[1] - o[0], b[3] - o[1], b[5] - o[2]],
+        view.width,
+        view.height,
+    );
+    u.blend = params.blend.code();
+    u.flags = flag_bits(&[
+        (depth_input, FLAG_DEPTH_INPUT),
+        (params.extremum_depth, FLAG_EXTREMUM_DEPTH),
+    ]);
+    u.clip_planes = params.clip_planes.len() as u32;
+    u.components = 1;
+    Ok(u)
+}

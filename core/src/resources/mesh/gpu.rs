@@ -1,0 +1,136 @@
+//! The prepared mesh on the device: storage buffers for points, tetrahedra, neighbours,
+//! cell scalars, the boundary triangles and their hierarchy (shaders/unstructured.wgsl).
+//!
+//! Per tetrahedron the device holds 16 bytes of points indices, 16 of neighbours and, with
+//! cell scalars, 4 of scalar; per point 16 bytes (position and scalar); per boundary
+//! triangle 4 bytes and about half a 32-byte hierarchy node. A tetrahedral mesh of n
+//! tetrahedra has about n / 5 to n / 6 points, so about 35 bytes per tetrahedron.
+
+use super::bvh::BvhNode;
+use super::TetMesh;
+use crate::error::{Error, Result};
+use crate::gpu::uniforms::{MeshUniforms, MESH_BVH_STACK, MESH_EVERY_ENTRY, MESH_KNOTS};
+use crate::gpu::Context;
+use crate::params::{ScalarLocation, UnstructuredVolume};
+use crate::resources::Resources;
+
+/// Bytes per tetrahedron of the tetrahedra and neighbours buffers (16 each).
+pub(crate) const TET_BYTES: u64 = 16;
+
+pub(crate) struct GpuMesh {
+    pub points: wgpu::Buffer,
+    pub tets: wgpu::Buffer,
+    pub neighbours: wgpu::Buffer,
+    /// One value per tetrahedron (cell scalars), or a placeholder of one.
+    pub cell_scalars: wgpu::Buffer,
+    pub nodes: wgpu::Buffer,
+    pub boundary: wgpu::Buffer,
+    pub uniforms: MeshUniforms,
+    pub location: ScalarLocation,
+    pub components: u32,
+    /// Where the device's coordinates are relative to.
+    pub origin: [f64; 3],
+    pub bounds: [f64; 6],
+}
+
+/// An error when the mesh's `label` of `size` bytes exceed `max`, the most one storage
+/// buffer binding holds on the device.
+pub(crate) fn check_binding_size(label: &str, size: u64, max: u64) -> Result<()> {
+    if size > max {
+        return Err(Error::OutOfMemory(format!(
+            "the mesh's {label} take {size} bytes, but this device binds at most {max} bytes \
+             in one storage buffer (max_storage_buffer_binding_size): the mesh is too large \
+             for it; decimate or split it (the tetrahedra and their neighbours take \
+             {TET_BYTES} bytes per tetrahedron)"
+        )));
+    }
+    Ok(())
+}
+
+/// A storage buffer holding `data` (at least 4 bytes), refused with the sizes when it exceeds
+/// what one binding can hold.
+fn storage(ctx: &Context, label: &str, data: &[u8]) -> Result<wgpu::Buffer> {
+    use wgpu::util::DeviceExt;
+    let max = ctx.info.limits.max_storage_buffer_binding_size;
+    check_binding_size(label, data.len() as u64, max)?;
+    let padded;
+    let contents = if data.len() < 4 {
+        padded = [0u8; 4];
+        &padded[..]
+    } else {
+        data
+    };
+    ctx.checked(&format!("allocating the mesh's {label}"), || {
+        ctx.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+    })
+}
+
+impl GpuMesh {
+    pub fn upload(ctx: &Context, m: &TetMesh) -> Result<GpuMesh> {
+        if m.bvh.depth > MESH_BVH_STACK {
+            return Err(Error::Unsupported(format!(
+                "the mesh's boundary hierarchy is {} levels deep; rays search at most {} \
+                 (split the mesh)",
+                m.bvh.depth, MESH_BVH_STACK
+            )));
+        }
+        use bytemuck::cast_slice as cast;
+        let cells: &[f32] = match m.location {
+            ScalarLocation::Cells => &m.cell_scalars,
+            ScalarLocation::Points => &[0.0],
+        };
+        let points = storage(ctx, "points", cast::<[f32; 4], u8>(&m.points))?;
+        let tets = storage(ctx, "tetrahedra", cast::<[u32; 4], u8>(&m.tets))?;
+        let neighbours = storage(ctx, "neighbours", cast::<[u32; 4], u8>(&m.neighbours))?;
+        let cell_scalars = storage(ctx, "cell scalars", cast::<f32, u8>(cells))?;
+        let nodes_data: &[BvhNode] = &m.bvh.nodes;
+        let nodes = storage(ctx, "boundary hierarchy", cast::<BvhNode, u8>(nodes_data))?;
+        let boundary = storage(ctx, "boundary triangles", cast::<u32, u8>(&m.boundary))?;
+        let n = m.tets.len() as u32;
+        // Steps a ray may take at most: every tetrahedron crossed once per entry, with room
+        // for re-entries; bounds the loop where rounding sends a ray back and forth.
+        let max_steps = n.saturating_mul(2).saturating_add(64);
+        let uniforms = MeshUniforms {
+            counts: [
+                n,
+                m.boundary.len() as u32,
+                m.bvh.nodes.len() as u32,
+                max_steps,
+            ],
+            unit: [1.0, 0.0, 0.0, 0.0],
+            split: [MESH_EVERY_ENTRY, 0, 0, 0],
+            knots: [[0.0; 4]; MESH_KNOTS / 4],
+        };
+        Ok(GpuMesh {
+            points,
+            tets,
+            neighbours,
+            cell_scalars,
+            nodes,
+            boundary,
+            uniforms,
+            location: m.location,
+            components: m.components,
+            origin: m.origin,
+            bounds: m.bounds,
+        })
+    }
+}
+
+impl Resources {
+    /// Prepares and uploads an unstructured volume, drawn from then on instead of the image
+    /// volume, which it replaces (with its level, occupancy, blanking and mask).
+    pub fn set_mesh(&mut self, ctx: &Context, v: &UnstructuredVolume) -> Result<()> {
+        let prepared = TetMesh::prepare(v)?;
+        let mesh = GpuMesh::upload(ctx, &prepared)?;
+        self.mesh = Some(mesh);
+        self.volume = None;
+        self.new_volume_state();
+        Ok(())
+    }
+}

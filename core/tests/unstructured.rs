@@ -1,0 +1,407 @@
+//! Unstructured volumes on a real wgpu device against the f64 CPU reference
+//! (common/mesh.rs): every generated mesh, every blend mode drawn, point and cell scalars;
+//! a ray that leaves the hollow cylinder and enters it again; the errors bad meshes get.
+//! Images go to `target/test-images/unstructured_*.png` for inspection.
+
+use ferrovol_core::*;
+
+#[path = "common/mod.rs"]
+mod common;
+
+use common::gpu::{assert_error, renderer};
+use common::images::save_enlarged;
+use common::mesh;
+use common::metrics::{compare_to_reference, footprint, reference_image};
+
+/// A colourful transfer function over [lo, hi], opacity rising to `max` per unit.
+fn tf(lo: f64, hi: f64, max: f32) -> TransferFunction {
+    let m = |f: f64| lo + f * (hi - lo);
+    let color = Piecewise::new(vec![
+        (m(0.0), [0.1, 0.2, 0.9]),
+        (m(0.5), [0.2, 0.9, 0.3]),
+        (m(1.0), [1.0, 0.3, 0.1]),
+    ])
+    .unwrap();
+    let opacity = Piecewise::new(vec![
+        (m(0.0), [0.0]),
+        (m(0.3), [0.2 * max]),
+        (m(1.0), [max]),
+    ])
+    .unwrap();
+    TransferFunction::single(ComponentTransfer::new(color, opacity))
+}
+
+/// Draws `v` on the GPU and on the CPU; prints and returns (mean error, PSNR, max error).
+fn compare(
+    name: &str,
+    v: &UnstructuredVolume,
+    tf: &TransferFunction,
+    view: &View,
+    params: &RenderParams,
+) -> (f64, f64, f64) {
+    let mut r = renderer();
+    r.set_unstructured(v).unwrap();
+    r.set_transfer_function(tf).unwrap();
+    let img = r.render_image(view, params).unwrap();
+    let reference = mesh::render(v, tf, view, params);
+    save_enlarged(&img, &format!("unstructured_{name}"));
+    save_enlarged(
+        &reference_image(&reference, view.width, view.height),
+        &format!("unstructured_{name}_reference"),
+    );
+    let (mean, psnr, max) = compare_to_reference(&img, &reference);
+    let covered = footprint(&img);
+    let lit: Vec<&[u8]> = img.rgba.chunks(4).filter(|p| p[3] > 0).collect();
+    let brightness = lit
+        .iter()
+        .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
+        .sum::<f64>()
+        / (3 * lit.len().max(1)) as f64;
+    println!(
+        "{name}: {covered} pixels drawn (mean colour {brightness:.1} of 255), mean error \
+         {mean:.4}, PSNR {psnr:.1} dB, max error {max:.0} (of 255)"
+    );
+    assert!(brightness > 4.0, "{name}: a nearly black image");
+    assert!(
+        covered > (view.width * view.height / 8) as usize,
+        "{name}: nearly nothing drawn"
+    );
+    (mean, psnr, max)
+}
+
+fn params(blend: BlendMode) -> RenderParams {
+    RenderParams {
+        blend,
+        ..Default::default()
+    }
+}
+
+/// The scalar range of a one-component mesh.
+fn range(v: &UnstructuredVolume) -> (f64, f64) {
+    (0..v.scalars.len())
+        .map(|i| v.scalars.get(i))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        })
+}
+
+/// A view of `v` from an angle, `size` pixels square. The clipping range is left as it was
+/// before turning, so that the near plane cuts through the mesh: rays start inside it.
+fn view_of(v: &UnstructuredVolume, size: u32) -> View {
+    let mut view = View::fit(v.bounds(), size, size);
+    view.camera.azimuth(30.0);
+    view.camera.elevation(20.0);
+    view
+}
+
+/// GPU against CPU: composite within a level or two of 255 (the f32 closed forms against
+/// f64 quadrature, the 1024-entry tables against the functions), the projections too.
+#[track_caller]
+fn agrees(name: &str, v: &UnstructuredVolume, blend: BlendMode, max_opacity: f32) {
+    let (lo, hi) = range(v);
+    let (mean, psnr, max) = compare(
+        name,
+        v,
+        &tf(lo, hi, max_opacity),
+        &view_of(v, 64),
+        &params(blend),
+    );
+    assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0, "{name}");
+}
+
+#[test]
+fn house_composite_matches_the_reference() {
+    // (opacity past 1 is clamped: the reference splits its pieces there too)
+    agrees("house", &synth::house(), BlendMode::Composite, 1.5);
+}
+
+#[test]
+fn tetrahedral_wavelet_matches_the_reference_in_every_blend_mode() {
+    let v = synth::tet_wavelet(12);
+    for (blend, name) in [
+        (BlendMode::Composite, "wavelet_composite"),
+        (BlendMode::Maximum, "wavelet_mip"),
+        (BlendMode::Minimum, "wavelet_minip"),
+        (BlendMode::Average, "wavelet_average"),
+        (BlendMode::Additive, "wavelet_additive"),
+    ] {
+        agrees(name, &v, blend, 0.3);
+    }
+}
+
+#[test]
+fn mixed_distorted_cells_match_the_reference_with_point_and_cell_scalars() {
+    let points = synth::mixed_cells(4, ScalarLocation::Points);
+    agrees("mixed_points_composite", &points, BlendMode::Composite, 0.8);
+    agrees("mixed_points_mip", &points, BlendMode::Maximum, 0.8);
+    let cells = synth::mixed_cells(4, ScalarLocation::Cells);
+    agrees("mixed_cells_composite", &cells, BlendMode::Composite, 0.8);
+    agrees("mixed_cells_minip", &cells, BlendMode::Minimum, 0.8);
+    agrees("mixed_cells_additive", &cells, BlendMode::Additive, 0.8);
+}
+
+#[test]
+fn rays_leave_the_hollow_cylinder_and_enter_it_again() {
+    let v = synth::hollow_cylinder(2, 24, 4);
+    // looking along x through the hole, the axis vertical: the centre ray crosses the
+    // wall, the hole, the wall
+    let mut view = View::fit(v.bounds(), 64, 64);
+    view.camera.position = glam::DVec3::new(8.0, 0.0, 0.0);
+    view.camera.focal_point = glam::DVec3::ZERO;
+    view.camera.view_up = glam::DVec3::Z;
+    view.camera.reset_clipping_range(v.bounds());
+    let (lo, hi) = range(&v);
+    let t = tf(lo, hi, 0.6);
+    let segs = mesh::Tets::of(&v).segments(&view);
+    let centre = &segs[(32 * 64 + 32) as usize];
+    let gap = centre
+        .windows(2)
+        .map(|w| w[1].t0 - w[0].t1)
+        .fold(0.0, f64::max);
+    println!("centre ray: {} segments, widest gap {gap:.3}", centre.len());
+    assert!(gap > 1.5, "the centre ray crosses the hole (2 wide)");
+    let (mean, psnr, max) = compare("cylinder", &v, &t, &view, &params(BlendMode::Composite));
+    assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
+    // the far wall shows through the hole: the centre is more opaque than one wall alone
+    let mut r = renderer();
+    let img = r
+        .render_image(&view, &params(BlendMode::Composite))
+        .unwrap();
+    let near_wall_only = mesh::integrate(
+        &centre
+            .iter()
+            .copied()
+            .filter(|s| s.t1 < centre[0].t1 + 1.0)
+            .collect::<Vec<_>>(),
+        &mesh::Table::of(&t),
+        BlendMode::Composite,
+        1.0,
+    );
+    let a = img.rgba[4 * (32 * 64 + 32) + 3] as f64 / 255.0;
+    println!(
+        "centre alpha {a:.3}, the near wall's alone {:.3}",
+        near_wall_only[3]
+    );
+    assert!(a > near_wall_only[3] + 0.05);
+}
+
+#[test]
+fn bad_meshes_get_errors_naming_the_cell() {
+    let mut r = renderer();
+    let mut flat = synth::house();
+    flat.points[8] = [0.5, 0.5, 1.0];
+    assert_error(
+        r.set_unstructured(&flat),
+        "a flat pyramid",
+        &["cell 1", "no volume"],
+    );
+    let three = UnstructuredVolume {
+        points: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [0.3, 0.3, 1.0],
+        ],
+        connectivity: vec![0, 1, 2, 3, 0, 1, 2, 4, 0, 1, 2, 5],
+        offsets: vec![0, 4, 8, 12],
+        cell_types: vec![10; 3],
+        location: ScalarLocation::Points,
+        components: 1,
+        scalars: Scalars::F32(vec![0.0; 6]),
+    };
+    assert_error(
+        r.set_unstructured(&three),
+        "a face of three cells",
+        &["more than two", "not manifold"],
+    );
+}
+
+#[test]
+fn modes_not_drawn_yet_are_refused_and_images_come_back() {
+    let mut r = renderer();
+    let v = synth::house();
+    r.set_unstructured(&v).unwrap();
+    r.set_transfer_function(&tf(0.0, 2.0, 1.0)).unwrap();
+    let view = view_of(&v, 32);
+    for blend in [
+        BlendMode::Isosurface,
+        BlendMode::PathTrace,
+        BlendMode::Slice,
+    ] {
+        let p = RenderParams {
+            slice_plane: Some(ClipPlane {
+                origin: glam::DVec3::ZERO,
+                normal: glam::DVec3::Z,
+            }),
+            ..params(blend)
+        };
+        let e = r.render_image(&view, &p);
+        assert!(matches!(e, Err(Error::Unsupported(_))), "{blend:?}: {e:?}");
+    }
+    let shaded = RenderParams {
+        shading: Shading {
+            enabled: true,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    assert_error(
+        r.render_image(&view, &shaded),
+        "shading",
+        &["without shading"],
+    );
+    let several = UnstructuredVolume {
+        components: 2,
+        scalars: Scalars::F32(vec![0.0; 18]),
+        ..v.clone()
+    };
+    r.set_unstructured(&several).unwrap();
+    assert_error(
+        r.render_image(&view, &params(BlendMode::Composite)),
+        "2 components",
+        &["one scalar component"],
+    );
+    // back to an image volume
+    let img_vol = synth::marschner_lobb(16);
+    r.set_volume(&img_vol).unwrap();
+    r.set_transfer_function(&TransferFunction::ramp([0.0, 1.0], 0.5))
+        .unwrap();
+    let img = r
+        .render_image(
+            &View::fit(img_vol.bounds(), 32, 32),
+            &RenderParams::default(),
+        )
+        .unwrap();
+    assert!(footprint(&img) > 100);
+}
+
+#[test]
+fn opaque_depth_and_clipping_planes_end_rays() {
+    let mut r = renderer();
+    let v = synth::tet_wavelet(8);
+    let (lo, hi) = range(&v);
+    r.set_unstructured(&v).unwrap();
+    r.set_transfer_function(&tf(lo, hi, 0.5)).unwrap();
+    let view = view_of(&v, 32);
+    let p = params(BlendMode::Composite);
+    let full = r.render_image(&view, &p).unwrap();
+    let alpha = |img: &Image| img.rgba.chunks(4).map(|c| c[3] as u64).sum::<u64>();
+    // opaque geometry at the near plane hides everything
+    r.render(&view, &p, Some(&vec![0.0; 32 * 32])).unwrap();
+    assert_eq!(alpha(&r.read_image().unwrap()), 0);
+    // geometry at the depth of the mesh's centre cuts rays in the middle
+    let b = v.bounds();
+    let centre = glam::DVec3::new(b[0] + b[1], b[2] + b[3], b[4] + b[5]) * 0.5;
+    let c = view.camera.view_projection(view.aspect()) * centre.extend(1.0);
+    let mid = (0.5 * c.z / c.w + 0.5) as f32;
+    r.render(&view, &p, Some(&vec![mid; 32 * 32])).unwrap();
+    let cut = r.read_image().unwrap();
+    let (a_full, a_cut) = (alpha(&full), alpha(&cut));
+    println!("alpha sums: full {a_full}, cut at the centre's depth {a_cut}");
+    assert!(a_cut > a_full / 10 && a_cut < a_full * 9 / 10);
+    // a clipping plane through the centre keeps about half
+    let clipped = RenderParams {
+        clip_planes: vec![ClipPlane {
+            origin: glam::DVec3::ZERO,
+            normal: glam::DVec3::X,
+        }],
+        ..p
+    };
+    let half = r.render_image(&view, &clipped).unwrap();
+    let (f, h) = (footprint(&full), footprint(&half));
+    println!("pixels drawn: full {f}, clipped {h}");
+    assert!(h < f * 3 / 4 && h > f / 4);
+}
+
+#[test]
+fn a_transfer_function_of_many_points_splits_segments_at_every_table_entry() {
+    // more points than the knots the pass holds (64): the pieces end at every entry
+    let v = synth::tet_wavelet(8);
+    let (lo, hi) = range(&v);
+    let n = 100;
+    let at = |i: usize| lo + (hi - lo) * i as f64 / (n - 1) as f64;
+    let opacity = Piecewise::new(
+        (0..n)
+            .map(|i| (at(i), [if i % 2 == 0 { 0.1 } else { 0.6 }]))
+            .collect(),
+    )
+    .unwrap();
+    let color = Piecewise::new(vec![(lo, [0.2, 0.4, 1.0]), (hi, [1.0, 0.6, 0.2])]).unwrap();
+    let t = TransferFunction::single(ComponentTransfer::new(color, opacity));
+    let (mean, psnr, max) = compare(
+        "many_points",
+        &v,
+        &t,
+        &view_of(&v, 48),
+        &params(BlendMode::Composite),
+    );
+    assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
+}
+
+#[test]
+fn a_non_conforming_face_is_crossed_without_a_gap() {
+    // the house's cube on two tetrahedra that split its bottom quad along the other
+    // diagonal (1–3, where the cube splits it along 0–2): the triangles do not match, so
+    // both sides are boundary, and rays leave the cube and enter the tetrahedra there
+    let mut points = synth::HOUSE_POINTS[..8].to_vec();
+    points.push([0.5, 0.5, -1.0]);
+    let v = UnstructuredVolume {
+        points,
+        connectivity: vec![0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 3, 8, 1, 2, 3, 8],
+        offsets: vec![0, 8, 12, 16],
+        cell_types: vec![12, 10, 10],
+        location: ScalarLocation::Points,
+        components: 1,
+        scalars: Scalars::F32(vec![0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 2.0]),
+    };
+    let mut view = View::fit(v.bounds(), 48, 48);
+    view.camera.elevation(70.0);
+    view.camera.reset_clipping_range(v.bounds());
+    let (mean, psnr, max) = compare(
+        "non_conforming",
+        &v,
+        &tf(0.0, 2.0, 1.0),
+        &view,
+        &params(BlendMode::Composite),
+    );
+    assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
+}
+
+#[test]
+fn composite_depth_is_where_the_ray_first_gathers_opacity() {
+    // the depth threshold 0: where the opacity first exceeds 0, the entry into the mesh
+    // wherever the entry's scalar has opacity
+    let v = synth::tet_wavelet(8);
+    let (lo, hi) = range(&v);
+    let t = tf(lo, hi, 0.5);
+    let mut view = view_of(&v, 32);
+    view.camera.reset_clipping_range(v.bounds());
+    let mut r = renderer();
+    r.set_unstructured(&v).unwrap();
+    r.set_transfer_function(&t).unwrap();
+    let img = r
+        .render_image(&view, &params(BlendMode::Composite))
+        .unwrap();
+    let segs = mesh::Tets::of(&v).segments(&view);
+    let table = mesh::Table::of(&t);
+    let vp = view.camera.view_projection(view.aspect());
+    let (mut checked, mut worst) = (0, 0.0f64);
+    for (i, s) in segs.iter().enumerate() {
+        let Some(first) = s.first() else {
+            assert_eq!(img.depth[i], 1.0, "pixel {i}: no mesh, far depth");
+            continue;
+        };
+        if table.at(first.s0)[3] < 0.01 {
+            continue;
+        }
+        let ray = common::raycast::pixel_ray(&view, i as u32 % 32, i as u32 / 32);
+        let c = vp * (ray.origin + first.t0 * ray.dir).extend(1.0);
+        let expected = 0.5 * c.z / c.w + 0.5;
+        worst = worst.max((img.depth[i] as f64 - expected).abs());
+        checked += 1;
+    }
+    println!("{checked} pixels: depth off by {worst:.2e} at most");
+    assert!(checked > 300 && worst < 1e-4);
+}
