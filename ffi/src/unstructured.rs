@@ -158,7 +158,7 @@ fn too_large(what: &str) -> FfiError {
 
 impl FvUnstructuredVolumeDesc {
     /// Reads the caller's arrays into a validated mesh.
-    fn to_mesh(&self) -> FfiResult<UnstructuredVolume> {
+    fn to_mesh(self) -> FfiResult<UnstructuredVolume> {
         let point_type = scalar_type("point_type", self.point_type)?;
         let coordinates = self
             .point_count

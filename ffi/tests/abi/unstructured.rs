@@ -348,7 +348,7 @@ fn bad_meshes_are_refused_naming_the_problem() {
     three.cell_types.push(10);
     let mut nan = Two::new();
     nan.points[4] = f64::NAN;
-    let unaligned = vec![0f64; 19];
+    let unaligned = [0f64; 19];
     // SAFETY: one byte into the vector: in bounds.
     let unaligned = unsafe { unaligned.as_ptr().cast::<u8>().add(1) };
     let cases: Vec<(FvUnstructuredVolumeDesc, FvStatus, &str)> = vec![
