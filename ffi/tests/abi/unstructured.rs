@@ -391,11 +391,31 @@ fn bad_meshes_are_refused_naming_the_problem() {
         lib.expect(new(&base, null_mut()), Null, "out is NULL");
         lib.ok(new(&base, &mut mesh));
         let set = lib.f::<SetH>("fv_renderer_set_unstructured");
-        let s = Session::new(&lib);
+        let mut s = Session::new(&lib);
         lib.expect(set(null_mut(), mesh), Null, "renderer is NULL");
         lib.expect(set(s.r, null_mut()), Null, "volume is NULL");
         lib.ok(set(s.r, mesh));
         lib.f::<Free>("fv_unstructured_volume_free")(mesh);
+        // two components per point: made, uploaded, and refused at render by the pass
+        let pairs: Vec<f32> = good.scalars.iter().flat_map(|&x| [x, -x]).collect();
+        let d = changed(base, |d| {
+            d.components = 2;
+            d.scalars = pairs.as_ptr().cast();
+        });
+        lib.ok(new(&d, &mut mesh));
+        lib.ok(set(s.r, mesh));
+        lib.f::<Free>("fv_unstructured_volume_free")(mesh);
+        s.set_transfer_function(
+            &[0.0, 1.0, 1.0, 1.0, 5.0, 1.0, 1.0, 1.0],
+            &[0.0, 0.0, 5.0, 1.0],
+        );
+        s.set_camera(&camera([0.3, 0.3, 6.0], [0.3, 0.3, 0.0], [1.0, 20.0]));
+        let render = lib.f::<Render>("fv_renderer_render");
+        lib.expect(
+            render(s.r, 8, 8, null(), 0),
+            FvStatus::Unsupported,
+            "drawn from one scalar component, and this mesh has 2",
+        );
     }
 }
 
