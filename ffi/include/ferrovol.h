@@ -290,6 +290,20 @@ typedef enum FvMaskType {
 } FvMaskType;
 
 /**
+ * Where the scalars of an unstructured volume live (FvUnstructuredVolumeDesc.location).
+ */
+typedef enum FvScalarLocation {
+  /**
+   * One tuple per point, interpolated within each cell (VTK's point data).
+   */
+  FV_SCALAR_LOCATION_POINTS = 0,
+  /**
+   * One tuple per cell, constant within it (VTK's cell data).
+   */
+  FV_SCALAR_LOCATION_CELLS = 1,
+} FvScalarLocation;
+
+/**
  * A GPU adapter and device. Create one per process (or per host graphics context) and
  * share it between renderers. Thread use: may be used from any thread; calls on one
  * context may run concurrently (the device is internally synchronised).
@@ -314,6 +328,13 @@ typedef struct FvRenderer FvRenderer;
  * functions), and per label of a label-map mask. Thread use: one thread at a time.
  */
 typedef struct FvTransferFunction FvTransferFunction;
+
+/**
+ * An unstructured volume on the CPU (a copy of the caller's arrays, validated), ready to
+ * upload to renderers; the caller may free it once they have it. Thread use: immutable;
+ * may be read from several threads at once.
+ */
+typedef struct FvUnstructuredVolume FvUnstructuredVolume;
 
 /**
  * Volume data on the CPU (a copy of the caller's array), ready to upload to renderers;
@@ -910,6 +931,74 @@ typedef struct FvResidency {
 typedef void (*FvProgressFn)(void *user, uint32_t done, uint32_t total);
 
 /**
+ * A mesh as VTK's vtkUnstructuredGrid holds it, in the caller's arrays (read during
+ * fv_unstructured_volume_new only). Fill with fv_unstructured_volume_desc_default() and set
+ * the arrays. A pointer may be NULL only where its count is 0. Each array is aligned for
+ * its type. Thread use: plain data.
+ */
+typedef struct FvUnstructuredVolumeDesc {
+  /**
+   * sizeof(this struct) as the caller's header declares it, written by
+   * fv_unstructured_volume_desc_default; fields added in later minor versions take their
+   * defaults when it is smaller.
+   */
+  size_t size;
+  /**
+   * `3 · point_count` coordinates, x, y, z per point, of `point_type`.
+   */
+  const void *points;
+  size_t point_count;
+  /**
+   * FV_SCALAR_TYPE_F64 (the default) or FV_SCALAR_TYPE_F32 (vtkPoints' two types).
+   */
+  uint32_t point_type;
+  /**
+   * The type of `connectivity` and `offsets` (vtkCellArray's): FV_SCALAR_TYPE_I64 (the
+   * default: VTK's vtkIdType and NumPy's default integer), FV_SCALAR_TYPE_I32,
+   * FV_SCALAR_TYPE_U32 or FV_SCALAR_TYPE_U64. Converted inside, each value checked to lie
+   * in 0 to 2^32 − 1.
+   */
+  uint32_t index_type;
+  /**
+   * `connectivity_count` point indices: cell c's points are entries `offsets[c]` to
+   * `offsets[c + 1] − 1`, in VTK's point order for its type.
+   */
+  const void *connectivity;
+  size_t connectivity_count;
+  /**
+   * `cell_count + 1` entries, the first 0 and the last `connectivity_count`, increasing
+   * (vtkCellArray's offsets; a .vtu file leaves out the leading 0).
+   */
+  const void *offsets;
+  /**
+   * `cell_count` VTK cell type codes: VTK_TETRA (10), VTK_VOXEL (11),
+   * VTK_HEXAHEDRON (12), VTK_WEDGE (13), VTK_PYRAMID (14), and VTK's quadratic 3D cells
+   * (24–27, 29, 31–33, 37), each linearised to the linear cell of its shape by keeping its
+   * corner points; any other type is refused naming the first cell that has it.
+   */
+  const uint8_t *cell_types;
+  size_t cell_count;
+  /**
+   * One of FvScalarType (64-bit integers are converted to double, exact up to 2^53).
+   */
+  uint32_t scalar_type;
+  /**
+   * Components per tuple, 1 to 4, interleaved (the unstructured pass draws one: a mesh
+   * of several fails at render with FV_STATUS_UNSUPPORTED).
+   */
+  uint32_t components;
+  /**
+   * One of FvScalarLocation (default FV_SCALAR_LOCATION_POINTS).
+   */
+  uint32_t location;
+  /**
+   * `components` values of `scalar_type` per point (`point_count` tuples) or per cell
+   * (`cell_count` tuples), as `location` says.
+   */
+  const void *scalars;
+} FvUnstructuredVolumeDesc;
+
+/**
  * A volume's geometry and scalar layout. Point (i, j, k) sits at
  * origin + direction · (spacing ⊙ (i, j, k)), as vtkImageData places it.
  * Thread use: plain data.
@@ -1408,6 +1497,42 @@ enum FvStatus fv_transfer_function_set_table_2d(struct FvTransferFunction *tf,
                                                 double scalar_lo,
                                                 double scalar_hi,
                                                 double gradient_max);
+
+/**
+ * Fills `*desc` with the defaults (no arrays; double points, int64 indices, one float
+ * component per point). `size` is `sizeof *desc` (see fv_render_params_default).
+ */
+enum FvStatus fv_unstructured_volume_desc_default(struct FvUnstructuredVolumeDesc *desc,
+                                                  size_t size);
+
+/**
+ * Copies a mesh from the caller's arrays (`*desc`), converting points, indices and scalars
+ * to ferrovol's types, and validates it: a NULL array with a non-zero count, an index
+ * outside 0 to 2^32 − 1 or past the points (dangling), offsets that do not start at 0,
+ * increase and end at connectivity_count, a cell type ferrovol does not take, a cell with
+ * the wrong number of points or a point listed twice, a face shared by more than two
+ * cells, NaN or infinite coordinates or scalars are refused with a message naming the
+ * array entry or the cell. `*out` receives the volume, NULL on failure.
+ */
+enum FvStatus fv_unstructured_volume_new(const struct FvUnstructuredVolumeDesc *desc,
+                                         struct FvUnstructuredVolume **out);
+
+/**
+ * Releases an unstructured volume (NULL is ignored). Renderers keep what they uploaded.
+ */
+void fv_unstructured_volume_free(struct FvUnstructuredVolume *volume);
+
+/**
+ * Uploads an unstructured volume, replacing the renderer's volume or mesh
+ * (fv_renderer_set_volume goes back to an image volume): its cells split into tetrahedra,
+ * their neighbours and a hierarchy over the boundary. Frames then ray cast it with the
+ * same camera, parameters and transfer function; what its pass does not draw (isosurfaces,
+ * path tracing, shading, several components, …) fails at render with
+ * FV_STATUS_UNSUPPORTED naming it. A mesh too large for the device's buffers is refused
+ * with the sizes.
+ */
+enum FvStatus fv_renderer_set_unstructured(struct FvRenderer *renderer,
+                                           const struct FvUnstructuredVolume *volume);
 
 /**
  * Copies a volume: `data` holds `dims[0]·dims[1]·dims[2]·components` values of

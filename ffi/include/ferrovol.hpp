@@ -128,6 +128,27 @@ private:
   detail::Handle<FvVolume, fv_volume_free> h_;
 };
 
+/// A mesh copied from the caller's VTK arrays (see FvUnstructuredVolume); the arrays may
+/// be released once it is made.
+class UnstructuredVolume {
+public:
+  explicit UnstructuredVolume(const FvUnstructuredVolumeDesc &desc) {
+    FvUnstructuredVolume *v = nullptr;
+    check(fv_unstructured_volume_new(&desc, &v));
+    h_.reset(v);
+  }
+  /// A description with no arrays yet (fv_unstructured_volume_desc_default).
+  static FvUnstructuredVolumeDesc default_desc() {
+    FvUnstructuredVolumeDesc d{};
+    check(fv_unstructured_volume_desc_default(&d, sizeof d));
+    return d;
+  }
+  const FvUnstructuredVolume *get() const noexcept { return h_.get(); }
+
+private:
+  detail::Handle<FvUnstructuredVolume, fv_unstructured_volume_free> h_;
+};
+
 /// Colour, opacity and gradient opacity per component (see FvTransferFunction).
 class TransferFunction {
 public:
@@ -273,6 +294,10 @@ public:
     return p;
   }
   void set_volume(const Volume &v) { check(fv_renderer_set_volume(h_.get(), v.get())); }
+  /// Replaces the volume with a mesh (fv_renderer_set_unstructured).
+  void set_unstructured(const UnstructuredVolume &v) {
+    check(fv_renderer_set_unstructured(h_.get(), v.get()));
+  }
   /// Volumes intermixed per sample with the main one (fv_renderer_set_intermixed_volumes);
   /// the handles each description points to may be released after the call. An empty
   /// vector clears them.

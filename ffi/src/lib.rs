@@ -6,7 +6,8 @@
 //! A frame: fv_context_new → fv_renderer_new → fv_volume_new + fv_renderer_set_volume →
 //! fv_transfer_function_new (+ set_color / set_opacity) + fv_renderer_set_transfer_function
 //! → fv_renderer_set_camera / set_lights / set_params → fv_renderer_render →
-//! fv_renderer_read_frame (CPU) or the shared images (zero copy).
+//! fv_renderer_read_frame (CPU) or the shared images (zero copy). A mesh instead of an image:
+//! fv_unstructured_volume_new + fv_renderer_set_unstructured.
 #![allow(clippy::missing_safety_doc)] // each export documents its pointer rules in the header
 
 mod context;
@@ -21,6 +22,7 @@ mod status;
 mod test_hooks;
 mod transfer;
 mod types;
+mod unstructured;
 mod volume;
 
 pub use context::*;
@@ -33,6 +35,7 @@ pub use status::*;
 pub use test_hooks::*;
 pub use transfer::*;
 pub use types::*;
+pub use unstructured::*;
 pub use volume::*;
 
 use ferrovol_core::{

@@ -98,55 +98,83 @@ pub(crate) use sized_params;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::FvRenderParams;
+    use crate::{FvRenderParams, FvUnstructuredVolumeDesc};
 
-    /// FvRenderParams as a later minor version might declare it: one field appended.
+    /// `T` as a later minor version might declare it: one field appended.
     #[repr(C)]
     #[derive(Clone, Copy)]
-    struct Later {
-        base: FvRenderParams,
+    struct Later<T> {
+        base: T,
         appended: f64,
     }
-    impl SizedParams for Later {
-        const NAME: &'static str = "FvRenderParams";
-        const FIRST_SIZE: usize = <FvRenderParams as SizedParams>::FIRST_SIZE;
+    impl<T: SizedParams> SizedParams for Later<T> {
+        const NAME: &'static str = T::NAME;
+        const FIRST_SIZE: usize = T::FIRST_SIZE;
         fn defaults() -> Self {
             Later {
-                base: FvRenderParams::defaults(),
+                base: T::defaults(),
                 appended: 42.0,
             }
         }
         fn set_size(&mut self, size: usize) {
-            self.base.size = size;
+            self.base.set_size(size);
         }
+    }
+
+    /// A `T` of this version, filled with its defaults and then `change`d, read by a later
+    /// version: `check` holds of the fields it knew, and the appended one takes its default.
+    fn older_reads_with_the_later_fields_at_their_defaults<T: SizedParams>(
+        size_of: fn(&T) -> usize,
+        change: fn(&mut T),
+        check: fn(&T),
+    ) {
+        let mut older = std::mem::MaybeUninit::<T>::uninit();
+        let size = std::mem::size_of::<T>();
+        write_defaults(older.as_mut_ptr(), size, "params").unwrap();
+        // SAFETY: write_defaults wrote all `size` bytes.
+        let mut older = unsafe { older.assume_init() };
+        assert_eq!(size_of(&older), size);
+        change(&mut older);
+        let read = read((&older as *const T).cast::<Later<T>>(), "params").unwrap();
+        check(&read.base);
+        assert_eq!(read.appended, 42.0, "the appended field takes its default");
+        assert_eq!(size_of(&read.base), std::mem::size_of::<Later<T>>());
     }
 
     #[test]
     fn an_older_smaller_struct_reads_with_the_later_fields_at_their_defaults() {
-        let mut older = std::mem::MaybeUninit::<FvRenderParams>::uninit();
-        let size = std::mem::size_of::<FvRenderParams>();
-        write_defaults(older.as_mut_ptr(), size, "params").unwrap();
-        // SAFETY: write_defaults wrote all `size` bytes.
-        let mut older = unsafe { older.assume_init() };
-        assert_eq!(older.size, size);
-        older.sample_distance = 0.25;
-        older.quadrature = 1;
-        let read = read((&older as *const FvRenderParams).cast::<Later>(), "params").unwrap();
-        assert_eq!(read.base.sample_distance, 0.25);
-        assert_eq!(read.base.quadrature, 1);
-        assert_eq!(read.appended, 42.0, "the appended field takes its default");
-        assert_eq!(read.base.size, std::mem::size_of::<Later>());
+        older_reads_with_the_later_fields_at_their_defaults::<FvRenderParams>(
+            |p| p.size,
+            |p| {
+                p.sample_distance = 0.25;
+                p.quadrature = 1;
+            },
+            |p| assert_eq!((p.sample_distance, p.quadrature), (0.25, 1)),
+        );
+        older_reads_with_the_later_fields_at_their_defaults::<FvUnstructuredVolumeDesc>(
+            |d| d.size,
+            |d| {
+                d.cell_count = 7;
+                d.location = 1;
+            },
+            |d| assert_eq!((d.cell_count, d.location, d.components), (7, 1, 1)),
+        );
     }
 
-    #[test]
-    fn defaults_write_only_the_callers_size() {
-        let size = std::mem::size_of::<FvRenderParams>();
-        let mut buf = vec![0xA5u8; std::mem::size_of::<Later>()];
-        write_defaults(buf.as_mut_ptr().cast::<Later>(), size, "params").unwrap();
+    fn defaults_write_only_the_callers_size<T: SizedParams>() {
+        let size = std::mem::size_of::<T>();
+        let mut buf = vec![0xA5u8; std::mem::size_of::<Later<T>>()];
+        write_defaults(buf.as_mut_ptr().cast::<Later<T>>(), size, "params").unwrap();
         assert!(
             buf[size..].iter().all(|&b| b == 0xA5),
             "nothing past the caller's size"
         );
+    }
+
+    #[test]
+    fn defaults_write_only_what_the_callers_size_covers() {
+        defaults_write_only_the_callers_size::<FvRenderParams>();
+        defaults_write_only_the_callers_size::<FvUnstructuredVolumeDesc>();
     }
 
     #[test]

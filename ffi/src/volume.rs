@@ -11,7 +11,7 @@ pub struct FvVolume {
     pub(crate) data: Arc<VolumeData>,
 }
 
-fn scalars_from_bytes(t: FvScalarType, bytes: &[u8]) -> Scalars {
+pub(crate) fn scalars_from_bytes(t: FvScalarType, bytes: &[u8]) -> Scalars {
     fn read<T: Copy, const N: usize>(b: &[u8], f: fn([u8; N]) -> T) -> Vec<T> {
         b.chunks_exact(N)
             .map(|c| f(c.try_into().expect("chunk of N")))
@@ -45,7 +45,20 @@ const SCALAR_TYPES: [FvScalarType; 10] = [
     FvScalarType::U64,
 ];
 
-fn scalar_size(t: FvScalarType) -> usize {
+/// The FvScalarType a C caller's `code` names (`what` is the field, for the message).
+pub(crate) fn scalar_type(what: &str, code: u32) -> FfiResult<FvScalarType> {
+    SCALAR_TYPES.get(code as usize).copied().ok_or_else(|| {
+        FfiError::new(
+            FvStatus::Unsupported,
+            format!(
+                "{what} {code} is not an FvScalarType (0 to {})",
+                SCALAR_TYPES.len() - 1
+            ),
+        )
+    })
+}
+
+pub(crate) fn scalar_size(t: FvScalarType) -> usize {
     use FvScalarType as T;
     match t {
         T::U8 | T::I8 => 1,
@@ -72,16 +85,7 @@ pub unsafe extern "C" fn fv_volume_new(
         if data.is_null() {
             return Err(FfiError::null("data"));
         }
-        let t = *SCALAR_TYPES.get(d.scalar_type as usize).ok_or_else(|| {
-            FfiError::new(
-                FvStatus::Unsupported,
-                format!(
-                    "scalar type {} is not an FvScalarType (0 to {})",
-                    d.scalar_type,
-                    SCALAR_TYPES.len() - 1
-                ),
-            )
-        })?;
+        let t = scalar_type("scalar type", d.scalar_type)?;
         let count = d
             .dims
             .iter()

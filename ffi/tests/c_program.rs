@@ -85,6 +85,10 @@ fn cpp_raii_wrapper_renders_and_throws() {
         "{out}"
     );
     assert!(out.contains("four intermixed volumes refused"), "{out}");
+    assert!(
+        out.contains("dangling index refused: FV_STATUS_INVALID_ARGUMENT: invalid volume: cell 0"),
+        "{out}"
+    );
 }
 
 /// Handles shared between threads as the header allows (one context and volume, a renderer

@@ -2,7 +2,9 @@
 //! header lets several threads share must be `Sync`, what it lets move between threads must
 //! be `Send`. (ffi/tests/c/thread_stress.c uses them that way from C.)
 
-use ferrovol::{FvContext, FvFrame, FvRenderer, FvTransferFunction, FvVolume};
+use ferrovol::{
+    FvContext, FvFrame, FvRenderer, FvTransferFunction, FvUnstructuredVolume, FvVolume,
+};
 
 fn shared_by_threads<T: Send + Sync>() {}
 fn used_by_one_thread_at_a_time<T: Send>() {}
@@ -13,6 +15,8 @@ fn handle_types_allow_what_the_header_promises() {
     shared_by_threads::<FvContext>();
     // "immutable after creation; may be read from several threads at once"
     shared_by_threads::<FvVolume>();
+    // "immutable; may be read from several threads at once"
+    shared_by_threads::<FvUnstructuredVolume>();
     // "immutable; may be read from several threads at once"
     shared_by_threads::<FvFrame>();
     // "one thread at a time (it may move between threads)"

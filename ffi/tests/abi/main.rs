@@ -14,6 +14,7 @@ use std::ptr::{null, null_mut};
 
 mod features;
 mod resources;
+mod unstructured;
 
 type H = *mut c_void;
 
@@ -234,6 +235,7 @@ fn free_functions_accept_null() {
         "fv_context_free",
         "fv_renderer_free",
         "fv_volume_free",
+        "fv_unstructured_volume_free",
         "fv_transfer_function_free",
         "fv_frame_free",
     ] {

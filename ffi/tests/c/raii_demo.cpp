@@ -1,12 +1,24 @@
 // Drives the C++ RAII wrapper (ferrovol.hpp): renders a small sphere volume, then a second
-// one intermixed with it, then checks that bad calls throw ferrovol::Error with the right
-// status and a message.
+// one intermixed with it, then a hexahedral mesh, and checks that bad calls throw
+// ferrovol::Error with the right status and a message.
 // Built with -std=c++17 -Wall -Wextra -Werror -pedantic by ffi/tests/c_program.rs.
 #include "ferrovol.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <vector>
+
+// Runs `call`, which must throw ferrovol::Error with `want`; prints "<what> refused: <message>".
+template <class F> static bool refused(const char *what, FvStatus want, F call) {
+  try {
+    call();
+  } catch (const ferrovol::Error &e) {
+    std::printf("%s refused: %s\n", what, e.what());
+    return e.status() == want;
+  }
+  std::fprintf(stderr, "%s accepted\n", what);
+  return false;
+}
 
 int main(int argc, char **argv) {
   if (argc != 2) {
@@ -71,15 +83,10 @@ int main(int argc, char **argv) {
       iv.matrix[12] = 8.0;
       iv.interpolation = FV_INTERPOLATION_LINEAR;
       renderer.set_intermixed_volumes({iv});
-      try {
-        renderer.set_intermixed_volumes(std::vector<FvIntermixedVolume>(4, iv));
-        std::fprintf(stderr, "four intermixed volumes were accepted\n");
+      if (!refused("four intermixed volumes", FV_STATUS_UNSUPPORTED, [&] {
+            renderer.set_intermixed_volumes(std::vector<FvIntermixedVolume>(4, iv));
+          })) {
         return 1;
-      } catch (const ferrovol::Error &e) {
-        std::printf("four intermixed volumes refused: %s\n", e.what());
-        if (e.status() != FV_STATUS_UNSUPPORTED) {
-          return 1;
-        }
       }
     }
     renderer.render(200, 150);
@@ -91,15 +98,47 @@ int main(int argc, char **argv) {
       return 1;
     }
     renderer.set_intermixed_volumes({});
-    try {
-      FvRenderParams bad = ferrovol::Renderer::default_params();
-      bad.blend_mode = 42;
-      renderer.set_params(bad);
-      std::fprintf(stderr, "an invalid blend mode was accepted\n");
+    if (!refused("invalid blend mode", FV_STATUS_INVALID_ARGUMENT, [&] {
+          FvRenderParams bad = ferrovol::Renderer::default_params();
+          bad.blend_mode = 42;
+          renderer.set_params(bad);
+        })) {
       return 1;
-    } catch (const ferrovol::Error &e) {
-      std::printf("invalid blend mode refused: %s\n", e.what());
-      if (e.status() != FV_STATUS_INVALID_ARGUMENT) {
+    }
+    {
+      // The same box as a mesh, in VTK's default arrays (double points, int64 cells): one
+      // hexahedron with a scalar per corner.
+      std::vector<double> points;
+      std::vector<float> scalars;
+      for (int k = 0; k < 2; ++k)
+        for (int j = 0; j < 2; ++j)
+          for (int i = 0; i < 2; ++i) {
+            points.insert(points.end(), {31.0 * (i ^ j), 31.0 * j, 31.0 * k});
+            scalars.push_back(static_cast<float>(255 * (i ^ j)));
+          }
+      std::vector<int64_t> connectivity = {0, 1, 2, 3, 4, 5, 6, 7}, offsets = {0, 8};
+      uint8_t hexahedron = 12;
+      FvUnstructuredVolumeDesc d = ferrovol::UnstructuredVolume::default_desc();
+      d.points = points.data();
+      d.point_count = 8;
+      d.connectivity = connectivity.data();
+      d.connectivity_count = connectivity.size();
+      d.offsets = offsets.data();
+      d.cell_types = &hexahedron;
+      d.cell_count = 1;
+      d.scalars = scalars.data();
+      renderer.set_unstructured(ferrovol::UnstructuredVolume(d));
+      renderer.render(200, 150);
+      ferrovol::Frame mesh = renderer.read_frame();
+      const uint8_t *c = mesh.rgba() + 4 * (75 * 200 + 100);
+      std::printf("mesh centre %u %u %u %u\n", c[0], c[1], c[2], c[3]);
+      if (c[3] < 128) {
+        std::fprintf(stderr, "the hexahedron is missing from the centre of the frame\n");
+        return 1;
+      }
+      connectivity[7] = 8;
+      if (!refused("dangling index", FV_STATUS_INVALID_ARGUMENT,
+                   [&] { ferrovol::UnstructuredVolume dangling(d); })) {
         return 1;
       }
     }
