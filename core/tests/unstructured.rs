@@ -32,6 +32,19 @@ fn tf(lo: f64, hi: f64, max: f32) -> TransferFunction {
 }
 
 /// Draws `v` on the GPU and on the CPU; prints and returns (mean error, PSNR, max error).
+/// `v` drawn through `tf` on the shared renderer (set here: tests take turns on it).
+fn draw(
+    v: &UnstructuredVolume,
+    tf: &TransferFunction,
+    view: &View,
+    params: &RenderParams,
+) -> Image {
+    let mut r = renderer();
+    r.set_unstructured(v).unwrap();
+    r.set_transfer_function(tf).unwrap();
+    r.render_image(view, params).unwrap()
+}
+
 fn compare(
     name: &str,
     v: &UnstructuredVolume,
@@ -39,10 +52,7 @@ fn compare(
     view: &View,
     params: &RenderParams,
 ) -> (f64, f64, f64) {
-    let mut r = renderer();
-    r.set_unstructured(v).unwrap();
-    r.set_transfer_function(tf).unwrap();
-    let img = r.render_image(view, params).unwrap();
+    let img = draw(v, tf, view, params);
     let reference = mesh::render(v, tf, view, params);
     save_enlarged(&img, &format!("unstructured_{name}"));
     save_enlarged(
@@ -163,13 +173,7 @@ fn rays_leave_the_hollow_cylinder_and_enter_it_again() {
     let (mean, psnr, max) = compare("cylinder", &v, &t, &view, &params(BlendMode::Composite));
     assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0);
     // the far wall shows through the hole: the centre is more opaque than one wall alone
-    // (the mesh set again: other tests take turns on the renderer)
-    let mut r = renderer();
-    r.set_unstructured(&v).unwrap();
-    r.set_transfer_function(&t).unwrap();
-    let img = r
-        .render_image(&view, &params(BlendMode::Composite))
-        .unwrap();
+    let img = draw(&v, &t, &view, &params(BlendMode::Composite));
     let near_wall_only = mesh::integrate(
         &centre
             .iter()
@@ -381,12 +385,7 @@ fn composite_depth_is_where_the_ray_first_gathers_opacity() {
     let t = tf(lo, hi, 0.5);
     let mut view = view_of(&v, 32);
     view.camera.reset_clipping_range(v.bounds());
-    let mut r = renderer();
-    r.set_unstructured(&v).unwrap();
-    r.set_transfer_function(&t).unwrap();
-    let img = r
-        .render_image(&view, &params(BlendMode::Composite))
-        .unwrap();
+    let img = draw(&v, &t, &view, &params(BlendMode::Composite));
     let segs = mesh::Tets::of(&v).segments(&view);
     let table = mesh::Table::of(&t);
     let vp = view.camera.view_projection(view.aspect());

@@ -41,6 +41,18 @@ pub enum BlendMode {
 }
 
 impl BlendMode {
+    /// Every blend mode, in declaration order.
+    pub const ALL: [BlendMode; 8] = [
+        BlendMode::Composite,
+        BlendMode::Maximum,
+        BlendMode::Minimum,
+        BlendMode::Average,
+        BlendMode::Additive,
+        BlendMode::Isosurface,
+        BlendMode::PathTrace,
+        BlendMode::Slice,
+    ];
+
     pub(crate) fn code(self) -> u32 {
         match self {
             BlendMode::Composite => BLEND_COMPOSITE,

@@ -326,14 +326,10 @@ mod tests {
     use super::*;
 
     /// The blend modes ray casting draws.
-    const BLENDS: [BlendMode; 6] = [
-        BlendMode::Composite,
-        BlendMode::Maximum,
-        BlendMode::Minimum,
-        BlendMode::Average,
-        BlendMode::Additive,
-        BlendMode::Slice,
-    ];
+    const BLENDS: [BlendMode; 6] = {
+        let [composite, max, min, average, additive, _, _, slice] = BlendMode::ALL;
+        [composite, max, min, average, additive, slice]
+    };
 
     fn facts() -> DvrFacts {
         DvrFacts {

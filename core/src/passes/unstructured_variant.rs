@@ -117,20 +117,9 @@ pub(crate) mod tests {
         }
     }
 
-    pub(crate) const BLENDS: [BlendMode; 8] = [
-        BlendMode::Composite,
-        BlendMode::Maximum,
-        BlendMode::Minimum,
-        BlendMode::Average,
-        BlendMode::Additive,
-        BlendMode::Isosurface,
-        BlendMode::PathTrace,
-        BlendMode::Slice,
-    ];
-
     /// Frames over every blend mode, component count and each setting on alone.
     pub(crate) fn matrix(each: &mut dyn FnMut(&UnstructuredFacts)) {
-        for blend in BLENDS {
+        for blend in BlendMode::ALL {
             for components in 1..=4 {
                 for cell_scalars in [false, true] {
                     let x = UnstructuredFacts {

@@ -63,14 +63,10 @@ fn binary_mask_leaves_out_samples() {
     let half = by_x(|x| u8::from(x >= 12));
     // samples with x < 11.5 (index = world here) are left out
     let edge = column(&view, 11.5);
-    for blend in [
-        BlendMode::Composite,
-        BlendMode::Maximum,
-        BlendMode::Minimum,
-        BlendMode::Average,
-        BlendMode::Additive,
-        BlendMode::Isosurface,
-    ] {
+    for blend in BlendMode::ALL {
+        if matches!(blend, BlendMode::PathTrace | BlendMode::Slice) {
+            continue;
+        }
         let p = params(blend);
         r.set_mask(None).unwrap();
         let plain = r.render_image(&view, &p).unwrap();
