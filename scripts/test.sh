@@ -17,9 +17,11 @@ mkdir -p "$LOGS"
 rm -f "$LOGS"/*.log "$LOGS"/*.status
 MAKE=${MAKE:-make}
 START=$SECONDS
-# Mesa's shader cache in this tree: what the first suites compile, the later ones reuse,
-# and a fresh clone starts cold whatever this machine ran before.
+# Mesa's shader cache and ferrovol's pipeline cache in this tree: what the first suites
+# compile, the later ones reuse, and a fresh clone starts cold whatever this machine ran
+# before.
 export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
+export FERROVOL_CACHE_DIR=$ROOT/build/ferrovol-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
 SUITES=(lint build-rust build-vtk build-vtk-pip

@@ -23,12 +23,14 @@ use ferrovol_core::{ScalarType, VolumeData};
 
 use crate::decode::{lookup_type, numbers, Geometry, Layout, TypeNames};
 use crate::vtkxml::{
-    appended_array, appended_encoding, appended_section, check_vtkfile, get, parse_xml, xml_part,
-    ArrayDesc, Arrays, Binary, Encoding, SUPPORTED_TYPES,
+    appended_array, appended_encoding, appended_section, get, read_xml, ArrayDesc, Arrays, Binary,
+    Encoding, SUPPORTED_TYPES,
 };
 use crate::ReadError;
 
 const FORMAT: &str = "VTK ImageData (.vti)";
+const OTHER_TYPE_HINT: &str =
+    "resample it to an image (e.g. ParaView's Resample To Image) and save as .vti";
 
 fn bad(message: impl Into<String>) -> ReadError {
     ReadError::bad_header(FORMAT, message)
@@ -106,15 +108,7 @@ struct Described {
 /// Reads the XML part of a `.vti` file (all of `bytes` up to any `<AppendedData>` start
 /// tag) and checks what it describes.
 fn describe(bytes: &[u8]) -> Result<Described, ReadError> {
-    let (xml, xml_end) = xml_part(FORMAT, ".vti", bytes)?;
-    let h = parse_xml(FORMAT, b"ImageData", xml)?;
-    let binary = check_vtkfile(
-        FORMAT,
-        &h,
-        "ImageData",
-        ".vti",
-        "resample it to an image (e.g. ParaView's Resample To Image) and save as .vti",
-    )?;
+    let (h, binary, xml_end) = read_xml(FORMAT, "ImageData", ".vti", OTHER_TYPE_HINT, bytes)?;
 
     // Geometry.
     let whole = get(&h.dataset, "WholeExtent");

@@ -184,10 +184,27 @@ pub(crate) enum Encoding {
     Base64,
 }
 
+/// Reads and checks the XML part of a `format` file whose dataset element is `dataset`
+/// (`ImageData`) and whose extension is `ext`; `hint` says what to do with a file of
+/// another type. Returns the header, how binary arrays are stored and where the XML part
+/// ends.
+pub(crate) fn read_xml(
+    format: &'static str,
+    dataset: &str,
+    ext: &str,
+    hint: &str,
+    bytes: &[u8],
+) -> Result<(Header, Binary, usize), ReadError> {
+    let (xml, xml_end) = xml_part(format, ext, bytes)?;
+    let h = parse_xml(format, dataset.as_bytes(), xml)?;
+    let binary = check_vtkfile(format, &h, dataset, ext, hint)?;
+    Ok((h, binary, xml_end))
+}
+
 /// The XML part of a file (`bytes` up to and including any `<AppendedData>` start tag,
 /// after which raw binary may follow) and where it ends. `ext` (".vti") names the file
 /// type in the message for text that is not UTF-8.
-pub(crate) fn xml_part<'a>(
+fn xml_part<'a>(
     format: &'static str,
     ext: &str,
     bytes: &'a [u8],
@@ -216,7 +233,7 @@ pub(crate) fn xml_part<'a>(
 
 /// The `<VTKFile>` attributes: it must be there, of type `file_type`; `hint` says what to
 /// do with a file of another type. Returns how binary data is stored.
-pub(crate) fn check_vtkfile(
+fn check_vtkfile(
     format: &'static str,
     h: &Header,
     file_type: &str,
@@ -416,11 +433,7 @@ impl<'a> Arrays<'a> {
 
 /// Parses the XML part of a file (everything up to and including the `<AppendedData>`
 /// start tag); `dataset` is the dataset element's name (`ImageData`).
-pub(crate) fn parse_xml(
-    format: &'static str,
-    dataset: &[u8],
-    xml: &str,
-) -> Result<Header, ReadError> {
+fn parse_xml(format: &'static str, dataset: &[u8], xml: &str) -> Result<Header, ReadError> {
     let mut h = Header::default();
     let mut reader = quick_xml::Reader::from_str(xml);
     let mut section: Option<Which> = None;

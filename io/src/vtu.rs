@@ -26,13 +26,11 @@ use ferrovol_core::{ScalarLocation, Scalars, UnstructuredVolume};
 
 use crate::decode::{lookup_type, TypeNames};
 use crate::error::Problem;
-use crate::vtkxml::{
-    appended_encoding, check_vtkfile, get, parse_xml, xml_part, ArrayDesc, Arrays, Piece,
-    SUPPORTED_TYPES,
-};
+use crate::vtkxml::{appended_encoding, get, read_xml, ArrayDesc, Arrays, Piece, SUPPORTED_TYPES};
 use crate::ReadError;
 
 const FORMAT: &str = "VTK UnstructuredGrid (.vtu)";
+const OTHER_TYPE_HINT: &str = "save the mesh as an unstructured grid (.vtu), e.g. after ParaView's Merge Blocks or Append Datasets";
 
 fn bad(message: impl Into<String>) -> ReadError {
     ReadError::bad_header(FORMAT, message)
@@ -40,15 +38,8 @@ fn bad(message: impl Into<String>) -> ReadError {
 
 /// Parses a `.vtu` file from its bytes.
 pub fn parse(bytes: &[u8]) -> Result<UnstructuredVolume, ReadError> {
-    let (xml, xml_end) = xml_part(FORMAT, ".vtu", bytes)?;
-    let h = parse_xml(FORMAT, b"UnstructuredGrid", xml)?;
-    let binary = check_vtkfile(
-        FORMAT,
-        &h,
-        "UnstructuredGrid",
-        ".vtu",
-        "save the mesh as an unstructured grid (.vtu), e.g. after ParaView's Merge Blocks or Append Datasets",
-    )?;
+    let (h, binary, xml_end) =
+        read_xml(FORMAT, "UnstructuredGrid", ".vtu", OTHER_TYPE_HINT, bytes)?;
     let arrays = Arrays::new(
         FORMAT,
         bytes,

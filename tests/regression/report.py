@@ -63,13 +63,18 @@ def write(out, summary, results, table):
 window setup (size, camera, lights, property) by <b>vtkGPUVolumeRayCastMapper</b> (the
 reference), by <b>vtkFerroVolumeMapper</b> and, where it supports the scene, by
 <b>vtkFixedPointVolumeRayCastMapper</b> (a second opinion: how far VTK's own mappers agree).
-Figures against the GPU mapper: SSIM (luminance, 11×11 Gaussian window), PSNR over RGB, mean
+Unstructured grids (<code>ugrid-*</code>) have <b>vtkUnstructuredGridVolumeRayCastMapper</b>
+as the reference, <b>vtkUnstructuredGridVolumeZSweepMapper</b> and
+<b>vtkProjectedTetrahedraMapper</b> as second opinions, and ferrovol's
+vtkFerroUnstructuredVolumeMapper
+(<a href="../../tests/regression/UNSTRUCTURED.md">UNSTRUCTURED.md</a>).
+Figures against the reference: SSIM (luminance, 11×11 Gaussian window), PSNR over RGB, mean
 <a href="https://research.nvidia.com/publication/2020-07_FLIP">FLIP</a> (Andersson et al.,
 HPG 2020; 67 pixels per degree) and ΔRGB, the mean absolute colour difference in 8-bit levels
 inside the volume's footprint (pixels where either image is not background). ferrovol's
 figures are held against <code>tests/regression/thresholds.toml</code> (each with its reason);
-the fixed-point figures are shown, not judged. Difference images are |image − reference| × 4;
-FLIP maps are black (no visible difference) to light yellow (1).
+the second opinions' figures are shown, not judged. Difference images are
+|image − reference| × 4; FLIP maps are black (no visible difference) to light yellow (1).
 <br><b>Sample placement</b>: ferrovol samples where VTK 9.2 does: the first sample one
 full step inside the volume's box (<code>g_rayOrigin += g_dirStep</code> when jittering is
 off), always taken, the exit-face sample kept, and up to one step past opaque depth and
@@ -85,13 +90,11 @@ span, VTK's multisampled outline) are in
     for _, name, _, _ in COLS:
         p.append("<th>%s</th>" % name)
     p.append("<th>thresholds (SSIM / PSNR / FLIP / ΔRGB)</th>")
-    for _, name, _, _ in COLS:
-        p.append("<th>fixed-pt %s</th>" % name)
-    p.append("<th>ms GPU / ferrovol / fixed</th></tr>")
+    p.append("<th class=l>second opinions: SSIM / PSNR dB</th>")
+    p.append("<th>ms reference / ferrovol / second opinions</th></tr>")
     for r in results:
         t = r.get("thresholds") or {}
         m = r["metrics"].get("ferrovol")
-        f = r["metrics"].get("vtk-fixed")
         p.append("<tr><td class=l><a href='#%s'>%s</a></td><td class='%s'>%s</td>"
                  "<td class=l>%s</td><td>%d×%d</td>"
                  % (_e(r["name"]), _e(r["name"]), r["status"], r["status"],
@@ -106,12 +109,14 @@ span, VTK's multisampled outline) are in
                         t.get("footprint", 0)))
         else:
             p.append("<td>–</td>")
-        for key, _, fs, kind in COLS:
-            p.append(_cell(f, None, key, fs, kind))
+        opinions = [(k, r["metrics"][k]) for k in r.get("opinions", []) if k in r["metrics"]]
+        p.append("<td class=l>%s</td>" % ("<br>".join(
+            "%s %.4f / %.2f" % (_e(k[4:]), f["ssim"], f["psnr"]) for k, f in opinions) or "–"))
         rd = r.get("renders", {})
+        order = [r.get("reference", "vtk-gpu"), "ferrovol"] + r.get("opinions", [])
         p.append("<td>%s</td></tr>" % " / ".join(
-            "%.0f" % rd[k]["ms"] if k in rd else "–" for k in ("vtk-gpu", "ferrovol",
-                                                              "vtk-fixed")))
+            "%.0f" % rd[k]["ms"] if rd.get(k, {}).get("ms") is not None else "–"
+            for k in order))
     p.append("</table>")
     measured = [r for r in results if "ferrovol" in r["metrics"] and r["status"] != "PENDING"]
     low = sorted(measured, key=lambda r: r["metrics"]["ferrovol"]["ssim"])[:3]
@@ -132,13 +137,13 @@ span, VTK's multisampled outline) are in
         if r.get("info"):
             p.append("<div><b>%s</b></div>" % _e(r["info"]))
         im = r.get("images", {})
-        figs = [("vtk-gpu", "vtkGPUVolumeRayCastMapper (reference)"),
-                ("ferrovol", "vtkFerroVolumeMapper"),
-                ("ferrovol-diff", "|ferrovol − reference| × 4"),
-                ("ferrovol-flip", "FLIP map, ferrovol"),
-                ("vtk-fixed", "vtkFixedPointVolumeRayCastMapper"),
-                ("vtk-fixed-diff", "|fixed point − reference| × 4"),
-                ("vtk-fixed-flip", "FLIP map, fixed point")]
+        ref = r.get("reference", "vtk-gpu")
+        labels = r.get("labels", {})
+        figs = [(ref, "%s (reference)" % labels.get(ref, ref))]
+        for k in ["ferrovol"] + r.get("opinions", []):
+            short = "ferrovol" if k == "ferrovol" else k[4:]
+            figs += [(k, labels.get(k, k)), (k + "-diff", "|%s − reference| × 4" % short),
+                     (k + "-flip", "FLIP map, %s" % short)]
         p.append("<div class=imgs>")
         for key, cap in figs:
             if key in im:
@@ -146,12 +151,12 @@ span, VTK's multisampled outline) are in
                          "</figcaption></figure>" % (_e(im[key]), _e(im[key]), _e(cap)))
         p.append("</div>")
         if r["metrics"]:
-            p.append("<table><tr><th class=l>against the GPU mapper</th>")
+            p.append("<table><tr><th class=l>against the reference</th>")
             for _, name, _, _ in COLS:
                 p.append("<th>%s</th>" % name)
             p.append("<th>mean ΔL (signed)</th><th>footprint</th><th>render ms</th></tr>")
-            rows = [("ferrovol", "vtkFerroVolumeMapper", t),
-                    ("vtk-fixed", "vtkFixedPointVolumeRayCastMapper", None)]
+            rows = [(k, labels.get(k, k), t if k == "ferrovol" else None)
+                    for k in ["ferrovol"] + r.get("opinions", [])]
             for key, label, th in rows:
                 m = r["metrics"].get(key)
                 if not m:

@@ -3,8 +3,11 @@
 
 Every scene of scenes.py is rendered in the same VTK window setup by
 vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper (a second
-opinion, where it supports the scene) and vtkFerroVolumeMapper; ferrovol's image and the
-fixed-point one are each compared with the reference (SSIM, PSNR, mean FLIP, mean colour
+opinion, where it supports the scene) and vtkFerroVolumeMapper; an unstructured-grid scene
+by vtkUnstructuredGridVolumeRayCastMapper (the reference), vtkUnstructuredGridVolumeZSweepMapper
+and vtkProjectedTetrahedraMapper (second opinions) and vtkFerroUnstructuredVolumeMapper
+(once the module `ferrovol` has it). ferrovol's image and the second opinions are each
+compared with the reference (SSIM, PSNR, mean FLIP, mean colour
 difference inside the volume's footprint) and ferrovol's figures are held against
 thresholds.toml. Writes build/regression/index.html (images side by side, figures,
 pass/fail), results.json and the images.
@@ -38,7 +41,18 @@ FIXED_BLENDS = {"composite", "maximum", "minimum", "additive"}
 BLEND = {"composite": "Composite", "maximum": "MaximumIntensity",
          "minimum": "MinimumIntensity", "average": "AverageIntensity",
          "additive": "Additive", "isosurface": "IsoSurface", "slice": "Slice"}
+# The mappers of a scene: the reference first, ferrovol, then the second opinions.
 MAPPERS = ("vtk-gpu", "ferrovol", "vtk-fixed")
+UGRID_MAPPERS = ("vtk-bunyk", "ferrovol", "vtk-zsweep", "vtk-pt")
+LABELS = {"vtk-gpu": "vtkGPUVolumeRayCastMapper", "vtk-fixed": "vtkFixedPointVolumeRayCastMapper",
+          "vtk-bunyk": "vtkUnstructuredGridVolumeRayCastMapper",
+          "vtk-zsweep": "vtkUnstructuredGridVolumeZSweepMapper",
+          "vtk-pt": "vtkProjectedTetrahedraMapper", "ferrovol": "vtkFerroVolumeMapper"}
+UGRID_FERROVOL = "vtkFerroUnstructuredVolumeMapper"
+
+
+def mappers_of(scene):
+    return UGRID_MAPPERS if scene.unstructured else MAPPERS
 
 
 def parse_args(argv):
@@ -47,7 +61,8 @@ def parse_args(argv):
     ap.add_argument("--only", default="", help="comma-separated scene names or globs")
     ap.add_argument("--out", default=os.path.join(ROOT, "build", "regression"))
     ap.add_argument("--no-fixed", action="store_true",
-                    help="skip vtkFixedPointVolumeRayCastMapper (the second opinion)")
+                    help="skip the second opinions (vtkFixedPointVolumeRayCastMapper; for "
+                    "unstructured grids the Z-sweep and projected-tetrahedra mappers)")
     ap.add_argument("--thresholds", default=os.path.join(HERE, "thresholds.toml"))
     return ap.parse_args(argv)
 
@@ -65,6 +80,7 @@ import vtk  # noqa: E402
 
 import ferrovol  # noqa: E402
 import fvtest  # noqa: E402
+import meshes  # noqa: E402
 import scenes as S  # noqa: E402
 from ferrovol_testing import flip  # noqa: E402
 from ferrovol_testing.metrics import (  # noqa: E402
@@ -78,9 +94,23 @@ def log(*a):
 # ---------------------------------------------------------------------------------------
 # Rendering
 
-def make_mapper(kind):
+def make_mapper(kind, unstructured=False):
+    """A mapper of that kind; None for ferrovol on an unstructured grid while the module has
+    no unstructured mapper."""
     if kind == "vtk-gpu":
         return vtk.vtkGPUVolumeRayCastMapper()
+    if kind in ("vtk-bunyk", "vtk-zsweep"):
+        m = (vtk.vtkUnstructuredGridVolumeRayCastMapper() if kind == "vtk-bunyk"
+             else vtk.vtkUnstructuredGridVolumeZSweepMapper())
+        # one ray per pixel, no time-driven coarsening
+        m.AutoAdjustSampleDistancesOff()
+        m.SetImageSampleDistance(1.0)
+        return m
+    if kind == "vtk-pt":
+        return vtk.vtkProjectedTetrahedraMapper()   # VTK's factory: the OpenGL one
+    if kind == "ferrovol" and unstructured:
+        cls = getattr(ferrovol, UGRID_FERROVOL, None)
+        return cls() if cls else None
     if kind == "ferrovol":
         m = ferrovol.vtkFerroVolumeMapper()
         path = os.environ.get("FERROVOL_OUTPUT_PATH")  # readback / shared: force one path
@@ -106,8 +136,14 @@ def auto_sample_distance(data, volume):
 
 
 def render(scene, kind):
-    """Renders the scene with one kind of mapper; returns (rgb float image, info)."""
+    """Renders the scene with one kind of mapper; returns (rgb float image, info), or
+    (None, info) where there is no such mapper yet."""
     data = S.DATA[scene.data]()
+    if scene.unstructured and kind != "ferrovol":
+        data = meshes.tetrahedralised(data)   # VTK's unstructured mappers: tetrahedra only
+    if kind == "ferrovol" and scene.unstructured and not hasattr(ferrovol, UGRID_FERROVOL):
+        return None, {"ms": None, "errors": [], "warnings": [], "drew": False,
+                      "missing": "the module ferrovol has no %s yet" % UGRID_FERROVOL}
     w, h = scene.size
     win = fvtest.new_window()
     win.SetSize(w, h)
@@ -115,7 +151,7 @@ def render(scene, kind):
         win.SetMultiSamples(scene.multisamples)
     mappers, errors, keep = [], [], []
     for view in scene.views:
-        m = make_mapper(kind)
+        m = make_mapper(kind, scene.unstructured)
         errors.append(fvtest.Errors(m))
         getattr(m, "SetBlendModeTo" + BLEND[view.blend])()
         prop = scene.prop()
@@ -172,8 +208,10 @@ def render(scene, kind):
             "errors": [e for c in errors for e in c.messages],
             "warnings": [e for c in errors for e in c.warnings]}
     if kind == "ferrovol":
-        info["drew"] = all(m.GetLastRenderDrew() for m in mappers)
-        info["output_path"] = mappers[0].GetOutputPathName()
+        info["drew"] = all(m.GetLastRenderDrew() if hasattr(m, "GetLastRenderDrew")
+                           else not info["errors"] for m in mappers)
+        if hasattr(mappers[0], "GetOutputPathName"):
+            info["output_path"] = mappers[0].GetOutputPathName()
     win.Finalize()
     return img, info
 
@@ -276,21 +314,29 @@ def run_scene(scene, table):
         res.update(status="SKIP", why=[str(e)])
         return res
     fixed_ok = set(scene.blends) <= FIXED_BLENDS and scene.fixed and not ARGS.no_fixed
+    kinds = mappers_of(scene)
+    res["reference"] = kinds[0]
+    res["opinions"] = [k for k in kinds[2:] if fixed_ok]
+    res["labels"] = {k: LABELS[k] for k in kinds}
+    if scene.unstructured:
+        res["labels"]["ferrovol"] = UGRID_FERROVOL
     imgs = {}
-    for kind in MAPPERS:
-        if kind == "vtk-fixed" and not fixed_ok:
+    for kind in kinds:
+        if kind in kinds[2:] and not fixed_ok:
             continue
         img, info = render(scene, kind)
-        imgs[kind] = img
         res["renders"][kind] = info
+        if img is None:
+            continue
+        imgs[kind] = img
         res["images"][kind] = save_png("%s-%s" % (scene.name, kind), img)
-    ref = imgs["vtk-gpu"]
+    ref = imgs[kinds[0]]
     fv = res["renders"]["ferrovol"]
     why = table_problems(scene, t)
     pending = t is not None and "pending" in t
     if coverage(ref) < 0.01:
         why.append("VTK's image is empty: bad scene")
-    for kind in ("ferrovol", "vtk-fixed"):
+    for kind in kinds[1:]:
         if kind not in imgs or (kind == "ferrovol" and pending and not fv["drew"]):
             continue
         m, fmap = measure(imgs[kind], ref)
@@ -305,13 +351,16 @@ def run_scene(scene, table):
         if fv["drew"]:
             why.append("ferrovol draws this scene now: measure it and replace `pending` "
                        "with thresholds")
+        elif fv.get("missing"):
+            why.append(fv["missing"])
         elif not fv["errors"]:
             why.append("ferrovol drew nothing and reported no error")
     else:
         if fv["errors"]:
             why.append("ferrovol reported: " + " | ".join(fv["errors"]))
         if not fv.get("drew"):
-            why.append("ferrovol drew nothing")
+            why.append("ferrovol drew nothing" + (": " + fv["missing"] if fv.get("missing")
+                                                  else ""))
         if "ferrovol" in res["metrics"] and t is not None and not table_problems(scene, t):
             why += check(scene, t, res["metrics"]["ferrovol"])
         res["status"] = "FAIL" if why else "PASS"
@@ -334,15 +383,16 @@ def fmt(m, k):
 
 def print_row(r):
     m = r["metrics"].get("ferrovol")
-    f = r["metrics"].get("vtk-fixed")
     line = "%-7s %-32s" % (r["status"], r["name"])
     if m:
         line += " SSIM %s  PSNR %6s dB  FLIP %s  dRGB %5s" % (
             fmt(m, "ssim"), fmt(m, "psnr"), fmt(m, "flip"), fmt(m, "footprint"))
     if m and "isosurface" in r["blends"]:
         line += "  silhouette SSIM %s" % fmt(m, "silhouette")
-    if f:
-        line += "   | fixed-point: SSIM %s PSNR %s" % (fmt(f, "ssim"), fmt(f, "psnr"))
+    for kind in r.get("opinions", []):
+        f = r["metrics"].get(kind)
+        if f:
+            line += "   | %s: SSIM %s PSNR %s" % (kind[4:], fmt(f, "ssim"), fmt(f, "psnr"))
     log(line)
     for w in r.get("why", []):
         log("        " + w)
@@ -361,7 +411,8 @@ def main():
     unknown = sorted(set(table) - set(S.BY_NAME))
     t0 = time.perf_counter()
     results = []
-    log("ferrovol regression: %d scenes against vtkGPUVolumeRayCastMapper (VTK %s)"
+    log("ferrovol regression: %d scenes against vtkGPUVolumeRayCastMapper (unstructured "
+        "grids: vtkUnstructuredGridVolumeRayCastMapper), VTK %s"
         % (len(chosen), vtk.vtkVersion.GetVTKVersion()))
     for scene in chosen:
         ts = time.perf_counter()

@@ -1,6 +1,9 @@
 """The regression matrix: every scene is rendered in the same VTK window setup by
 vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper (a second
-opinion, where it supports the scene) and vtkFerroVolumeMapper.
+opinion, where it supports the scene) and vtkFerroVolumeMapper; an unstructured-grid scene
+(`unstructured=True`, the meshes of meshes.py) by vtkUnstructuredGridVolumeRayCastMapper
+(the reference), vtkUnstructuredGridVolumeZSweepMapper and vtkProjectedTetrahedraMapper
+(second opinions) and ferrovol's vtkFerroUnstructuredVolumeMapper.
 
 A scene is data + volume property + blend mode + mapper settings + camera (+ actors, volume
 matrix, viewports). Its thresholds live in thresholds.toml under the same name. Scenes with
@@ -615,6 +618,10 @@ class Scene:
     # scene's (port 0): () -> [(data key, prop, vtkVolume transform or None)]
     intermix: Optional[Callable] = None
     fixed: bool = True                     # False: the fixed-point mapper lacks a setting used
+    # True: the data is a vtkUnstructuredGrid, drawn by vtkUnstructuredGridVolumeRayCastMapper
+    # (the reference), vtkUnstructuredGridVolumeZSweepMapper and vtkProjectedTetrahedraMapper
+    # (second opinions) and ferrovol's vtkFerroUnstructuredVolumeMapper
+    unstructured: bool = False
     quick: bool = False
     note: str = ""                   # known, understood differences shown next to the images
 
@@ -879,5 +886,12 @@ SCENES = [
           "categorical TF, nearest", "labels", label_tf, quick=True,
           views=one(camera=ct_front(30, 10))),
 ]
+
+# The unstructured grids' data and scenes (ugrid_scenes.py builds them from the pieces above;
+# import this module, not that one, first).
+import ugrid_scenes  # noqa: E402
+
+DATA.update(ugrid_scenes.DATA)
+SCENES += ugrid_scenes.SCENES
 
 BY_NAME = {s.name: s for s in SCENES}

@@ -3,6 +3,7 @@
 //! `FERROVOL_ADAPTER` picks the first adapter whose name contains the given text
 //! (case-insensitive, e.g. `llvmpipe` or `nvidia`).
 
+use super::disk_cache::DiskCache;
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::sync::{Mutex, MutexGuard};
@@ -48,18 +49,19 @@ impl DeviceMemory {
 }
 
 /// The compiled shaders of one device, shared by every renderer on it (a [`Context`] and its
-/// clones hold one; the pipeline module fills it): shader modules by pass file, compute
-/// pipelines by file, entry point and override constants. Compiling is most of a new
+/// clones hold one; the pipeline module fills it): parsed pass files by name, compute
+/// pipelines by file, entry point and override constants, and the persistent pipeline
+/// cache the driver compiles through ([`DiskCache`]). Compiling is most of a new
 /// renderer's first frame, so a renderer made on a device that already drew (another volume
 /// in the window, or the same one after its graphics resources were released) compiles only
 /// what is new to the device. A cached pipeline keeps the layout of the renderer that
 /// compiled it; another renderer's bind groups fit it because a pass builds its bind group
 /// layouts from the context alone, and wgpu gives layouts of equal entries one identity on
 /// a device.
-#[derive(Default)]
 pub(crate) struct ShaderStore {
-    pub(crate) modules: Mutex<HashMap<&'static str, wgpu::ShaderModule>>,
+    pub(crate) parsed: Mutex<HashMap<&'static str, std::sync::Arc<super::specialise::Parsed>>>,
     pub(crate) pipelines: Mutex<HashMap<PipelineKey, wgpu::ComputePipeline>>,
+    pub(crate) disk: Option<DiskCache>,
 }
 
 /// A compiled pipeline's identity: its pass file, entry point and override constants (their
@@ -182,6 +184,7 @@ impl Context {
             wgpu::Features::FLOAT32_FILTERABLE,
             wgpu::Features::TEXTURE_FORMAT_16BIT_NORM,
             wgpu::Features::TIMESTAMP_QUERY,
+            wgpu::Features::PIPELINE_CACHE,
         ] {
             if feats.contains(f) {
                 required |= f;
@@ -223,6 +226,7 @@ impl Context {
                 }
             }
         });
+        let disk = DiskCache::open(&device, &ai);
         Ok(Context {
             adapter,
             device,
@@ -230,7 +234,11 @@ impl Context {
             info,
             lost,
             memory_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
-            shaders: Default::default(),
+            shaders: std::sync::Arc::new(ShaderStore {
+                parsed: Default::default(),
+                pipelines: Default::default(),
+                disk,
+            }),
             last_submission: Default::default(),
             waits: Default::default(),
         })

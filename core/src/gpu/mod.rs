@@ -7,11 +7,13 @@
 pub(crate) mod binding;
 pub(crate) mod buffers;
 pub(crate) mod context;
+pub(crate) mod disk_cache;
 pub mod interop;
 pub(crate) mod pipeline;
 pub(crate) mod readback;
 pub(crate) mod shaders;
 pub(crate) mod slots;
+pub(crate) mod specialise;
 pub(crate) mod texture;
 pub(crate) mod timing;
 pub(crate) mod uniforms;

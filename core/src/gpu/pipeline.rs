@@ -2,11 +2,26 @@
 //! ([`super::context::ShaderStore`]) and specialised by pipeline-overridable constants.
 
 use super::context::{lock, PipelineKey};
+use super::specialise::{self, Parsed};
 use super::Context;
 use crate::error::Result;
 use std::hash::Hash;
+use std::sync::Arc;
 
-/// The shader module of pass `file` (composed by [`super::shaders::compose`]), created
+/// Pass `file` composed ([`super::shaders::compose`]), parsed and validated, the first time
+/// the device needs it ([`super::context::ShaderStore`]).
+pub(crate) fn parsed_shader(ctx: &Context, file: &'static str) -> Result<Arc<Parsed>> {
+    if let Some(p) = lock(&ctx.shaders.parsed).get(file) {
+        return Ok(p.clone());
+    }
+    let parsed = Arc::new(specialise::parse(file, &super::shaders::compose(file))?);
+    Ok(lock(&ctx.shaders.parsed)
+        .entry(file)
+        .or_insert(parsed)
+        .clone())
+}
+
+/// The shader module of one variant of pass `file` ([`specialise::specialise`]), created
 /// without wgpu's injected bounds checks and loop counters: those cost a clamp per access
 /// and a counter per loop iteration, a large share of the frame time on lavapipe.
 ///
@@ -16,26 +31,24 @@ use std::hash::Hash;
 /// clamped to MAX_ISO, G-buffer layers below the layer count the textures were made with,
 /// the cone table indexed modulo its length), and every loop advances toward a bound (ray
 /// steps, bisection steps, samples, lights, components, bounces).
-/// The device compiles each file once ([`super::context::ShaderStore`]).
-pub(crate) fn shader_module(ctx: &Context, file: &'static str) -> Result<wgpu::ShaderModule> {
-    if let Some(m) = lock(&ctx.shaders.modules).get(file) {
-        return Ok(m.clone());
-    }
-    let module = ctx.checked(&format!("compiling shader {file}"), || {
+fn variant_module(
+    ctx: &Context,
+    file: &'static str,
+    entry: &str,
+    constants: &[(&'static str, f64)],
+) -> Result<wgpu::ShaderModule> {
+    let module = specialise::specialise(file, &*parsed_shader(ctx, file)?, entry, constants)?;
+    ctx.checked(&format!("compiling shader {file}"), || {
         let desc = wgpu::ShaderModuleDescriptor {
             label: Some(file),
-            source: wgpu::ShaderSource::Wgsl(super::shaders::compose(file).into()),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
         };
         // SAFETY: see the function's documentation.
         unsafe {
             ctx.device
                 .create_shader_module_trusted(desc, wgpu::ShaderRuntimeChecks::unchecked())
         }
-    })?;
-    Ok(lock(&ctx.shaders.modules)
-        .entry(file)
-        .or_insert(module)
-        .clone())
+    })
 }
 
 /// A pipeline layout of `groups` bind group layouts.
@@ -71,7 +84,7 @@ pub(crate) fn compute_pipeline(
     if let Some(p) = lock(&ctx.shaders.pipelines).get(&key) {
         return Ok(p.clone());
     }
-    let module = shader_module(ctx, file)?;
+    let module = variant_module(ctx, file, entry, constants)?;
     let pipeline = ctx.checked(&format!("creating the {label} pipeline"), || {
         ctx.device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -80,13 +93,16 @@ pub(crate) fn compute_pipeline(
                 module: &module,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
+                    constants: &[],
                     // no pass uses workgroup memory
                     zero_initialize_workgroup_memory: false,
                 },
-                cache: None,
+                cache: ctx.shaders.disk.as_ref().map(|d| &d.cache),
             })
     })?;
+    if let Some(disk) = &ctx.shaders.disk {
+        disk.save();
+    }
     Ok(lock(&ctx.shaders.pipelines)
         .entry(key)
         .or_insert(pipeline)
@@ -158,7 +174,7 @@ impl<K: Variant> PipelineCache<K> {
         groups: &[&wgpu::BindGroupLayout],
     ) -> Result<PipelineCache<K>> {
         // compiled here, so that a broken shader fails the pass's creation
-        shader_module(ctx, file)?;
+        parsed_shader(ctx, file)?;
         Ok(PipelineCache {
             file,
             label,

@@ -31,38 +31,44 @@ use std::collections::HashMap;
 use super::volume::{beyond_f32, ScalarType, Scalars};
 use crate::error::{Error, Result};
 
-/// A cell type the renderer takes, with its VTK code as discriminant.
+/// A cell type the renderer takes. VTK numbers these five consecutively, from VTK_TETRA
+/// (10) to VTK_PYRAMID (14), in the order the variants are declared.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[repr(u8)]
 pub enum CellType {
     /// VTK_TETRA: 4 points.
-    Tetra = 10,
+    Tetra,
     /// VTK_VOXEL: 8 points of an axis-aligned box, x fastest (not a hexahedron's order).
-    Voxel = 11,
+    Voxel,
     /// VTK_HEXAHEDRON: 8 points, the bottom quad (0–3) then the top quad (4–7).
-    Hexahedron = 12,
+    Hexahedron,
     /// VTK_WEDGE: 6 points, two triangles (0–2, 3–5).
-    Wedge = 13,
+    Wedge,
     /// VTK_PYRAMID: 5 points, the base quad (0–3) and the apex (4).
-    Pyramid = 14,
+    Pyramid,
 }
 
+/// VTK's code of the first type the renderer takes (VTK_TETRA).
+const FIRST_VTK_CODE: u8 = 10;
+
 impl CellType {
+    /// Every type the renderer takes, in VTK's code order.
+    pub const ALL: [CellType; 5] = [
+        CellType::Tetra,
+        CellType::Voxel,
+        CellType::Hexahedron,
+        CellType::Wedge,
+        CellType::Pyramid,
+    ];
+
     /// The type VTK calls `code`, if the renderer takes it.
     pub fn from_vtk(code: u8) -> Option<CellType> {
-        Some(match code {
-            10 => CellType::Tetra,
-            11 => CellType::Voxel,
-            12 => CellType::Hexahedron,
-            13 => CellType::Wedge,
-            14 => CellType::Pyramid,
-            _ => return None,
-        })
+        let index = code.checked_sub(FIRST_VTK_CODE)?;
+        Self::ALL.get(usize::from(index)).copied()
     }
 
     /// VTK's code for this type.
     pub fn vtk_code(self) -> u8 {
-        self as u8
+        FIRST_VTK_CODE + self as u8
     }
 
     /// The number of points of a cell of this type.
