@@ -45,9 +45,10 @@ def bunyk():
     return m
 
 
-def render(mapper, grid, prop=None, size=(300, 300)):
+def render(mapper, grid, prop=None, size=(300, 300), actors=()):
     errors = Errors(mapper)
-    scene = Scene(mapper, grid, prop or wavelet_property(), size=size, camera=view)
+    scene = Scene(mapper, grid, prop or wavelet_property(), size=size, camera=view,
+                  actors=actors)
     return scene.render(), errors
 
 
@@ -68,12 +69,12 @@ class AgainstVtk(unittest.TestCase):
         cls.mixed = meshes.mixed()
         cls.mixed_tets = meshes.tetrahedralised(cls.mixed)
 
-    def check(self, name, ours_grid, vtk_grid, floor=(FLOOR_SSIM, FLOOR_PSNR)):
+    def check(self, name, ours_grid, vtk_grid, floor=(FLOOR_SSIM, FLOOR_PSNR), actors=None):
         mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
-        ours, errors = render(mapper, ours_grid)
+        ours, errors = render(mapper, ours_grid, actors=actors() if actors else ())
         self.assertEqual(errors.messages, [])
         self.assertTrue(mapper.GetLastRenderDrew())
-        theirs, _ = render(bunyk(), vtk_grid)
+        theirs, _ = render(bunyk(), vtk_grid, actors=actors() if actors else ())
         self.assertGreater(coverage(ours), 0.2, "ferrovol's image is (nearly) empty")
         self.assertGreater(coverage(theirs), 0.2, "VTK's image is (nearly) empty")
         s, p = compare("unstructured-" + name, ours, theirs)
@@ -94,6 +95,26 @@ class AgainstVtk(unittest.TestCase):
         # ferrovol's own split (hexahedra into 12 about their centroid) against
         # vtkDataSetTriangleFilter's: the interpolants differ inside the cells
         self.check("mixed", self.mixed, self.mixed_tets)
+
+    def test_opaque_geometry(self):
+        """An opaque sphere half inside the mesh: the rays stop at its depth, as the ray
+        caster's (IntermixIntersectingGeometry, on by default) do."""
+        self.check("wavelet-sphere", self.wavelet, self.wavelet,
+                   actors=lambda: [fvtest.sphere_actor((4.0, 4.0, 8.0), 5.0, (0.9, 0.8, 0.2))])
+
+    def test_clipping_plane(self):
+        """A clipping plane through the middle: half the mesh is drawn."""
+        plane = vtk.vtkPlane()
+        plane.SetOrigin(0.0, 0.0, 0.0)
+        plane.SetNormal(1.0, 0.0, 0.0)
+        mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        mapper.AddClippingPlane(plane)
+        clipped, errors = render(mapper, self.wavelet, size=(80, 80))
+        whole, _ = render(ferrovol.vtkFerroUnstructuredVolumeMapper(), self.wavelet,
+                          size=(80, 80))
+        self.assertEqual(errors.messages, [])
+        self.assertLess(coverage(clipped), 0.8 * coverage(whole))
+        self.assertGreater(coverage(clipped), 0.3 * coverage(whole))
 
     def test_blend_modes(self):
         """The modes VTK's unstructured mappers ignore: each draws, MIP differs from
