@@ -18,8 +18,9 @@
  * default, VTK's unstructured ray caster's), maximum and minimum intensity, average and
  * additive, as vtkVolumeMapper numbers them; VTK's own unstructured mappers ignore the
  * blend mode and always composite. The mapper's clipping planes and the vtkVolume's matrix
- * are honoured; shading, gradient opacity and 2D transfer functions are not (refused with
- * an error naming them). Errors from ferrovol reach vtkErrorMacro with its message.
+ * are honoured; the property's Shade is ignored, as VTK's unstructured mappers ignore it, and
+ * a gradient opacity or 2D transfer function is refused with an error naming it. Errors
+ * from ferrovol reach vtkErrorMacro with its message.
  */
 #ifndef vtkFerroUnstructuredVolumeMapper_h
 #define vtkFerroUnstructuredVolumeMapper_h

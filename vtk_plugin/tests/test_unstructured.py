@@ -2,9 +2,10 @@
 (vtkUnstructuredGridVolumeRayCastMapper, one ray per pixel, its linear integrator: the
 quantity ferrovol integrates) on tests/regression/meshes.py's tetrahedralised wavelet and
 mixed mesh (VTK gets the mixed mesh split into tetrahedra, ferrovol gets it as it is and as
-VTK's split), point and cell scalars; the blend modes VTK's mappers lack draw; bad input
-(an empty grid, unsupported cells, two components) is an ErrorEvent naming why, not a crash,
-and a good input renders again after it."""
+VTK's split), point and cell scalars, opaque geometry; the blend modes VTK's mappers lack
+draw; clipping planes and the array selection apply; bad input (an empty grid, unsupported
+cells, two components, no scalars, a gradient opacity) is an ErrorEvent naming why, not a
+crash, and a good input renders again after it."""
 import os
 import sys
 import unittest
@@ -205,6 +206,18 @@ class BadInput(unittest.TestCase):
         two.Fill(100.0)
         g.GetPointData().SetScalars(two)
         self.refused(g, ["2 components", "one"])
+
+    def test_gradient_opacity(self):
+        g = vtk.vtkPiecewiseFunction()
+        g.AddPoint(0.0, 0.0)
+        g.AddPoint(10.0, 1.0)
+        prop = self.scene.volume.GetProperty()
+        prop.SetGradientOpacity(g)
+        self.assertLess(coverage(self.scene.render()), 0.01)
+        self.assertFalse(self.mapper.GetLastRenderDrew())
+        self.assertIn("gradient opacity", self.errors.last())
+        prop.DisableGradientOpacityOn()
+        self.assertGreater(coverage(self.scene.render()), 0.1)
 
     def test_no_scalars(self):
         g = vtk.vtkUnstructuredGrid()
