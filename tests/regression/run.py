@@ -6,7 +6,7 @@ vtkGPUVolumeRayCastMapper (the reference), vtkFixedPointVolumeRayCastMapper (a s
 opinion, where it supports the scene) and vtkFerroVolumeMapper; an unstructured-grid scene
 by vtkUnstructuredGridVolumeRayCastMapper (the reference), vtkUnstructuredGridVolumeZSweepMapper
 and vtkProjectedTetrahedraMapper (second opinions) and vtkFerroUnstructuredVolumeMapper
-(once the module `ferrovol` has it). ferrovol's image and the second opinions are each
+(pending where the module `ferrovol` lacks it). ferrovol's image and the second opinions are each
 compared with the reference (SSIM, PSNR, mean FLIP, mean colour
 difference inside the volume's footprint) and ferrovol's figures are held against
 thresholds.toml. Writes build/regression/index.html (images side by side, figures,

@@ -1,7 +1,7 @@
 """The regression suite's unstructured-grid scenes (issue 40): the meshes of meshes.py drawn
 by vtkUnstructuredGridVolumeRayCastMapper (the reference), vtkUnstructuredGridVolumeZSweepMapper
 and vtkProjectedTetrahedraMapper (second opinions) and ferrovol's
-vtkFerroUnstructuredVolumeMapper, pending until the module `ferrovol` has it. scenes.py
+vtkFerroUnstructuredVolumeMapper (pending where the module `ferrovol` lacks it). scenes.py
 adds DATA and SCENES to its own (import scenes, not this module, first); UNSTRUCTURED.md
 has VTK's conventions and the figures.
 """

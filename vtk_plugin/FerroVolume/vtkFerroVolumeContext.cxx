@@ -123,3 +123,12 @@ std::string vtkFerroVolumeFailure(const char* what, const ferrovol::Error& e)
   }
   return s.str();
 }
+
+bool vtkFerroVolumeRendererSlot::Make(vtkFerroVolumeReport& report)
+{
+  this->Renderer.reset();
+  const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(report);
+  this->Generation = vtkFerroVolumeContext::Generation();
+  return ctx && vtkFerroVolumeCall("create a renderer", report,
+                  [&] { this->Renderer.reset(new ferrovol::Renderer(*ctx)); });
+}

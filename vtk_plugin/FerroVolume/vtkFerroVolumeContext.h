@@ -7,6 +7,7 @@
 #include "vtkFerroVolumeReport.h"
 #include "vtkType.h"
 
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -51,6 +52,23 @@ private:
   bool Tried = false;
   std::string Error;
   std::string Desc;
+};
+
+// A mapper's ferrovol renderer and the device generation it was made under.
+struct vtkFerroVolumeRendererSlot
+{
+  std::unique_ptr<ferrovol::Renderer> Renderer;
+  // vtkFerroVolumeContext::Generation() when the renderer was made
+  unsigned Generation = 0;
+
+  // Whether the renderer was made on a device since lost.
+  bool Lost() const
+  {
+    return this->Renderer && this->Generation != vtkFerroVolumeContext::Generation();
+  }
+  // A new renderer from the process-wide device (the old one released first); false with
+  // the reason.
+  bool Make(vtkFerroVolumeReport& report);
 };
 
 // "ferrovol could not <what> (FV_STATUS_…): <the library's message>"; a lost device is

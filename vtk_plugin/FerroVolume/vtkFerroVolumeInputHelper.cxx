@@ -23,45 +23,6 @@
 
 namespace
 {
-// ferrovol's scalar type and the byte size of a VTK scalar type; false when ferrovol has none.
-bool ToFvScalarType(int vtkType, uint32_t& fvType, size_t& size)
-{
-  struct Entry
-  {
-    int Vtk;
-    FvScalarType Fv;
-    size_t Size;
-  };
-  static const Entry table[] = {
-    { VTK_CHAR, std::numeric_limits<char>::is_signed ? FV_SCALAR_TYPE_I8 : FV_SCALAR_TYPE_U8, 1 },
-    { VTK_SIGNED_CHAR, FV_SCALAR_TYPE_I8, 1 },
-    { VTK_UNSIGNED_CHAR, FV_SCALAR_TYPE_U8, 1 },
-    { VTK_BIT, FV_SCALAR_TYPE_U8, 1 }, // converted to one byte per value first
-    { VTK_SHORT, FV_SCALAR_TYPE_I16, 2 },
-    { VTK_UNSIGNED_SHORT, FV_SCALAR_TYPE_U16, 2 },
-    { VTK_INT, FV_SCALAR_TYPE_I32, 4 },
-    { VTK_UNSIGNED_INT, FV_SCALAR_TYPE_U32, 4 },
-    { VTK_LONG, sizeof(long) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32, sizeof(long) },
-    { VTK_UNSIGNED_LONG, sizeof(unsigned long) == 8 ? FV_SCALAR_TYPE_U64 : FV_SCALAR_TYPE_U32,
-      sizeof(unsigned long) },
-    { VTK_LONG_LONG, FV_SCALAR_TYPE_I64, 8 },
-    { VTK_UNSIGNED_LONG_LONG, FV_SCALAR_TYPE_U64, 8 },
-    { VTK_ID_TYPE, sizeof(vtkIdType) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32,
-      sizeof(vtkIdType) },
-    { VTK_FLOAT, FV_SCALAR_TYPE_F32, 4 },
-    { VTK_DOUBLE, FV_SCALAR_TYPE_F64, 8 },
-  };
-  for (const Entry& e : table)
-  {
-    if (e.Vtk == vtkType)
-    {
-      fvType = static_cast<uint32_t>(e.Fv);
-      size = e.Size;
-      return true;
-    }
-  }
-  return false;
-}
 
 // The scalars of the input as VTK's mappers pick them (ScalarMode, SelectScalarArray), or an
 // error saying why there are none.
@@ -188,7 +149,7 @@ bool PrepareVolume(vtkImageData* image, vtkDataArray* scalars, bool cells, Prepa
   }
   uint32_t fvType = 0;
   size_t typeSize = 0;
-  if (!ToFvScalarType(scalars->GetDataType(), fvType, typeSize))
+  if (!vtkFerroVolumeInputHelper::ToFvScalarType(scalars->GetDataType(), fvType, typeSize))
   {
     return report.Fail(std::string("scalars of type ") + scalars->GetDataTypeAsString() +
       " cannot be volume rendered (cast them with vtkImageCast)");
@@ -374,6 +335,45 @@ std::array<std::vector<double>, 3> GridCoordinates(
   return out;
 }
 } // namespace
+
+bool vtkFerroVolumeInputHelper::ToFvScalarType(int vtkType, uint32_t& fvType, size_t& size)
+{
+  struct Entry
+  {
+    int Vtk;
+    FvScalarType Fv;
+    size_t Size;
+  };
+  static const Entry table[] = {
+    { VTK_CHAR, std::numeric_limits<char>::is_signed ? FV_SCALAR_TYPE_I8 : FV_SCALAR_TYPE_U8, 1 },
+    { VTK_SIGNED_CHAR, FV_SCALAR_TYPE_I8, 1 },
+    { VTK_UNSIGNED_CHAR, FV_SCALAR_TYPE_U8, 1 },
+    { VTK_BIT, FV_SCALAR_TYPE_U8, 1 }, // converted to one byte per value first
+    { VTK_SHORT, FV_SCALAR_TYPE_I16, 2 },
+    { VTK_UNSIGNED_SHORT, FV_SCALAR_TYPE_U16, 2 },
+    { VTK_INT, FV_SCALAR_TYPE_I32, 4 },
+    { VTK_UNSIGNED_INT, FV_SCALAR_TYPE_U32, 4 },
+    { VTK_LONG, sizeof(long) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32, sizeof(long) },
+    { VTK_UNSIGNED_LONG, sizeof(unsigned long) == 8 ? FV_SCALAR_TYPE_U64 : FV_SCALAR_TYPE_U32,
+      sizeof(unsigned long) },
+    { VTK_LONG_LONG, FV_SCALAR_TYPE_I64, 8 },
+    { VTK_UNSIGNED_LONG_LONG, FV_SCALAR_TYPE_U64, 8 },
+    { VTK_ID_TYPE, sizeof(vtkIdType) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32,
+      sizeof(vtkIdType) },
+    { VTK_FLOAT, FV_SCALAR_TYPE_F32, 4 },
+    { VTK_DOUBLE, FV_SCALAR_TYPE_F64, 8 },
+  };
+  for (const Entry& e : table)
+  {
+    if (e.Vtk == vtkType)
+    {
+      fvType = static_cast<uint32_t>(e.Fv);
+      size = e.Size;
+      return true;
+    }
+  }
+  return false;
+}
 
 bool vtkFerroVolumeInputHelper::Key::operator==(const Key& o) const
 {

@@ -27,6 +27,10 @@ class vtkVolumeMapper;
 class vtkFerroVolumeInputHelper
 {
 public:
+  // ferrovol's scalar type and the byte size of a VTK scalar type; false when ferrovol has
+  // none.
+  static bool ToFvScalarType(int vtkType, uint32_t& fvType, size_t& size);
+
   using Ranges = std::array<std::array<double, 2>, 4>;
 
   // Updates the mapper's input and finds its image and scalars (ScalarMode,

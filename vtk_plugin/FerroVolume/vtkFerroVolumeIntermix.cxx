@@ -179,7 +179,8 @@ bool vtkFerroVolumeIntermix::Update(vtkVolumeMapper* self, vtkMultiVolume* multi
   for (size_t i = 0; i < this->Ports.size(); ++i)
   {
     Port& p = this->Ports[i];
-    if (!vtkFerroVolumeLookupTables::BuildIntermixed(p.Property, p.Range, types, tfs[i], report))
+    if (!vtkFerroVolumeLookupTables::BuildFirstComponent(
+          p.Property, p.Range, types, "intermixed volumes", tfs[i], report))
     {
       report.PrefixError("port " + std::to_string(p.Index) + ": ");
       p.Property = nullptr;

@@ -528,19 +528,19 @@ double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
   return std::cbrt(std::fabs(volume->GetMatrix()->Determinant()));
 }
 
-bool vtkFerroVolumeLookupTables::BuildIntermixed(vtkVolumeProperty* prop,
-  const std::array<double, 2>& range, const RangeTypes& types,
+bool vtkFerroVolumeLookupTables::BuildFirstComponent(vtkVolumeProperty* prop,
+  const std::array<double, 2>& range, const RangeTypes& types, const char* what,
   std::unique_ptr<ferrovol::TransferFunction>& tf, vtkFerroVolumeReport& report)
 {
   if (prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D)
   {
-    return report.Fail("its property has a 2D transfer function: intermixed volumes are "
-                       "classified by 1D colour and scalar opacity functions");
+    return report.Fail(std::string("its property has a 2D transfer function: ") + what +
+      " are classified by 1D colour and scalar opacity functions");
   }
   if (prop->HasGradientOpacity(0) && !prop->GetDisableGradientOpacity(0))
   {
-    return report.Fail("its property has a gradient opacity function: intermixed volumes are "
-                       "classified by colour and scalar opacity only (DisableGradientOpacityOn)");
+    return report.Fail(std::string("its property has a gradient opacity function: ") + what +
+      " are classified by colour and scalar opacity only (DisableGradientOpacityOn)");
   }
   vtkFerroVolumeInputHelper::Ranges ranges{};
   ranges[0] = range;

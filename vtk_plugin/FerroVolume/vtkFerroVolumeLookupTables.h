@@ -49,10 +49,11 @@ public:
     const RangeTypes& rangeTypes, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   // The transfer function of `prop`'s first component over the data range `range`, for a
-  // volume intermixed with the main one (colour and scalar opacity: a gradient opacity or
-  // 2D function is refused); false with the reason.
-  static bool BuildIntermixed(vtkVolumeProperty* prop, const std::array<double, 2>& range,
-    const RangeTypes& types, std::unique_ptr<ferrovol::TransferFunction>& tf,
+  // volume intermixed with the main one or a mesh (colour and scalar opacity: a gradient
+  // opacity or 2D function is refused, saying that `what`, "intermixed volumes", are drawn
+  // without); false with the reason.
+  static bool BuildFirstComponent(vtkVolumeProperty* prop, const std::array<double, 2>& range,
+    const RangeTypes& types, const char* what, std::unique_ptr<ferrovol::TransferFunction>& tf,
     vtkFerroVolumeReport& report);
 
   // Forget the upload (the renderer is gone).

@@ -108,13 +108,13 @@ int vtkFerroVolumeMapper::GetTableUploadCount()
 
 int vtkFerroVolumeMapper::GetAccumulatedSamples()
 {
-  if (!this->Internals->Renderer)
+  if (!this->Internals->Slot.Renderer)
   {
     return -1;
   }
   try
   {
-    return static_cast<int>(this->Internals->Renderer->accumulated_samples());
+    return static_cast<int>(this->Internals->Slot.Renderer->accumulated_samples());
   }
   catch (const ferrovol::Error&)
   {

@@ -174,7 +174,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     uint32_t before = 0;
     if (!vtkFerroVolumeCall("count the accumulated paths", report,
-          [&] { before = in->Renderer->accumulated_samples(); }))
+          [&] { before = in->Slot.Renderer->accumulated_samples(); }))
     {
       vtkErrorMacro(<< report.GetError());
       return;
@@ -186,7 +186,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   }
   in->Settings.SetIntermixing(multi != nullptr);
   switch (
-    in->Settings.Apply(this, ren, main, in->Input, *in->Renderer, traceBudget, report))
+    in->Settings.Apply(this, ren, main, in->Input, *in->Slot.Renderer, traceBudget, report))
   {
     case vtkFerroVolumeSettings::Result::Failed:
       vtkErrorMacro(<< report.GetError());
@@ -199,14 +199,12 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
 
   // Camera and lights for this viewport.
   vtkFerroVolumeFrameRequest req;
-  req.Window = win;
-  ren->GetTiledSizeAndOrigin(&req.ViewportW, &req.ViewportH, &req.ViewportX, &req.ViewportY);
-  if (req.ViewportW < 1 || req.ViewportH < 1)
+  if (!req.ForViewport(ren, vol, win))
   {
     return;
   }
   if (!in->Settings.ApplyView(
-        this, ren, req.ViewportW, req.ViewportH, *in->Renderer, report))
+        this, ren, req.ViewportW, req.ViewportH, *in->Slot.Renderer, report))
   {
     vtkErrorMacro(<< report.GetError());
     return;
@@ -216,12 +214,11 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   // AutoAdjustSampleDistances is on or off, as VTK 9.2), through the output path.
   req.RenderW = std::max(1, static_cast<int>(req.ViewportW / this->ImageSampleDistance));
   req.RenderH = std::max(1, static_cast<int>(req.ViewportH / this->ImageSampleDistance));
-  req.UseDepth = vtkFerroVolumeDepthReader::SceneHasOpaqueGeometry(ren, vol);
   req.ColorScale = 1.0f / this->FinalColorWindow;
   req.ColorBias = 0.5f - this->FinalColorLevel / this->FinalColorWindow;
   if (peeling && !selector && !this->RenderToImage)
   {
-    if (!in->Peeling.Draw(peeling, this, vol, *in->Renderer, req, report))
+    if (!in->Peeling.Draw(peeling, this, vol, *in->Slot.Renderer, req, report))
     {
       vtkErrorMacro(<< report.GetError());
       return;
@@ -234,7 +231,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   std::string warning;
   // (a frame summed across processes is read back, and the sum written into its texture)
   const int outputPath = in->PieceSum.Pending() ? OUTPUT_PATH_READBACK : this->OutputPath;
-  if (!in->Output.Render(outputPath, *in->Renderer, req, report, warning))
+  if (!in->Output.Render(outputPath, *in->Slot.Renderer, req, report, warning))
   {
     vtkErrorMacro(<< report.GetError());
     return;
@@ -331,7 +328,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
     // Refine while the accumulation is short of SamplesPerPixel.
     uint32_t samples = 0;
     if (!vtkFerroVolumeCall("count the accumulated paths", report,
-          [&] { samples = in->Renderer->accumulated_samples(); }))
+          [&] { samples = in->Slot.Renderer->accumulated_samples(); }))
     {
       vtkErrorMacro(<< report.GetError());
       in->Refinement.Stop();

@@ -47,9 +47,7 @@
 class vtkFerroVolumeMapper::vtkInternals
 {
 public:
-  std::unique_ptr<ferrovol::Renderer> Renderer;
-  // vtkFerroVolumeContext::Generation() when the renderer was made
-  unsigned RendererGeneration = 0;
+  vtkFerroVolumeRendererSlot Slot;
   vtkFerroVolumeInputHelper Input;
   vtkFerroVolumeLookupTables Tables;
   vtkFerroVolumeIntermix Intermix;
@@ -72,27 +70,21 @@ public:
   }
   ~vtkInternals() { this->FreeRenderer(); }
 
-  // The renderer, created on first use from the process-wide device; the passes of a
-  // streamed frame (a volume over the memory budget) report to `self`'s progress.
   // Whether the renderer was made on a device since lost.
-  bool RendererLost() const
-  {
-    return this->Renderer && this->RendererGeneration != vtkFerroVolumeContext::Generation();
-  }
+  bool RendererLost() const { return this->Slot.Lost(); }
 
-  // A renderer made on a device since lost is made again (with its input and tables).
+  // The renderer, created on first use from the process-wide device; the passes of a
+  // streamed frame (a volume over the memory budget) report to `self`'s progress. A
+  // renderer made on a device since lost is made again (with its input and tables).
   bool MakeRenderer(vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report)
   {
-    if (this->Renderer && !this->RendererLost())
+    if (this->Slot.Renderer && !this->Slot.Lost())
     {
       return true;
     }
     this->FreeRenderer();
-    const ferrovol::Context* ctx = vtkFerroVolumeContext::Acquire(report);
-    this->RendererGeneration = vtkFerroVolumeContext::Generation();
-    return ctx && vtkFerroVolumeCall("create a renderer", report, [&] {
-      this->Renderer.reset(new ferrovol::Renderer(*ctx));
-      this->Renderer->set_progress(&vtkInternals::StreamProgress, self);
+    return this->Slot.Make(report) && vtkFerroVolumeCall("create a renderer", report, [&] {
+      this->Slot.Renderer->set_progress(&vtkInternals::StreamProgress, self);
     });
   }
 
@@ -122,29 +114,29 @@ public:
     types.GradientOpacity = self->GetGradientOpacityRangeType();
     this->Input.SetWholeRanges(this->WholeRanges);
     if (!(this->Input.Select(self, report) && this->MakeRenderer(self, report) &&
-          this->Input.Upload(*this->Renderer, budget, report)))
+          this->Input.Upload(*this->Slot.Renderer, budget, report)))
     {
       return false;
     }
-    if (!this->Input.UpdateBlanking(*this->Renderer, report))
+    if (!this->Input.UpdateBlanking(*this->Slot.Renderer, report))
     {
       report.WarnOnce("blanking",
         "the ghost arrays' blanking is not applied (the cells are drawn): " + report.GetError());
       report.ClearError();
     }
     if (!this->Input.UpdateMask(
-          self->GetMaskInput(), self->GetMaskType(), *this->Renderer, report))
+          self->GetMaskInput(), self->GetMaskType(), *this->Slot.Renderer, report))
     {
       report.PrefixError("MaskInput: ");
       return false;
     }
-    return this->Tables.Update(vol, this->Input, types, *this->Renderer, report) &&
-      this->Intermix.Update(self, multi, types, *this->Renderer, report);
+    return this->Tables.Update(vol, this->Input, types, *this->Slot.Renderer, report) &&
+      this->Intermix.Update(self, multi, types, *this->Slot.Renderer, report);
   }
 
   void FreeRenderer()
   {
-    this->Renderer.reset();
+    this->Slot.Renderer.reset();
     this->Input.Reset();
     this->Tables.Reset();
     this->Intermix.Reset();
@@ -171,13 +163,13 @@ public:
   // The renderer's counters; false before the first frame.
   bool Stats(FvStats& s) const
   {
-    if (!this->Renderer)
+    if (!this->Slot.Renderer)
     {
       return false;
     }
     try
     {
-      s = this->Renderer->stats();
+      s = this->Slot.Renderer->stats();
       return true;
     }
     catch (const ferrovol::Error&)
@@ -198,7 +190,7 @@ public:
     {
       if (!this->Convergence || this->ConvergenceFrame != s.frames)
       {
-        this->Convergence = this->Renderer->convergence();
+        this->Convergence = this->Slot.Renderer->convergence();
         this->ConvergenceFrame = s.frames;
       }
       c = *this->Convergence;

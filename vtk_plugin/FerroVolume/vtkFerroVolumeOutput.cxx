@@ -38,6 +38,18 @@ void vtkFerroVolumeSetSampling(vtkTextureObject* texture, bool linear)
   texture->SetWrapT(vtkTextureObject::ClampToEdge);
 }
 
+bool vtkFerroVolumeFrameRequest::ForViewport(
+  vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* win)
+{
+  this->Window = win;
+  ren->GetTiledSizeAndOrigin(
+    &this->ViewportW, &this->ViewportH, &this->ViewportX, &this->ViewportY);
+  this->RenderW = this->ViewportW;
+  this->RenderH = this->ViewportH;
+  this->UseDepth = vtkFerroVolumeDepthReader::SceneHasOpaqueGeometry(ren, vol);
+  return this->ViewportW >= 1 && this->ViewportH >= 1;
+}
+
 namespace
 {
 // Frames through the CPU: VTK's depth with glReadPixels, the frame back with read_frame and

@@ -43,6 +43,10 @@ struct vtkFerroVolumeFrameRequest
   // ColorBias = 1/2 − level / window (1 and 0 by default: unchanged).
   float ColorScale = 1.0f;
   float ColorBias = 0.0f;
+
+  // The request for `ren`'s viewport in `win`, rendered at the viewport's size, with
+  // UseDepth from the scene's props besides `vol`; false when the viewport is empty.
+  bool ForViewport(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* win);
 };
 
 // Linear (colour) or nearest (depth) filtering, clamped to the edges.

@@ -190,8 +190,7 @@ double ClippedIntensityInDataUnits(int type, double value, const std::array<doub
 
 } // namespace
 
-bool vtkFerroVolumeSettings::SelectBlendMode(
-  vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report)
+bool vtkFerroVolumeSettings::ToFvBlend(int vtkBlendMode, uint32_t& blend)
 {
   static const std::pair<int, FvBlendMode> modes[] = {
     { vtkVolumeMapper::COMPOSITE_BLEND, FV_BLEND_MODE_COMPOSITE },
@@ -203,16 +202,28 @@ bool vtkFerroVolumeSettings::SelectBlendMode(
     { vtkVolumeMapper::SLICE_BLEND, FV_BLEND_MODE_SLICE },
   };
   const auto mode = std::find_if(std::begin(modes), std::end(modes),
-    [&](const std::pair<int, FvBlendMode>& m) { return m.first == self->GetBlendMode(); });
+    [&](const std::pair<int, FvBlendMode>& m) { return m.first == vtkBlendMode; });
   if (mode == std::end(modes))
+  {
+    return false;
+  }
+  blend = mode->second;
+  return true;
+}
+
+bool vtkFerroVolumeSettings::SelectBlendMode(
+  vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report)
+{
+  uint32_t blend = FV_BLEND_MODE_COMPOSITE;
+  if (!ToFvBlend(self->GetBlendMode(), blend))
   {
     return report.Fail("blend mode " + std::to_string(self->GetBlendMode()) +
       " is not supported by vtkFerroVolumeMapper (composite, maximum, minimum, average, "
       "additive, isosurface and slice are): nothing is drawn");
   }
   this->Blend = self->GetRenderMode() == vtkFerroVolumeMapper::RENDER_MODE_PATH_TRACE
-    ? FV_BLEND_MODE_PATH_TRACE
-    : mode->second;
+    ? static_cast<uint32_t>(FV_BLEND_MODE_PATH_TRACE)
+    : blend;
   return true;
 }
 
@@ -278,7 +289,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   this->SetUpRayOptions(self, ren);
   this->SetUpWholeExtent(self, input);
   this->SetUpQuadrature(self, report);
-  ToColumnMajor(vol->GetMatrix(), params.volume_matrix);
+  SetVolumeMatrix(vol, params);
   this->Background = false;
   if (this->Blend == FV_BLEND_MODE_ISOSURFACE)
   {
@@ -497,29 +508,7 @@ void vtkFerroVolumeSettings::SetUpCroppingAndClipping(vtkFerroVolumeMapper* self
   const double* crop = self->GetCroppingRegionPlanes();
   std::copy(crop, crop + 6, params.cropping_planes);
   params.cropping_regions = static_cast<uint32_t>(self->GetCroppingRegionFlags());
-  vtkPlaneCollection* planes = self->GetClippingPlanes();
-  if (!planes)
-  {
-    return;
-  }
-  int count = planes->GetNumberOfItems();
-  if (count > FV_MAX_CLIP_PLANES)
-  {
-    if (report.FirstTime("planes"))
-    {
-      vtkWarningWithObjectMacro(self,
-        << count << " clipping planes: ferrovol, as vtkGPUVolumeRayCastMapper, takes at most "
-        << FV_MAX_CLIP_PLANES << " and uses the first " << FV_MAX_CLIP_PLANES);
-    }
-    count = FV_MAX_CLIP_PLANES;
-  }
-  for (int i = 0; i < count; ++i)
-  {
-    vtkPlane* plane = planes->GetItem(i);
-    plane->GetOrigin(params.clip_planes[i].origin);
-    plane->GetNormal(params.clip_planes[i].normal);
-  }
-  params.clip_plane_count = static_cast<uint32_t>(count);
+  const int count = SetUpClippingPlanes(self->GetClippingPlanes(), params, report);
   if (!prop->GetUseClippedVoxelIntensity() || count == 0)
   {
     return;
@@ -540,6 +529,28 @@ void vtkFerroVolumeSettings::SetUpCroppingAndClipping(vtkFerroVolumeMapper* self
                                                    : "normals from the opacity")
                                     << " read the data beyond the clipping planes");
   }
+}
+
+int vtkFerroVolumeSettings::SetUpClippingPlanes(
+  vtkPlaneCollection* planes, FvRenderParams& params, vtkFerroVolumeReport& report)
+{
+  int count = planes ? planes->GetNumberOfItems() : 0;
+  if (count > FV_MAX_CLIP_PLANES)
+  {
+    report.WarnOnce("planes",
+      std::to_string(count) + " clipping planes: ferrovol, as vtkGPUVolumeRayCastMapper, " +
+        "takes at most " + std::to_string(FV_MAX_CLIP_PLANES) + " and uses the first " +
+        std::to_string(FV_MAX_CLIP_PLANES));
+    count = FV_MAX_CLIP_PLANES;
+  }
+  for (int i = 0; i < count; ++i)
+  {
+    vtkPlane* plane = planes->GetItem(i);
+    plane->GetOrigin(params.clip_planes[i].origin);
+    plane->GetNormal(params.clip_planes[i].normal);
+  }
+  params.clip_plane_count = static_cast<uint32_t>(count);
+  return count;
 }
 
 void vtkFerroVolumeSettings::SetUpRayOptions(vtkFerroVolumeMapper* self, vtkRenderer* ren)
@@ -610,11 +621,22 @@ void vtkFerroVolumeSettings::SetUpQuadrature(
   }
 }
 
+void vtkFerroVolumeSettings::SetVolumeMatrix(vtkVolume* vol, FvRenderParams& params)
+{
+  ToColumnMajor(vol->GetMatrix(), params.volume_matrix);
+}
+
+bool vtkFerroVolumeSettings::ApplyCamera(
+  vtkRenderer* ren, int vw, int vh, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report)
+{
+  return vtkFerroVolumeCall(
+    "use the camera", report, [&] { renderer.set_camera(ToFvCamera(ren, vw, vh)); });
+}
+
 bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw,
   int vh, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report)
 {
-  if (!vtkFerroVolumeCall(
-        "use the camera", report, [&] { renderer.set_camera(ToFvCamera(ren, vw, vh)); }))
+  if (!ApplyCamera(ren, vw, vh, renderer, report))
   {
     return false;
   }

@@ -13,6 +13,7 @@
 class vtkFerroVolumeInputHelper;
 class vtkFerroVolumeMapper;
 class vtkFerroVolumeReport;
+class vtkPlaneCollection;
 class vtkRenderer;
 class vtkVolume;
 class vtkVolumeProperty;
@@ -23,6 +24,9 @@ public:
   // The mapper's blend mode (or path tracing) in ferrovol's terms; false with the reason
   // when ferrovol has no such mode.
   bool SelectBlendMode(vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report);
+  // vtkVolumeMapper's blend mode `vtkBlendMode` in ferrovol's terms (an FvBlendMode); false
+  // when ferrovol has no such mode.
+  static bool ToFvBlend(int vtkBlendMode, uint32_t& blend);
   // The blend mode SelectBlendMode chose (an FvBlendMode).
   uint32_t GetBlend() const { return this->Blend; }
 
@@ -46,6 +50,16 @@ public:
   // viewport) and the renderer's lights.
   bool ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* ren, int vw, int vh,
     ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
+
+  // What every ferrovol mapper gives the frame alike: the camera VTK draws the opaque
+  // geometry with (for a vw × vh viewport), the vtkVolume's matrix, and the first
+  // FV_MAX_CLIP_PLANES of `planes` (world coordinates; warned once past them), returning
+  // their count.
+  static bool ApplyCamera(vtkRenderer* ren, int vw, int vh, ferrovol::Renderer& renderer,
+    vtkFerroVolumeReport& report);
+  static void SetVolumeMatrix(vtkVolume* vol, FvRenderParams& params);
+  static int SetUpClippingPlanes(
+    vtkPlaneCollection* planes, FvRenderParams& params, vtkFerroVolumeReport& report);
 
   // Paths per pixel below which the path-traced image shown is denoised as a preview:
   // PathTracingDenoiseUntil, never past SamplesPerPixel (a converged image is unfiltered).

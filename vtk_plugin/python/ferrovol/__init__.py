@@ -1,7 +1,9 @@
-"""ferrovol for VTK: vtkFerroVolumeMapper, a vtkVolumeMapper that renders with ferrovol.
+"""ferrovol for VTK: vtkFerroVolumeMapper, a vtkVolumeMapper that renders with ferrovol, and
+vtkFerroUnstructuredVolumeMapper, a vtkUnstructuredGridVolumeMapper for vtkUnstructuredGrid.
 
     import vtk, ferrovol
     mapper = ferrovol.vtkFerroVolumeMapper()
+    mesh_mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
 
 PyVista (or any vtkVolume drawn by another mapper): one call puts ferrovol under it,
 

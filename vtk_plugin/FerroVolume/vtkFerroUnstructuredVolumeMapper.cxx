@@ -1,0 +1,321 @@
+// vtkFerroUnstructuredVolumeMapper: a vtkUnstructuredGrid ray cast by ferrovol's unstructured
+// pass (fv_unstructured_volume_new, fv_renderer_set_unstructured). It draws through the
+// units vtkFerroVolumeMapper draws through (see vtkFerroVolumeMapper.cxx): the process-wide
+// device (vtkFerroVolumeContext), the property's tables (vtkFerroVolumeLookupTables), the
+// camera, matrix and clipping planes (vtkFerroVolumeSettings), the depth of opaque geometry
+// (vtkFerroVolumeDepthReader) and the output into VTK's framebuffer (vtkFerroVolumeOutput),
+// with its errors and warnings in a vtkFerroVolumeReport. Its own part is the mesh: VTK's
+// arrays handed to the C ABI as they are (vtkCellArray's 64- or 32-bit storage, float or
+// double points), only when the input or its scalars changed.
+#include "vtkFerroUnstructuredVolumeMapper.h"
+
+#include "vtkFerroVolumeContext.h"
+#include "vtkFerroVolumeEnums.h"
+#include "vtkFerroVolumeInputHelper.h"
+#include "vtkFerroVolumeLookupTables.h"
+#include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumeReport.h"
+#include "vtkFerroVolumeSettings.h"
+#include "vtkCellArray.h"
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkPoints.h"
+#include "vtkRenderer.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include <array>
+#include <memory>
+#include <string>
+
+vtkStandardNewMacro(vtkFerroUnstructuredVolumeMapper);
+
+namespace
+{
+// The scalars the mapper's selection picks on `grid`, `cells` saying where they live; false
+// with the reason when there are none or they are not one component of a type ferrovol
+// takes.
+bool SelectScalars(vtkFerroUnstructuredVolumeMapper* self, vtkUnstructuredGrid* grid,
+  vtkDataArray*& scalars, bool& cells, vtkFerroVolumeReport& report)
+{
+  int cellFlag = 0;
+  scalars = vtkAbstractMapper::GetScalars(grid, self->GetScalarMode(), self->GetArrayAccessMode(),
+    self->GetArrayId(), self->GetArrayName(), cellFlag);
+  cells = cellFlag == 1;
+  if (!scalars)
+  {
+    return report.Fail("the input has no scalars to draw (point or cell scalars, or the array "
+                       "SelectScalarArray names with a ScalarMode of point or cell field data)");
+  }
+  if (scalars->GetNumberOfComponents() != 1)
+  {
+    return report.Fail("the scalars '" + std::string(scalars->GetName() ? scalars->GetName() : "") +
+      "' have " + std::to_string(scalars->GetNumberOfComponents()) +
+      " components: ferrovol's unstructured pass draws one (select a one-component array)");
+  }
+  uint32_t type = 0;
+  size_t size = 0;
+  if (scalars->GetDataType() == VTK_BIT ||
+    !vtkFerroVolumeInputHelper::ToFvScalarType(scalars->GetDataType(), type, size))
+  {
+    return report.Fail(std::string("scalars of type ") + scalars->GetDataTypeAsString() +
+      " are not supported by ferrovol's unstructured pass");
+  }
+  return true;
+}
+}
+
+class vtkFerroUnstructuredVolumeMapper::vtkInternals
+{
+public:
+  vtkFerroVolumeRendererSlot Slot;
+  vtkFerroVolumeOutput Output;
+  vtkFerroVolumeReport Report;
+
+  // What the uploaded mesh and tables were made from.
+  struct MeshKey
+  {
+    vtkUnstructuredGrid* Grid = nullptr;
+    vtkMTimeType GridMTime = 0;
+    vtkDataArray* Scalars = nullptr;
+    vtkMTimeType ScalarsMTime = 0;
+    bool operator==(const MeshKey& o) const
+    {
+      return this->Grid == o.Grid && this->GridMTime == o.GridMTime &&
+        this->Scalars == o.Scalars && this->ScalarsMTime == o.ScalarsMTime;
+    }
+  };
+  bool HaveMesh = false;
+  MeshKey Mesh;
+  std::array<double, 2> Range{};
+  vtkVolumeProperty* Property = nullptr;
+  vtkMTimeType PropertyMTime = 0;
+  std::array<double, 2> TablesRange{};
+
+  explicit vtkInternals(vtkObject* self)
+    : Report(self)
+  {
+  }
+
+  void FreeRenderer()
+  {
+    this->Slot.Renderer.reset();
+    this->HaveMesh = false;
+    this->Property = nullptr;
+  }
+
+  // The renderer, made on first use and again (with the mesh and tables) after a device
+  // loss.
+  bool MakeRenderer(vtkOpenGLRenderWindow* win)
+  {
+    if (this->Slot.Renderer && !this->Slot.Lost())
+    {
+      return true;
+    }
+    this->Output.ReleaseGraphicsResources(win);
+    this->FreeRenderer();
+    return this->Slot.Make(this->Report);
+  }
+
+  // The mesh with `scalars` uploaded when the input or its scalars changed.
+  bool Upload(vtkUnstructuredGrid* grid, vtkDataArray* scalars, bool cells)
+  {
+    MeshKey key;
+    key.Grid = grid;
+    key.GridMTime = grid->GetMTime();
+    key.Scalars = scalars;
+    key.ScalarsMTime = scalars->GetMTime();
+    if (this->HaveMesh && this->Mesh == key)
+    {
+      return true;
+    }
+    this->HaveMesh = false;
+    vtkCellArray* cellArray = grid->GetCells();
+    vtkUnsignedCharArray* types = grid->GetCellTypesArray();
+    if (!grid->GetPoints() || grid->GetNumberOfPoints() == 0 || !cellArray || !types ||
+      grid->GetNumberOfCells() == 0)
+    {
+      return this->Report.Fail("the input has no cells: nothing to draw");
+    }
+    FvUnstructuredVolumeDesc desc;
+    if (!vtkFerroVolumeCall("describe the mesh", this->Report,
+          [&] { desc = ferrovol::UnstructuredVolume::default_desc(); }))
+    {
+      return false;
+    }
+    // Points: float or double as they are, other types converted to double.
+    vtkDataArray* points = grid->GetPoints()->GetData();
+    vtkNew<vtkDoubleArray> converted;
+    if (points->GetDataType() != VTK_FLOAT && points->GetDataType() != VTK_DOUBLE)
+    {
+      converted->DeepCopy(points);
+      points = converted;
+    }
+    desc.points = points->GetVoidPointer(0);
+    desc.point_count = static_cast<size_t>(points->GetNumberOfTuples());
+    desc.point_type = points->GetDataType() == VTK_FLOAT ? FV_SCALAR_TYPE_F32 : FV_SCALAR_TYPE_F64;
+    // vtkCellArray's connectivity and offsets in their own storage.
+    vtkDataArray* connectivity = cellArray->GetConnectivityArray();
+    desc.index_type = cellArray->IsStorage64Bit() ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32;
+    desc.connectivity = connectivity->GetVoidPointer(0);
+    desc.connectivity_count = static_cast<size_t>(connectivity->GetNumberOfValues());
+    desc.offsets = cellArray->GetOffsetsArray()->GetVoidPointer(0);
+    desc.cell_types = types->GetPointer(0);
+    desc.cell_count = static_cast<size_t>(cellArray->GetNumberOfCells());
+    size_t size = 0;
+    vtkFerroVolumeInputHelper::ToFvScalarType(scalars->GetDataType(), desc.scalar_type, size);
+    desc.components = 1;
+    desc.location = cells ? FV_SCALAR_LOCATION_CELLS : FV_SCALAR_LOCATION_POINTS;
+    desc.scalars = scalars->GetVoidPointer(0);
+    if (!vtkFerroVolumeCall("upload the mesh", this->Report, [&] {
+          ferrovol::UnstructuredVolume mesh(desc);
+          this->Slot.Renderer->set_unstructured(mesh);
+        }))
+    {
+      return false;
+    }
+    scalars->GetRange(this->Range.data(), 0);
+    this->Mesh = key;
+    this->HaveMesh = true;
+    return true;
+  }
+
+  // The property's colour and scalar opacity over the scalars' range, when either changed.
+  bool UpdateTables(vtkVolumeProperty* prop)
+  {
+    if (this->Property == prop && this->PropertyMTime == prop->GetMTime() &&
+      this->TablesRange == this->Range)
+    {
+      return true;
+    }
+    this->Property = nullptr;
+    std::unique_ptr<ferrovol::TransferFunction> tf;
+    if (!vtkFerroVolumeLookupTables::BuildFirstComponent(prop, this->Range,
+          vtkFerroVolumeLookupTables::RangeTypes(), "meshes", tf, this->Report) ||
+      !vtkFerroVolumeCall("set the transfer function", this->Report,
+        [&] { this->Slot.Renderer->set_transfer_function(*tf); }))
+    {
+      return false;
+    }
+    this->Property = prop;
+    this->PropertyMTime = prop->GetMTime();
+    this->TablesRange = this->Range;
+    return true;
+  }
+};
+
+//------------------------------------------------------------------------------------------
+vtkFerroUnstructuredVolumeMapper::vtkFerroUnstructuredVolumeMapper()
+  : Internals(new vtkInternals(this))
+{
+}
+
+vtkFerroUnstructuredVolumeMapper::~vtkFerroUnstructuredVolumeMapper()
+{
+  delete this->Internals;
+}
+
+void vtkFerroUnstructuredVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "LastRenderDrew: " << this->LastRenderDrew << "\n";
+}
+
+void vtkFerroUnstructuredVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
+{
+  this->Internals->Output.ReleaseGraphicsResources(window);
+  this->Internals->FreeRenderer();
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  this->LastRenderDrew = 0;
+  vtkInternals* in = this->Internals;
+  vtkFerroVolumeReport& report = in->Report;
+  report.ClearError();
+  if (!ren || !vol || !vol->GetProperty())
+  {
+    return;
+  }
+  vtkOpenGLRenderWindow* win = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!win)
+  {
+    vtkErrorMacro(<< "vtkFerroUnstructuredVolumeMapper needs an OpenGL render window "
+                     "(vtkOpenGLRenderWindow)");
+    return;
+  }
+  uint32_t blend = FV_BLEND_MODE_COMPOSITE;
+  if (!vtkFerroVolumeSettings::ToFvBlend(this->BlendMode, blend) ||
+    blend == FV_BLEND_MODE_ISOSURFACE || blend == FV_BLEND_MODE_SLICE)
+  {
+    vtkErrorMacro(<< "blend mode " << this->BlendMode
+                  << " is not supported by vtkFerroUnstructuredVolumeMapper (composite, "
+                     "maximum, minimum, average and additive are): nothing is drawn");
+    return;
+  }
+  // The input: a vtkUnstructuredGrid, or another vtkUnstructuredGridBase copied into one.
+  vtkUnstructuredGridBase* input = this->GetInput();
+  vtkSmartPointer<vtkUnstructuredGrid> grid = vtkUnstructuredGrid::SafeDownCast(input);
+  if (input && !grid)
+  {
+    grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
+    grid->DeepCopy(input);
+  }
+  if (!grid)
+  {
+    vtkErrorMacro(<< "no input: SetInputData or SetInputConnection with a vtkUnstructuredGrid");
+    return;
+  }
+  vtkDataArray* scalars = nullptr;
+  bool cells = false;
+  if (!SelectScalars(this, grid, scalars, cells, report) || !in->MakeRenderer(win) ||
+    !in->Upload(grid, scalars, cells) || !in->UpdateTables(vol->GetProperty()))
+  {
+    vtkErrorMacro(<< report.GetError());
+    return;
+  }
+
+  // The frame's parameters, camera and output.
+  vtkFerroVolumeFrameRequest req;
+  if (!req.ForViewport(ren, vol, win))
+  {
+    return;
+  }
+  FvRenderParams params;
+  if (!vtkFerroVolumeCall(
+        "use the mapper's settings", report, [&] { params = ferrovol::Renderer::default_params(); }))
+  {
+    vtkErrorMacro(<< report.GetError());
+    return;
+  }
+  params.blend_mode = blend;
+  vtkFerroVolumeSettings::SetVolumeMatrix(vol, params);
+  vtkFerroVolumeSettings::SetUpClippingPlanes(this->ClippingPlanes, params, report);
+  std::string warning;
+  if (!vtkFerroVolumeCall(
+        "use the mapper's settings", report, [&] { in->Slot.Renderer->set_params(params); }) ||
+    !vtkFerroVolumeSettings::ApplyCamera(
+      ren, req.ViewportW, req.ViewportH, *in->Slot.Renderer, report) ||
+    !in->Output.Render(vtkFerroVolumeEnums::OUTPUT_PATH_AUTOMATIC, *in->Slot.Renderer, req, report,
+      warning))
+  {
+    vtkErrorMacro(<< report.GetError());
+    return;
+  }
+  if (!warning.empty())
+  {
+    report.WarnOnce(warning);
+  }
+  const int rect[4] = { 0, 0, req.ViewportW, req.ViewportH };
+  if (in->Output.Composite(req, rect, report) == vtkFerroVolumeOutput::Composited::Failed)
+  {
+    vtkErrorMacro(<< report.GetError());
+    return;
+  }
+  this->LastRenderDrew = 1;
+}

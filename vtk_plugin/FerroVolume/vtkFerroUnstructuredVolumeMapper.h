@@ -1,0 +1,85 @@
+/**
+ * @class   vtkFerroUnstructuredVolumeMapper
+ * @brief   ray casts a vtkUnstructuredGrid on the GPU with ferrovol
+ *
+ * A vtkUnstructuredGridVolumeMapper: it takes the place of
+ * vtkUnstructuredGridVolumeRayCastMapper, vtkUnstructuredGridVolumeZSweepMapper or
+ * vtkProjectedTetrahedraMapper wherever they are used. ferrovol splits every linear 3D cell
+ * into tetrahedra (hexahedra, voxels, wedges and pyramids by a conforming rule; quadratic
+ * cells linearised), walks each pixel's ray from tetrahedron to tetrahedron, entering
+ * non-convex meshes again, and integrates each segment exactly as VTK's unstructured
+ * integrators model light: the scalar opacity read as attenuation per
+ * ScalarOpacityUnitDistance, the colour as emission. The frame is composited into VTK's
+ * framebuffer with depth against opaque geometry, as vtkFerroVolumeMapper's is.
+ *
+ * The scalars are those vtkAbstractVolumeMapper's ScalarMode, ArrayAccessMode, ArrayId and
+ * ArrayName select, on points or cells, one component (more are refused). The mesh is
+ * uploaded again only when the input or its scalars change. Blend modes: composite (the
+ * default, VTK's unstructured ray caster's), maximum and minimum intensity, average and
+ * additive, as vtkVolumeMapper numbers them; VTK's own unstructured mappers ignore the
+ * blend mode and always composite. The mapper's clipping planes and the vtkVolume's matrix
+ * are honoured; the property's Shade is ignored, as VTK's unstructured mappers ignore it, and
+ * a gradient opacity or 2D transfer function is refused with an error naming it. Errors
+ * from ferrovol reach vtkErrorMacro with its message.
+ */
+#ifndef vtkFerroUnstructuredVolumeMapper_h
+#define vtkFerroUnstructuredVolumeMapper_h
+
+#include "vtkFerroVolumeModule.h" // For export macro
+#include "vtkUnstructuredGridVolumeMapper.h"
+#include "vtkVolumeMapper.h" // For the blend mode numbers
+
+class VTKFERROVOLUME_EXPORT vtkFerroUnstructuredVolumeMapper
+  : public vtkUnstructuredGridVolumeMapper
+{
+public:
+  static vtkFerroUnstructuredVolumeMapper* New();
+  vtkTypeMacro(vtkFerroUnstructuredVolumeMapper, vtkUnstructuredGridVolumeMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * The blend modes ferrovol draws meshes with beside the base class's composite and
+   * maximum intensity (vtkVolumeMapper's numbers).
+   */
+  void SetBlendModeToMinimumIntensity()
+  {
+    this->SetBlendMode(vtkVolumeMapper::MINIMUM_INTENSITY_BLEND);
+  }
+  void SetBlendModeToAverageIntensity()
+  {
+    this->SetBlendMode(vtkVolumeMapper::AVERAGE_INTENSITY_BLEND);
+  }
+  void SetBlendModeToAdditive() { this->SetBlendMode(vtkVolumeMapper::ADDITIVE_BLEND); }
+  ///@}
+
+  /**
+   * Whether the last Render drew the mesh (0 after an error or before the first render).
+   */
+  vtkGetMacro(LastRenderDrew, int);
+
+  /**
+   * WARNING: INTERNAL METHOD - NOT INTENDED FOR GENERAL USE
+   */
+  void Render(vtkRenderer* ren, vtkVolume* vol) override;
+
+  /**
+   * WARNING: INTERNAL METHOD - NOT INTENDED FOR GENERAL USE
+   */
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+
+protected:
+  vtkFerroUnstructuredVolumeMapper();
+  ~vtkFerroUnstructuredVolumeMapper() override;
+
+  int LastRenderDrew = 0;
+
+private:
+  vtkFerroUnstructuredVolumeMapper(const vtkFerroUnstructuredVolumeMapper&) = delete;
+  void operator=(const vtkFerroUnstructuredVolumeMapper&) = delete;
+
+  class vtkInternals;
+  vtkInternals* Internals;
+};
+
+#endif

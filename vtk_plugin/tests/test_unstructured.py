@@ -1,0 +1,230 @@
+"""vtkFerroUnstructuredVolumeMapper against VTK's exact unstructured ray caster
+(vtkUnstructuredGridVolumeRayCastMapper, one ray per pixel, its linear integrator: the
+quantity ferrovol integrates) on tests/regression/meshes.py's tetrahedralised wavelet and
+mixed mesh (VTK gets the mixed mesh split into tetrahedra, ferrovol gets it as it is and as
+VTK's split), point and cell scalars, opaque geometry; the blend modes VTK's mappers lack
+draw; clipping planes and the array selection apply; bad input (an empty grid, unsupported
+cells, two components, no scalars, a gradient opacity) is an ErrorEvent naming why, not a
+crash, and a good input renders again after it."""
+import os
+import sys
+import unittest
+
+import numpy as np
+import vtk
+
+import ferrovol
+import fvtest
+from fvtest import Errors, Scene, compare, coverage, tf_property
+
+sys.path.insert(0, os.path.join(fvtest.ROOT, "tests", "regression"))
+import meshes  # noqa: E402  (tests/regression/meshes.py)
+
+# SSIM / PSNR floors against the ray caster: the issue's goal (measured at 300 x 300:
+# 0.991-0.994, 38.4-40.5 dB; at 160 x 160 the silhouette's pixels, where the two cast rays
+# through a pixel differently, weigh more and the mixed mesh falls to 0.977 / 33 dB).
+FLOOR_SSIM, FLOOR_PSNR = 0.98, 35.0
+
+
+def wavelet_property(unit_distance=1.0):
+    p = tf_property(interpolation="linear")
+    p.SetScalarOpacityUnitDistance(unit_distance)
+    return p
+
+
+def view(cam):
+    cam.Azimuth(35.0)
+    cam.Elevation(25.0)
+    cam.OrthogonalizeViewUp()
+
+
+def bunyk():
+    m = vtk.vtkUnstructuredGridVolumeRayCastMapper()
+    m.AutoAdjustSampleDistancesOff()
+    m.SetImageSampleDistance(1.0)
+    m.SetRayIntegrator(vtk.vtkUnstructuredGridLinearRayIntegrator())
+    return m
+
+
+def render(mapper, grid, prop=None, size=(300, 300), actors=()):
+    errors = Errors(mapper)
+    scene = Scene(mapper, grid, prop or wavelet_property(), size=size, camera=view,
+                  actors=actors)
+    return scene.render(), errors
+
+
+def cell_scalars(grid):
+    f = vtk.vtkPointDataToCellData()
+    f.SetInputData(grid)
+    f.Update()
+    out = vtk.vtkUnstructuredGrid()
+    out.ShallowCopy(f.GetOutput())
+    out.GetPointData().Initialize()
+    return out
+
+
+class AgainstVtk(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.wavelet = meshes.tet_wavelet(10)
+        cls.mixed = meshes.mixed()
+        cls.mixed_tets = meshes.tetrahedralised(cls.mixed)
+
+    def check(self, name, ours_grid, vtk_grid, floor=(FLOOR_SSIM, FLOOR_PSNR), actors=None):
+        mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        ours, errors = render(mapper, ours_grid, actors=actors() if actors else ())
+        self.assertEqual(errors.messages, [])
+        self.assertTrue(mapper.GetLastRenderDrew())
+        theirs, _ = render(bunyk(), vtk_grid, actors=actors() if actors else ())
+        self.assertGreater(coverage(ours), 0.2, "ferrovol's image is (nearly) empty")
+        self.assertGreater(coverage(theirs), 0.2, "VTK's image is (nearly) empty")
+        s, p = compare("unstructured-" + name, ours, theirs)
+        self.assertGreaterEqual(s, floor[0])
+        self.assertGreaterEqual(p, floor[1])
+
+    def test_wavelet_points(self):
+        self.check("wavelet", self.wavelet, self.wavelet)
+
+    def test_wavelet_cells(self):
+        cells = cell_scalars(self.wavelet)
+        self.check("wavelet-cells", cells, cells)
+
+    def test_mixed_split_alike(self):
+        self.check("mixed-tets", self.mixed_tets, self.mixed_tets)
+
+    def test_mixed_as_is(self):
+        # ferrovol's own split (hexahedra into 12 about their centroid) against
+        # vtkDataSetTriangleFilter's: the interpolants differ inside the cells
+        self.check("mixed", self.mixed, self.mixed_tets)
+
+    def test_opaque_geometry(self):
+        """An opaque sphere half inside the mesh: the rays stop at its depth, as the ray
+        caster's (IntermixIntersectingGeometry, on by default) do."""
+        self.check("wavelet-sphere", self.wavelet, self.wavelet,
+                   actors=lambda: [fvtest.sphere_actor((4.0, 4.0, 8.0), 5.0, (0.9, 0.8, 0.2))])
+
+    def test_clipping_plane(self):
+        """A clipping plane through the middle: half the mesh is drawn."""
+        plane = vtk.vtkPlane()
+        plane.SetOrigin(0.0, 0.0, 0.0)
+        plane.SetNormal(1.0, 0.0, 0.0)
+        mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        mapper.AddClippingPlane(plane)
+        clipped, errors = render(mapper, self.wavelet, size=(80, 80))
+        whole, _ = render(ferrovol.vtkFerroUnstructuredVolumeMapper(), self.wavelet,
+                          size=(80, 80))
+        self.assertEqual(errors.messages, [])
+        self.assertLess(coverage(clipped), 0.8 * coverage(whole))
+        self.assertGreater(coverage(clipped), 0.3 * coverage(whole))
+
+    def test_blend_modes(self):
+        """The modes VTK's unstructured mappers ignore: each draws, MIP differs from
+        composite."""
+        images = {}
+        for mode in ("Composite", "MaximumIntensity", "MinimumIntensity", "AverageIntensity",
+                     "Additive"):
+            mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+            getattr(mapper, "SetBlendModeTo" + mode)()
+            images[mode], errors = render(mapper, self.wavelet, size=(80, 80))
+            self.assertEqual(errors.messages, [], mode)
+            self.assertGreater(coverage(images[mode]), 0.2, mode)
+        self.assertGreater(np.abs(images["Composite"] - images["MaximumIntensity"]).mean(), 1.0)
+
+
+    def test_selected_array(self):
+        """SelectScalarArray with ScalarMode UsePointFieldData draws the array named, not the
+        active scalars: a constant 37.35 (transparent in the property) draws nothing."""
+        g = vtk.vtkUnstructuredGrid()
+        g.ShallowCopy(self.wavelet)
+        flat = vtk.vtkFloatArray()
+        flat.SetName("flat")
+        flat.SetNumberOfTuples(g.GetNumberOfPoints())
+        flat.Fill(37.3531)
+        g.GetPointData().AddArray(flat)
+        mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        mapper.SetScalarModeToUsePointFieldData()
+        mapper.SelectScalarArray("flat")
+        image, errors = render(mapper, g, size=(80, 80))
+        self.assertEqual(errors.messages, [])
+        self.assertTrue(mapper.GetLastRenderDrew())
+        self.assertLess(coverage(image), 0.01)
+        mapper.SelectScalarArray("RTData")
+        self.assertGreater(coverage(render(mapper, g, size=(80, 80))[0]), 0.2)
+
+
+class BadInput(unittest.TestCase):
+    def setUp(self):
+        self.mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        self.errors = Errors(self.mapper)
+        self.good = meshes.tet_wavelet(4)
+        self.scene = Scene(self.mapper, self.good, wavelet_property(), size=(64, 64),
+                           camera=view)
+        self.assertGreater(coverage(self.scene.render()), 0.1)
+        self.assertEqual(self.errors.messages, [])
+
+    def refused(self, grid, words):
+        self.mapper.SetInputData(grid)
+        image = self.scene.render()
+        self.assertFalse(self.mapper.GetLastRenderDrew())
+        self.assertTrue(self.errors.messages, "no ErrorEvent")
+        for w in words:
+            self.assertIn(w, self.errors.last())
+        self.assertLess(coverage(image), 0.01)
+        # the good input renders again
+        self.mapper.SetInputData(self.good)
+        self.assertGreater(coverage(self.scene.render()), 0.1)
+        self.assertTrue(self.mapper.GetLastRenderDrew())
+
+    def test_empty_grid(self):
+        empty = vtk.vtkUnstructuredGrid()
+        empty.SetPoints(vtk.vtkPoints())
+        empty.GetPointData().SetScalars(vtk.vtkFloatArray())
+        self.refused(empty, ["no cells"])
+
+    def test_unsupported_cells(self):
+        # a grid of triangles (2D cells) with point scalars
+        g = vtk.vtkUnstructuredGrid()
+        pts = vtk.vtkPoints()
+        for p in ((0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)):
+            pts.InsertNextPoint(p)
+        g.SetPoints(pts)
+        for ids in ((0, 1, 2), (1, 3, 2)):
+            g.InsertNextCell(vtk.VTK_TRIANGLE, 3, ids)
+        s = vtk.vtkFloatArray()
+        for v in range(4):
+            s.InsertNextValue(100.0 * v)
+        g.GetPointData().SetScalars(s)
+        self.refused(g, ["ferrovol could not upload the mesh"])
+
+    def test_two_components(self):
+        g = vtk.vtkUnstructuredGrid()
+        g.DeepCopy(self.good)
+        two = vtk.vtkFloatArray()
+        two.SetName("two")
+        two.SetNumberOfComponents(2)
+        two.SetNumberOfTuples(g.GetNumberOfPoints())
+        two.Fill(100.0)
+        g.GetPointData().SetScalars(two)
+        self.refused(g, ["2 components", "one"])
+
+    def test_gradient_opacity(self):
+        g = vtk.vtkPiecewiseFunction()
+        g.AddPoint(0.0, 0.0)
+        g.AddPoint(10.0, 1.0)
+        prop = self.scene.volume.GetProperty()
+        prop.SetGradientOpacity(g)
+        self.assertLess(coverage(self.scene.render()), 0.01)
+        self.assertFalse(self.mapper.GetLastRenderDrew())
+        self.assertIn("gradient opacity", self.errors.last())
+        prop.DisableGradientOpacityOn()
+        self.assertGreater(coverage(self.scene.render()), 0.1)
+
+    def test_no_scalars(self):
+        g = vtk.vtkUnstructuredGrid()
+        g.DeepCopy(self.good)
+        g.GetPointData().Initialize()
+        self.refused(g, ["no scalars"])
+
+
+if __name__ == "__main__":
+    unittest.main()
