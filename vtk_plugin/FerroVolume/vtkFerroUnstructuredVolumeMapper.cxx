@@ -19,11 +19,11 @@
 #include "vtkCellArray.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkPoints.h"
 #include "vtkRenderer.h"
-#include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
@@ -31,6 +31,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 vtkStandardNewMacro(vtkFerroUnstructuredVolumeMapper);
 
@@ -135,8 +136,7 @@ public:
     }
     this->HaveMesh = false;
     vtkCellArray* cellArray = grid->GetCells();
-    vtkUnsignedCharArray* types = grid->GetCellTypesArray();
-    if (!grid->GetPoints() || grid->GetNumberOfPoints() == 0 || !cellArray || !types ||
+    if (!grid->GetPoints() || grid->GetNumberOfPoints() == 0 || !cellArray ||
       grid->GetNumberOfCells() == 0)
     {
       return this->Report.Fail("the input has no cells: nothing to draw");
@@ -158,14 +158,43 @@ public:
     desc.points = points->GetVoidPointer(0);
     desc.point_count = static_cast<size_t>(points->GetNumberOfTuples());
     desc.point_type = points->GetDataType() == VTK_FLOAT ? FV_SCALAR_TYPE_F32 : FV_SCALAR_TYPE_F64;
-    // vtkCellArray's connectivity and offsets in their own storage.
+    // vtkCellArray's connectivity and offsets in their own memory where both are plain
+    // arrays of one integer type (VTK 9.2 always); copied as vtkIdType where VTK keeps them
+    // otherwise (VTK 9.6's fixed-size and implicit storage).
     vtkDataArray* connectivity = cellArray->GetConnectivityArray();
-    desc.index_type = cellArray->IsStorage64Bit() ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32;
+    vtkDataArray* offsets = cellArray->GetOffsetsArray();
+    uint32_t connectivityType = 0, offsetsType = 0;
+    size_t indexSize = 0;
+    const bool plain = connectivity->HasStandardMemoryLayout() &&
+      offsets->HasStandardMemoryLayout() &&
+      vtkFerroVolumeInputHelper::ToFvScalarType(
+        connectivity->GetDataType(), connectivityType, indexSize) &&
+      vtkFerroVolumeInputHelper::ToFvScalarType(offsets->GetDataType(), offsetsType, indexSize) &&
+      connectivityType == offsetsType &&
+      (connectivityType == FV_SCALAR_TYPE_I32 || connectivityType == FV_SCALAR_TYPE_I64 ||
+        connectivityType == FV_SCALAR_TYPE_U32 || connectivityType == FV_SCALAR_TYPE_U64);
+    vtkNew<vtkIdTypeArray> connectivityCopy, offsetsCopy;
+    if (!plain)
+    {
+      connectivityCopy->DeepCopy(connectivity);
+      offsetsCopy->DeepCopy(offsets);
+      connectivity = connectivityCopy;
+      offsets = offsetsCopy;
+      connectivityType = sizeof(vtkIdType) == 8 ? FV_SCALAR_TYPE_I64 : FV_SCALAR_TYPE_I32;
+    }
+    desc.index_type = connectivityType;
     desc.connectivity = connectivity->GetVoidPointer(0);
     desc.connectivity_count = static_cast<size_t>(connectivity->GetNumberOfValues());
-    desc.offsets = cellArray->GetOffsetsArray()->GetVoidPointer(0);
-    desc.cell_types = types->GetPointer(0);
-    desc.cell_count = static_cast<size_t>(cellArray->GetNumberOfCells());
+    desc.offsets = offsets->GetVoidPointer(0);
+    // The cell types, one byte each (VTK 9.6 may keep them in an implicit array).
+    const vtkIdType cellCount = grid->GetNumberOfCells();
+    std::vector<unsigned char> types(static_cast<size_t>(cellCount));
+    for (vtkIdType c = 0; c < cellCount; ++c)
+    {
+      types[static_cast<size_t>(c)] = static_cast<unsigned char>(grid->GetCellType(c));
+    }
+    desc.cell_types = types.data();
+    desc.cell_count = static_cast<size_t>(cellCount);
     size_t size = 0;
     vtkFerroVolumeInputHelper::ToFvScalarType(scalars->GetDataType(), desc.scalar_type, size);
     desc.components = 1;
