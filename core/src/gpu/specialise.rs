@@ -60,7 +60,7 @@ pub(crate) fn specialise(
     )
     .map_err(|e| Error::Gpu(format!("shader {file}, entry {entry}: {e}")))?;
     let mut module = module.into_owned();
-    let fold = |module: &Module, f: &mut Function| {
+    let prune_function = |module: &Module, f: &mut Function| {
         let mut pruner = Pruner {
             module,
             expressions: &f.expressions,
@@ -70,15 +70,15 @@ pub(crate) fn specialise(
         pruner.prune(&mut f.body);
         f.named_expressions.clear();
     };
+    // `process_overrides` kept only `entry` among the entry points.
     let mut functions = std::mem::take(&mut module.functions);
     for (_, f) in functions.iter_mut() {
-        fold(&module, f);
+        prune_function(&module, f);
     }
     module.functions = functions;
     let mut entries = std::mem::take(&mut module.entry_points);
-    entries.retain(|e| e.name == entry);
     for e in entries.iter_mut() {
-        fold(&module, &mut e.function);
+        prune_function(&module, &mut e.function);
     }
     module.entry_points = entries;
     naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
