@@ -579,6 +579,8 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     if a.iso.no_lights {
         view.lights.clear();
     }
+    pb.set_message("compiling the pipelines");
+    r.prepare(&view, &params)?;
     pb.set_message("rendering");
     let t0 = std::time::Instant::now();
     let mut img = r.render_image(&view, &params)?;

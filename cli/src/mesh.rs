@@ -52,10 +52,11 @@ pub fn render(a: &RenderArgs, path: &Path) -> Result<(), CliError> {
     pb.set_message("preparing the mesh");
     let t0 = std::time::Instant::now();
     r.set_unstructured(&m)?;
-    let prepared = t0.elapsed().as_secs_f64();
     r.set_transfer_function(&tf)?;
     let mut view = view_of(a, m.bounds())?;
     let params = render_params(a, m.bounds());
+    r.prepare(&view, &params)?;
+    let prepared = t0.elapsed().as_secs_f64();
     pb.set_message("rendering");
     let mut img = r.render_image(&view, &params)?;
     let mut timing = None;

@@ -11,7 +11,7 @@ use crate::params::{
     TransferFunction, UnstructuredVolume, UploadOptions, View, VolumeData,
 };
 use crate::passes::dvr::DvrPass;
-use crate::passes::frame::{self, FrameInput};
+use crate::passes::frame::{self, FrameInput, Purpose};
 use crate::passes::iso::{self, IsoPass};
 use crate::passes::pathtrace::PathTracePass;
 use crate::passes::scatter_check;
@@ -325,7 +325,18 @@ impl Renderer {
             Some(d) => DepthSource::Cpu(d),
             None => DepthSource::None,
         };
-        self.render_from(view, params, source)
+        self.render_from(view, params, source, Purpose::Draw)
+    }
+
+    /// Prepares what a frame with `view` and `params` needs, without drawing it: the pass of
+    /// its blend mode, the transfer function's tables, the occupancy and environment maps,
+    /// the bricks it reads, the output images of the view's size and the pipelines of the
+    /// variant it selects, compiled. A host calls it at set-up, after
+    /// [`Renderer::set_volume`] and [`Renderer::set_transfer_function`], so that its first
+    /// [`Renderer::render`] with those settings does not pay for them. Settings a frame
+    /// would refuse are refused here, with the same error.
+    pub fn prepare(&mut self, view: &View, params: &RenderParams) -> Result<()> {
+        self.render_from(view, params, DepthSource::None, Purpose::Prepare)
     }
 
     /// Like [`Renderer::render`] with a depth input, but the depth is what the host wrote into
@@ -359,7 +370,7 @@ impl Renderer {
                 ))
             }
         }
-        self.render_from(view, params, DepthSource::Shared)
+        self.render_from(view, params, DepthSource::Shared, Purpose::Draw)
     }
 
     /// Like [`Renderer::render`], but each pixel's ray samples only between two window depths
@@ -389,7 +400,7 @@ impl Renderer {
                  without a depth range, or use a ray-casting blend mode)"
             )));
         }
-        self.render_from(view, params, DepthSource::Range(near, far))
+        self.render_from(view, params, DepthSource::Range(near, far), Purpose::Draw)
     }
 
     fn render_from(
@@ -397,6 +408,7 @@ impl Renderer {
         view: &View,
         params: &RenderParams,
         depth: DepthSource<'_>,
+        purpose: Purpose,
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
         let (ctx, res) = (&self.ctx, &mut self.res);
@@ -410,8 +422,9 @@ impl Renderer {
                 view,
                 params,
                 depth,
+                purpose,
             });
-            if done.is_ok() {
+            if done.is_ok() && purpose == Purpose::Draw {
                 self.previous_frame =
                     std::mem::replace(&mut self.last_frame, ctx.last_submission());
             }
@@ -455,6 +468,7 @@ impl Renderer {
             view,
             params,
             depth,
+            purpose,
         };
         let done = match params.blend {
             BlendMode::Isosurface => {
@@ -474,7 +488,7 @@ impl Renderer {
             _ => self.dvr.render(input(&mut *res)),
         };
         res.leave_level();
-        if done.is_ok() {
+        if done.is_ok() && purpose == Purpose::Draw {
             self.previous_frame = std::mem::replace(&mut self.last_frame, ctx.last_submission());
         }
         done

@@ -1303,6 +1303,15 @@ enum FvStatus fv_renderer_render(struct FvRenderer *renderer,
                                  size_t depth_count);
 
 /**
+ * Prepares what a `width × height` frame with the current settings needs, without drawing
+ * it: the blend mode's pass, the transfer function's tables, the output images, the bricks
+ * it reads and its pipelines, compiled. Call it at set-up (after the volume and the transfer
+ * function) so that the first fv_renderer_render does not pay for them; settings a frame
+ * would refuse are refused here with the same status and message.
+ */
+enum FvStatus fv_renderer_prepare(struct FvRenderer *renderer, uint32_t width, uint32_t height);
+
+/**
  * Renders like fv_renderer_render, each pixel's ray sampling only between two window depths:
  * `near` and `far` hold `count` = width·height depths each (0 near … 1 far, rows top to
  * bottom), the interval half-open and empty where near ≥ far, the samples on the lattice of

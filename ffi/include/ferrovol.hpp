@@ -343,6 +343,10 @@ public:
   void set_max_brick_points(uint32_t points) {
     check(fv_renderer_set_max_brick_points(h_.get(), points));
   }
+  /// Everything a width × height frame needs but the drawing (fv_renderer_prepare).
+  void prepare(uint32_t width, uint32_t height) {
+    check(fv_renderer_prepare(h_.get(), width, height));
+  }
   /// `depth`: width·height window depths of opaque geometry (rows top to bottom), or empty.
   void render(uint32_t width, uint32_t height, const std::vector<float> &depth = {}) {
     check(fv_renderer_render(h_.get(), width, height, detail::data_or_null(depth), depth.size()));

@@ -399,6 +399,25 @@ pub unsafe extern "C" fn fv_renderer_render(
     })
 }
 
+/// Prepares what a `width × height` frame with the current settings needs, without drawing
+/// it: the blend mode's pass, the transfer function's tables, the output images, the bricks
+/// it reads and its pipelines, compiled. Call it at set-up (after the volume and the transfer
+/// function) so that the first fv_renderer_render does not pay for them; settings a frame
+/// would refuse are refused here with the same status and message.
+#[no_mangle]
+pub unsafe extern "C" fn fv_renderer_prepare(
+    renderer: *mut FvRenderer,
+    width: u32,
+    height: u32,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        r.view.width = width;
+        r.view.height = height;
+        r.r.prepare(&r.view, &r.params)?;
+        Ok(())
+    })
+}
+
 /// Renders like fv_renderer_render, each pixel's ray sampling only between two window depths:
 /// `near` and `far` hold `count` = width·height depths each (0 near … 1 far, rows top to
 /// bottom), the interval half-open and empty where near ≥ far, the samples on the lattice of

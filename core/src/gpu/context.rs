@@ -337,6 +337,12 @@ impl Context {
         self.waits.load(std::sync::atomic::Ordering::Relaxed)
     }
 
+    /// How many compute pipelines (pass variants) have been compiled on this device, by every
+    /// renderer on it together ([`crate::Renderer::prepare`] compiles a frame's ahead).
+    pub fn compiled_pipelines(&self) -> usize {
+        lock(&self.shaders.pipelines).len()
+    }
+
     /// The buffers, textures and device memory the context holds now.
     pub fn device_memory(&self) -> DeviceMemory {
         let hal = self.device.get_internal_counters().hal;

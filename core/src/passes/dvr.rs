@@ -5,7 +5,7 @@
 //! ray's extremum.
 
 use super::dvr_variant::{select, DvrFacts, DvrVariant};
-use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput};
+use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput, Purpose};
 
 use crate::error::Result;
 use crate::gpu::binding::{
@@ -86,6 +86,7 @@ impl DvrPass {
 
     /// One ray-cast frame.
     pub fn render(&mut self, input: FrameInput<'_>) -> Result<()> {
+        let purpose = input.purpose;
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         if params.shading.enabled {
@@ -189,6 +190,9 @@ impl DvrPass {
         u.rect = frame::prepare_intermix(ctx, res, params, view, step, u.rect)?;
         let vol = res.volume()?;
         let dvr = self.pipelines.get(ctx, variant)?;
+        if purpose == Purpose::Prepare {
+            return Ok(());
+        }
         let t = res.targets.as_ref().expect("targets allocated above");
         let (_, tables) = res.tables.as_ref().expect("tables built above");
         let occupancy = &res.occupancy.as_ref().expect("occupancy built above").grid;

@@ -47,14 +47,24 @@ pub(crate) fn groups(r: [u32; 4]) -> [u32; 2] {
 }
 
 /// What a pass renders a frame from: the device, the renderer's resources (which the pass
-/// builds on demand and borrows for the frame), the view, the render parameters and where
-/// the depth input comes from.
+/// builds on demand and borrows for the frame), the view, the render parameters, where
+/// the depth input comes from, and whether the frame is drawn or only prepared.
 pub(crate) struct FrameInput<'a> {
     pub ctx: &'a Context,
     pub res: &'a mut Resources,
     pub view: &'a View,
     pub params: &'a RenderParams,
     pub depth: DepthSource<'a>,
+    pub purpose: Purpose,
+}
+
+/// What a pass does with a frame: draws it, or does everything before the drawing (tables,
+/// resident bricks, output images, the selected variant's pipelines) and stops
+/// ([`crate::Renderer::prepare`]).
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Purpose {
+    Draw,
+    Prepare,
 }
 
 impl<'a> FrameInput<'a> {

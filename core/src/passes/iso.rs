@@ -22,7 +22,7 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
-use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput};
+use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput, Purpose};
 use super::iso_variant::{self, DeferredVariant, FirstHitVariant, IsoFacts};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
@@ -375,6 +375,7 @@ impl IsoPass {
     /// One isosurface frame of the iso-values `iso` (an error without them): first hit,
     /// then deferred shading.
     pub fn render(&mut self, input: FrameInput<'_>, iso: Option<&IsoParams>) -> Result<()> {
+        let purpose = input.purpose;
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         let iso = iso.ok_or_else(|| {
@@ -505,6 +506,9 @@ impl IsoPass {
             iso.max_layers
         };
         self.ensure_gbuffer(ctx, view.width, view.height, layers)?;
+        if purpose == Purpose::Prepare {
+            return Ok(());
+        }
         let frame = f.uniforms;
         self.last_rect = frame.rect;
         let env = res.current_environment()?;

@@ -30,7 +30,7 @@
 
 use super::denoise::{DenoiseOutputs, DenoisePass};
 use super::depth_check::DepthCheck;
-use super::frame::{self, groups, FrameInput};
+use super::frame::{self, groups, FrameInput, Purpose};
 use super::medium;
 use super::pathtrace_variant::{self, PathTraceFacts, PathTraceVariant};
 use crate::error::{Error, Result};
@@ -309,6 +309,7 @@ impl PathTracePass {
 
     /// One path-traced frame: `samples_per_frame` more paths per pixel.
     pub fn render(&mut self, input: FrameInput<'_>, pp: &PathTraceParams) -> Result<()> {
+        let purpose = input.purpose;
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         let pp = *pp;
@@ -392,6 +393,9 @@ impl PathTracePass {
         self.ensure_accum(ctx, view.width, view.height)?;
         if guided && self.denoise.is_none() {
             self.denoise = Some(DenoisePass::new(ctx)?);
+        }
+        if purpose == Purpose::Prepare {
+            return Ok(());
         }
         // (a host's depth may change from frame to frame without telling: compare it)
         let depth_changed = if depth_input {

@@ -5,7 +5,7 @@
 //! distance); MIP and MinIP take the exact extrema of the linear segments, average and
 //! additive the exact integrals of opacity × normalised scalar.
 
-use super::frame::{groups, index_plane, screen_rect, FrameInput};
+use super::frame::{groups, index_plane, screen_rect, FrameInput, Purpose};
 use super::unstructured_variant::{select, UnstructuredFacts, UnstructuredVariant};
 
 use crate::error::{Error, Result};
@@ -72,6 +72,7 @@ impl UnstructuredPass {
 
     /// One frame of the renderer's mesh.
     pub fn render(&mut self, input: FrameInput<'_>) -> Result<()> {
+        let purpose = input.purpose;
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
         let tf = res.transfer_function()?.clone();
@@ -101,6 +102,9 @@ impl UnstructuredPass {
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
         let pipeline = self.pipelines.get(ctx, variant)?;
+        if purpose == Purpose::Prepare {
+            return Ok(());
+        }
         let mesh = res.mesh.as_ref().expect("checked above");
         let t = res.targets.as_ref().expect("targets allocated above");
         let (_, tables) = res.tables.as_ref().expect("tables built above");

@@ -240,3 +240,62 @@ fn preview_frames_do_not_wait_and_converge() {
     assert_eq!(last, 0, "complete");
     assert!(max <= 2, "the complete preview equals in core");
 }
+
+/// `Renderer::prepare` does a frame's set-up without drawing: the frame after it compiles no
+/// pipeline and draws what a renderer that was not prepared draws; what a frame would
+/// refuse, prepare refuses with the same message.
+#[test]
+fn prepared_frames_compile_nothing_and_draw_the_same() {
+    let mut r = crate::common::gpu::new_renderer();
+    let blob = blob_volume(32);
+    let tf = TransferFunction::single(blob_transfer());
+    r.set_volume(&blob).unwrap();
+    r.set_transfer_function(&tf).unwrap();
+    let iso = IsoParams::with_values(vec![IsoValue::new(0.4, [0.9, 0.8, 0.7], 1.0)]);
+    r.set_isosurface(&iso).unwrap();
+    let view = View::fit(blob.bounds(), 48, 48);
+    let mut other = Renderer::new(r.context().clone()).unwrap();
+    other.set_volume(&blob).unwrap();
+    other.set_transfer_function(&tf).unwrap();
+    other.set_isosurface(&iso).unwrap();
+    for (what, params) in [
+        ("composite", RenderParams::default()),
+        ("shaded", shaded()),
+        (
+            "isosurface",
+            RenderParams {
+                blend: BlendMode::Isosurface,
+                ..Default::default()
+            },
+        ),
+        ("path traced", pt_params()),
+    ] {
+        let compiled = r.context().compiled_pipelines();
+        let frames = r.stats().frames;
+        r.prepare(&view, &params).unwrap();
+        let prepared = r.context().compiled_pipelines();
+        assert_eq!(r.stats().frames, frames, "{what}: prepare drew");
+        let img = r.render_image(&view, &params).unwrap();
+        println!(
+            "{what}: prepare compiled {} pipelines, the frame {}",
+            prepared - compiled,
+            r.context().compiled_pipelines() - prepared
+        );
+        assert!(prepared > compiled, "{what}: prepare compiled nothing");
+        assert_eq!(
+            r.context().compiled_pipelines(),
+            prepared,
+            "{what}: the prepared frame compiled"
+        );
+        assert!(img.rgba.chunks(4).any(|p| p[3] > 0), "{what}: empty frame");
+        let unprepared = other.render_image(&view, &params).unwrap();
+        assert_eq!(image_diff(&img, &unprepared).1, 0, "{what}");
+    }
+    let refused = RenderParams {
+        sample_distance: Some(-1.0),
+        ..Default::default()
+    };
+    let prepare = r.prepare(&view, &refused).unwrap_err().to_string();
+    let render = r.render(&view, &refused, None).unwrap_err().to_string();
+    assert_eq!(prepare, render);
+}

@@ -619,7 +619,14 @@ fn renderer_errors() {
             FvStatus::Unsupported,
             "depth range",
         );
+        // Prepared at set-up: the same refusals as a frame, then the frame it prepared.
+        let prepare = lib.f::<unsafe extern "C" fn(H, u32, u32) -> FvStatus>("fv_renderer_prepare");
+        lib.expect(prepare(null_mut(), 16, 16), Null, "renderer");
+        lib.expect(prepare(s.r, 16, 16), Invalid, "set_isosurface");
         s.set_params(&p);
+        lib.expect(prepare(s.r, 0, 16), Invalid, "0x16");
+        lib.ok(prepare(s.r, 16, 16));
+        assert_eq!(s.frame(16, 16)[4 * (8 * 16 + 8) + 3], centre);
         let png = lib.f::<unsafe extern "C" fn(H, *const c_char, *const [f32; 3]) -> FvStatus>(
             "fv_frame_write_png",
         );
