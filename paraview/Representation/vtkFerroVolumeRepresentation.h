@@ -30,7 +30,8 @@
  *   PreIntegration, MidpointQuadrature, AdaptiveSampling and CubicInterpolation.
  *
  * Inputs: vtkImageData only (what vtkFerroVolumeMapper renders). Rectilinear grids and
- * composite datasets, which "Volume" accepts, are not drawn; a warning says so.
+ * composite datasets of images, which "Volume" accepts, are not drawn; a warning says so.
+ * Unstructured grids and composite datasets of them are vtkFerroUnstructuredVolumeRepresentation's.
  *
  * Multi-component arrays with independent components (MapScalars on, MultiComponentsMapping
  * off): the colour map's vector mode decides, as vtkSmartVolumeMapper's VectorMode does for

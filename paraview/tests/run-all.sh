@@ -70,6 +70,8 @@ step progressive-pvbatch  pvbatch $T/test_progressive.py
 step mpi-serial    pvbatch $T/test_mpi.py serial
 # (bounded: a rank that never joins a collective operation would hang the run)
 step "mpi-n$RANKS" timeout 1200 "${MPIEXEC[@]}" pvbatch --symmetric $T/test_mpi.py distributed
+step unstructured-serial pvbatch $T/test_unstructured.py serial
+step "unstructured-n$RANKS" timeout 600 "${MPIEXEC[@]}" pvbatch --symmetric $T/test_unstructured.py distributed
 end=$(date +%s)
 if [ ${#failed[@]} -gt 0 ]; then
   echo "== FAILED: ${failed[*]} ($((end - start)) s)"

@@ -27,6 +27,7 @@
 #include "vtkUnstructuredGrid.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
+#include "vtkWeakPointer.h"
 
 #include <array>
 #include <memory>
@@ -96,6 +97,14 @@ public:
   vtkVolumeProperty* Property = nullptr;
   vtkMTimeType PropertyMTime = 0;
   std::array<double, 2> TablesRange{};
+  int MeshUploads = 0;
+  int TableUploads = 0;
+
+  // An input that is not a vtkUnstructuredGrid, copied into one, and the input and its
+  // MTime the copy was made from.
+  vtkSmartPointer<vtkUnstructuredGrid> Copy;
+  vtkWeakPointer<vtkUnstructuredGridBase> CopySource;
+  vtkMTimeType CopySourceMTime = 0;
 
   explicit vtkInternals(vtkObject* self)
     : Report(self)
@@ -107,6 +116,30 @@ public:
     this->Slot.Renderer.reset();
     this->HaveMesh = false;
     this->Property = nullptr;
+  }
+
+  // `input` as a vtkUnstructuredGrid: itself, or its copy (made again only when the input
+  // or its MTime changed, so that an unchanged input keeps the uploaded mesh).
+  vtkUnstructuredGrid* AsGrid(vtkUnstructuredGridBase* input)
+  {
+    if (auto grid = vtkUnstructuredGrid::SafeDownCast(input))
+    {
+      this->Copy = nullptr;
+      this->CopySource = nullptr;
+      return grid;
+    }
+    if (!input)
+    {
+      return nullptr;
+    }
+    if (!this->Copy || this->CopySource != input || this->CopySourceMTime != input->GetMTime())
+    {
+      this->Copy = vtkSmartPointer<vtkUnstructuredGrid>::New();
+      this->Copy->DeepCopy(input);
+      this->CopySource = input;
+      this->CopySourceMTime = input->GetMTime();
+    }
+    return this->Copy;
   }
 
   // The renderer, made on first use and again (with the mesh and tables) after a device
@@ -210,6 +243,7 @@ public:
     scalars->GetRange(this->Range.data(), 0);
     this->Mesh = key;
     this->HaveMesh = true;
+    ++this->MeshUploads;
     return true;
   }
 
@@ -233,6 +267,7 @@ public:
     this->Property = prop;
     this->PropertyMTime = prop->GetMTime();
     this->TablesRange = this->Range;
+    ++this->TableUploads;
     return true;
   }
 };
@@ -288,13 +323,7 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   // The input: a vtkUnstructuredGrid, or another vtkUnstructuredGridBase copied into one.
-  vtkUnstructuredGridBase* input = this->GetInput();
-  vtkSmartPointer<vtkUnstructuredGrid> grid = vtkUnstructuredGrid::SafeDownCast(input);
-  if (input && !grid)
-  {
-    grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
-    grid->DeepCopy(input);
-  }
+  vtkUnstructuredGrid* grid = in->AsGrid(this->GetInput());
   if (!grid)
   {
     vtkErrorMacro(<< "no input: SetInputData or SetInputConnection with a vtkUnstructuredGrid");
@@ -302,8 +331,12 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
   vtkDataArray* scalars = nullptr;
   bool cells = false;
-  if (!SelectScalars(this, grid, scalars, cells, report) || !in->MakeRenderer(win) ||
-    !in->Upload(grid, scalars, cells) || !in->UpdateTables(vol->GetProperty()))
+  const bool ready = SelectScalars(this, grid, scalars, cells, report) &&
+    in->MakeRenderer(win) && in->Upload(grid, scalars, cells) &&
+    in->UpdateTables(vol->GetProperty());
+  this->MeshUploadCount = in->MeshUploads;
+  this->TableUploadCount = in->TableUploads;
+  if (!ready)
   {
     vtkErrorMacro(<< report.GetError());
     return;

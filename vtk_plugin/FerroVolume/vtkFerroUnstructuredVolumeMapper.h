@@ -14,7 +14,9 @@
  *
  * The scalars are those vtkAbstractVolumeMapper's ScalarMode, ArrayAccessMode, ArrayId and
  * ArrayName select, on points or cells, one component (more are refused). The mesh is
- * uploaded again only when the input or its scalars change. Blend modes: composite (the
+ * uploaded again only when the input or its scalars change; an input that is another
+ * vtkUnstructuredGridBase than vtkUnstructuredGrid is copied into one once per change of
+ * the input (its MTime), not once per frame. Blend modes: composite (the
  * default, VTK's unstructured ray caster's), maximum and minimum intensity, average and
  * additive, as vtkVolumeMapper numbers them; VTK's own unstructured mappers ignore the
  * blend mode and always composite. The mapper's clipping planes and the vtkVolume's matrix
@@ -58,6 +60,15 @@ public:
    */
   vtkGetMacro(LastRenderDrew, int);
 
+  ///@{
+  /**
+   * How many times the mapper handed ferrovol the mesh with its scalars, and the colour and
+   * opacity tables (an unchanged input and property upload nothing).
+   */
+  vtkGetMacro(MeshUploadCount, int);
+  vtkGetMacro(TableUploadCount, int);
+  ///@}
+
   /**
    * WARNING: INTERNAL METHOD - NOT INTENDED FOR GENERAL USE
    */
@@ -73,6 +84,8 @@ protected:
   ~vtkFerroUnstructuredVolumeMapper() override;
 
   int LastRenderDrew = 0;
+  int MeshUploadCount = 0;
+  int TableUploadCount = 0;
 
 private:
   vtkFerroUnstructuredVolumeMapper(const vtkFerroUnstructuredVolumeMapper&) = delete;

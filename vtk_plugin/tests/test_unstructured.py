@@ -152,6 +152,26 @@ class AgainstVtk(unittest.TestCase):
         self.assertGreater(coverage(render(mapper, g, size=(80, 80))[0]), 0.2)
 
 
+class Uploads(unittest.TestCase):
+    def test_unchanged_input_uploads_once(self):
+        """Renders that change only the camera upload nothing; new scalar values upload the
+        mesh again, a new colour function the tables."""
+        grid = meshes.tet_wavelet(4)
+        mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        scene = Scene(mapper, grid, wavelet_property(), size=(64, 64), camera=view)
+        for _ in range(3):
+            scene.render()
+            scene.renderer.GetActiveCamera().Azimuth(20.0)
+        self.assertTrue(mapper.GetLastRenderDrew())
+        self.assertEqual((mapper.GetMeshUploadCount(), mapper.GetTableUploadCount()), (1, 1))
+        grid.GetPointData().GetScalars().Modified()
+        scene.render()
+        self.assertEqual(mapper.GetMeshUploadCount(), 2)
+        scene.volume.GetProperty().GetRGBTransferFunction().AddRGBPoint(100.0, 1.0, 0.0, 0.0)
+        scene.render()
+        self.assertEqual((mapper.GetMeshUploadCount(), mapper.GetTableUploadCount()), (2, 2))
+
+
 class BadInput(unittest.TestCase):
     def setUp(self):
         self.mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()

@@ -1,0 +1,100 @@
+#include "vtkFerroUnstructuredVolumeRepresentation.h"
+
+#include "vtkFerroUnstructuredVolumeMapper.h"
+#include "vtkMultiProcessController.h"
+#include "vtkObjectFactory.h"
+#include "vtkVolumeMapper.h"
+
+#include <cstring>
+
+vtkStandardNewMacro(vtkFerroUnstructuredVolumeRepresentation);
+
+//------------------------------------------------------------------------------------------
+vtkFerroUnstructuredVolumeRepresentation::vtkFerroUnstructuredVolumeRepresentation()
+{
+  this->AddVolumeMapper(MapperName(), this->FerroMapper);
+  this->Superclass::SetActiveVolumeMapper(MapperName());
+}
+
+vtkFerroUnstructuredVolumeRepresentation::~vtkFerroUnstructuredVolumeRepresentation() = default;
+
+void vtkFerroUnstructuredVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FerrovolBlendMode: " << this->FerrovolBlendMode << "\n";
+}
+
+vtkFerroUnstructuredVolumeMapper*
+vtkFerroUnstructuredVolumeRepresentation::GetFerroUnstructuredVolumeMapper()
+{
+  return this->FerroMapper;
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroUnstructuredVolumeRepresentation::SetActiveVolumeMapper(const char* name)
+{
+  if (name && name[0] && std::strcmp(name, MapperName()) != 0)
+  {
+    vtkErrorMacro(<< "\"Ferrovol Volume\" draws unstructured grids with ferrovol only; the "
+                     "mapper \""
+                  << name << "\" is one of \"Volume\"'s (its Select Mapper): ignored");
+  }
+  this->Superclass::SetActiveVolumeMapper(MapperName());
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetFerrovolBlendMode(int mode)
+{
+  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ADDITIVE_BLEND)
+  {
+    vtkErrorMacro(<< "blend mode " << mode
+                  << " is not drawn on unstructured grids (composite 0, maximum 1, minimum 2, "
+                     "average 3, additive 4 are): the blend mode stays "
+                  << this->FerrovolBlendMode);
+    return;
+  }
+  if (this->FerrovolBlendMode != mode)
+  {
+    this->FerrovolBlendMode = mode;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------------------
+void vtkFerroUnstructuredVolumeRepresentation::UpdateMapperParameters()
+{
+  this->Superclass::UpdateMapperParameters();
+  if (this->UseSeparateOpacityArray)
+  {
+    vtkErrorMacro(<< "\"Ferrovol Volume\" on unstructured grids draws one component: a "
+                     "separate opacity array (Use Separate Opacity Array) is not supported, "
+                     "nothing is drawn");
+  }
+  this->FerroMapper->SetBlendMode(this->FerrovolBlendMode);
+  auto* controller = vtkMultiProcessController::GetGlobalController();
+  const bool distributed = controller && controller->GetNumberOfProcesses() > 1;
+  if (distributed && this->FerrovolBlendMode != vtkVolumeMapper::COMPOSITE_BLEND &&
+    this->WarnedBlendMode != this->FerrovolBlendMode)
+  {
+    vtkWarningMacro(<< "blend mode " << this->FerrovolBlendMode
+                    << " under MPI: each rank draws its piece of the mesh with it and IceT "
+                       "composites the pieces' images in visibility order (\"over\"), which "
+                       "is exact for composite only");
+  }
+  this->WarnedBlendMode = this->FerrovolBlendMode;
+}
+
+//------------------------------------------------------------------------------------------
+int vtkFerroUnstructuredVolumeRepresentation::GetFerrovolLastRenderDrew()
+{
+  return this->FerroMapper->GetLastRenderDrew();
+}
+
+int vtkFerroUnstructuredVolumeRepresentation::GetFerrovolVolumeUploadCount()
+{
+  return this->FerroMapper->GetMeshUploadCount();
+}
+
+int vtkFerroUnstructuredVolumeRepresentation::GetFerrovolTableUploadCount()
+{
+  return this->FerroMapper->GetTableUploadCount();
+}
