@@ -21,6 +21,22 @@ fn with_renderer(
     guard(|| f(mut_ref(renderer, "renderer")?))
 }
 
+/// [`with_renderer`] for the calls that draw (or prepare) a `width × height` frame: the view
+/// takes the size first.
+fn with_frame(
+    renderer: *mut FvRenderer,
+    width: u32,
+    height: u32,
+    f: impl FnOnce(&mut FvRenderer) -> ferrovol_core::Result<()>,
+) -> FvStatus {
+    with_renderer(renderer, |r| {
+        r.view.width = width;
+        r.view.height = height;
+        f(r)?;
+        Ok(())
+    })
+}
+
 /// [`with_renderer`] for the calls that only read the renderer.
 fn with_renderer_ref(
     renderer: *const FvRenderer,
@@ -385,17 +401,14 @@ pub unsafe extern "C" fn fv_renderer_render(
     depth: *const f32,
     depth_count: usize,
 ) -> FvStatus {
-    with_renderer(renderer, |r| {
-        r.view.width = width;
-        r.view.height = height;
+    with_frame(renderer, width, height, |r| {
         let depth = if depth.is_null() {
             None
         } else {
             // SAFETY: the caller guarantees `depth_count` floats at `depth`.
             Some(unsafe { std::slice::from_raw_parts(depth, depth_count) })
         };
-        r.r.render(&r.view, &r.params, depth)?;
-        Ok(())
+        r.r.render(&r.view, &r.params, depth)
     })
 }
 
@@ -410,12 +423,7 @@ pub unsafe extern "C" fn fv_renderer_prepare(
     width: u32,
     height: u32,
 ) -> FvStatus {
-    with_renderer(renderer, |r| {
-        r.view.width = width;
-        r.view.height = height;
-        r.r.prepare(&r.view, &r.params)?;
-        Ok(())
-    })
+    with_frame(renderer, width, height, |r| r.r.prepare(&r.view, &r.params))
 }
 
 /// Renders like fv_renderer_render, each pixel's ray sampling only between two window depths:
@@ -555,11 +563,8 @@ pub unsafe extern "C" fn fv_renderer_render_with_shared_depth(
     width: u32,
     height: u32,
 ) -> FvStatus {
-    with_renderer(renderer, |r| {
-        r.view.width = width;
-        r.view.height = height;
-        r.r.render_with_shared_depth(&r.view, &r.params)?;
-        Ok(())
+    with_frame(renderer, width, height, |r| {
+        r.r.render_with_shared_depth(&r.view, &r.params)
     })
 }
 

@@ -15,7 +15,7 @@ use crate::gpu::binding::{
 use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::slots;
 use crate::gpu::texture::block_grid;
-use crate::gpu::uniforms::FLAG_DEPTH_RANGE;
+use crate::gpu::uniforms::{FLAG_DEPTH_RANGE, PIXEL_STATE_BYTES};
 use crate::gpu::Context;
 use crate::params::downsample::Reduction;
 use crate::params::BlendMode;
@@ -38,6 +38,8 @@ pub(crate) struct DvrPass {
     no_tables_2d: Tables,
     /// Bound in place of a rectilinear grid's lookup for a uniform grid.
     no_grid_lookup: wgpu::TextureView,
+    /// Bound in place of the per-pixel ray state by frames that do not stream (one pixel's).
+    no_ray_state: wgpu::Buffer,
     /// The intermixed volumes' bindings.
     intermix_binding: IntermixBinding,
 }
@@ -80,6 +82,12 @@ impl DvrPass {
             no_preintegration: Tables::with_format(&ctx.device, [1, 1], PREINTEGRATION_FORMAT),
             no_tables_2d: Tables::new(&ctx.device, [1, 1]),
             no_grid_lookup: no_grid_lookup(ctx),
+            no_ray_state: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("no ray state"),
+                size: PIXEL_STATE_BYTES,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
             intermix_binding: IntermixBinding::new(ctx),
         })
     }
@@ -219,7 +227,14 @@ impl DvrPass {
                 bind_view(slots::DEPTH_NEAR, &depth_near_view),
                 bind_view(slots::OUT_COLOR, &color_view),
                 bind_view(slots::OUT_DEPTH, &depth_view),
-                bind(slots::RAY_STATE, t.state.as_entire_binding()),
+                bind(
+                    slots::RAY_STATE,
+                    match variant.streaming {
+                        true => t.state(ctx),
+                        false => &self.no_ray_state,
+                    }
+                    .as_entire_binding(),
+                ),
                 res.blanking_entry(&self.no_blanking),
                 bind_view(slots::PREINT_TABLES, &preintegrated.view),
                 bind(
@@ -261,7 +276,7 @@ impl DvrPass {
             Some(plan) => {
                 // One pass per group of bricks, front to back: each ray marches what is
                 // resident and stops where its next brick waits, its state in `t.state`.
-                enc.clear_buffer(&t.state, 0, None);
+                enc.clear_buffer(t.state(ctx), 0, None);
                 ctx.submit([enc.finish()]);
                 for g in 0..plan.groups.len() {
                     res.load_stream_group(ctx, &plan, g)?;

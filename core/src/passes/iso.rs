@@ -309,7 +309,7 @@ impl IsoPass {
                 "no isosurface frame has been rendered yet".into(),
             ));
         };
-        let state = read_buffer(ctx, &t.state)?;
+        let state = read_buffer(ctx, t.state(ctx))?;
         let states: &[[f32; 12]] = bytemuck::cast_slice(&state);
         let r = self.last_rect;
         let counts = (0..gb.width * gb.height)
@@ -608,7 +608,7 @@ impl IsoPass {
             layout: &self.firsthit_bgl,
             entries: &[
                 bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind(2, t.state.as_entire_binding()),
+                bind(2, t.state(ctx).as_entire_binding()),
                 bind_view(slots::OCCUPANCY, occupancy),
                 bind_view(slots::DEPTH_IN, &depth_in_view),
                 bind(slots::ISO, self.iso_buf.as_entire_binding()),
@@ -631,7 +631,7 @@ impl IsoPass {
             layout: &self.deferred_bgl,
             entries: &[
                 bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind(2, t.state.as_entire_binding()),
+                bind(2, t.state(ctx).as_entire_binding()),
                 bind_view(slots::OUT_COLOR, &color_view),
                 bind_view(slots::OUT_DEPTH, &depth_view),
                 bind(slots::ISO, self.iso_buf.as_entire_binding()),
@@ -675,7 +675,7 @@ impl IsoPass {
             Some(plan) => {
                 // One pass per group of bricks, front to back (as dvr.rs streams), then the
                 // deferred shading of the layers they wrote.
-                let state = t.state.clone();
+                let state = t.state(ctx).clone();
                 enc.clear_buffer(&state, 0, None);
                 ctx.submit([enc.finish()]);
                 for g in 0..plan.groups.len() {

@@ -9,11 +9,14 @@ use crate::gpu::texture::{texture_2d, upload_texture};
 use crate::gpu::uniforms::PIXEL_STATE_BYTES;
 use crate::gpu::Context;
 use crate::params::{Image, View};
+use std::sync::OnceLock;
 
 pub(crate) struct Targets {
     pub width: u32,
     pub height: u32,
-    pub(crate) state: wgpu::Buffer,
+    /// The per-pixel ray state, allocated by the first frame that keeps one
+    /// ([`Targets::state`]): streamed ray casting and isosurfaces.
+    state: OnceLock<wgpu::Buffer>,
     pub(crate) color: wgpu::Texture,
     pub(crate) depth: wgpu::Texture,
     pub(crate) depth_in: wgpu::Texture,
@@ -27,6 +30,22 @@ pub(crate) struct Targets {
 }
 
 impl Targets {
+    /// The per-pixel ray state ([`PIXEL_STATE_BYTES`] a pixel), allocated on first use: most
+    /// frames keep none, and it is the largest of the images (48 bytes a pixel).
+    pub(crate) fn state(&self, ctx: &Context) -> &wgpu::Buffer {
+        self.state.get_or_init(|| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ray state"),
+                size: PIXEL_STATE_BYTES * self.width as u64 * self.height as u64,
+                // (COPY_SRC: Renderer::read_gbuffer reads the isosurface layer counts)
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        })
+    }
+
     pub fn path(&self) -> OutputPath {
         if self.exported.is_some() {
             OutputPath::Shared
@@ -158,15 +177,7 @@ impl Resources {
             Ok(Targets {
                 width,
                 height,
-                state: d.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("ray state"),
-                    size: PIXEL_STATE_BYTES * width as u64 * height as u64,
-                    // (COPY_SRC: Renderer::read_gbuffer reads the isosurface layer counts)
-                    usage: wgpu::BufferUsages::STORAGE
-                        | wgpu::BufferUsages::COPY_DST
-                        | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                }),
+                state: OnceLock::new(),
                 color,
                 depth,
                 depth_in,

@@ -524,3 +524,40 @@ fn blanking_leaves_hidden_points_out() {
         &["bricked"],
     );
 }
+
+/// The per-pixel ray state (48 bytes a pixel, the largest of a frame's images) is allocated
+/// only by frames that keep one: a ray-cast frame that does not stream holds none, an
+/// isosurface frame allocates it.
+#[test]
+fn ray_state_only_where_a_frame_keeps_one() {
+    let mut r = new_renderer();
+    let vol = blob_volume(24);
+    r.set_volume(&vol).unwrap();
+    r.set_transfer_function(&TransferFunction::single(blob_transfer()))
+        .unwrap();
+    let (w, h) = (512, 384);
+    let view = View::fit(vol.bounds(), w, h);
+    let state_bytes = 48 * w as u64 * h as u64;
+    let mut img = r.render_image(&view, &shaded()).unwrap();
+    assert!(img.rgba.chunks(4).any(|p| p[3] > 0), "empty frame");
+    let ray_cast = r.context().device_memory().buffer_bytes;
+    r.set_isosurface(&IsoParams::with_values(vec![IsoValue::new(
+        0.4,
+        [0.9, 0.8, 0.7],
+        1.0,
+    )]))
+    .unwrap();
+    let iso = RenderParams {
+        blend: BlendMode::Isosurface,
+        ..Default::default()
+    };
+    img = r.render_image(&view, &iso).unwrap();
+    assert!(img.rgba.chunks(4).any(|p| p[3] > 0), "empty isosurface frame");
+    let with_state = r.context().device_memory().buffer_bytes;
+    println!(
+        "buffers after a ray-cast frame {ray_cast} bytes, after an isosurface frame \
+         {with_state} (the ray state of {w}x{h}: {state_bytes})"
+    );
+    assert!(ray_cast < state_bytes, "the ray-cast frame holds a ray state");
+    assert!(with_state >= ray_cast + state_bytes);
+}
