@@ -552,12 +552,18 @@ fn ray_state_only_where_a_frame_keeps_one() {
         ..Default::default()
     };
     img = r.render_image(&view, &iso).unwrap();
-    assert!(img.rgba.chunks(4).any(|p| p[3] > 0), "empty isosurface frame");
+    assert!(
+        img.rgba.chunks(4).any(|p| p[3] > 0),
+        "empty isosurface frame"
+    );
     let with_state = r.context().device_memory().buffer_bytes;
     println!(
         "buffers after a ray-cast frame {ray_cast} bytes, after an isosurface frame \
          {with_state} (the ray state of {w}x{h}: {state_bytes})"
     );
-    assert!(ray_cast < state_bytes, "the ray-cast frame holds a ray state");
+    assert!(
+        ray_cast < state_bytes,
+        "the ray-cast frame holds a ray state"
+    );
     assert!(with_state >= ray_cast + state_bytes);
 }
