@@ -149,9 +149,13 @@ fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> 
             }
         }
         if (visit && nd.count == 0u && sp < MESH_BVH_STACK) {
-            stack[sp] = nd.a;
+            // the nearer child first (the first holds the lower half along the split axis,
+            // taken as the box's longest), so that the nearest hit culls the farther boxes
+            let ext = nd.hi - nd.lo;
+            let along = select(select(d.z, d.y, ext.y >= ext.z), d.x, ext.x >= max(ext.y, ext.z));
+            stack[sp] = select(nd.a, node + 1u, along < 0.0);
             sp = sp + 1u;
-            node = node + 1u;
+            node = select(node + 1u, nd.a, along < 0.0);
             continue;
         }
         if (sp == 0u) {
@@ -524,6 +528,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // (from the line's first boundary crossing, behind the camera too: a near plane
         // inside the mesh starts its rays inside, where they are integrated from seg.x)
         var hit = next_entry(o, d, -3.0e38, seg.y, NO_HIT);
+        let root = nodes[0];
+        let r0 = (root.lo - o) / d;
+        let r1 = (root.hi - o) / d;
+        let root_far = min(min(max(r0.x, r1.x), max(r0.y, r1.y)), max(r0.z, r1.z));
         var k: Tet;
         if (hit.tf != NO_HIT) {
             k = load_tet(hit.tf >> 2u);
@@ -551,6 +559,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 break;
             }
             let nb = neighbours[t][ex.tf & 3u];
+            if (nb == NO_NEIGHBOUR && ex.t >= root_far - 1e-5 * (abs(ex.t) + length(o))) {
+                break; // (where the ray leaves the boundary's box, no triangle faces it beyond)
+            }
             if (nb == NO_NEIGHBOUR) {
                 // the next boundary triangle facing the ray: further on in a non-convex
                 // mesh, or right there where a face does not conform (the triangles on
