@@ -17,7 +17,8 @@ scalars), vtkUnstructuredGridVolumeZSweepMapper, vtkProjectedTetrahedraMapper (V
 gives vtkOpenGLProjectedTetrahedraMapper) and, once the module `ferrovol` has it,
 vtkFerroUnstructuredVolumeMapper: one more entry of MAPPERS. With --cli, ferrovol's CLI
 draws the same mesh (written to a .vtu), transfer function, size and camera path in the
-same run (`ferrovol render --repeat`, its own device; the mean of its steady frames).
+same run, before VTK's mappers (`ferrovol render --repeat`, its own device; the mean of
+its steady frames); --cli may be given more than once (two builds in one run).
 
 --tf picks the transfer function: `wavelet` (the regression suite's: opacity rising from 0
 at the scalar range's low end, nothing empty) or `partly-empty` (the same with opacity 0 up
@@ -26,7 +27,7 @@ to 170, over about 60% of the mesh's points: what a user looking at the high val
     . build/env.sh
     scripts/with-xvfb.sh /usr/bin/python3 bench/unstructured_vtk.py [--tets 1000000]
         [--size 900x900] [--frames 5] [--budget 300] [--only bunyk,pt] [--png-dir DIR]
-        [--tf wavelet|partly-empty] [--cli target/release/ferrovol]
+        [--tf wavelet|partly-empty] [--cli [NAME=]target/release/ferrovol ...]
 """
 import argparse
 import json
@@ -144,7 +145,9 @@ def main(argv):
                     help="the window's MultiSamples (default VTK's: 8 on VTK 9.2)")
     ap.add_argument("--png-dir", help="write each mapper's first frame here")
     ap.add_argument("--tf", choices=sorted(TRANSFER_FUNCTIONS), default="wavelet")
-    ap.add_argument("--cli", help="ferrovol's CLI: time it on the same mesh (row ferrovol-cli)")
+    ap.add_argument("--cli", action="append", default=[], metavar="[NAME=]PATH",
+                    help="ferrovol's CLI: time it on the same mesh (row NAME, default "
+                    "ferrovol-cli); repeatable, e.g. before=OLD after=NEW")
     a = ap.parse_args(argv)
     w, h = (int(v) for v in a.size.split("x"))
     names = [n.strip() for n in a.only.split(",") if n.strip()] or list(MAPPERS)
@@ -183,12 +186,14 @@ def main(argv):
         os.makedirs(a.png_dir, exist_ok=True)
 
     rows = []
-    if a.cli:
-        png = os.path.join(a.png_dir, "unstructured-ferrovol-cli.png") if a.png_dir else None
-        prepared, steady = time_cli(a.cli, mesh, tf, (w, h), a.frames, png)
+    for spec in a.cli:
+        name, _, path = spec.rpartition("=")
+        name = name or "ferrovol-cli"
+        png = os.path.join(a.png_dir, "unstructured-%s.png" % name) if a.png_dir else None
+        prepared, steady = time_cli(path, mesh, tf, (w, h), a.frames, png)
         print("%-9s %-42s prepare_ms=%.0f steady_ms_mean=%.0f (%d frames)"
-              % ("cli", os.path.basename(a.cli), prepared, steady[0], a.frames), flush=True)
-        rows.append(("ferrovol-cli", steady[0]))
+              % (name, path, prepared, steady[0], a.frames), flush=True)
+        rows.append((name, steady[0]))
     for name in names:
         make = MAPPERS.get(name)
         if make is None:

@@ -546,7 +546,12 @@ mod layout_tests {
             [env_rotation, medium, surface, lobe, counts, options, rect]
         );
         let m = module("unstructured.wgsl");
-        check!(m, "Mesh", MeshUniforms, [counts, unit, split, knots, opaque]);
+        check!(
+            m,
+            "Mesh",
+            MeshUniforms,
+            [counts, unit, split, knots, opaque]
+        );
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
         let m = module("pathtrace_show.wgsl");
