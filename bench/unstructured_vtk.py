@@ -15,29 +15,47 @@ after --budget seconds of steady frames (at least one), and says so.
 Rows: vtkUnstructuredGridVolumeRayCastMapper (Bunyk; its default integrator for point
 scalars), vtkUnstructuredGridVolumeZSweepMapper, vtkProjectedTetrahedraMapper (VTK's factory
 gives vtkOpenGLProjectedTetrahedraMapper) and, once the module `ferrovol` has it,
-vtkFerroUnstructuredVolumeMapper: one more entry of MAPPERS.
+vtkFerroUnstructuredVolumeMapper: one more entry of MAPPERS. With --cli, ferrovol's CLI
+draws the same mesh (written to a .vtu), transfer function, size and camera path in the
+same run, before VTK's mappers (`ferrovol render --repeat`, its own device; the mean of
+its steady frames); --cli may be given more than once (two builds in one run).
+
+--tf picks the transfer function: `wavelet` (the regression suite's: opacity rising from 0
+at the scalar range's low end, nothing empty) or `partly-empty` (the same with opacity 0 up
+to 170, over about 60% of the mesh's points: what a user looking at the high values sets).
 
     . build/env.sh
     scripts/with-xvfb.sh /usr/bin/python3 bench/unstructured_vtk.py [--tets 1000000]
         [--size 900x900] [--frames 5] [--budget 300] [--only bunyk,pt] [--png-dir DIR]
+        [--tf wavelet|partly-empty] [--cli [NAME=]target/release/ferrovol ...]
 """
 import argparse
+import json
 import os
 import platform
+import re
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path[:0] = [os.path.join(ROOT, "tests", "regression"),
-                os.path.join(ROOT, "vtk_plugin", "tests"), os.path.join(ROOT, "tests")]
+                os.path.join(ROOT, "vtk_plugin", "examples")]
 
 import vtk  # noqa: E402
 
 import meshes  # noqa: E402  tests/regression/meshes.py
-from ferrovol_testing.png import write_png  # noqa: E402
-from fvtest import grab, tf_property  # noqa: E402
+from volume_scene import (  # noqa: E402  vtk_plugin/examples/volume_scene.py
+    WAVELET_COLOR, WAVELET_OPACITY, volume_property, write_png)
+
+# --tf: name -> (colour points, opacity points)
+TRANSFER_FUNCTIONS = {
+    "wavelet": (WAVELET_COLOR, WAVELET_OPACITY),
+    "partly-empty": (WAVELET_COLOR, [(37.3531, 0.0), (170.0, 0.0), (276.829, 1.0)]),
+}
 
 
 def _ray_cast_mapper(cls):
@@ -76,7 +94,7 @@ def time_mapper(win, ren, vol, mesh, make, frames, budget, png=None):
     win.Render()
     first = (time.perf_counter() - t0) * 1e3
     if png:
-        write_png(png, grab(win))
+        write_png(win, png)
     steady = []
     spent = 0.0
     for _ in range(frames):
@@ -92,6 +110,29 @@ def time_mapper(win, ren, vol, mesh, make, frames, budget, png=None):
     return first, steady, m.GetClassName()
 
 
+def time_cli(cli, mesh, tf, size, frames, png=None):
+    """(prepare ms, [mean steady frame ms]) of ferrovol's CLI drawing the mesh (as a .vtu)
+    with the transfer function (colour points, opacity points) at size (w, h): the
+    benchmark's camera, then frames turns of +1 degree."""
+    with tempfile.TemporaryDirectory() as tmp:
+        vtu = os.path.join(tmp, "timing.vtu")
+        meshes.write_vtu(mesh, vtu, mode="raw", compress=False)
+        tf_json = os.path.join(tmp, "tf.json")
+        with open(tf_json, "w") as f:
+            json.dump({"color": [list(p) for p in tf[0]], "opacity": [list(p) for p in tf[1]],
+                       "unit_distance": 1.0}, f)
+        out = png or os.path.join(tmp, "ferrovol.png")
+        cmd = [cli, "render", vtu, "--size", "%dx%d" % size, "--tf", tf_json, "--azimuth",
+               "30", "--elevation", "20", "--repeat", str(frames + 1), "--orbit", "1",
+               "--out", out]
+        done = subprocess.run(cmd, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError("%s failed:\n%s%s" % (" ".join(cmd), done.stdout, done.stderr))
+    prepared = float(re.search(r"prepared in ([0-9.]+) s", done.stdout).group(1))
+    mean = float(re.search(r"([0-9.]+) ms/frame", done.stdout).group(1))
+    return prepared * 1e3, [mean]
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--tets", type=int, default=1_000_000)
@@ -103,6 +144,10 @@ def main(argv):
     ap.add_argument("--multisamples", type=int, metavar="N",
                     help="the window's MultiSamples (default VTK's: 8 on VTK 9.2)")
     ap.add_argument("--png-dir", help="write each mapper's first frame here")
+    ap.add_argument("--tf", choices=sorted(TRANSFER_FUNCTIONS), default="wavelet")
+    ap.add_argument("--cli", action="append", default=[], metavar="[NAME=]PATH",
+                    help="ferrovol's CLI: time it on the same mesh (row NAME, default "
+                    "ferrovol-cli); repeatable, e.g. before=OLD after=NEW")
     a = ap.parse_args(argv)
     w, h = (int(v) for v in a.size.split("x"))
     names = [n.strip() for n in a.only.split(",") if n.strip()] or list(MAPPERS)
@@ -111,8 +156,8 @@ def main(argv):
     mesh = meshes.timing(a.tets)
     made = time.perf_counter() - t0
     print("# mesh: %d tetrahedra, %d points (tests/regression/meshes.py timing(%d), made in "
-          "%.2f s); %dx%d; VTK %s; %s, %d CPUs; load average %s"
-          % (mesh.GetNumberOfCells(), mesh.GetNumberOfPoints(), a.tets, made, w, h,
+          "%.2f s); %dx%d; --tf %s; VTK %s; %s, %d CPUs; load average %s"
+          % (mesh.GetNumberOfCells(), mesh.GetNumberOfPoints(), a.tets, made, w, h, a.tf,
              vtk.vtkVersion.GetVTKVersion(), platform.node(), os.cpu_count(),
              " ".join("%.2f" % v for v in os.getloadavg())), flush=True)
 
@@ -123,7 +168,9 @@ def main(argv):
     ren = vtk.vtkRenderer()
     ren.SetBackground(0.0, 0.0, 0.0)
     win.AddRenderer(ren)
-    prop = tf_property(interpolation="linear")
+    tf = TRANSFER_FUNCTIONS[a.tf]
+    prop = volume_property(*tf)
+    prop.SetInterpolationTypeToLinear()
     prop.SetScalarOpacityUnitDistance(1.0)
     vol = vtk.vtkVolume()
     vol.SetProperty(prop)
@@ -139,6 +186,14 @@ def main(argv):
         os.makedirs(a.png_dir, exist_ok=True)
 
     rows = []
+    for spec in a.cli:
+        name, _, path = spec.rpartition("=")
+        name = name or "ferrovol-cli"
+        png = os.path.join(a.png_dir, "unstructured-%s.png" % name) if a.png_dir else None
+        prepared, steady = time_cli(path, mesh, tf, (w, h), a.frames, png)
+        print("%-9s %-42s prepare_ms=%.0f steady_ms_mean=%.0f (%d frames)"
+              % (name, path, prepared, steady[0], a.frames), flush=True)
+        rows.append((name, steady[0]))
     for name in names:
         make = MAPPERS.get(name)
         if make is None:
@@ -155,9 +210,11 @@ def main(argv):
               % (name, cls, first, med, " ".join("%.0f" % v for v in steady), cut), flush=True)
         rows.append((name, med))
     win.Finalize()
-    if rows and rows[0][0] == "bunyk" and len(rows) > 1:
-        print("# ratio of steady frame time to the Bunyk ray caster's: " + ", ".join(
-            "%s %.3f" % (n, ms / rows[0][1]) for n, ms in rows[1:]))
+    times = dict(rows)
+    for anchor in ("bunyk", "zsweep", "pt"):
+        if anchor in times and len(times) > 1:
+            print("# ratio of steady frame time to %s's: " % anchor + ", ".join(
+                "%s %.3f" % (n, ms / times[anchor]) for n, ms in rows if n != anchor))
     return 0
 
 

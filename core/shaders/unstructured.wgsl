@@ -1,8 +1,8 @@
 // Ray casting an unstructured volume (core/src/passes/unstructured.rs): one thread per
 // pixel. A ray enters the mesh where it first meets a boundary triangle facing it (a
 // bounding volume hierarchy over the boundary triangles), walks from tetrahedron to
-// tetrahedron across shared faces, each tetrahedron's exit the nearest of its other faces'
-// planes the ray leaves through, and where it leaves the mesh looks for the next boundary
+// tetrahedron across shared faces, each tetrahedron's exit face and point from the ray's
+// Plücker products with its edges, and where it leaves the mesh looks for the next boundary
 // triangle facing it beyond (non-convex meshes). Along a tetrahedron the scalar is linear
 // (barycentric on the entry and exit faces; cell scalars constant), and each segment is
 // integrated exactly for the transfer tables (linear between entries): split at the
@@ -10,7 +10,8 @@
 // τ = opacity / unit distance, emission colour · τ (VTK's unstructured integrators).
 // "Index space" is the mesh's own coordinates relative to its centre; t is world distance.
 // Only the part of each ray within the near and far planes, the host's depth and the
-// clipping planes is integrated.
+// clipping planes is integrated; composite skips the integral of a tetrahedron whose
+// scalars the transfer function makes fully transparent (empty-space skipping).
 #include "lib/output.wgsl"
 #include "lib/march.wgsl"
 
@@ -22,6 +23,7 @@ struct Mesh {
     unit: vec4<f32>,    // x: 1 / unit distance
     split: vec4<u32>,   // x: knots, or MESH_EVERY_ENTRY (pieces end at every table entry)
     knots: array<vec4<f32>, MESH_KNOTS / 4>, // table coordinates where pieces end, ascending
+    opaque: array<vec4<u32>, MESH_OPAQUE_WORDS / 4>, // a bit per table entry of opacity > 0
 }
 
 struct BvhNode {
@@ -89,25 +91,6 @@ fn make_face(pa: vec4<f32>, pb: vec4<f32>, pc: vec4<f32>) -> Face {
     return out;
 }
 
-// The point scalar at p on face fc (barycentric, clamped to the triangle), or the cell's.
-fn face_scalar(fc: Face, p: vec3<f32>, t: u32) -> f32 {
-    if (CELL_SCALARS) {
-        return cell_scalars[t];
-    }
-    // (signed areas, positive inside for either orientation of the normal)
-    var w = vec3<f32>(
-        dot(fc.n, cross(fc.b - p, fc.c - p)),
-        dot(fc.n, cross(fc.c - p, fc.a - p)),
-        dot(fc.n, cross(fc.a - p, fc.b - p)),
-    );
-    w = max(w * sign(dot(fc.n, cross(fc.b - fc.a, fc.c - fc.a))), vec3<f32>(0.0));
-    let sum = w.x + w.y + w.z;
-    if (sum <= 0.0) {
-        return (fc.sa + fc.sb + fc.sc) / 3.0;
-    }
-    return dot(w, vec3<f32>(fc.sa, fc.sb, fc.sc)) / sum;
-}
-
 // The ray's entry into the mesh: the nearest boundary triangle facing the ray at a
 // distance ≥ t_min, not of tetrahedron `skip` (the one the ray just left).
 fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> Hit {
@@ -166,9 +149,13 @@ fn next_entry(o: vec3<f32>, d: vec3<f32>, t_min: f32, t_max: f32, skip: u32) -> 
             }
         }
         if (visit && nd.count == 0u && sp < MESH_BVH_STACK) {
-            stack[sp] = nd.a;
+            // the nearer child first (the first holds the lower half along the split axis,
+            // taken as the box's longest), so that the nearest hit culls the farther boxes
+            let ext = nd.hi - nd.lo;
+            let along = select(select(d.z, d.y, ext.y >= ext.z), d.x, ext.x >= max(ext.y, ext.z));
+            stack[sp] = select(nd.a, node + 1u, along < 0.0);
             sp = sp + 1u;
-            node = node + 1u;
+            node = select(node + 1u, nd.a, along < 0.0);
             continue;
         }
         if (sp == 0u) {
@@ -220,51 +207,59 @@ fn next_tet(old: Tet, t: u32, f: u32) -> Tet {
     return out;
 }
 
-// Point i mod 4 of tetrahedron k (selects: a local array indexed at run time would live in
-// memory).
-fn corner(k: Tet, i: u32) -> vec4<f32> {
-    let j = i % 4u;
-    return select(select(select(k.p3, k.p2, j == 2u), k.p1, j == 1u), k.p0, j == 0u);
-}
-
-// Where the ray leaves through the plane of face (a, b, c) opposite q: its distance, or
-// +∞ where the ray does not leave through it (entering or parallel).
-fn leaves_at(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, q: vec3<f32>) -> f32 {
-    var n = cross(b - a, c - a);
-    n = select(n, -n, dot(n, q - a) > 0.0);
-    let den = dot(n, d);
-    return select(3.0e38, dot(n, a - o) / den, den > 0.0);
-}
-
-// The ray's exit from tetrahedron k (index t) entered through face f_in at t_in: the
-// nearest plane of the other faces that the ray leaves through (at t_in at the earliest).
-// tf NO_HIT when no face is left through (a ray grazing a face).
+// The ray's exit from tetrahedron k (index t), entered through face f_in at t_in, from the
+// signs of the ray's products with the tetrahedron's edges (Plücker coordinates, as Platis
+// and Theoharis 2003), taken from the entry point e: w(i, j) = d · ((p_i − e) × (p_j − e)).
+// The faces (1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1) are outward (resources/mesh orients
+// every tetrahedron positively), and the ray leaves through the one whose three edges'
+// products are ≥ 0, which are then its exit point's barycentric weights. Of the faces but
+// f_in, the one whose least product is largest (ties at an edge or rounding: the nearest
+// miss); tf NO_HIT where the ray does not leave through it (a ray along a face).
 fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> Hit {
-    let q0 = k.p0.xyz;
-    let q1 = k.p1.xyz;
-    let q2 = k.p2.xyz;
-    let q3 = k.p3.xyz;
-    var ts = vec4<f32>(
-        leaves_at(o, d, q1, q2, q3, q0),
-        leaves_at(o, d, q2, q3, q0, q1),
-        leaves_at(o, d, q3, q0, q1, q2),
-        leaves_at(o, d, q0, q1, q2, q3),
+    let e = o + t_in * d;
+    let r0 = k.p0.xyz - e;
+    let r1 = k.p1.xyz - e;
+    let r2 = k.p2.xyz - e;
+    let r3 = k.p3.xyz - e;
+    let c0 = cross(d, r0);
+    let c1 = cross(d, r1);
+    let c2 = cross(d, r2);
+    let e01 = dot(c0, r1);
+    let e02 = dot(c0, r2);
+    let e03 = dot(c0, r3);
+    let e12 = dot(c1, r2);
+    let e13 = dot(c1, r3);
+    let e23 = dot(c2, r3);
+    // per face, its points' weights (0 for the point opposite) and the least of them
+    let w0 = vec4<f32>(0.0, e23, -e13, e12);
+    let w1 = vec4<f32>(-e23, 0.0, e03, -e02);
+    let w2 = vec4<f32>(e13, -e03, 0.0, e01);
+    let w3 = vec4<f32>(-e12, e02, -e01, 0.0);
+    var m = vec4<f32>(
+        min(min(e23, -e13), e12),
+        min(min(-e23, e03), -e02),
+        min(min(e13, -e03), e01),
+        min(min(-e12, e02), -e01),
     );
-    ts = select(ts, vec4<f32>(3.0e38), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in));
-    // the nearest, and its face's points (f + 1, f + 2, f + 3) mod 4
-    let best = min(min(ts.x, ts.y), min(ts.z, ts.w));
-    let f = select(select(select(3u, 2u, ts.z == best), 1u, ts.y == best), 0u, ts.x == best);
-    let pa = corner(k, f + 1u);
-    let pb = corner(k, f + 2u);
-    let pc = corner(k, f + 3u);
+    m = select(m, vec4<f32>(-3.0e38), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in));
+    let best = max(max(m.x, m.y), max(m.z, m.w));
+    let f = select(select(select(3u, 2u, m.z == best), 1u, m.y == best), 0u, m.x == best);
+    let w = select(select(select(w3, w2, f == 2u), w1, f == 1u), w0, f == 0u);
     var out: Hit;
     out.tf = NO_HIT;
-    if (best >= 3.0e38) {
+    if (!(w.x + w.y + w.z + w.w > 0.0)) {
         return out;
     }
-    out.t = max(best, t_in);
+    let l = max(w, vec4<f32>(0.0));
+    let bary = l / (l.x + l.y + l.z + l.w);
+    let depth = vec4<f32>(dot(r0, d), dot(r1, d), dot(r2, d), dot(r3, d));
+    out.t = max(t_in + dot(bary, depth) / dot(d, d), t_in);
     out.tf = 4u * t + f;
-    out.s = face_scalar(make_face(pa, pb, pc), o + out.t * d, t);
+    if (CELL_SCALARS) {
+        out.s = cell_scalars[t];
+    } else {
+        out.s = dot(bary, vec4<f32>(k.p0.w, k.p1.w, k.p2.w, k.p3.w));
+    }
     return out;
 }
 
@@ -470,6 +465,48 @@ fn integrate_within(r: Ray, seg: vec2<f32>, ta: f32, tb: f32, sa: f32, sb: f32) 
     integrate(r, s0, s1, lo, hi - lo);
 }
 
+// Whether a table entry from x0 to x1 (table coordinates, one entry wider each way for the
+// lookups' rounding) has an opacity above 0.
+fn any_opaque(x0: f32, x1: f32) -> bool {
+    if (!(x0 <= x1)) {
+        return true; // (NaN scalars: integrated as they are)
+    }
+    let last = f32(TABLE_N - 1u);
+    let i0 = u32(clamp(floor(x0) - 1.0, 0.0, last));
+    let i1 = u32(clamp(ceil(x1) + 1.0, 0.0, last));
+    for (var w = i0 / 32u; w <= i1 / 32u; w = w + 1u) {
+        var bits = mesh.opaque[w / 4u][w % 4u];
+        if (w == i0 / 32u) {
+            bits = bits & (0xffffffffu << (i0 % 32u));
+        }
+        if (w == i1 / 32u) {
+            bits = bits & (0xffffffffu >> (31u - i1 % 32u));
+        }
+        if (bits != 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Whether composite may skip tetrahedron k (index t): the transfer function's opacity is 0
+// over its scalars (the range of its points', or its cell scalar), so it adds nothing.
+fn empty_tet(k: Tet, t: u32) -> bool {
+    if (BLEND != BLEND_COMPOSITE) {
+        return false;
+    }
+    var lo: f32;
+    var hi: f32;
+    if (CELL_SCALARS) {
+        lo = cell_scalars[t];
+        hi = lo;
+    } else {
+        lo = min(min(k.p0.w, k.p1.w), min(k.p2.w, k.p3.w));
+        hi = max(max(k.p0.w, k.p1.w), max(k.p2.w, k.p3.w));
+    }
+    return !any_opaque(entry_of(lo), entry_of(hi));
+}
+
 fn done() -> bool {
     return BLEND == BLEND_COMPOSITE && st.color.a >= frame.termination;
 }
@@ -491,6 +528,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // (from the line's first boundary crossing, behind the camera too: a near plane
         // inside the mesh starts its rays inside, where they are integrated from seg.x)
         var hit = next_entry(o, d, -3.0e38, seg.y, NO_HIT);
+        let root = nodes[0];
+        let r0 = (root.lo - o) / d;
+        let r1 = (root.hi - o) / d;
+        let root_far = min(min(max(r0.x, r1.x), max(r0.y, r1.y)), max(r0.z, r1.z));
         var k: Tet;
         if (hit.tf != NO_HIT) {
             k = load_tet(hit.tf >> 2u);
@@ -511,11 +552,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 continue;
             }
-            integrate_within(ray, seg, hit.t, ex.t, hit.s, ex.s);
+            if (!empty_tet(k, t)) {
+                integrate_within(ray, seg, hit.t, ex.t, hit.s, ex.s);
+            }
             if (done() || ex.t >= seg.y) {
                 break;
             }
             let nb = neighbours[t][ex.tf & 3u];
+            if (nb == NO_NEIGHBOUR && ex.t >= root_far - 1e-5 * (abs(ex.t) + length(o))) {
+                break; // (where the ray leaves the boundary's box, no triangle faces it beyond)
+            }
             if (nb == NO_NEIGHBOUR) {
                 // the next boundary triangle facing the ray: further on in a non-convex
                 // mesh, or right there where a face does not conform (the triangles on

@@ -8,6 +8,11 @@ bench/multi_volume.py and the VTK module's tests (vtk_plugin/tests/fvtest.py) us
 """
 import vtk
 
+# VTK's TestGPURayCastMapperBenchmark transfer function for the wavelet.
+WAVELET_COLOR = [(37.3531, 0.2, 0.29, 1.0), (157.091, 0.87, 0.87, 0.87),
+                 (276.829, 0.7, 0.015, 0.15)]
+WAVELET_OPACITY = [(37.3531, 0.0), (276.829, 1.0)]
+
 
 def color_function(points):
     """A vtkColorTransferFunction through (value, r, g, b) points."""

@@ -23,17 +23,12 @@ from ferrovol_testing.metrics import (  # noqa: E402,F401  (re-exported for the 
 from ferrovol_testing.png import write_png  # noqa: E402
 sys.path.append(os.path.join(ROOT, "vtk_plugin", "examples"))
 from volume_scene import (  # noqa: E402,F401  (the function helpers re-exported for the suites)
-    color_function, opacity_function, volume_property)
+    WAVELET_COLOR, WAVELET_OPACITY, color_function, opacity_function, volume_property)
 # The VTK under test: (major, minor), for the thresholds that differ between VTK versions.
 VTK_VERSION = (vtk.vtkVersion.GetVTKMajorVersion(), vtk.vtkVersion.GetVTKMinorVersion())
 OUTPUT = os.environ.get("FERROVOL_TEST_OUTPUT", os.path.join(ROOT, "build", "vtk", "test-images"))
 DATA = os.environ.get("FERROVOL_DATA_DIR", os.path.join(ROOT, "build", "data"))
 os.makedirs(OUTPUT, exist_ok=True)
-
-# VTK's TestGPURayCastMapperBenchmark transfer function for the wavelet.
-WAVELET_COLOR = [(37.3531, 0.2, 0.29, 1.0), (157.091, 0.87, 0.87, 0.87),
-                 (276.829, 0.7, 0.015, 0.15)]
-WAVELET_OPACITY = [(37.3531, 0.0), (276.829, 1.0)]
 
 
 def log(*args):

@@ -110,8 +110,13 @@ pub struct MeshUniforms {
     /// the transfer functions' points and the tables' ends, between which colour and
     /// opacity are linear.
     pub knots: [[f32; 4]; MESH_KNOTS / 4],
+    /// Bit i (word i / 32, bit i mod 32) set where table entry i's opacity is above 0:
+    /// composite skips the integral of a tetrahedron whose scalars reach no set entry.
+    pub opaque: [[u32; 4]; MESH_OPAQUE_WORDS / 4],
 }
 
+/// The 32-bit words of [`MeshUniforms::opaque`]: a bit per table entry.
+pub const MESH_OPAQUE_WORDS: usize = TABLE_SIZE / 32;
 /// The most knots [`MeshUniforms`] holds.
 pub const MESH_KNOTS: usize = 64;
 /// A transfer function of more knots: segments split at every table entry.
@@ -351,6 +356,7 @@ pub const WGSL_CONSTANTS: &[(&str, Wgsl)] = &[
     ("MESH_KNOTS", Wgsl::U32(MESH_KNOTS as u32)),
     ("MESH_EVERY_ENTRY", Wgsl::U32(MESH_EVERY_ENTRY)),
     ("MESH_BVH_STACK", Wgsl::U32(MESH_BVH_STACK as u32)),
+    ("MESH_OPAQUE_WORDS", Wgsl::U32(MESH_OPAQUE_WORDS as u32)),
     ("TABLE_N", Wgsl::U32(TABLE_SIZE as u32)),
     ("MAX_ISO", Wgsl::U32(ISO_MAX_VALUES as u32)),
     ("SPECULAR_CONE", Wgsl::U32(SPECULAR_CONE)),
@@ -540,7 +546,12 @@ mod layout_tests {
             [env_rotation, medium, surface, lobe, counts, options, rect]
         );
         let m = module("unstructured.wgsl");
-        check!(m, "Mesh", MeshUniforms, [counts, unit, split, knots]);
+        check!(
+            m,
+            "Mesh",
+            MeshUniforms,
+            [counts, unit, split, knots, opaque]
+        );
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);
         let m = module("pathtrace_show.wgsl");

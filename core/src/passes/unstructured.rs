@@ -17,10 +17,10 @@ use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::slots;
 use crate::gpu::uniforms::{
     flag_bits, mat, FrameUniforms, MeshUniforms, FLAG_DEPTH_INPUT, FLAG_EXTREMUM_DEPTH,
-    MESH_EVERY_ENTRY, MESH_KNOTS,
+    MESH_EVERY_ENTRY, MESH_KNOTS, MESH_OPAQUE_WORDS,
 };
 use crate::gpu::Context;
-use crate::params::{ComponentTransfer, ScalarLocation, TABLE_SIZE};
+use crate::params::{build_tables, ComponentTransfer, ScalarLocation, TABLE_SIZE};
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -98,6 +98,7 @@ impl UnstructuredPass {
         let mut mu = mesh.uniforms;
         mu.unit[0] = (1.0 / ct.unit_distance) as f32;
         set_knots(&mut mu, ct);
+        set_opaque(&mut mu, ct);
         res.ensure_tables(ctx, 1.0)?;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
@@ -195,6 +196,18 @@ fn set_knots(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
     mu.split[0] = knots.len() as u32;
     for (i, k) in knots.into_iter().enumerate() {
         mu.knots[i / 4][i % 4] = k;
+    }
+}
+
+/// The table entries whose opacity is above 0, read from the opacity row of the tables the
+/// shader integrates: a tetrahedron whose scalars reach none of them adds nothing to a
+/// composite, and the shader skips its integral.
+fn set_opaque(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
+    mu.opaque = [[0; 4]; MESH_OPAQUE_WORDS / 4];
+    for (i, e) in build_tables(ct, 1.0)[TABLE_SIZE..].iter().enumerate() {
+        if e[0] > 0.0 {
+            mu.opaque[i / 128][i / 32 % 4] |= 1 << (i % 32);
+        }
     }
 }
 

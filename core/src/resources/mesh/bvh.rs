@@ -1,7 +1,8 @@
 //! A bounding volume hierarchy over the boundary triangles: where rays enter the mesh and,
 //! in non-convex meshes, enter it again. Built by median splits along the longest axis of
 //! the triangles' centroids, leaves of at most [`LEAF`] triangles, nodes in depth-first
-//! order (an inner node's first child follows it).
+//! order (an inner node's first child follows it, and holds the lower half). Rays visit the
+//! nearer child first, taken along the node's longest side.
 
 /// Triangles per leaf at most.
 pub(crate) const LEAF: usize = 4;

@@ -9,7 +9,9 @@
 use super::bvh::BvhNode;
 use super::TetMesh;
 use crate::error::{Error, Result};
-use crate::gpu::uniforms::{MeshUniforms, MESH_BVH_STACK, MESH_EVERY_ENTRY, MESH_KNOTS};
+use crate::gpu::uniforms::{
+    MeshUniforms, MESH_BVH_STACK, MESH_EVERY_ENTRY, MESH_KNOTS, MESH_OPAQUE_WORDS,
+};
 use crate::gpu::Context;
 use crate::params::{ScalarLocation, UnstructuredVolume};
 use crate::resources::Resources;
@@ -105,6 +107,7 @@ impl GpuMesh {
             unit: [1.0, 0.0, 0.0, 0.0],
             split: [MESH_EVERY_ENTRY, 0, 0, 0],
             knots: [[0.0; 4]; MESH_KNOTS / 4],
+            opaque: [[u32::MAX; 4]; MESH_OPAQUE_WORDS / 4],
         };
         Ok(GpuMesh {
             points,

@@ -26,9 +26,12 @@
 //!   copied to each of the cell's tetrahedra.
 //! * **Coordinates.** Points are stored as `f32` relative to the centre of the mesh's
 //!   bounds ([`TetMesh::origin`], kept in `f64`).
+//! * **Order.** Points and tetrahedra are stored in Z-order along the mesh's bounds
+//!   ([`order`]), not in the cells' order: a walk's next tetrahedron is near in memory.
 
 pub(crate) mod bvh;
 pub(crate) mod gpu;
+mod order;
 
 use std::collections::HashMap;
 
@@ -245,12 +248,19 @@ impl TetMesh {
         let origin = [0, 1, 2].map(|a| 0.5 * (bounds[2 * a] + bounds[2 * a + 1]));
         let nc = v.components as usize;
         let Tetrahedra {
-            points,
-            point_scalars,
-            tets,
-            tet_cell,
+            mut points,
+            mut point_scalars,
+            mut tets,
+            mut tet_cell,
             ..
         } = split;
+        order::morton_order(
+            &mut points,
+            &mut point_scalars,
+            &mut tets,
+            &mut tet_cell,
+            bounds,
+        );
         let neighbours = adjacency(&tets, &tet_cell)?;
         let cell_scalars = match v.location {
             ScalarLocation::Cells => tet_cell
