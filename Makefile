@@ -81,7 +81,7 @@ vtk-test: vtk
 	@scripts/fetch-data.sh >/dev/null || echo "vtk-test: no build/data/cranium.vti; the examples render a synthetic volume"
 	$(call VTK_CTEST,$(VTK_BUILD))
 test-vtk:
-	$(call VTK_CTEST,$(VTK_BUILD))
+	$(call VTK_CTEST,$(VTK_BUILD)) -LE timing
 
 # The VTK module, its wrapping, examples and C++ tests built with AddressSanitizer and UBSan
 # (FERROVOL_SANITIZE, vtk_plugin/CMakeLists.txt), and the tests only ASan can add to
@@ -123,6 +123,11 @@ test-build-vtk-pip:
 # mapper, bad input and a short soak.
 test-vtk-pip:
 	$(call VTK_CTEST,$(PIP_BUILD)) -L pip
+# The timed tests (CTest label timing: how long progressive renders take) on both VTKs; `make
+# test` runs them last, alone, as CPU time taken by the other lane's builds is not theirs.
+test-timing:
+	$(call VTK_CTEST,$(VTK_BUILD)) -L timing
+	$(call VTK_CTEST,$(PIP_BUILD)) -L timing
 # The wheel as a pip user gets it: packed from build/vtk-pip, installed with PyPI's vtk and
 # PyVista into a new venv, tested there (tests/wheel/run.sh).
 test-wheel:

@@ -3,7 +3,8 @@
 #
 # First the builds, one after another, each using both cores (cargo, ninja -j2). Then the
 # suites in two lanes side by side: most of a suite's time is one process (a Python or
-# pvbatch test, afl-fuzz, valgrind), so two lanes keep both cores busy. Each suite's output
+# pvbatch test, afl-fuzz, valgrind), so two lanes keep both cores busy. Last, alone, the
+# tests that time renders. Each suite's output
 # goes to build/test-logs/NAME.log and is printed whole when the suite ends, under a line
 # with its wall time; a suite whose build failed is not run. The last line counts them.
 #
@@ -26,7 +27,8 @@ export FERROVOL_CACHE_DIR=$ROOT/build/ferrovol-cache
 # The suites, in the order their results are listed; build-* suites are builds.
 SUITES=(lint build-rust build-vtk build-vtk-pip
         rust-tests lint-fuzz lint-publish fuzz-smoke build-paraview paraview vtk-pip
-        vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel)
+        vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel
+        timing)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
   [build-vtk]=build-rust
@@ -36,6 +38,7 @@ declare -A NEEDS=(
   [regression-quick]=build-vtk
   [build-vtk-pip]=build-rust [vtk-pip]=build-vtk-pip [regression-quick-pip]=build-vtk-pip
   [wheel]=build-vtk-pip
+  [timing]="build-vtk build-vtk-pip"
 )
 # What each suite runs: a make target (Makefile), without the builds it depends on.
 declare -A CMD=(
@@ -57,6 +60,7 @@ declare -A CMD=(
   [vtk-pip]=test-vtk-pip
   [regression-quick-pip]=test-regression-quick-pip
   [wheel]=test-wheel
+  [timing]=test-timing
 )
 
 declare -A WANTED=()
@@ -138,6 +142,8 @@ lane1=$!
 ) &
 lane2=$!
 wait $lane1 $lane2
+# Last, alone: the tests that time renders (their bounds are for a machine not building).
+suite timing
 
 passed=0 failed=0 names=()
 echo

@@ -4,7 +4,9 @@ accumulation and which do not, the preview denoising, the convergence figures, a
 render is progressive (an interactor that runs timers; pvbatch's generic interactor and
 windows without one are not). Images: build/vtk/test-images (progressive-*.png).
 
-Times are those of whole vtkRenderWindow::Render() calls. Not counted: the first render of
+The timed tests (class Budget) are a CTest entry of their own, python.test_progressive.budget
+(label timing), which `make test` runs after every other suite, with nothing beside it. Times
+are those of whole vtkRenderWindow::Render() calls. Not counted: the first render of
 the process (it builds the path tracer's pipelines, seconds on lavapipe) and of each window
 (its GL context, images and textures)."""
 import statistics
@@ -72,7 +74,8 @@ def opaque_sphere():
     return fvtest.sphere_actor((10, 0, 10), 6, (1, 0, 0))
 
 
-class Progressive(unittest.TestCase):
+class Scenes(unittest.TestCase):
+    """The wavelet medium path traced in a 128x128 window (the pipelines built once)."""
     @classmethod
     def setUpClass(cls):
         cls.src = wavelet(31)  # 64^3
@@ -94,114 +97,9 @@ class Progressive(unittest.TestCase):
         iren.Initialize()
         return iren
 
-    def budgeted_renders(self, budget, spp):
-        """Renders a progressive scene after a camera change until SamplesPerPixel; returns
-        each Render()'s time, the mean paths per pixel after each, and the scene."""
-        s = self.scene(path_tracing(spp, budget, "On"))
-        s.render()
-        s.renderer.GetActiveCamera().Azimuth(5.0)  # starts over: the renders below count
-        times, mean = [], []
-        while s.mapper.GetAccumulatedSamples() < spp and len(times) < 500:
-            t0 = time.perf_counter()
-            s.window.Render()
-            times.append(time.perf_counter() - t0)
-            mean.append(s.mapper.GetMeanAccumulatedSamples())
-        return times, mean, s
 
-    def test_renders_stay_within_the_budget(self):
-        for budget, spp in ((0.1, 64), (0.2, 128)):
-            limit = 1.2 * budget + SLACK
-            for attempt in range(1, ATTEMPTS + 1):
-                times, mean, s = self.budgeted_renders(budget, spp)
-                log("budget %.2f s, %d paths per pixel (run %d): Render() %s; mean paths per "
-                    "pixel after renders 1, 2, 3: %s, reached %d in %d renders; over %.3f s: %d"
-                    % (budget, spp, attempt, distribution(times),
-                       ", ".join("%.2f" % m for m in mean[:3]),
-                       s.mapper.GetAccumulatedSamples(), len(times), limit,
-                       sum(t > limit for t in times)))
-                self.assertEqual(self.errors.messages, [])
-                self.assertTrue(s.mapper.GetLastRenderProgressive())
-                self.assertEqual(s.mapper.GetAccumulatedSamples(), spp)
-                self.assertGreater(len(times), 2, "the budget spreads the paths over renders")
-                self.assertTrue(all(b > a for a, b in zip(mean, mean[1:-1])),
-                                "each render adds paths: %s" % mean)
-                if within_budget(times, budget):
-                    break
-            self.assertTrue(within_budget(times, budget), distribution(times))
-
-    def refine_in_event_loop(self, spp, give_up=60.0, rest=0.3):
-        """Renders a progressive scene once in an on-screen window with an X interactor, then
-        runs the event loop until SamplesPerPixel and `rest` seconds more. Terminating VTK
-        9.2's X event loop finalizes the window, so everything is read inside it."""
-        s = self.scene(path_tracing(spp), onscreen=True)
-        iren = self.with_interactor(s)
-        iren.SetInteractorStyle(None)  # TimerEvent observers: the mapper's and this test's
-        starts, times = [], []
-        s.window.AddObserver("StartEvent", lambda *_: starts.append(time.perf_counter()))
-        s.window.AddObserver("EndEvent", lambda *_: times.append(time.perf_counter() - starts[-1]))
-        s.window.Render()  # also creates the X window and its GL context: not counted
-        seen = {"first": s.mapper.GetAccumulatedSamples()}
-        del times[:]
-        t0 = time.perf_counter()
-
-        def check(_obj, _event):
-            t = time.perf_counter() - t0
-            if "converged" not in seen and s.mapper.GetAccumulatedSamples() >= spp:
-                seen.update(converged=t, renders=len(times), image=fvtest.grab(s.window))
-            elif t > seen.get("converged", give_up) + rest or t > give_up:
-                seen["later"] = len(times) - seen.get("renders", 0)
-                iren.TerminateApp()
-
-        iren.CreateRepeatingTimer(50)
-        tag = iren.AddObserver("TimerEvent", check)
-        iren.Start()
-        iren.RemoveObserver(tag)
-        # VTK 9.2's X interactor finalizes the window as its loop ends (later ones keep it):
-        # a finalized window leaves no observer of the mapper's behind.
-        seen["finalized"] = s.window.GetGenericWindowId() is None
-        seen["observing"] = bool(iren.HasObserver("TimerEvent"))
-        # a screenshot after Start() returns renders again: the paths traced stay
-        seen["after_loop"] = s.mapper.GetMeanAccumulatedSamples()
-        s.window.Render()
-        seen["after_render"] = s.mapper.GetMeanAccumulatedSamples()
-        # That Render() initialized the interactor again, which puts it back in the X
-        # interactors' process-wide list; VTK (9.2 to 9.6) takes it out only in an event
-        # loop, never in the destructor, so the next test's Start() would fire the timers of
-        # a deleted interactor (a crash without ferrovol too). One pass of the loop, done.
-        iren.TerminateApp()
-        iren.ProcessEvents()
-        return seen, times
-
-    def test_view_refines_itself_through_the_interactor(self):
-        """A VTK program's window with an X interactor: after the script's one Render(), the
-        event loop alone brings the accumulation to SamplesPerPixel, the renders within the
-        budget (within_budget), and then renders no more."""
-        spp, rest = 64, 0.3
-        budget = 0.1  # automatic: 1/DesiredUpdateRate (0.0001 at rest), at most 0.1 s
-        for attempt in range(1, ATTEMPTS + 1):
-            seen, times = self.refine_in_event_loop(spp, rest=rest)
-            if "image" in seen:
-                save("progressive-refined", seen["image"])
-            log("interactor refinement, automatic budget %.2f s (run %d): %d paths per pixel "
-                "after the script's one Render(), %d after %.1f s of the event loop alone, in "
-                "%d renders (%s); renders in the %.1f s after: %d; after the loop, the window "
-                "finalized: %s, the mapper observing the interactor: %s; mean paths per "
-                "pixel after the loop %.2f, after one more Render() %.2f"
-                % (budget, attempt, seen["first"], spp, seen.get("converged", -1),
-                   seen.get("renders", -1), distribution(times), rest, seen["later"],
-                   seen["finalized"], seen["observing"], seen["after_loop"],
-                   seen["after_render"]))
-            self.assertEqual(self.errors.messages, [])
-            self.assertLess(seen["first"], spp)
-            self.assertIn("converged", seen, "the accumulation reached SamplesPerPixel")
-            self.assertEqual(seen["later"], 0, "renders once converged")
-            if seen["finalized"]:
-                self.assertFalse(seen["observing"])
-            self.assertGreaterEqual(seen["after_loop"], spp)
-            self.assertGreaterEqual(seen["after_render"], spp)
-            if within_budget(times, budget):
-                break
-        self.assertTrue(within_budget(times, budget), distribution(times))
+class Progressive(Scenes):
+    """What progressive rendering does: timers, restarts, preview, convergence."""
 
     def test_refinement_timers(self):
         """An application that runs the interactor's timers itself (a
@@ -480,6 +378,118 @@ class Progressive(unittest.TestCase):
         self.assertEqual((fresh.GetAccumulatedSamples(), fresh.GetMeanAccumulatedSamples(),
                           fresh.GetPathTracingError()), (-1, -1.0, -1.0))
 
+
+class Budget(Scenes):
+    """How long renders take: timed, so `make test` runs it alone (CTest label timing)."""
+
+    def budgeted_renders(self, budget, spp):
+        """Renders a progressive scene after a camera change until SamplesPerPixel; returns
+        each Render()'s time, the mean paths per pixel after each, and the scene."""
+        s = self.scene(path_tracing(spp, budget, "On"))
+        s.render()
+        s.renderer.GetActiveCamera().Azimuth(5.0)  # starts over: the renders below count
+        times, mean = [], []
+        while s.mapper.GetAccumulatedSamples() < spp and len(times) < 500:
+            t0 = time.perf_counter()
+            s.window.Render()
+            times.append(time.perf_counter() - t0)
+            mean.append(s.mapper.GetMeanAccumulatedSamples())
+        return times, mean, s
+
+    def test_renders_stay_within_the_budget(self):
+        for budget, spp in ((0.1, 64), (0.2, 128)):
+            limit = 1.2 * budget + SLACK
+            for attempt in range(1, ATTEMPTS + 1):
+                times, mean, s = self.budgeted_renders(budget, spp)
+                log("budget %.2f s, %d paths per pixel (run %d): Render() %s; mean paths per "
+                    "pixel after renders 1, 2, 3: %s, reached %d in %d renders; over %.3f s: %d"
+                    % (budget, spp, attempt, distribution(times),
+                       ", ".join("%.2f" % m for m in mean[:3]),
+                       s.mapper.GetAccumulatedSamples(), len(times), limit,
+                       sum(t > limit for t in times)))
+                self.assertEqual(self.errors.messages, [])
+                self.assertTrue(s.mapper.GetLastRenderProgressive())
+                self.assertEqual(s.mapper.GetAccumulatedSamples(), spp)
+                self.assertGreater(len(times), 2, "the budget spreads the paths over renders")
+                self.assertTrue(all(b > a for a, b in zip(mean, mean[1:-1])),
+                                "each render adds paths: %s" % mean)
+                if within_budget(times, budget):
+                    break
+            self.assertTrue(within_budget(times, budget), distribution(times))
+
+    def refine_in_event_loop(self, spp, give_up=60.0, rest=0.3):
+        """Renders a progressive scene once in an on-screen window with an X interactor, then
+        runs the event loop until SamplesPerPixel and `rest` seconds more. Terminating VTK
+        9.2's X event loop finalizes the window, so everything is read inside it."""
+        s = self.scene(path_tracing(spp), onscreen=True)
+        iren = self.with_interactor(s)
+        iren.SetInteractorStyle(None)  # TimerEvent observers: the mapper's and this test's
+        starts, times = [], []
+        s.window.AddObserver("StartEvent", lambda *_: starts.append(time.perf_counter()))
+        s.window.AddObserver("EndEvent", lambda *_: times.append(time.perf_counter() - starts[-1]))
+        s.window.Render()  # also creates the X window and its GL context: not counted
+        seen = {"first": s.mapper.GetAccumulatedSamples()}
+        del times[:]
+        t0 = time.perf_counter()
+
+        def check(_obj, _event):
+            t = time.perf_counter() - t0
+            if "converged" not in seen and s.mapper.GetAccumulatedSamples() >= spp:
+                seen.update(converged=t, renders=len(times), image=fvtest.grab(s.window))
+            elif t > seen.get("converged", give_up) + rest or t > give_up:
+                seen["later"] = len(times) - seen.get("renders", 0)
+                iren.TerminateApp()
+
+        iren.CreateRepeatingTimer(50)
+        tag = iren.AddObserver("TimerEvent", check)
+        iren.Start()
+        iren.RemoveObserver(tag)
+        # VTK 9.2's X interactor finalizes the window as its loop ends (later ones keep it):
+        # a finalized window leaves no observer of the mapper's behind.
+        seen["finalized"] = s.window.GetGenericWindowId() is None
+        seen["observing"] = bool(iren.HasObserver("TimerEvent"))
+        # a screenshot after Start() returns renders again: the paths traced stay
+        seen["after_loop"] = s.mapper.GetMeanAccumulatedSamples()
+        s.window.Render()
+        seen["after_render"] = s.mapper.GetMeanAccumulatedSamples()
+        # That Render() initialized the interactor again, which puts it back in the X
+        # interactors' process-wide list; VTK (9.2 to 9.6) takes it out only in an event
+        # loop, never in the destructor, so the next test's Start() would fire the timers of
+        # a deleted interactor (a crash without ferrovol too). One pass of the loop, done.
+        iren.TerminateApp()
+        iren.ProcessEvents()
+        return seen, times
+
+    def test_view_refines_itself_through_the_interactor(self):
+        """A VTK program's window with an X interactor: after the script's one Render(), the
+        event loop alone brings the accumulation to SamplesPerPixel, the renders within the
+        budget (within_budget), and then renders no more."""
+        spp, rest = 64, 0.3
+        budget = 0.1  # automatic: 1/DesiredUpdateRate (0.0001 at rest), at most 0.1 s
+        for attempt in range(1, ATTEMPTS + 1):
+            seen, times = self.refine_in_event_loop(spp, rest=rest)
+            if "image" in seen:
+                save("progressive-refined", seen["image"])
+            log("interactor refinement, automatic budget %.2f s (run %d): %d paths per pixel "
+                "after the script's one Render(), %d after %.1f s of the event loop alone, in "
+                "%d renders (%s); renders in the %.1f s after: %d; after the loop, the window "
+                "finalized: %s, the mapper observing the interactor: %s; mean paths per "
+                "pixel after the loop %.2f, after one more Render() %.2f"
+                % (budget, attempt, seen["first"], spp, seen.get("converged", -1),
+                   seen.get("renders", -1), distribution(times), rest, seen["later"],
+                   seen["finalized"], seen["observing"], seen["after_loop"],
+                   seen["after_render"]))
+            self.assertEqual(self.errors.messages, [])
+            self.assertLess(seen["first"], spp)
+            self.assertIn("converged", seen, "the accumulation reached SamplesPerPixel")
+            self.assertEqual(seen["later"], 0, "renders once converged")
+            if seen["finalized"]:
+                self.assertFalse(seen["observing"])
+            self.assertGreaterEqual(seen["after_loop"], spp)
+            self.assertGreaterEqual(seen["after_render"], spp)
+            if within_budget(times, budget):
+                break
+        self.assertTrue(within_budget(times, budget), distribution(times))
 
 if __name__ == "__main__":
     unittest.main()
