@@ -12,11 +12,17 @@
 // Only the part of each ray within the near and far planes, the host's depth and the
 // clipping planes is integrated; composite skips the integral of a tetrahedron whose
 // scalars the transfer function makes fully transparent (empty-space skipping).
+// SHADE: each segment is lit as at its middle, by the gradient interpolated there from the
+// points' (gradient_in): the lighting is then a constant affine map of the emitted colour
+// along the segment, so its integral stays in closed form (the clamp to [0, 1] applied to
+// a piece's mean colour rather than to each point's).
 #include "lib/output.wgsl"
 #include "lib/march.wgsl"
+#include "lib/shading.wgsl"
 
 override BLEND: u32 = BLEND_COMPOSITE;
 override CELL_SCALARS: bool = false;
+override SHADE: bool = false;
 
 struct Mesh {
     counts: vec4<u32>,  // tetrahedra, boundary triangles, hierarchy nodes, most steps
@@ -42,6 +48,8 @@ var<private> mesh: Mesh;
 // NO_NEIGHBOUR on the boundary
 @group(0) @binding(SLOT_MESH_NEIGHBOURS) var<storage, read> neighbours: array<vec4<u32>>;
 @group(0) @binding(SLOT_MESH_CELL_SCALARS) var<storage, read> cell_scalars: array<f32>;
+// the scalar's gradient at each point (xyz; SHADE)
+@group(0) @binding(SLOT_MESH_GRADIENTS) var<storage, read> gradients: array<vec4<f32>>;
 @group(0) @binding(SLOT_MESH_NODES) var<storage, read> nodes: array<BvhNode>;
 // boundary triangles as 4 · tetrahedron + face, in the hierarchy's leaf order
 @group(0) @binding(SLOT_MESH_BOUNDARY) var<storage, read> boundary: array<u32>;
@@ -207,6 +215,26 @@ fn next_tet(old: Tet, t: u32, f: u32) -> Tet {
     return out;
 }
 
+// The scalar's gradient at index-space point x of tetrahedron k, in index space: its
+// points' gradients (resources/mesh/gradients.rs) weighted by x's barycentric coordinates
+// (their mean in a tetrahedron too flat to invert).
+fn gradient_in(k: Tet, x: vec3<f32>) -> vec3<f32> {
+    let e1 = k.p1.xyz - k.p0.xyz;
+    let e2 = k.p2.xyz - k.p0.xyz;
+    let e3 = k.p3.xyz - k.p0.xyz;
+    let det = dot(e1, cross(e2, e3));
+    var l = vec4<f32>(0.25);
+    if (abs(det) > 1e-30) {
+        let r = x - k.p0.xyz;
+        let l1 = dot(r, cross(e2, e3)) / det;
+        let l2 = dot(r, cross(e3, e1)) / det;
+        let l3 = dot(r, cross(e1, e2)) / det;
+        l = clamp(vec4<f32>(1.0 - l1 - l2 - l3, l1, l2, l3), vec4<f32>(0.0), vec4<f32>(1.0));
+    }
+    return l.x * gradients[k.ids.x].xyz + l.y * gradients[k.ids.y].xyz +
+        l.z * gradients[k.ids.z].xyz + l.w * gradients[k.ids.w].xyz;
+}
+
 // The ray's exit from tetrahedron k (index t), entered through face f_in at t_in, from the
 // signs of the ray's products with the tetrahedron's edges (Plücker coordinates, as Platis
 // and Theoharis 2003), taken from the entry point e: w(i, j) = d · ((p_i − e) × (p_j − e)).
@@ -334,6 +362,8 @@ fn psi(a: f32, b: f32) -> f32 {
 
 // The ray's state: premultiplied colour, the projections' value and length, the depth.
 var<private> st: PixelState;
+// SHADE: the lighting of the tetrahedron being integrated.
+var<private> lit: Lighting;
 
 // Composites a piece of length len whose colour and attenuation run linearly from cf to cb
 // (rgb colour, a attenuation), starting at distance t0.
@@ -345,7 +375,11 @@ fn composite_piece(r: Ray, cf: vec4<f32>, cb: vec4<f32>, len: f32, t0: f32) {
     }
     let zeta = exp(-(a + b));
     let p = psi(a, b);
-    let emitted = cb.rgb * (1.0 - zeta) + (cf.rgb - cb.rgb) * (1.0 - p);
+    var emitted = cb.rgb * (1.0 - zeta) + (cf.rgb - cb.rgb) * (1.0 - p);
+    if (SHADE) {
+        emitted = clamp(emitted * lit.scale + lit.add * (1.0 - zeta), vec3<f32>(0.0),
+                        vec3<f32>(1.0 - zeta));
+    }
     let before = st.color.a;
     let keep = 1.0 - before;
     st.color = st.color + keep * vec4<f32>(emitted, 1.0 - zeta);
@@ -553,6 +587,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             if (!empty_tet(k, t)) {
+                if (SHADE) {
+                    let mid = 0.5 * (max(hit.t, seg.x) + min(ex.t, seg.y));
+                    let g = gradient_in(k, o + mid * d);
+                    let gw = (frame.gradient_to_world * vec4<f32>(g, 0.0)).xyz;
+                    lit = lighting(gw, ray.origin + mid * ray.dir, ray.dir, frame.material);
+                }
                 integrate_within(ray, seg, hit.t, ex.t, hit.s, ex.s);
             }
             if (done() || ex.t >= seg.y) {

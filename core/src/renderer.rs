@@ -109,7 +109,7 @@ impl Renderer {
     /// their cells. Drawn from its first scalar component. [`Renderer::render`] and [`Renderer::render_image`] then draw
     /// it with the same view, parameters and transfer function as an image volume;
     /// [`Renderer::set_volume`] goes back to an image. A mesh whose buffers exceed the
-    /// device's storage-buffer binding size is refused with the sizes (about 35 bytes per
+    /// device's storage-buffer binding size is refused with the sizes (about 38 bytes per
     /// tetrahedron).
     pub fn set_unstructured(&mut self, v: &UnstructuredVolume) -> Result<()> {
         self.res.set_mesh(&self.ctx, v)

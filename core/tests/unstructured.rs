@@ -11,7 +11,9 @@ mod common;
 use common::gpu::{assert_error, renderer};
 use common::images::save_enlarged;
 use common::mesh;
-use common::metrics::{compare_to_reference, footprint, reference_image};
+use common::metrics::{
+    compare_to_reference, footprint, image_diff, pixels_off_by_more, reference_image,
+};
 
 /// A colourful transfer function over [lo, hi], opacity rising to `max` per unit.
 fn tf(lo: f64, hi: f64, max: f32) -> TransferFunction {
@@ -150,6 +152,64 @@ fn mixed_distorted_cells_match_the_reference_with_point_and_cell_scalars() {
     agrees("mixed_cells_additive", &cells, BlendMode::Additive, 0.8);
 }
 
+/// Shaded composite (VTK's default material, the headlight) against the reference, which
+/// lights a segment by the gradient interpolated from the points' (at its middle as the
+/// shader does, and at every point); and the shading shows:
+/// the image differs from the unshaded one by more than the comparison's error.
+#[test]
+fn shaded_composite_matches_the_reference_with_point_and_cell_scalars() {
+    let shaded = RenderParams {
+        shading: Shading {
+            enabled: true,
+            ..Default::default()
+        },
+        ..params(BlendMode::Composite)
+    };
+    for (name, v, max_opacity) in [
+        ("wavelet_shaded", synth::tet_wavelet(12), 0.3),
+        (
+            "mixed_points_shaded",
+            synth::mixed_cells(4, ScalarLocation::Points),
+            0.8,
+        ),
+        (
+            "mixed_cells_shaded",
+            synth::mixed_cells(4, ScalarLocation::Cells),
+            0.8,
+        ),
+    ] {
+        let (lo, hi) = range(&v);
+        let t = tf(lo, hi, max_opacity);
+        let view = view_of(&v, 64);
+        // Against the reference lit as the shader lights (each segment as at its middle),
+        // within the unshaded comparisons' few levels; against lighting at every point (the
+        // exact model), the figures of the approximation.
+        let lit = draw(&v, &t, &view, &shaded);
+        let middle = mesh::render_lit(&v, &t, &view, &shaded, mesh::LightAt::Middle);
+        let (mean, psnr, max) = compare_to_reference(&lit, &middle);
+        println!(
+            "{name}: against the reference lit at each segment's middle: mean error \
+                  {mean:.4}, PSNR {psnr:.1} dB, max error {max:.1}"
+        );
+        assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0, "{name}");
+        let (exact_mean, exact_psnr, _) = compare(name, &v, &t, &view, &shaded);
+        let off = pixels_off_by_more(&lit, &mesh::render(&v, &t, &view, &shaded), 3.0);
+        println!(
+            "{name}: against lighting at every point, {off} of {} drawn pixels off by \
+                  more than 3 levels",
+            footprint(&lit)
+        );
+        assert!(exact_mean < 1.0 && exact_psnr > 45.0, "{name}");
+        let flat = draw(&v, &t, &view, &params(BlendMode::Composite));
+        let (diff, most) = image_diff(&lit, &flat);
+        println!("{name}: mean difference from the unshaded image {diff:.2} levels, most {most}");
+        assert!(
+            diff > 5.0 * exact_mean && most > 20,
+            "{name}: shading shows"
+        );
+    }
+}
+
 #[test]
 fn rays_leave_the_hollow_cylinder_and_enter_it_again() {
     let v = synth::hollow_cylinder(2, 24, 4);
@@ -247,18 +307,16 @@ fn modes_not_drawn_yet_are_refused_and_images_come_back() {
         let e = r.render_image(&view, &p);
         assert!(matches!(e, Err(Error::Unsupported(_))), "{blend:?}: {e:?}");
     }
-    let shaded = RenderParams {
-        shading: Shading {
-            enabled: true,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let mut graded = tf(0.0, 2.0, 1.0);
+    graded.components[0].gradient_opacity =
+        Some(Piecewise::new(vec![(0.0, [0.2]), (1.0, [1.0])]).unwrap());
+    r.set_transfer_function(&graded).unwrap();
     assert_error(
-        r.render_image(&view, &shaded),
-        "shading",
-        &["without shading"],
+        r.render_image(&view, &params(BlendMode::Composite)),
+        "gradient opacity",
+        &["without gradient opacity"],
     );
+    r.set_transfer_function(&tf(0.0, 2.0, 1.0)).unwrap();
     let several = UnstructuredVolume {
         components: 2,
         scalars: Scalars::F32(vec![0.0; 18]),

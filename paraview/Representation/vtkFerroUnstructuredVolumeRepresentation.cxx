@@ -4,6 +4,7 @@
 #include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkVolumeMapper.h"
+#include "vtkVolumeProperty.h"
 
 #include <cstring>
 
@@ -40,6 +41,31 @@ void vtkFerroUnstructuredVolumeRepresentation::SetActiveVolumeMapper(const char*
                   << name << "\" is one of \"Volume\"'s (its Select Mapper): ignored");
   }
   this->Superclass::SetActiveVolumeMapper(MapperName());
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetShade(bool shade)
+{
+  this->Property->SetShade(shade ? 1 : 0);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetAmbient(double value)
+{
+  this->Property->SetAmbient(value);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetDiffuse(double value)
+{
+  this->Property->SetDiffuse(value);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetSpecular(double value)
+{
+  this->Property->SetSpecular(value);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetSpecularPower(double value)
+{
+  this->Property->SetSpecularPower(value);
 }
 
 void vtkFerroUnstructuredVolumeRepresentation::SetFerrovolBlendMode(int mode)

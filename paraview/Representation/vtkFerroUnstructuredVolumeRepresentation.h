@@ -67,6 +67,20 @@ public:
   vtkGetMacro(FerrovolBlendMode, int);
   ///@}
 
+  ///@{
+  /**
+   * Lighting, as "Volume" of image data has it (ParaView's unstructured "Volume" has none):
+   * Shade on lights composite with the view's lights; the material's ambient, diffuse,
+   * specular and specular power (shared with the Lighting group). They go to the volume's
+   * vtkVolumeProperty.
+   */
+  void SetShade(bool shade);
+  void SetAmbient(double value);
+  void SetDiffuse(double value);
+  void SetSpecular(double value);
+  void SetSpecularPower(double value);
+  ///@}
+
   /**
    * The mapper this representation renders with.
    */

@@ -6,7 +6,8 @@ ParaView's own "Volume" of the same data, serial and under MPI.
       the grid drawn by "Ferrovol Volume" and by "Volume" with each of its mappers
       (MAPPERS); the multiblock (its blocks merged by the representation, as "Volume" merges
       them) against the single grid; the mesh uploaded once for renders that change only the
-      camera; a three-component array refused (nothing drawn). Writes the references the
+      camera; Shade lights it (drawn, unlike the unshaded image); a three-component array
+      refused (nothing drawn). Writes the references the
       distributed step compares with.
   mpiexec -n N pvbatch --symmetric test_unstructured.py distributed
       every rank's source holds interleaved slabs of the grid (cells by z, alternating between
@@ -169,6 +170,16 @@ def serial(failures):
     disp.FerrovolBlendMode = "Composite"
     # the thresholds can fail: another blend mode's image must fall under them
     T.compare("control: MIP vs composite", mip, refs["oblique"], *SAME, failures,
+              expect_fail=True)
+    # Shade (which "Volume"'s unstructured mappers ignore) lights the mesh: drawn, and not
+    # the unshaded image
+    disp.Shade = 1
+    lit = shot(view, "ugrid-serial-ferrovol-shaded", "oblique")
+    disp.Shade = 0
+    check_drawn(lit, "ferrovol shaded", failures)
+    if ferrovol_info(disp)["FerrovolLastRenderDrew"] != 1:
+        failures.append("ferrovol did not draw the shaded grid")
+    T.compare("control: shaded vs unshaded", lit, refs["oblique"], *SAME, failures,
               expect_fail=True)
 
     disp.Representation = "Volume"

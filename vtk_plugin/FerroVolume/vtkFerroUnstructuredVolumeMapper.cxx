@@ -2,7 +2,7 @@
 // pass (fv_unstructured_volume_new, fv_renderer_set_unstructured). It draws through the
 // units vtkFerroVolumeMapper draws through (see vtkFerroVolumeMapper.cxx): the process-wide
 // device (vtkFerroVolumeContext), the property's tables (vtkFerroVolumeLookupTables), the
-// camera, matrix and clipping planes (vtkFerroVolumeSettings), the depth of opaque geometry
+// camera, matrix, clipping planes, shading and lights (vtkFerroVolumeSettings), the depth of opaque geometry
 // (vtkFerroVolumeDepthReader) and the output into VTK's framebuffer (vtkFerroVolumeOutput),
 // with its errors and warnings in a vtkFerroVolumeReport. Its own part is the mesh: VTK's
 // arrays handed to the C ABI as they are (vtkCellArray's 64- or 32-bit storage, float or
@@ -359,8 +359,10 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   vtkFerroVolumeSettings::SetVolumeMatrix(vol, params);
   vtkFerroVolumeSettings::SetUpClippingPlanes(this->ClippingPlanes, params, report);
   std::string warning;
-  if (!vtkFerroVolumeCall(
-        "use the mapper's settings", report, [&] { in->Slot.Renderer->set_params(params); }) ||
+  if (!vtkFerroVolumeSettings::ApplyShading(
+        this, ren, vol->GetProperty(), params, *in->Slot.Renderer, report) ||
+    !vtkFerroVolumeCall(
+      "use the mapper's settings", report, [&] { in->Slot.Renderer->set_params(params); }) ||
     !vtkFerroVolumeSettings::ApplyCamera(
       ren, req.ViewportW, req.ViewportH, *in->Slot.Renderer, report) ||
     !in->Output.Render(vtkFerroVolumeEnums::OUTPUT_PATH_AUTOMATIC, *in->Slot.Renderer, req, report,

@@ -20,9 +20,12 @@
  * default, VTK's unstructured ray caster's), maximum and minimum intensity, average and
  * additive, as vtkVolumeMapper numbers them; VTK's own unstructured mappers ignore the
  * blend mode and always composite. The mapper's clipping planes and the vtkVolume's matrix
- * are honoured; the property's Shade is ignored, as VTK's unstructured mappers ignore it, and
- * a gradient opacity or 2D transfer function is refused with an error naming it. Errors
- * from ferrovol reach vtkErrorMacro with its message.
+ * are honoured. With the property's Shade on (which VTK's unstructured mappers ignore),
+ * composite is lit by the renderer's lights with the property's ambient, diffuse, specular
+ * and specular power, as vtkGPUVolumeRayCastMapper lights image data, each tetrahedron by
+ * its own gradient (of the linear interpolant of point scalars; from the neighbours across
+ * its faces for cell scalars). A gradient opacity or 2D transfer function is refused with
+ * an error naming it. Errors from ferrovol reach vtkErrorMacro with its message.
  */
 #ifndef vtkFerroUnstructuredVolumeMapper_h
 #define vtkFerroUnstructuredVolumeMapper_h

@@ -98,7 +98,7 @@ FvLight ToFvLight(vtkLight* light, bool defaultLighting)
 }
 
 // The renderer's switched-on lights (at most FV_MAX_LIGHTS, warned once when more).
-std::vector<FvLight> SceneLights(vtkFerroVolumeMapper* self, vtkRenderer* ren,
+std::vector<FvLight> SceneLights(vtkObject* self, vtkRenderer* ren,
   vtkFerroVolumeReport& report)
 {
   std::vector<FvLight> lights;
@@ -485,11 +485,7 @@ void vtkFerroVolumeSettings::SetUpShading(vtkFerroVolumeMapper* self, vtkRendere
                                       << " are shaded with the scalar gradient");
     }
   }
-  params.ambient = static_cast<float>(prop->GetAmbient(0));
-  params.diffuse = static_cast<float>(prop->GetDiffuse(0));
-  params.specular = static_cast<float>(prop->GetSpecular(0));
-  params.specular_power = static_cast<float>(prop->GetSpecularPower(0));
-  params.two_sided_lighting = ren->GetTwoSidedLighting() != 0;
+  SetMaterial(prop, ren, params);
   if (!isosurface)
   {
     params.volumetric_scattering_blending =
@@ -654,6 +650,31 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
     lights.push_back(l);
   }
   else if (this->Params.shade || this->Blend == FV_BLEND_MODE_PATH_TRACE)
+  {
+    lights = SceneLights(self, ren, report);
+  }
+  return vtkFerroVolumeCall(
+    "use the renderer's lights", report, [&] { renderer.set_lights(lights); });
+}
+
+void vtkFerroVolumeSettings::SetMaterial(
+  vtkVolumeProperty* prop, vtkRenderer* ren, FvRenderParams& params)
+{
+  params.ambient = static_cast<float>(prop->GetAmbient(0));
+  params.diffuse = static_cast<float>(prop->GetDiffuse(0));
+  params.specular = static_cast<float>(prop->GetSpecular(0));
+  params.specular_power = static_cast<float>(prop->GetSpecularPower(0));
+  params.two_sided_lighting = ren->GetTwoSidedLighting() != 0;
+}
+
+bool vtkFerroVolumeSettings::ApplyShading(vtkObject* self, vtkRenderer* ren,
+  vtkVolumeProperty* prop, FvRenderParams& params, ferrovol::Renderer& renderer,
+  vtkFerroVolumeReport& report)
+{
+  params.shade = prop->GetShade(0) != 0 && params.blend_mode == FV_BLEND_MODE_COMPOSITE;
+  SetMaterial(prop, ren, params);
+  std::vector<FvLight> lights;
+  if (params.shade)
   {
     lights = SceneLights(self, ren, report);
   }

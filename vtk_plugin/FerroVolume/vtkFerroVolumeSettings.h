@@ -13,6 +13,7 @@
 class vtkFerroVolumeInputHelper;
 class vtkFerroVolumeMapper;
 class vtkFerroVolumeReport;
+class vtkObject;
 class vtkPlaneCollection;
 class vtkRenderer;
 class vtkVolume;
@@ -58,6 +59,14 @@ public:
   static bool ApplyCamera(vtkRenderer* ren, int vw, int vh, ferrovol::Renderer& renderer,
     vtkFerroVolumeReport& report);
   static void SetVolumeMatrix(vtkVolume* vol, FvRenderParams& params);
+  // The property's material (ambient, diffuse, specular, specular power) and the renderer's
+  // two-sided lighting.
+  static void SetMaterial(vtkVolumeProperty* prop, vtkRenderer* ren, FvRenderParams& params);
+  // For a mapper whose only shaded mode is composite (params.blend_mode set): Shade from the
+  // property, the material, and the renderer's lights given to `renderer` when shaded (none
+  // otherwise). `self` warns, once, past FV_MAX_LIGHTS lights.
+  static bool ApplyShading(vtkObject* self, vtkRenderer* ren, vtkVolumeProperty* prop,
+    FvRenderParams& params, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
   static int SetUpClippingPlanes(
     vtkPlaneCollection* planes, FvRenderParams& params, vtkFerroVolumeReport& report);
 

@@ -43,6 +43,19 @@ fn shade(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>)
 // shade() with the material m (ambient, diffuse, specular, specular power).
 fn shade_material(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>,
                   m: vec4<f32>) -> vec3<f32> {
+    let l = lighting(grad, pos, view_dir, m);
+    return clamp(color * l.scale + l.add, vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// What the lights make of a colour c at a point: c · scale + add, clamped to [0, 1].
+struct Lighting {
+    scale: vec3<f32>, // the material's ambient and diffuse terms, summed over the lights
+    add: vec3<f32>,   // its specular term
+}
+
+// The lights at pos, with gradient grad, for the material m (ambient, diffuse, specular,
+// specular power).
+fn lighting(grad: vec3<f32>, pos: vec3<f32>, view_dir: vec3<f32>, m: vec4<f32>) -> Lighting {
     let glen = length(grad);
     var ambient = vec3<f32>(0.0);
     var diffuse = vec3<f32>(0.0);
@@ -77,6 +90,8 @@ fn shade_material(color: vec3<f32>, grad: vec3<f32>, pos: vec3<f32>, view_dir: v
             }
         }
     }
-    let lit = color * (m.x * ambient + m.y * diffuse) + m.z * specular;
-    return clamp(lit, vec3<f32>(0.0), vec3<f32>(1.0));
+    var out: Lighting;
+    out.scale = m.x * ambient + m.y * diffuse;
+    out.add = m.z * specular;
+    return out;
 }

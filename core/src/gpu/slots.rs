@@ -48,6 +48,8 @@ pub const GRID_LOOKUP: u32 = 23;
 pub const TABLES_2D: u32 = 24;
 /// Where each pixel's ray starts in a depth range (dvr.wgsl).
 pub const DEPTH_NEAR: u32 = 25;
+/// An unstructured volume's gradient per point (unstructured.wgsl).
+pub const MESH_GRADIENTS: u32 = 26;
 
 /// Group 1, a volume's bricks (lib/volume.wgsl): the pool's uniforms, the pool texture and
 /// its sampler, the precomputed gradients, the page table, the non-resident bricks'
@@ -80,6 +82,7 @@ pub const WGSL_SLOTS: &[(&str, u32)] = &[
     ("SLOT_MESH_CELL_SCALARS", MESH_CELL_SCALARS),
     ("SLOT_MESH_NODES", MESH_NODES),
     ("SLOT_MESH_BOUNDARY", MESH_BOUNDARY),
+    ("SLOT_MESH_GRADIENTS", MESH_GRADIENTS),
     ("SLOT_INTERMIX", INTERMIX),
     ("SLOT_INTERMIX_ATLAS", INTERMIX_ATLAS),
     ("SLOT_INTERMIX_TABLES", INTERMIX_TABLES),

@@ -101,9 +101,7 @@ impl Frame {
 
     /// Whether any of them is positional.
     pub fn positional_lights(&self) -> bool {
-        self.uniforms.lights[..self.lights() as usize]
-            .iter()
-            .any(|l| l.position[3] == 1.0)
+        positional_lights(&self.uniforms)
     }
 }
 
@@ -290,11 +288,10 @@ pub(crate) fn frame(
         any_go |= params.mask_blend > 0.0 && tf.labels_gradient_opacity();
     }
     let s = &params.shading;
-    u.material = [s.ambient, s.diffuse, s.specular, s.specular_power];
+    let mut flags = set_lights(&mut u, view, params);
     for (c, m) in u.component_materials.iter_mut().enumerate() {
         *m = tf.component(c).material.unwrap_or(u.material);
     }
-    let mut flags = 0;
     if let Some(c) = &params.cropping {
         u.crop_lo = [
             c.planes[0] as f32,
@@ -332,48 +329,6 @@ pub(crate) fn frame(
     if let Some([lo, hi]) = params.whole_box {
         u.whole_lo = [lo[0] as f32, lo[1] as f32, lo[2] as f32, 0.0];
         u.whole_hi = [hi[0] as f32, hi[1] as f32, hi[2] as f32, 0.0];
-    }
-    let mut nl = 0;
-    if s.enabled {
-        for l in view.lights.iter().take(MAX_LIGHTS) {
-            let (pos, focal) = l.world_placement(&view.camera);
-            let k = l.intensity;
-            let g = &mut u.lights[nl];
-            if l.positional {
-                g.position = [pos.x as f32, pos.y as f32, pos.z as f32, 1.0];
-                let axis = (focal - pos).try_normalize().unwrap_or(DVec3::NEG_Z);
-                let cone = if l.cone_angle < 90.0 {
-                    (l.cone_angle as f64).to_radians().cos() as f32
-                } else {
-                    -2.0
-                };
-                g.spot = [axis.x as f32, axis.y as f32, axis.z as f32, cone];
-            } else {
-                let dir = (pos - focal).try_normalize().unwrap_or(DVec3::Z);
-                // A headlight shines along each ray (w = 2), as VTK's headlight path
-                // lights every sample from the camera.
-                let w = if l.space == LightSpace::Headlight {
-                    2.0
-                } else {
-                    0.0
-                };
-                g.position = [dir.x as f32, dir.y as f32, dir.z as f32, w];
-                g.spot = [0.0, 0.0, 0.0, -2.0];
-            }
-            g.diffuse = [
-                l.diffuse[0] * k,
-                l.diffuse[1] * k,
-                l.diffuse[2] * k,
-                l.exponent,
-            ];
-            g.specular = [l.specular[0] * k, l.specular[1] * k, l.specular[2] * k, 0.0];
-            g.ambient = [l.ambient[0] * k, l.ambient[1] * k, l.ambient[2] * k, 0.0];
-            g.attenuation = [l.attenuation[0], l.attenuation[1], l.attenuation[2], 0.0];
-            nl += 1;
-        }
-        if s.two_sided {
-            flags |= FLAG_TWO_SIDED;
-        }
     }
     flags |= flag_bits(&[
         (params.jitter, FLAG_JITTER),
@@ -428,7 +383,6 @@ pub(crate) fn frame(
     u.blend = params.blend.code();
     u.flags = flags;
     u.clip_planes = params.clip_planes.len() as u32;
-    u.light_count = nl as u32;
     u.block_size = BLOCK_SIZE;
     u.components = vol.components;
     u.occupancy_dims = [
@@ -443,6 +397,65 @@ pub(crate) fn frame(
         independent: tf.independent,
         volumetric,
     })
+}
+
+/// Whether any of the lights `u` carries is positional.
+pub(crate) fn positional_lights(u: &FrameUniforms) -> bool {
+    u.lights[..u.light_count as usize]
+        .iter()
+        .any(|l| l.position[3] == 1.0)
+}
+
+/// The material and, where the frame is shaded, the view's lights (world placement, colours
+/// times intensity) in `u`; returns the flags they set (two-sided lighting).
+pub(crate) fn set_lights(u: &mut FrameUniforms, view: &View, params: &RenderParams) -> u32 {
+    let s = &params.shading;
+    u.material = [s.ambient, s.diffuse, s.specular, s.specular_power];
+    let mut nl = 0;
+    let mut flags = 0;
+    if s.enabled {
+        for l in view.lights.iter().take(MAX_LIGHTS) {
+            let (pos, focal) = l.world_placement(&view.camera);
+            let k = l.intensity;
+            let g = &mut u.lights[nl];
+            if l.positional {
+                g.position = [pos.x as f32, pos.y as f32, pos.z as f32, 1.0];
+                let axis = (focal - pos).try_normalize().unwrap_or(DVec3::NEG_Z);
+                let cone = if l.cone_angle < 90.0 {
+                    (l.cone_angle as f64).to_radians().cos() as f32
+                } else {
+                    -2.0
+                };
+                g.spot = [axis.x as f32, axis.y as f32, axis.z as f32, cone];
+            } else {
+                let dir = (pos - focal).try_normalize().unwrap_or(DVec3::Z);
+                // A headlight shines along each ray (w = 2), as VTK's headlight path
+                // lights every sample from the camera.
+                let w = if l.space == LightSpace::Headlight {
+                    2.0
+                } else {
+                    0.0
+                };
+                g.position = [dir.x as f32, dir.y as f32, dir.z as f32, w];
+                g.spot = [0.0, 0.0, 0.0, -2.0];
+            }
+            g.diffuse = [
+                l.diffuse[0] * k,
+                l.diffuse[1] * k,
+                l.diffuse[2] * k,
+                l.exponent,
+            ];
+            g.specular = [l.specular[0] * k, l.specular[1] * k, l.specular[2] * k, 0.0];
+            g.ambient = [l.ambient[0] * k, l.ambient[1] * k, l.ambient[2] * k, 0.0];
+            g.attenuation = [l.attenuation[0], l.attenuation[1], l.attenuation[2], 0.0];
+            nl += 1;
+        }
+        if s.two_sided {
+            flags |= FLAG_TWO_SIDED;
+        }
+    }
+    u.light_count = nl as u32;
+    flags
 }
 
 /// The volume's bricks front to back for this view (index space), for streaming.

@@ -5,7 +5,9 @@
 //! distance); MIP and MinIP take the exact extrema of the linear segments, average and
 //! additive the exact integrals of opacity × normalised scalar.
 
-use super::frame::{groups, index_plane, screen_rect, FrameInput, Purpose};
+use super::frame::{
+    groups, index_plane, positional_lights, screen_rect, set_lights, FrameInput, Purpose,
+};
 use super::unstructured_variant::{select, UnstructuredFacts, UnstructuredVariant};
 
 use crate::error::{Error, Result};
@@ -52,6 +54,7 @@ impl UnstructuredPass {
             buffer_entry(slots::MESH_CELL_SCALARS, read),
             buffer_entry(slots::MESH_NODES, read),
             buffer_entry(slots::MESH_BOUNDARY, read),
+            buffer_entry(slots::MESH_GRADIENTS, read),
         ]
     }
 
@@ -78,11 +81,14 @@ impl UnstructuredPass {
         let tf = res.transfer_function()?.clone();
         let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
         let ct = tf.component(0);
+        let u = frame_uniforms(res, view, params, !matches!(depth, DepthSource::None))?;
         let variant = select(&UnstructuredFacts {
             blend: params.blend,
             components: mesh.components,
             cell_scalars: mesh.location == ScalarLocation::Cells,
             shade: params.shading.enabled,
+            lights: u.light_count,
+            positional_lights: positional_lights(&u),
             gradient_opacity: ct.gradient_opacity.is_some(),
             tables_2d: ct.table_2d.is_some(),
             cropping: params.cropping.is_some(),
@@ -93,7 +99,6 @@ impl UnstructuredPass {
             intermix: res.intermix.is_some(),
         })
         .map_err(Error::from)?;
-        let u = frame_uniforms(res, view, params, !matches!(depth, DepthSource::None))?;
         let mesh = res.mesh.as_ref().expect("checked above");
         let mut mu = mesh.uniforms;
         mu.unit[0] = (1.0 / ct.unit_distance) as f32;
@@ -134,6 +139,7 @@ impl UnstructuredPass {
                 ),
                 bind(slots::MESH_NODES, mesh.nodes.as_entire_binding()),
                 bind(slots::MESH_BOUNDARY, mesh.boundary.as_entire_binding()),
+                bind(slots::MESH_GRADIENTS, mesh.gradients.as_entire_binding()),
             ],
         });
         let rect = u.rect;
@@ -213,7 +219,7 @@ fn set_opaque(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
 
 /// The frame uniforms of a frame of the renderer's mesh: the camera, the mesh's coordinates
 /// (relative to its centre) as the index space, the first component's table range, the
-/// clipping planes and the pixels the mesh's box covers.
+/// material and lights, the clipping planes and the pixels the mesh's box covers.
 fn frame_uniforms(
     res: &Resources,
     view: &crate::params::View,
@@ -258,10 +264,11 @@ fn frame_uniforms(
         view.height,
     );
     u.blend = params.blend.code();
-    u.flags = flag_bits(&[
-        (depth_input, FLAG_DEPTH_INPUT),
-        (params.extremum_depth, FLAG_EXTREMUM_DEPTH),
-    ]);
+    u.flags = set_lights(&mut u, view, params)
+        | flag_bits(&[
+            (depth_input, FLAG_DEPTH_INPUT),
+            (params.extremum_depth, FLAG_EXTREMUM_DEPTH),
+        ]);
     u.clip_planes = params.clip_planes.len() as u32;
     u.components = 1;
     Ok(u)

@@ -11,6 +11,9 @@ pipeline_variant! {
     pub(crate) struct UnstructuredVariant {
         blend: u32 => "BLEND",
         cell_scalars: bool => "CELL_SCALARS",
+        shade: bool => "SHADE",
+        lights: u32 => "NUM_LIGHTS",
+        positional_lights: bool => "POSITIONAL_LIGHTS",
     }
 }
 
@@ -21,6 +24,9 @@ pub(crate) struct UnstructuredFacts {
     pub components: u32,
     pub cell_scalars: bool,
     pub shade: bool,
+    /// The lights the frame carries, and whether any is positional.
+    pub lights: u32,
+    pub positional_lights: bool,
     pub gradient_opacity: bool,
     pub tables_2d: bool,
     pub cropping: bool,
@@ -77,7 +83,6 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         return Err(R::Components(x.components));
     }
     let settings = [
-        (x.shade, "shading"),
         (x.gradient_opacity, "gradient opacity"),
         (x.tables_2d, "2D transfer functions"),
         (x.cropping, "cropping"),
@@ -90,9 +95,15 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
     if let Some((_, what)) = settings.iter().find(|(on, _)| *on) {
         return Err(R::Setting(what));
     }
+    // Shading lights composite alone, as VTK's ray casters shade (the projections are of
+    // the scalar); a frame without lights is ambient only, as an image volume's is.
+    let shade = x.shade && x.blend == BlendMode::Composite;
     Ok(UnstructuredVariant {
         blend: x.blend.code(),
         cell_scalars: x.cell_scalars,
+        shade,
+        lights: if shade { x.lights } else { 0 },
+        positional_lights: shade && x.positional_lights,
     })
 }
 
@@ -106,6 +117,8 @@ pub(crate) mod tests {
             components: 1,
             cell_scalars: false,
             shade: false,
+            lights: 1,
+            positional_lights: false,
             gradient_opacity: false,
             tables_2d: false,
             cropping: false,
@@ -157,7 +170,7 @@ pub(crate) mod tests {
             R::Components(_) => (1, "a mesh of several components"),
             R::Setting(_) => (
                 2,
-                "shading, gradient opacity, 2D transfer functions, cropping, an average range, \
+                "gradient opacity, 2D transfer functions, cropping, an average range, \
                  a whole box, volumetric shadows, a depth range or intermixed volumes",
             ),
         }
@@ -173,6 +186,8 @@ pub(crate) mod tests {
                     assert_eq!(v.blend, x.blend.code());
                     assert_eq!(v.cell_scalars, x.cell_scalars);
                     assert_eq!(x.components, 1);
+                    assert_eq!(v.shade, x.shade && x.blend == BlendMode::Composite);
+                    assert!(v.shade || (v.lights == 0 && !v.positional_lights));
                 }
                 Err(UnstructuredRefusal::Blend(b)) => assert_eq!(b, x.blend),
                 Err(UnstructuredRefusal::Components(n)) => {

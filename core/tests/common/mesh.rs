@@ -3,19 +3,27 @@
 //! four planes (no traversal, no hierarchy), the scalar linear in each, and the segments
 //! integrated by the same conventions (VTK's unstructured integrators: attenuation
 //! τ = opacity / unit distance, emission colour · τ) with the transfer functions
-//! themselves and composite Gauss–Legendre quadrature instead of closed forms.
+//! themselves and composite Gauss–Legendre quadrature instead of closed forms. Shaded
+//! composite lights every point of a segment by the gradient interpolated there from the
+//! points' (each the volume-weighted mean of its tetrahedra's; the headlight,
+//! raycast::shade, clamped point by point).
 
-use super::raycast::{eval_pw, pixel_ray, to_pixel, Ray};
+use super::raycast::{eval_pw, pixel_ray, shade, to_pixel, Ray};
 use ferrovol_core::*;
 use glam::DVec3;
+use std::collections::HashMap;
 
-/// One piece of a ray inside a tetrahedron: entry and exit distance, scalar at each.
+/// One piece of a ray inside a tetrahedron: entry and exit distance, scalar and gradient at
+/// each (both linear between), and the ray's direction.
 #[derive(Clone, Copy, Debug)]
 pub struct Segment {
     pub t0: f64,
     pub t1: f64,
     pub s0: f64,
     pub s1: f64,
+    pub g0: DVec3,
+    pub g1: DVec3,
+    pub dir: DVec3,
 }
 
 /// The tetrahedra of a mesh with their scalars (per point, or per tetrahedron).
@@ -26,6 +34,8 @@ pub struct Tets {
     pub point_scalars: Vec<f64>,
     /// Per tetrahedron (cell scalars) or empty.
     pub cell_scalars: Vec<f64>,
+    /// The scalar's gradient per point.
+    pub point_gradients: Vec<DVec3>,
 }
 
 impl Tets {
@@ -40,7 +50,7 @@ impl Tets {
                 .collect(),
             ScalarLocation::Points => vec![],
         };
-        Tets {
+        let mut tets = Tets {
             points: t.points.iter().map(|p| DVec3::from(*p)).collect(),
             point_scalars: match v.location {
                 ScalarLocation::Points => t.point_scalars,
@@ -48,7 +58,10 @@ impl Tets {
             },
             tets: t.tets,
             cell_scalars,
-        }
+            point_gradients: vec![],
+        };
+        tets.point_gradients = tets.point_gradients();
+        tets
     }
 
     /// The part of `ray` inside tetrahedron `k`, if any.
@@ -79,12 +92,76 @@ impl Tets {
             return None;
         }
         let s = |t: f64| self.scalar(k, ray.origin + t * ray.dir);
+        let g = |t: f64| self.gradient(k, ray.origin + t * ray.dir);
         Some(Segment {
             t0,
             t1,
             s0: s(t0),
             s1: s(t1),
+            g0: g(t0),
+            g1: g(t1),
+            dir: ray.dir,
         })
+    }
+
+    /// The barycentric coordinates of point x in tetrahedron k.
+    fn barycentric(&self, k: usize, x: DVec3) -> [f64; 4] {
+        let p = self.tets[k].map(|i| self.points[i as usize]);
+        let m = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+        let l = m.inverse() * (x - p[0]);
+        [1.0 - l.x - l.y - l.z, l.x, l.y, l.z]
+    }
+
+    /// The gradient at point x of tetrahedron k, interpolated from its points'.
+    fn gradient(&self, k: usize, x: DVec3) -> DVec3 {
+        let w = self.barycentric(k, x);
+        (0..4)
+            .map(|i| w[i] * self.point_gradients[self.tets[k][i] as usize])
+            .sum()
+    }
+
+    /// The gradients of the barycentric coordinates of tetrahedron k.
+    fn barycentric_gradients(&self, k: usize) -> [DVec3; 4] {
+        let p = self.tets[k].map(|i| self.points[i as usize]);
+        let inv = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0])
+            .inverse()
+            .transpose();
+        let (g1, g2, g3) = (inv.x_axis, inv.y_axis, inv.z_axis);
+        [-(g1 + g2 + g3), g1, g2, g3]
+    }
+
+    /// Every tetrahedron's gradient: of its linear interpolant (point scalars), or
+    /// Green–Gauss over its faces from the cell scalars across them (each face the mean of
+    /// the two cells', the cell's own on the boundary), as resources/mesh/gradients.rs.
+    fn tet_gradients(&self) -> Vec<DVec3> {
+        let mut across: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+        if !self.cell_scalars.is_empty() {
+            for (k, ids) in self.tets.iter().enumerate() {
+                for f in 0..4 {
+                    across.entry(face_key(ids, f)).or_default().push(k);
+                }
+            }
+        }
+        (0..self.tets.len())
+            .map(|k| {
+                let g = self.barycentric_gradients(k);
+                let ids = self.tets[k];
+                (0..4)
+                    .map(|i| {
+                        let w = if self.cell_scalars.is_empty() {
+                            self.point_scalars[ids[i] as usize]
+                        } else {
+                            let s = self.cell_scalars[k];
+                            let cells = &across[&face_key(&ids, i)];
+                            let n = cells.iter().find(|&&c| c != k);
+                            let sn = n.map_or(s, |&c| self.cell_scalars[c]);
+                            -1.5 * (sn - s)
+                        };
+                        w * g[i]
+                    })
+                    .sum()
+            })
+            .collect()
     }
 
     /// The scalar at point x of tetrahedron k (barycentric, or the cell's).
@@ -93,13 +170,26 @@ impl Tets {
             return self.cell_scalars[k];
         }
         let ids = self.tets[k];
-        let p = ids.map(|i| self.points[i as usize]);
-        let m = glam::DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
-        let l = m.inverse() * (x - p[0]);
-        let w = [1.0 - l.x - l.y - l.z, l.x, l.y, l.z];
+        let w = self.barycentric(k, x);
         (0..4)
             .map(|i| w[i] * self.point_scalars[ids[i] as usize])
             .sum()
+    }
+
+    /// Every point's gradient: the mean of its tetrahedra's, weighted by their volumes.
+    fn point_gradients(&self) -> Vec<DVec3> {
+        let mut sum = vec![(DVec3::ZERO, 0.0); self.points.len()];
+        for (ids, g) in self.tets.iter().zip(self.tet_gradients()) {
+            let p = ids.map(|i| self.points[i as usize]);
+            let volume = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])).abs();
+            for &i in ids {
+                sum[i as usize].0 += volume * g;
+                sum[i as usize].1 += volume;
+            }
+        }
+        sum.iter()
+            .map(|(g, w)| if *w > 0.0 { *g / *w } else { DVec3::ZERO })
+            .collect()
     }
 
     /// Every pixel's segments, front to back, within [0, far] of its ray.
@@ -127,9 +217,13 @@ impl Tets {
                         let (lo, hi) = (s.t0.max(0.0), s.t1.min(rays[p].far));
                         if lo < hi {
                             let span = s.t1 - s.t0;
+                            let (u0, u1) = ((lo - s.t0) / span, (hi - s.t0) / span);
                             let (a, b) = (s.s0, s.s1);
-                            s.s0 = a + (b - a) * (lo - s.t0) / span;
-                            s.s1 = a + (b - a) * (hi - s.t0) / span;
+                            s.s0 = a + (b - a) * u0;
+                            s.s1 = a + (b - a) * u1;
+                            let (g0, g1) = (s.g0, s.g1);
+                            s.g0 = g0.lerp(g1, u0);
+                            s.g1 = g0.lerp(g1, u1);
                             s.t0 = lo;
                             s.t1 = hi;
                             out[p].push(s);
@@ -145,13 +239,31 @@ impl Tets {
     }
 }
 
+/// The face of tetrahedron `ids` opposite its point f, as sorted point indices.
+fn face_key(ids: &[u32; 4], f: usize) -> [u32; 3] {
+    let mut k = [ids[(f + 1) % 4], ids[(f + 2) % 4], ids[(f + 3) % 4]];
+    k.sort_unstable();
+    k
+}
+
+/// Where a shaded segment's lighting is taken.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightAt {
+    /// At every point (the gradient interpolated there).
+    EachPoint,
+    /// At the segment's middle, for the whole segment (as unstructured.wgsl).
+    Middle,
+}
+
 /// Component 0's transfer functions in f64 (the renderer's 1024-entry tables, read
-/// linearly, stand in for them to a fraction of a level).
+/// linearly, stand in for them to a fraction of a level), and the shading composite
+/// applies (none: unshaded).
 pub struct Table {
     tf: ComponentTransfer,
     lo: f64,
     hi: f64,
     pub inv_unit: f64,
+    pub shading: Option<(Shading, LightAt)>,
 }
 
 impl Table {
@@ -163,6 +275,7 @@ impl Table {
             tf: c,
             lo,
             hi,
+            shading: None,
         }
     }
 
@@ -282,7 +395,19 @@ pub fn integrate(segs: &[Segment], table: &Table, blend: BlendMode, termination:
         let l = s.t1 - s.t0;
         for (u0, u1) in table.pieces(x0, x1) {
             let d = l * (u1 - u0);
-            let at = |u: f64| table.at(x0 + (x1 - x0) * (u0 + (u1 - u0) * u));
+            let at = |u: f64| {
+                let f = u0 + (u1 - u0) * u;
+                let e = table.at(x0 + (x1 - x0) * f);
+                let Some((sh, at)) = &table.shading else {
+                    return e;
+                };
+                let g = match at {
+                    LightAt::EachPoint => s.g0.lerp(s.g1, f),
+                    LightAt::Middle => s.g0.lerp(s.g1, 0.5),
+                };
+                let c = shade([e[0], e[1], e[2]], g, s.dir, sh);
+                [c[0], c[1], c[2], e[3]]
+            };
             let (tf, tb) = (at(0.0)[3] * table.inv_unit, at(1.0)[3] * table.inv_unit);
             // optical depth from the piece's start to u (τ linear)
             let depth = |u: f64| d * (tf * u + 0.5 * (tb - tf) * u * u);
@@ -305,16 +430,30 @@ pub fn integrate(segs: &[Segment], table: &Table, blend: BlendMode, termination:
     c
 }
 
-/// The reference image of `v` under `tf` in `view` with `params`' blend mode and early
-/// termination (premultiplied RGBA per pixel, rows top to bottom).
+/// The reference image of `v` under `tf` in `view` with `params`' blend mode, shading (lit
+/// at each point) and early termination (premultiplied RGBA per pixel, rows top to bottom).
 pub fn render(
     v: &UnstructuredVolume,
     tf: &TransferFunction,
     view: &View,
     params: &RenderParams,
 ) -> Vec<[f64; 4]> {
+    render_lit(v, tf, view, params, LightAt::EachPoint)
+}
+
+/// [`render`], shaded segments lit as `at` says.
+pub fn render_lit(
+    v: &UnstructuredVolume,
+    tf: &TransferFunction,
+    view: &View,
+    params: &RenderParams,
+    at: LightAt,
+) -> Vec<[f64; 4]> {
     let tets = Tets::of(v);
-    let table = Table::of(tf);
+    let mut table = Table::of(tf);
+    if params.shading.enabled && params.blend == BlendMode::Composite {
+        table.shading = Some((params.shading, at));
+    }
     tets.segments(view)
         .iter()
         .map(|segs| {

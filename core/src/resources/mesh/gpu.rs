@@ -1,10 +1,11 @@
-//! The prepared mesh on the device: storage buffers for points, tetrahedra, neighbours,
-//! cell scalars, the boundary triangles and their hierarchy (shaders/unstructured.wgsl).
+//! The prepared mesh on the device: storage buffers for points, their gradients,
+//! tetrahedra, neighbours, cell scalars, the boundary triangles and their hierarchy
+//! (shaders/unstructured.wgsl).
 //!
 //! Per tetrahedron the device holds 16 bytes of points indices, 16 of neighbours and, with
-//! cell scalars, 4 of scalar; per point 16 bytes (position and scalar); per boundary
-//! triangle 4 bytes and about half a 32-byte hierarchy node. A tetrahedral mesh of n
-//! tetrahedra has about n / 5 to n / 6 points, so about 35 bytes per tetrahedron.
+//! cell scalars, 4 of scalar; per point 32 bytes (position and scalar, gradient); per
+//! boundary triangle 4 bytes and about half a 32-byte hierarchy node. A tetrahedral mesh of
+//! n tetrahedra has about n / 5 to n / 6 points, so about 38 bytes per tetrahedron.
 
 use super::bvh::BvhNode;
 use super::TetMesh;
@@ -21,6 +22,7 @@ pub(crate) const TET_BYTES: u64 = 16;
 
 pub(crate) struct GpuMesh {
     pub points: wgpu::Buffer,
+    pub gradients: wgpu::Buffer,
     pub tets: wgpu::Buffer,
     pub neighbours: wgpu::Buffer,
     /// One value per tetrahedron (cell scalars), or a placeholder of one.
@@ -87,6 +89,7 @@ impl GpuMesh {
             ScalarLocation::Points => &[0.0],
         };
         let points = storage(ctx, "points", cast::<[f32; 4], u8>(&m.points))?;
+        let gradients = storage(ctx, "gradients", cast::<[f32; 4], u8>(&m.point_gradients))?;
         let tets = storage(ctx, "tetrahedra", cast::<[u32; 4], u8>(&m.tets))?;
         let neighbours = storage(ctx, "neighbours", cast::<[u32; 4], u8>(&m.neighbours))?;
         let cell_scalars = storage(ctx, "cell scalars", cast::<f32, u8>(cells))?;
@@ -111,6 +114,7 @@ impl GpuMesh {
         };
         Ok(GpuMesh {
             points,
+            gradients,
             tets,
             neighbours,
             cell_scalars,

@@ -26,11 +26,14 @@
 //!   copied to each of the cell's tetrahedra.
 //! * **Coordinates.** Points are stored as `f32` relative to the centre of the mesh's
 //!   bounds ([`TetMesh::origin`], kept in `f64`).
+//! * **Gradients.** Each point carries the scalar's gradient, the volume-weighted mean of
+//!   its tetrahedra's ([`gradients`]), which shaded frames interpolate.
 //! * **Order.** Points and tetrahedra are stored in Z-order along the mesh's bounds
 //!   ([`order`]), not in the cells' order: a walk's next tetrahedron is near in memory.
 
 pub(crate) mod bvh;
 pub(crate) mod gpu;
+mod gradients;
 mod order;
 
 use std::collections::HashMap;
@@ -60,6 +63,8 @@ pub(crate) struct TetMesh {
     pub neighbours: Vec<[u32; 4]>,
     /// Cell scalars: each tetrahedron's (empty for point scalars).
     pub cell_scalars: Vec<f32>,
+    /// The scalar's gradient at each point (xyz; [`gradients`]), for shading.
+    pub point_gradients: Vec<[f32; 4]>,
     /// The boundary triangles as `4 · tet + face`, in the hierarchy's order.
     pub boundary: Vec<u32>,
     pub bvh: Bvh,
@@ -293,12 +298,15 @@ impl TetMesh {
             })
         };
         let bvh = Bvh::build(&mut boundary, triangle);
+        let point_gradients =
+            gradients::point_gradients(&points, &tets, &neighbours, &cell_scalars);
         Ok(TetMesh {
             origin,
             points,
             tets,
             neighbours,
             cell_scalars,
+            point_gradients,
             boundary,
             bvh,
             location: v.location,
