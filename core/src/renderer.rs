@@ -412,18 +412,19 @@ impl Renderer {
     ) -> Result<()> {
         self.ctx.check_lost("rendering")?;
         let (ctx, res) = (&self.ctx, &mut self.res);
+        let input = |res| FrameInput {
+            ctx,
+            res,
+            view,
+            params,
+            depth,
+            purpose,
+        };
         if res.mesh.is_some() {
             let pass = ensure(&mut self.unstructured, || {
                 Ok(Box::new(UnstructuredPass::new(ctx)?))
             })?;
-            let done = pass.render(FrameInput {
-                ctx,
-                res,
-                view,
-                params,
-                depth,
-                purpose,
-            });
+            let done = pass.render(input(res));
             if done.is_ok() && purpose == Purpose::Draw {
                 self.previous_frame =
                     std::mem::replace(&mut self.last_frame, ctx.last_submission());
@@ -462,14 +463,6 @@ impl Renderer {
                 params.blend
             )));
         }
-        let input = |res| FrameInput {
-            ctx,
-            res,
-            view,
-            params,
-            depth,
-            purpose,
-        };
         let done = match params.blend {
             BlendMode::Isosurface => {
                 let brick_bgl = &res.brick_bgl;
