@@ -59,13 +59,11 @@ fn render_returns_before_the_device_finishes_the_frame() {
         returned * 1e3,
         finished * 1e3
     );
+    // (the times are printed, not held to a ratio: on a loaded machine the render call's
+    // own CPU time varies more than the frame's)
     assert!(
         !status.is_queue_empty(),
         "the frame was still on the device when render returned"
-    );
-    assert!(
-        returned < 0.5 * finished,
-        "render did not wait for the frame"
     );
 }
 
