@@ -1,7 +1,9 @@
 //! `ferrovol bench`: VTK's TestGPURayCastMapperBenchmark scene (wavelet over extent
 //! −127..128, 900×900, colour/opacity as VTK's test, camera azimuth +1° and elevation +1°
 //! per frame), unshaded then shaded; optionally the same scene through VTK's
-//! vtkGPUVolumeRayCastMapper in the same run, and the ratio.
+//! vtkGPUVolumeRayCastMapper in the same run, and the ratio. `--mesh-points N`: the same
+//! wavelet on tetrahedra instead (the unstructured pass): preparation, device memory per
+//! tetrahedron and frame times.
 
 use crate::{presets, spinner, CliError};
 use ferrovol_core::{synth, Context, Interpolation, RenderParams, Renderer, View};
@@ -36,6 +38,20 @@ pub struct BenchArgs {
     /// Write the last frame of each configuration to DIR/ferrovol-{unshaded,shaded}.png.
     #[arg(long)]
     png_dir: Option<std::path::PathBuf>,
+    /// Bench an unstructured mesh instead: the wavelet on N points per axis, each cube split
+    /// into six tetrahedra (6 (N−1)³: 57 give 1.05 million, 120 give 10.1 million); prints
+    /// the preparation and upload time, the device memory per tetrahedron, the host's peak
+    /// memory and the frame times, unshaded and shaded.
+    #[arg(long, value_name = "N")]
+    mesh_points: Option<u32>,
+}
+
+/// The benchmark's camera motion: azimuth +1° and elevation +1° per frame.
+fn advance(v: &mut View, bounds: [f64; 6]) {
+    v.camera.azimuth(1.0);
+    v.camera.elevation(1.0);
+    v.camera.orthogonalize_view_up();
+    v.camera.reset_clipping_range(bounds);
 }
 
 /// Samples a full march would take (no early termination or skipping), summed over pixels.
@@ -78,14 +94,8 @@ fn time_config(
 ) -> Result<Figures, CliError> {
     let mut view = base.clone();
     let step = r.sample_distance(params)?;
-    let advance = |v: &mut View| {
-        v.camera.azimuth(1.0);
-        v.camera.elevation(1.0);
-        v.camera.orthogonalize_view_up();
-        v.camera.reset_clipping_range(bounds);
-    };
     for _ in 0..2 {
-        advance(&mut view);
+        advance(&mut view, bounds);
         r.render(&view, params, None)?;
         r.context().wait_idle()?;
     }
@@ -94,7 +104,7 @@ fn time_config(
     let mut elapsed = 0.0;
     let mut times = Vec::with_capacity(frames as usize);
     for _ in 0..frames {
-        advance(&mut view);
+        advance(&mut view, bounds);
         let t = Instant::now();
         r.render(&view, params, None)?;
         r.context().wait_idle()?;
@@ -165,7 +175,91 @@ fn run_vtk(a: &BenchArgs, multisamples: Option<u32>) -> Result<[(f64, f64); 2], 
     Ok([find("vtk_gpu unshaded")?, find("vtk_gpu shaded")?])
 }
 
+/// The host's peak resident memory in MiB (Linux: VmHWM), if it can be read.
+fn peak_host_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// `--mesh-points N`: the tetrahedralised wavelet through the unstructured pass.
+fn run_mesh(a: &BenchArgs, n: u32) -> Result<(), CliError> {
+    if n < 2 || a.frames == 0 {
+        return Err(CliError::Usage(
+            "--mesh-points must be at least 2 and --frames at least 1".into(),
+        ));
+    }
+    let pb = spinner("building the mesh");
+    let t = Instant::now();
+    let mesh = synth::tet_wavelet(n);
+    let built = t.elapsed().as_secs_f64();
+    let tets = 6 * (n as u64 - 1).pow(3);
+    let bounds = mesh.bounds();
+    pb.set_message("preparing and uploading");
+    let mut r = Renderer::new(Context::new()?)?;
+    let before = r.context().device_memory().buffer_bytes;
+    let t = Instant::now();
+    r.set_unstructured(&mesh)?;
+    r.context().wait_idle()?;
+    let uploaded = t.elapsed().as_secs_f64();
+    drop(mesh);
+    r.set_transfer_function(&presets::wavelet_tf())?;
+    let (w, h) = a.size;
+    // (read after a frame: the upload's staging copies are gone by then)
+    r.render(&View::fit(bounds, w, h), &RenderParams::default(), None)?;
+    r.context().wait_idle()?;
+    let bytes = r
+        .context()
+        .device_memory()
+        .buffer_bytes
+        .saturating_sub(before);
+    pb.finish_and_clear();
+    println!(
+        "# ferrovol bench: wavelet on {n}^3 points, {tets} tetrahedra, {w}x{h}, {} frames, \
+         adapter {} ({})",
+        a.frames,
+        r.context().info.name,
+        r.context().info.backend
+    );
+    println!(
+        "mesh built_s={built:.2} prepared_and_uploaded_s={uploaded:.2} device_mib={:.1} \
+         bytes_per_tet={:.1} peak_host_mib={}",
+        bytes as f64 / (1 << 20) as f64,
+        bytes as f64 / tets as f64,
+        peak_host_mib().map_or("?".into(), |m| format!("{m:.0}"))
+    );
+    for shaded in [false, true] {
+        let mut params = RenderParams::default();
+        params.shading.enabled = shaded;
+        let mut view = View::fit(bounds, w, h);
+        advance(&mut view, bounds);
+        r.render(&view, &params, None)?;
+        r.context().wait_idle()?;
+        let mut times = Vec::with_capacity(a.frames as usize);
+        for _ in 0..a.frames {
+            advance(&mut view, bounds);
+            let t = Instant::now();
+            r.render(&view, &params, None)?;
+            r.context().wait_idle()?;
+            times.push(t.elapsed().as_secs_f64());
+        }
+        let mean = times.iter().sum::<f64>() / times.len() as f64;
+        times.sort_by(f64::total_cmp);
+        let name = if shaded { "shaded" } else { "unshaded" };
+        println!(
+            "ferrovol mesh {name} ms_per_frame={:.1} median_ms={:.1}",
+            1e3 * mean,
+            1e3 * times[times.len() / 2]
+        );
+    }
+    Ok(())
+}
+
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
+    if let Some(n) = a.mesh_points {
+        return run_mesh(&a, n);
+    }
     if a.extent < 1 || a.frames == 0 {
         return Err(CliError::Usage(
             "--extent and --frames must be at least 1".into(),
