@@ -26,8 +26,8 @@ export FERROVOL_CACHE_DIR=$ROOT/build/ferrovol-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
 SUITES=(lint build-rust build-vtk build-vtk-pip
-        rust-tests lint-fuzz lint-publish fuzz-smoke build-paraview paraview vtk-pip
-        vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel
+        rust-tests lint-fuzz lint-publish fuzz-smoke build-paraview paraview
+        vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel vtk-pip
         timing)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
@@ -118,7 +118,7 @@ suite build-rust
 suite build-vtk
 suite build-vtk-pip
 # Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the crates' publish dry run,
-# the ParaView plugin, the VTK module's suites on pip's VTK.
+# the ParaView plugin.
 (
   suite rust-tests
   suite lint-fuzz
@@ -126,11 +126,11 @@ suite build-vtk-pip
   suite fuzz-smoke
   suite build-paraview
   suite paraview
-  suite vtk-pip
 ) &
 lane1=$!
 # Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the C
-# ABI under sanitizers, the quick regression on pip's VTK, the wheel in a new venv.
+# ABI under sanitizers, the quick regression on pip's VTK, the wheel in a new venv, the VTK
+# module's suites on pip's VTK (the lanes' lengths balanced by the suites' times).
 (
   suite vtk
   suite build-vtk-asan
@@ -139,6 +139,7 @@ lane1=$!
   suite sanitize
   suite regression-quick-pip
   suite wheel
+  suite vtk-pip
 ) &
 lane2=$!
 wait $lane1 $lane2
