@@ -2,9 +2,9 @@
 // pass (fv_unstructured_volume_new, fv_renderer_set_unstructured). It draws through the
 // units vtkFerroVolumeMapper draws through (see vtkFerroVolumeMapper.cxx): the process-wide
 // device (vtkFerroVolumeContext), the property's tables (vtkFerroVolumeLookupTables), the
-// camera, matrix, clipping planes, shading and lights (vtkFerroVolumeSettings), the depth of opaque geometry
-// (vtkFerroVolumeDepthReader) and the output into VTK's framebuffer (vtkFerroVolumeOutput),
-// with its errors and warnings in a vtkFerroVolumeReport. Its own part is the mesh: VTK's
+// camera, matrix, clipping planes, shading and lights (vtkFerroVolumeSettings), the depth of
+// opaque geometry (vtkFerroVolumeDepthReader) and the output into VTK's framebuffer
+// (vtkFerroVolumeOutput), with its errors and warnings in a vtkFerroVolumeReport. Its own part is the mesh: VTK's
 // arrays handed to the C ABI as they are (vtkCellArray's 64- or 32-bit storage, float or
 // double points), only when the input or its scalars changed.
 #include "vtkFerroUnstructuredVolumeMapper.h"

@@ -22,10 +22,10 @@
  * blend mode and always composite. The mapper's clipping planes and the vtkVolume's matrix
  * are honoured. With the property's Shade on (which VTK's unstructured mappers ignore),
  * composite is lit by the renderer's lights with the property's ambient, diffuse, specular
- * and specular power, as vtkGPUVolumeRayCastMapper lights image data, each tetrahedron by
- * its own gradient (of the linear interpolant of point scalars; from the neighbours across
- * its faces for cell scalars). A gradient opacity or 2D transfer function is refused with
- * an error naming it. Errors from ferrovol reach vtkErrorMacro with its message.
+ * and specular power, as vtkGPUVolumeRayCastMapper lights image data, each ray segment by
+ * the scalar's gradient interpolated from the mesh's points (each point's the mean of its
+ * tetrahedra's; from the neighbours across faces for cell scalars). A gradient opacity or
+ * 2D transfer function is refused with an error naming it. Errors from ferrovol reach vtkErrorMacro with its message.
  */
 #ifndef vtkFerroUnstructuredVolumeMapper_h
 #define vtkFerroUnstructuredVolumeMapper_h

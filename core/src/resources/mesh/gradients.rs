@@ -10,27 +10,19 @@
 //! mesh's coordinates (scalar units per unit of length).
 
 use super::BOUNDARY;
+use glam::DVec3;
 
 /// The gradients of the barycentric coordinates of the tetrahedron of points `p` and its
 /// signed volume times six; `None` for a flat one.
-fn barycentric_gradients(p: [[f64; 3]; 4]) -> Option<([[f64; 3]; 4], f64)> {
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let (e1, e2, e3) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
-    let c = [cross(e2, e3), cross(e3, e1), cross(e1, e2)];
-    let det = e1[0] * c[0][0] + e1[1] * c[0][1] + e1[2] * c[0][2];
+fn barycentric_gradients(p: [DVec3; 4]) -> Option<([DVec3; 4], f64)> {
+    let (e1, e2, e3) = (p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+    let c = [e2.cross(e3), e3.cross(e1), e1.cross(e2)];
+    let det = e1.dot(c[0]);
     if det == 0.0 || !det.is_finite() {
         return None;
     }
-    let g = c.map(|v| v.map(|x| x / det));
-    let g0 = [0, 1, 2].map(|a| -(g[0][a] + g[1][a] + g[2][a]));
-    Some(([g0, g[0], g[1], g[2]], det))
+    let g = c.map(|v| v / det);
+    Some(([-(g[0] + g[1] + g[2]), g[0], g[1], g[2]], det))
 }
 
 /// Per point of `points` (xyz, w the point scalar), its gradient as xyz (w 0): of the point
@@ -41,11 +33,11 @@ pub(crate) fn point_gradients(
     neighbours: &[[u32; 4]],
     cell_scalars: &[f32],
 ) -> Vec<[f32; 4]> {
-    let mut sum = vec![[0.0f64; 4]; points.len()];
+    let mut sum = vec![(DVec3::ZERO, 0.0f64); points.len()];
     for (t, ids) in tets.iter().enumerate() {
         let p = ids.map(|i| {
             let q = points[i as usize];
-            [q[0] as f64, q[1] as f64, q[2] as f64]
+            DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64)
         });
         let Some((grads, det)) = barycentric_gradients(p) else {
             continue;
@@ -63,25 +55,18 @@ pub(crate) fn point_gradients(
                 -1.5 * (across - s)
             })
         };
-        let mut g = [0.0; 3];
-        for (w, gi) in weights.iter().zip(&grads) {
-            for a in 0..3 {
-                g[a] += w * gi[a];
-            }
-        }
+        let g: DVec3 = weights.iter().zip(&grads).map(|(w, gi)| *w * *gi).sum();
         let volume = det.abs();
         for &i in ids {
             let acc = &mut sum[i as usize];
-            for a in 0..3 {
-                acc[a] += volume * g[a];
-            }
-            acc[3] += volume;
+            acc.0 += volume * g;
+            acc.1 += volume;
         }
     }
     sum.iter()
-        .map(|s| {
-            let w = if s[3] > 0.0 { 1.0 / s[3] } else { 0.0 };
-            [(s[0] * w) as f32, (s[1] * w) as f32, (s[2] * w) as f32, 0.0]
+        .map(|&(g, w)| {
+            let g = if w > 0.0 { g / w } else { DVec3::ZERO };
+            [g.x as f32, g.y as f32, g.z as f32, 0.0]
         })
         .collect()
 }
