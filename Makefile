@@ -35,7 +35,7 @@ FERROVOL := target/release/ferrovol
 .PHONY: deps build demo test check lint lint-workspace lint-fuzz lint-publish bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
         regression regression-quick fuzz-smoke soak sanitize vtk-asan vtk-pip wheel \
         test-build-vtk-pip test-vtk-pip test-wheel test-regression-quick-pip test-build-rust test-rust test-sanitize test-build-vtk test-vtk test-build-vtk-asan \
-        test-vtk-asan test-build-paraview test-paraview test-regression-quick
+        test-vtk-asan lint-static test-crates test-build-paraview test-paraview test-regression-quick
 
 deps:
 	@bash scripts/install-deps.sh
@@ -171,29 +171,41 @@ demo: build
 	@echo "demo image: $(CURDIR)/build/demo.png"
 
 lint: deps lint-workspace lint-fuzz lint-publish
-lint-workspace:
-	$(CARGO) fmt --all --check
+lint-workspace: lint-static
 	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
-	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --locked --no-deps -p ferrovol-core -p ferrovol-io -p ferrovol-ffi
+	$(DOC)
+# What needs no build: formatting (the workspace and the fuzz targets), the core's layers,
+# file sizes, docs/ARCHITECTURE.md against the code.
+lint-static:
+	$(CARGO) fmt --all --check
+	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
 	python3 scripts/check-core-layers.py
 	python3 scripts/check-file-sizes.py
 	python3 scripts/check-architecture-doc.py
+DOC := RUSTDOCFLAGS="-D warnings" $(CARGO) doc --locked --no-deps -p ferrovol-core -p ferrovol-io -p ferrovol-ffi
 # The fuzz targets are a workspace of their own (fuzz/Cargo.toml), checked in their own
 # target folder.
 lint-fuzz:
 	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
 	$(CARGO) clippy --locked --manifest-path fuzz/Cargo.toml --all-targets -- -D warnings
-# The library crates as crates.io would take them: packaged alone (the shaders inside
-# ferrovol-core) and built from the package, in a target folder of their own. Cargo
-# verifies ferrovol-io against the ferrovol-core it just packaged, through a local registry
-# whose crates it takes as immutable: it reuses an unpacked copy, or a build, of a version
-# it has seen (the same 0.2.0 with older code). Those copies and builds go first.
-PUBLISH_TARGET := target/publish
+# The library crates as crates.io would take them (scripts/check-packages.sh).
 lint-publish:
-	rm -rf $${CARGO_HOME:-$$HOME/.cargo}/registry/src/-*/ferrovol-* \
-	  $(PUBLISH_TARGET)/debug/deps/*ferrovol_* $(PUBLISH_TARGET)/debug/.fingerprint/ferrovol-*
-	CARGO_TARGET_DIR=$(PUBLISH_TARGET) $(CARGO) publish --dry-run --locked --allow-dirty \
-	  -p ferrovol-core -p ferrovol-io
+	scripts/check-packages.sh
+# make test's share of the lint that needs the dependencies type-checked: the crates'
+# documentation with rustdoc's warnings denied, then the packages (which find those checks
+# made).
+test-crates:
+	$(DOC)
+	scripts/check-packages.sh
+
+# The test build is also the workspace's clippy: clippy-driver, which `cargo clippy` runs in
+# rustc's place for the workspace's own crates, compiles them with their lints denied and
+# generates their code as rustc does (the dependencies are compiled by rustc as always), so
+# `make test` and `make check` compile the crates once for both. The targets that build or
+# run the test build all name it, since the setting is part of the artifacts' hashes.
+LINTED := test-build-rust test-rust test-sanitize sanitize vtk-asan check
+$(LINTED): export RUSTC_WORKSPACE_WRAPPER = $(shell command -v clippy-driver)
+$(LINTED): export CLIPPY_ARGS = -D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__
 
 # Everything CI runs (scripts/test.sh: the builds, then the suites in two lanes, each
 # suite's log in build/test-logs and its wall time; `scripts/test.sh NAME...` runs some).
@@ -204,7 +216,7 @@ test: deps
 # test binaries two at a time, scripts/rust-tests.sh).
 check: deps
 	$(CARGO) fmt --all --check
-	$(CARGO) clippy --locked --workspace --all-targets -- -D warnings
+	$(FFI_TEST)
 	scripts/rust-tests.sh
 
 # The suites of `make test` one by one, without the builds they need (scripts/test.sh runs

@@ -54,29 +54,38 @@ def main():
                 or any(d.endswith("/" + m) for d in dirs)):
             missing.append(f"folder {m}/")
 
+    # What the sources declare and use, word by word, collected once.
+    def words(pattern):
+        return set(re.findall(pattern, sources, re.M))
+    types = words(r"\b(?:struct|enum|trait|class|type)\s+(\w+)")
+    functions = words(r"\bfn\s+(\w+)")
+    declared = types | functions | words(r"\b(?:const|mod|union)\s+(\w+)")
+    called = words(r"\b(\w+)\s*\(")
+    used = called | words(r"\b(\w+)\s*[={]")
+    # Variants and methods: called after `::`, or a line's first word before ( , = {.
+    variants = words(r"::(\w+)\s*\(") | words(r"^\s*(\w+)\s*[(,={]")
+    before_colon = words(r"(\w+):")
+
+    # Defined: declared, called, assigned, opening a block or followed by a colon (the end of
+    # a longer word counts there, as in `self.name:` or `x_name:`).
+
     def defined(name):
-        return re.search(
-            rf"\b(struct|enum|trait|class|type|fn|const|mod|union)\s+{name}\b|"
-            rf"^\s*(pub(\(crate\))?\s+)?(fn|struct|enum)\s+{name}\b|"
-            rf"\b{name}\s*\(|\b{name}\s*=|\b{name}\b\s*\{{|{name}:",
-            sources, re.M,
-        )
+        return (name in declared or name in used
+                or any(w.endswith(name) for w in before_colon))
 
     # Types: CamelCase words.
     for name in set(re.findall(r"\b([A-Z][a-z0-9]+(?:[A-Z][a-z0-9]*)+|vtkFerro\w+|Fv[A-Z]\w*)\b(?!\.(?:rs|wgsl|cxx|hpp|h|py)\b)", doc)):
         if EXTERNAL.match(name):
             continue
-        if not (re.search(rf"\b(struct|enum|trait|class|type)\s+{name}\b", sources)
-                or re.search(rf"::{name}\s*\(|^\s*{name}\s*[(,={{]", sources, re.M)
-                or name in dirs):
+        if not (name in types or name in variants or name in dirs):
             missing.append(f"type, variant or method {name}")
     # Type::function.
     for t, f in set(re.findall(r"\b(\w+)::(\w+)\b", doc)):
         if EXTERNAL.match(t) or t in ("frame",):
-            if t == "frame" and not re.search(rf"\bfn\s+{f}\b", sources):
+            if t == "frame" and f not in functions:
                 missing.append(f"function {t}::{f}")
             continue
-        if not re.search(rf"\bfn\s+{f}\b|::{f}\s*\(|\b{f}\s*\(", sources):
+        if not (f in functions or f in called):
             missing.append(f"function {t}::{f}")
     # snake_case names in code spans and in the layout tree.
     spans = re.findall(r"`([a-z_][a-z0-9_]*)`", doc)

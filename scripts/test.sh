@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make test`: every check CI runs, timed suite by suite (README.md, "Tests").
 #
-# First the builds, one after another, each using both cores (cargo, ninja -j2). Then the
+# First the builds, one after another, each using both cores (cargo, ninja -j2; the Rust
+# test build is also clippy's lint, Makefile: LINTED). Then the
 # suites in two lanes side by side: most of a suite's time is one process (a Python or
 # pvbatch test, afl-fuzz, valgrind), so two lanes keep both cores busy. Last, alone, the
 # tests that time renders. Each suite's output
@@ -15,7 +16,7 @@ cd "$(dirname "$0")/.."
 ROOT=$PWD
 LOGS=$ROOT/build/test-logs
 mkdir -p "$LOGS"
-rm -f "$LOGS"/*.log "$LOGS"/*.status
+rm -f "$LOGS"/*.log "$LOGS"/*.status "$LOGS"/*.seconds "$LOGS"/*.cpu
 MAKE=${MAKE:-make}
 START=$SECONDS
 # Mesa's shader cache and ferrovol's pipeline cache in this tree: what the first suites
@@ -25,10 +26,10 @@ export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
 export FERROVOL_CACHE_DIR=$ROOT/build/ferrovol-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
-SUITES=(lint build-rust build-vtk build-vtk-pip
-        rust-tests lint-fuzz lint-publish fuzz-smoke build-paraview paraview
-        vtk build-vtk-asan vtk-asan regression-quick sanitize regression-quick-pip wheel vtk-pip
-        timing)
+SUITES=(lint build-rust build-vtk
+        rust-tests crates sanitize fuzz-smoke build-paraview paraview
+        vtk build-vtk-asan vtk-asan regression-quick build-vtk-pip regression-quick-pip wheel
+        vtk-pip timing)
 # What each suite needs to have passed first.
 declare -A NEEDS=(
   [build-vtk]=build-rust
@@ -42,9 +43,8 @@ declare -A NEEDS=(
 )
 # What each suite runs: a make target (Makefile), without the builds it depends on.
 declare -A CMD=(
-  [lint]=lint-workspace
-  [lint-fuzz]=lint-fuzz
-  [lint-publish]=lint-publish
+  [lint]=lint-static
+  [crates]=test-crates
   [build-rust]=test-build-rust
   [build-vtk]=test-build-vtk
   [rust-tests]=test-rust
@@ -87,11 +87,22 @@ suite() {
       return 0
     fi
   done
-  $MAKE --no-print-directory "${CMD[$name]}" >"$log" 2>&1 </dev/null || rc=$?
-  local took=$((SECONDS - t0))
+  # The subshell's `times` (a builtin: in a pipe or $(...) it would run in a new process,
+  # which has waited for nothing): the CPU time, user and system, of make and all it waited
+  # for.
+  (
+    $MAKE --no-print-directory "${CMD[$name]}" >"$log" 2>&1 </dev/null
+    r=$?
+    times >"$LOGS/$name.cpu"
+    awk 'NR == 2 { t = 0; for (i = 1; i <= 2; i++) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] }; printf "%d\n", t }' \
+      "$LOGS/$name.cpu" >"$LOGS/$name.cpu.tmp" && mv "$LOGS/$name.cpu.tmp" "$LOGS/$name.cpu"
+    exit $r
+  ) || rc=$?
+  local took=$((SECONDS - t0)) cpu
+  cpu=$(cat "$LOGS/$name.cpu")
   if [ $rc -eq 0 ]; then
     echo ok >"$LOGS/$name.status"
-    report "$name" "ok in ${took} s" "$log"
+    report "$name" "ok in ${took} s, CPU ${cpu} s" "$log"
   else
     echo FAILED >"$LOGS/$name.status"
     report "$name" "FAILED (exit $rc) after ${took} s; log: build/test-logs/$name.log" "$log"
@@ -116,27 +127,27 @@ echo "make test: logs in build/test-logs; the builds first, then two lanes of su
 suite lint
 suite build-rust
 suite build-vtk
-suite build-vtk-pip
-# Lane 1: the Rust tests, the fuzz targets' lint and fuzzing, the crates' publish dry run,
-# the ParaView plugin.
+# Lane 1: the Rust tests, the crates' documentation and packages, the C ABI under
+# sanitizers, fuzzing (its build is the fuzz targets' lint), the ParaView plugin.
 (
   suite rust-tests
-  suite lint-fuzz
-  suite lint-publish
+  suite crates
+  suite sanitize
   suite fuzz-smoke
   suite build-paraview
   suite paraview
 ) &
 lane1=$!
-# Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the C
-# ABI under sanitizers, the quick regression on pip's VTK, the wheel in a new venv, the VTK
-# module's suites on pip's VTK (the lanes' lengths balanced by the suites' times).
+# Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the
+# module built against PyPI's VTK (its SDK's downloads overlap lane 1's work) and its
+# quick regression, the wheel in a new venv, its suites on pip's VTK (the lanes' lengths
+# balanced by the suites' times).
 (
   suite vtk
   suite build-vtk-asan
   suite vtk-asan
   suite regression-quick
-  suite sanitize
+  suite build-vtk-pip
   suite regression-quick-pip
   suite wheel
   suite vtk-pip
@@ -146,18 +157,21 @@ wait $lane1 $lane2
 # Last, alone: the tests that time renders (their bounds are for a machine not building).
 suite timing
 
-passed=0 failed=0 names=()
+passed=0 failed=0 total_cpu=0 names=()
 echo
-echo "make test: wall time per suite"
+echo "make test: wall and CPU time (user + system) per suite"
 for s in "${SUITES[@]}"; do
   [ -n "${WANTED[$s]:-}" ] || continue
   st=$(cat "$LOGS/$s.status" 2>/dev/null || echo "not run")
   secs=$(cat "$LOGS/$s.seconds" 2>/dev/null || echo -)
-  printf '  %-18s %-8s %6s s\n' "$s" "$st" "$secs"
+  cpu=$(cat "$LOGS/$s.cpu" 2>/dev/null || echo -)
+  [ "$cpu" = - ] || total_cpu=$((total_cpu + cpu))
+  printf '  %-20s %-8s %6s s %8s s CPU\n' "$s" "$st" "$secs" "$cpu"
   if [ "$st" = ok ]; then passed=$((passed + 1)); else failed=$((failed + 1)); names+=("$s"); fi
 done
 total=$((SECONDS - START))
-printf '  %-18s %-8s %6s s (%d min %02d s)\n' total "" "$total" $((total / 60)) $((total % 60))
+printf '  %-20s %-8s %6s s %8s s CPU (%d min %02d s)\n' total "" "$total" "$total_cpu" \
+  $((total / 60)) $((total % 60))
 [ $failed -eq 0 ] || echo "make test: not passed: ${names[*]}"
 echo "suites: $passed passed, $failed failed"
 [ $failed -eq 0 ]
