@@ -35,7 +35,7 @@ FERROVOL := target/release/ferrovol
 .PHONY: deps build demo test check lint lint-workspace lint-fuzz lint-publish bench bench-vtk pictures vtk vtk-test paraview paraview-test paraview-regression \
         regression regression-quick fuzz-smoke soak sanitize vtk-asan vtk-pip wheel \
         test-build-vtk-pip test-vtk-pip test-wheel test-regression-quick-pip test-build-rust test-rust test-sanitize test-build-vtk test-vtk test-build-vtk-asan \
-        test-vtk-asan lint-static test-crates test-build-paraview test-paraview test-regression-quick
+        test-vtk-asan lint-static test-crates test-data test-vtk-sdk test-build-paraview test-paraview test-regression-quick
 
 deps:
 	@bash scripts/install-deps.sh
@@ -117,6 +117,8 @@ vtk-pip: deps
 	$(call VTK_PIP_MODULE,$(RELEASE_LIB))
 wheel: vtk-pip
 	. $(PIP_SDK) && $$FERROVOL_SDK_PYTHON scripts/wheel.py $(PIP_BUILD) $(RELEASE_LIB) dist
+test-vtk-sdk:
+	scripts/vtk-sdk.sh
 test-build-vtk-pip:
 	$(call VTK_PIP_MODULE,$(TEST_LIB))
 # The VTK module's suites on pip's VTK (CTest label pip): the comparisons with that VTK's own
@@ -184,16 +186,23 @@ lint-static:
 	python3 scripts/check-architecture-doc.py
 DOC := RUSTDOCFLAGS="-D warnings" $(CARGO) doc --locked --no-deps -p ferrovol-core -p ferrovol-io -p ferrovol-ffi
 # The fuzz targets are a workspace of their own (fuzz/Cargo.toml), checked in their own
-# target folder.
+# target folder (their formatting: lint-static).
 lint-fuzz:
-	$(CARGO) fmt --manifest-path fuzz/Cargo.toml --check
 	$(CARGO) clippy --locked --manifest-path fuzz/Cargo.toml --all-targets -- -D warnings
-# The library crates as crates.io would take them (scripts/check-packages.sh).
+# The library crates as crates.io would take them: packaged alone (the shaders inside
+# ferrovol-core) and built from the package, in a target folder of their own. Cargo
+# verifies ferrovol-io against the ferrovol-core it just packaged, through a local registry
+# whose crates it takes as immutable: it reuses an unpacked copy, or a build, of a version
+# it has seen (the same 0.2.0 with older code). Those copies and builds go first.
+PUBLISH_TARGET := target/publish
 lint-publish:
-	scripts/check-packages.sh
+	rm -rf $${CARGO_HOME:-$$HOME/.cargo}/registry/src/-*/ferrovol-* \
+	  $(PUBLISH_TARGET)/debug/deps/*ferrovol_* $(PUBLISH_TARGET)/debug/.fingerprint/ferrovol-*
+	CARGO_TARGET_DIR=$(PUBLISH_TARGET) $(CARGO) publish --dry-run --locked --allow-dirty \
+	  -p ferrovol-core -p ferrovol-io
 # make test's share of the lint that needs the dependencies type-checked: the crates'
-# documentation with rustdoc's warnings denied, then the packages (which find those checks
-# made).
+# documentation with rustdoc's warnings denied, then the packages type-checked rather than
+# built (scripts/check-packages.sh), which finds the documentation's checks made.
 test-crates:
 	$(DOC)
 	scripts/check-packages.sh
@@ -223,8 +232,9 @@ check: deps
 # those first). The Rust tests' binaries and the test build of the C ABI library (the C ABI
 # tests load and link target/debug/libferrovol.so, which `cargo test` alone does not build),
 # and the real volumes of build/data (scripts/fetch-data.sh) for the suites after it.
+test-data:
+	@scripts/fetch-data.sh >/dev/null || echo "test-data: some of build/data is missing; those tests skip"
 test-build-rust:
-	@scripts/fetch-data.sh >/dev/null || echo "test-build-rust: some of build/data is missing; those tests skip"
 	$(FFI_TEST)
 test-rust:
 	scripts/rust-tests.sh

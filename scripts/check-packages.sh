@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# The library crates as crates.io would take them (`make lint-publish`, `make test`): each
-# packaged (`cargo package`: what the .crate holds, the shaders inside ferrovol-core),
-# unpacked, and type-checked from the package alone: ferrovol-core by itself, ferrovol-io
-# against the ferrovol-core just packaged. A check finds what the publish dry run's build
-# of the package found (a file the package lacks, a feature a crate uses but does not ask
-# for, a dependency resolved differently) without generating code. The checks use the
-# workspace's profiles and target folder, so a dependency already checked there with the
-# same features (by `cargo doc`, clippy) is not checked again.
+# The library crates as crates.io would take them (`make test`; `make lint` runs cargo's own
+# publish dry run, which builds them): each packaged (`cargo package`: what the .crate
+# holds, the shaders inside ferrovol-core), unpacked, and type-checked from the package
+# alone: ferrovol-core by itself, ferrovol-io against the ferrovol-core just packaged. A
+# check finds what the dry run's build of the package finds (a file the package lacks, a
+# feature a crate uses but does not ask for, a dependency resolved differently) without
+# generating code. The checks use the workspace's profiles and target folder, so a
+# dependency already checked there with the same features (by `cargo doc`) is not checked
+# again.
 #   scripts/check-packages.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."

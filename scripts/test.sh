@@ -2,7 +2,8 @@
 # `make test`: every check CI runs, timed suite by suite (README.md, "Tests").
 #
 # First the builds, one after another, each using both cores (cargo, ninja -j2; the Rust
-# test build is also clippy's lint, Makefile: LINTED). Then the
+# test build is also clippy's lint, Makefile: LINTED), with the downloads beside them (the
+# real volumes, pip VTK's SDK). Then the
 # suites in two lanes side by side: most of a suite's time is one process (a Python or
 # pvbatch test, afl-fuzz, valgrind), so two lanes keep both cores busy. Last, alone, the
 # tests that time renders. Each suite's output
@@ -26,7 +27,7 @@ export MESA_SHADER_CACHE_DIR=$ROOT/build/mesa-shader-cache
 export FERROVOL_CACHE_DIR=$ROOT/build/ferrovol-cache
 
 # The suites, in the order their results are listed; build-* suites are builds.
-SUITES=(lint build-rust build-vtk
+SUITES=(data vtk-sdk lint build-rust build-vtk
         rust-tests crates sanitize fuzz-smoke build-paraview paraview
         vtk build-vtk-asan vtk-asan regression-quick build-vtk-pip regression-quick-pip wheel
         vtk-pip timing)
@@ -37,12 +38,14 @@ declare -A NEEDS=(
   [build-paraview]=build-rust [paraview]=build-paraview
   [vtk]=build-vtk [build-vtk-asan]=build-rust [vtk-asan]=build-vtk-asan
   [regression-quick]=build-vtk
-  [build-vtk-pip]=build-rust [vtk-pip]=build-vtk-pip [regression-quick-pip]=build-vtk-pip
+  [build-vtk-pip]="build-rust vtk-sdk" [vtk-pip]=build-vtk-pip [regression-quick-pip]=build-vtk-pip
   [wheel]=build-vtk-pip
   [timing]="build-vtk build-vtk-pip"
 )
 # What each suite runs: a make target (Makefile), without the builds it depends on.
 declare -A CMD=(
+  [data]=test-data
+  [vtk-sdk]=test-vtk-sdk
   [lint]=lint-static
   [crates]=test-crates
   [build-rust]=test-build-rust
@@ -70,6 +73,8 @@ if [ $# -gt 0 ]; then
     WANTED[$1]=1
     local d
     for d in ${NEEDS[$1]:-}; do add "$d"; done
+    # The suites after the Rust build read the real volumes (those without them skip).
+    [ "$1" != build-rust ] || WANTED[data]=1
   }
   for s in "$@"; do add "$s"; done
 else
@@ -124,9 +129,15 @@ report() {
 }
 
 echo "make test: logs in build/test-logs; the builds first, then two lanes of suites"
+# The real volumes and pip VTK's SDK are mostly downloads: they go on beside the builds.
+suite data &
+data=$!
+suite vtk-sdk &
+sdk=$!
 suite lint
 suite build-rust
 suite build-vtk
+wait $data $sdk
 # Lane 1: the Rust tests, the crates' documentation and packages, the C ABI under
 # sanitizers, fuzzing (its build is the fuzz targets' lint), the ParaView plugin.
 (
