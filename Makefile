@@ -211,8 +211,9 @@ test-crates:
 # rustc's place for the workspace's own crates, compiles them with their lints denied and
 # generates their code as rustc does (the dependencies are compiled by rustc as always), so
 # `make test` and `make check` compile the crates once for both. The targets that build or
-# run the test build all name it, since the setting is part of the artifacts' hashes.
-LINTED := test-build-rust test-rust test-sanitize sanitize vtk-asan check
+# run the test build all name it, since the setting is part of the artifacts' hashes; so
+# does fuzz-smoke, whose build (scripts/fuzz.sh) is the fuzz targets' lint the same way.
+LINTED := test-build-rust test-rust test-sanitize sanitize vtk-asan check fuzz-smoke
 $(LINTED): export RUSTC_WORKSPACE_WRAPPER = $(shell command -v clippy-driver)
 $(LINTED): export CLIPPY_ARGS = -D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__
 

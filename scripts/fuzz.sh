@@ -34,11 +34,9 @@ build() {
     -C llvm-args=-sanitizer-coverage-trace-compares
     -C link-arg="$AFL_RT"
   )
-  # clippy-driver compiles the fuzz targets themselves (as `cargo clippy` would, lints
-  # denied), so this build is also their lint.
+  # Under make (fuzz-smoke is one of the Makefile's LINTED targets), clippy-driver compiles
+  # the fuzz targets themselves, lints denied, so this build is also their lint.
   CARGO_TARGET_DIR=$FUZZ_TARGET RUSTFLAGS="${flags[*]}" \
-    RUSTC_WORKSPACE_WRAPPER=$(command -v clippy-driver) \
-    CLIPPY_ARGS=-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__ \
     cargo build --release --locked --manifest-path "$ROOT/fuzz/Cargo.toml"
 }
 

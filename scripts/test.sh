@@ -8,7 +8,7 @@
 # pvbatch test, afl-fuzz, valgrind), so two lanes keep both cores busy. Last, alone, the
 # tests that time renders. Each suite's output
 # goes to build/test-logs/NAME.log and is printed whole when the suite ends, under a line
-# with its wall time; a suite whose build failed is not run. The last line counts them.
+# with its wall and CPU time; a suite whose build failed is not run. The last line counts them.
 #
 #   scripts/test.sh            everything (what `make test` runs)
 #   scripts/test.sh NAME...    only those suites (and the builds they need)
@@ -150,8 +150,8 @@ wait $data $sdk
 ) &
 lane1=$!
 # Lane 2: the VTK module's suite, its ASan build and suite, the quick regression, the
-# module built against PyPI's VTK (its SDK's downloads overlap lane 1's work) and its
-# quick regression, the wheel in a new venv, its suites on pip's VTK (the lanes' lengths
+# module built against PyPI's VTK (its SDK fetched beside the builds) and its quick
+# regression, the wheel in a new venv, its suites on pip's VTK (the lanes' lengths
 # balanced by the suites' times).
 (
   suite vtk
