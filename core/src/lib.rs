@@ -15,18 +15,33 @@
 //! # Ok::<(), ferrovol_core::Error>(())
 //! ```
 
+//!
+//! Without the default feature `gpu` the crate is its data model alone (the [`params`] and
+//! [`synth`] modules), with no GPU stack to build.
+
+// Without the renderer, the data model's GPU-facing helpers (the uniforms' mirrors, table
+// builders, shader codes) have no caller; the default build lints them all.
+#![cfg_attr(not(feature = "gpu"), allow(dead_code, unused_imports))]
+
 pub mod error;
 mod gpu;
 pub mod params;
+#[cfg(feature = "gpu")]
 mod passes;
+#[cfg(feature = "gpu")]
 pub mod renderer;
+#[cfg(feature = "gpu")]
 mod resources;
 pub mod synth;
 
 pub use error::{Error, Result};
+#[cfg(feature = "gpu")]
 pub use gpu::interop::{self, DeviceUuids, OutputPath, SharedImage, SharedTargets};
+#[cfg(feature = "gpu")]
 pub use gpu::{Context, DeviceInfo, DeviceMemory};
 pub use params::environment::{cube_direction, cube_face_coords, FACE_NAMES};
 pub use params::*;
+#[cfg(feature = "gpu")]
 pub use renderer::Renderer;
+#[cfg(feature = "gpu")]
 pub use resources::mesh::{tetrahedralize, Tetrahedra};
