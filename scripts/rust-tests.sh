@@ -3,14 +3,17 @@
 # binaries side by side (JOBS at a time, 2 by default): each binary's tests take turns on
 # one renderer, so one binary keeps about one core busy. Every binary runs in its package's
 # folder, as cargo runs it; its output is printed whole when it ends, with its wall time.
-# The slowest binaries of the last run (target/rust-tests.seconds) start first. Then the
-# doc tests. Extra arguments go to every test binary (a filter, --nocapture...).
+# The slowest binaries of the last run (target/rust-tests.seconds; on a fresh tree
+# scripts/rust-tests.seconds, a make test run's figures) start first. Then the doc tests.
+# Extra arguments go to every test binary (a filter, --nocapture...).
 #   scripts/rust-tests.sh [TEST ARGUMENTS...]        (`make check`, `make test`)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=${JOBS:-2}
 CARGO=${CARGO:-cargo}
 SECONDS_FILE=${CARGO_TARGET_DIR:-target}/rust-tests.seconds
+ORDER_FILE=$SECONDS_FILE
+[ -f "$ORDER_FILE" ] || ORDER_FILE=scripts/rust-tests.seconds
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -18,7 +21,7 @@ trap 'rm -rf "$tmp"' EXIT
 # build messages (the build is the one `cargo build --workspace --all-targets` makes).
 $CARGO test --locked --workspace --no-run --message-format=json-render-diagnostics \
   >"$tmp/build.json"
-python3 - "$tmp/build.json" "$SECONDS_FILE" >"$tmp/binaries" <<'EOF'
+python3 - "$tmp/build.json" "$ORDER_FILE" >"$tmp/binaries" <<'EOF'
 import json, os, sys
 took = {}
 if os.path.exists(sys.argv[2]):

@@ -28,11 +28,16 @@ use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::{DMat4, DVec3};
 
-/// The unstructured pass: its pipelines (one per variant) and its uniforms.
+/// The table entries with opacity (`MeshUniforms::opaque`) of a component's transfer.
+type OpaqueBits = [[u32; 4]; MESH_OPAQUE_WORDS / 4];
+
+/// The unstructured pass: its pipelines (one per variant), its uniforms, and the opaque
+/// entries of the last transfer function it drew (rebuilt only when that changes).
 pub(crate) struct UnstructuredPass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<UnstructuredVariant>,
     mesh_buf: wgpu::Buffer,
+    opaque: Option<(ComponentTransfer, OpaqueBits)>,
 }
 
 impl UnstructuredPass {
@@ -70,7 +75,20 @@ impl UnstructuredPass {
             bgl,
             pipelines,
             mesh_buf,
+            opaque: None,
         })
+    }
+
+    /// `opaque_entries` of `ct`, from the last frame's when its transfer is the same.
+    fn opaque_bits(&mut self, ct: &ComponentTransfer) -> OpaqueBits {
+        match &self.opaque {
+            Some((last, bits)) if last == ct => *bits,
+            _ => {
+                let bits = opaque_entries(ct);
+                self.opaque = Some((ct.clone(), bits));
+                bits
+            }
+        }
     }
 
     /// One frame of the renderer's mesh.
@@ -103,7 +121,7 @@ impl UnstructuredPass {
         let mut mu = mesh.uniforms;
         mu.unit[0] = (1.0 / ct.unit_distance) as f32;
         set_knots(&mut mu, ct);
-        set_opaque(&mut mu, ct);
+        mu.opaque = self.opaque_bits(ct);
         res.ensure_tables(ctx, 1.0)?;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
@@ -208,13 +226,14 @@ fn set_knots(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
 /// The table entries whose opacity is above 0, read from the opacity row of the tables the
 /// shader integrates: a tetrahedron whose scalars reach none of them adds nothing to a
 /// composite, and the shader skips its integral.
-fn set_opaque(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
-    mu.opaque = [[0; 4]; MESH_OPAQUE_WORDS / 4];
+fn opaque_entries(ct: &ComponentTransfer) -> OpaqueBits {
+    let mut bits = [[0; 4]; MESH_OPAQUE_WORDS / 4];
     for (i, e) in build_tables(ct, 1.0)[TABLE_SIZE..].iter().enumerate() {
         if e[0] > 0.0 {
-            mu.opaque[i / 128][i / 32 % 4] |= 1 << (i % 32);
+            bits[i / 128][i / 32 % 4] |= 1 << (i % 32);
         }
     }
+    bits
 }
 
 /// The frame uniforms of a frame of the renderer's mesh: the camera, the mesh's coordinates
