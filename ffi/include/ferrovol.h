@@ -972,9 +972,10 @@ typedef struct FvUnstructuredVolumeDesc {
   const void *offsets;
   /**
    * `cell_count` VTK cell type codes: VTK_TETRA (10), VTK_VOXEL (11),
-   * VTK_HEXAHEDRON (12), VTK_WEDGE (13), VTK_PYRAMID (14), and VTK's quadratic 3D cells
-   * (24–27, 29, 31–33, 37), each linearised to the linear cell of its shape by keeping its
-   * corner points; any other type is refused naming the first cell that has it.
+   * VTK_HEXAHEDRON (12), VTK_WEDGE (13), VTK_PYRAMID (14), VTK_PENTAGONAL_PRISM (15),
+   * VTK_HEXAGONAL_PRISM (16), and VTK's quadratic 3D cells (24–27, 29, 31–33, 37), each
+   * linearised to the linear cell of its shape by keeping its corner points; any other
+   * type is refused naming the first cell that has it.
    */
   const uint8_t *cell_types;
   size_t cell_count;

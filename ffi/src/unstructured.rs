@@ -46,9 +46,10 @@ pub struct FvUnstructuredVolumeDesc {
     /// (vtkCellArray's offsets; a .vtu file leaves out the leading 0).
     pub offsets: *const c_void,
     /// `cell_count` VTK cell type codes: VTK_TETRA (10), VTK_VOXEL (11),
-    /// VTK_HEXAHEDRON (12), VTK_WEDGE (13), VTK_PYRAMID (14), and VTK's quadratic 3D cells
-    /// (24–27, 29, 31–33, 37), each linearised to the linear cell of its shape by keeping its
-    /// corner points; any other type is refused naming the first cell that has it.
+    /// VTK_HEXAHEDRON (12), VTK_WEDGE (13), VTK_PYRAMID (14), VTK_PENTAGONAL_PRISM (15),
+    /// VTK_HEXAGONAL_PRISM (16), and VTK's quadratic 3D cells (24–27, 29, 31–33, 37), each
+    /// linearised to the linear cell of its shape by keeping its corner points; any other
+    /// type is refused naming the first cell that has it.
     pub cell_types: *const u8,
     pub cell_count: usize,
     /// One of FvScalarType (64-bit integers are converted to double, exact up to 2^53).

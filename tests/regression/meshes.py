@@ -11,6 +11,8 @@ range (37.35..276.83), so that the wavelet's transfer functions apply to all of 
                       points): every cell non-affine, every one of positive volume
   torus()             a torus with a hollow tube (annular cross-section), tetrahedra: rays
                       leave and re-enter it up to four times
+  prisms()            a honeycomb of hexagonal prisms in layers, every other one cut into
+                      a pentagonal prism and a wedge: VTK's prisms meeting face to face
   timing(tets)        the tetrahedralised wavelet with at least `tets` tetrahedra
                       (1 million by default), for timing
 
@@ -39,7 +41,9 @@ LO, HI = 37.3531, 276.829
 # VTK's linear cell types and their point counts
 TETRA, HEXAHEDRON, WEDGE, PYRAMID = (vtk.VTK_TETRA, vtk.VTK_HEXAHEDRON, vtk.VTK_WEDGE,
                                      vtk.VTK_PYRAMID)
-NPTS = {TETRA: 4, HEXAHEDRON: 8, WEDGE: 6, PYRAMID: 5}
+PENTAGONAL_PRISM, HEXAGONAL_PRISM = vtk.VTK_PENTAGONAL_PRISM, vtk.VTK_HEXAGONAL_PRISM
+NPTS = {TETRA: 4, HEXAHEDRON: 8, WEDGE: 6, PYRAMID: 5, PENTAGONAL_PRISM: 10,
+        HEXAGONAL_PRISM: 12}
 
 
 # ---------------------------------------------------------------------------------------
@@ -255,6 +259,46 @@ def torus(major=6.5, inner=1.5, outer=3.5, n=(4, 24, 64)):
     return grid_from_arrays(pts, {TETRA: tets}, _to_range(g))
 
 
+def prisms(cols=6, rows=5, layers=5, radius=2.0, height=4.0):
+    """A honeycomb of cols x rows flat-topped hexagons (circumradius `radius`) extruded in
+    `layers` layers of `height`: hexagonal prisms (corners counter-clockwise seen from
+    above), except that every hexagon with (col + row) even is cut along the chord from its
+    corner 0 to its corner 2 into a pentagonal prism and a wedge (whose quads meet the
+    pentagonal prism's). Corners are shared, so cells meet face to face. Point scalars: a smooth field of position on the
+    wavelet's range."""
+    ids, pts = {}, []
+
+    def pid(x, y, level):
+        key = (round(x, 6), round(y, 6), level)
+        if key not in ids:
+            ids[key] = len(pts)
+            pts.append((x, y, level * height))
+        return ids[key]
+
+    cells = {HEXAGONAL_PRISM: [], PENTAGONAL_PRISM: [], WEDGE: []}
+    for c in range(cols):
+        for r in range(rows):
+            cx = 1.5 * radius * c
+            cy = np.sqrt(3.0) * radius * (r + 0.5 * (c % 2))
+            angles = np.pi / 3 * np.arange(6)
+            corners = list(zip(cx + radius * np.cos(angles), cy + radius * np.sin(angles)))
+            for level in range(layers):
+                lo = [pid(x, y, level) for x, y in corners]
+                hi = [pid(x, y, level + 1) for x, y in corners]
+                if (c + r) % 2:
+                    cells[HEXAGONAL_PRISM].append(lo + hi)
+                else:
+                    pent = [0, 2, 3, 4, 5]
+                    cells[PENTAGONAL_PRISM].append([lo[i] for i in pent] + [hi[i] for i in pent])
+                    # (VTK 9.2's wedge: its first triangle clockwise seen from the second)
+                    cells[WEDGE].append([lo[0], lo[2], lo[1], hi[0], hi[2], hi[1]])
+    pts = np.array(pts, np.float64)
+    pts -= 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    x, y, z = pts.T
+    g = 0.55 * np.sin(0.35 * x + 0.4) * np.cos(0.3 * y) + 0.45 * np.sin(0.25 * z + 0.2 * x)
+    return grid_from_arrays(pts, cells, _to_range(g))
+
+
 def tetrahedralised(ug):
     """ug's cells split into tetrahedra by vtkDataSetTriangleFilter (vtkOrderedTriangulator
     on global point ids: neighbouring cells split their shared faces alike), as VTK's
@@ -266,7 +310,8 @@ def tetrahedralised(ug):
     return out
 
 
-MESHES = {"wavelet_tets": tet_wavelet, "mixed": mixed, "torus": torus, "timing": timing}
+MESHES = {"wavelet_tets": tet_wavelet, "mixed": mixed, "torus": torus, "prisms": prisms,
+          "timing": timing}
 
 
 # ---------------------------------------------------------------------------------------

@@ -5,8 +5,8 @@
  * A vtkUnstructuredGridVolumeMapper: it takes the place of
  * vtkUnstructuredGridVolumeRayCastMapper, vtkUnstructuredGridVolumeZSweepMapper or
  * vtkProjectedTetrahedraMapper wherever they are used. ferrovol splits every linear 3D cell
- * into tetrahedra (hexahedra, voxels, wedges and pyramids by a conforming rule; quadratic
- * cells linearised), walks each pixel's ray from tetrahedron to tetrahedron, entering
+ * into tetrahedra (hexahedra, voxels, wedges, pyramids and pentagonal and hexagonal prisms
+ * by a conforming rule; quadratic cells linearised), walks each pixel's ray from tetrahedron to tetrahedron, entering
  * non-convex meshes again, and integrates each segment exactly as VTK's unstructured
  * integrators model light: the scalar opacity read as attenuation per
  * ScalarOpacityUnitDistance, the colour as emission. The frame is composited into VTK's

@@ -1,8 +1,8 @@
 """vtkFerroUnstructuredVolumeMapper against VTK's exact unstructured ray caster
 (vtkUnstructuredGridVolumeRayCastMapper, one ray per pixel, its linear integrator: the
-quantity ferrovol integrates) on tests/regression/meshes.py's tetrahedralised wavelet and
-mixed mesh (VTK gets the mixed mesh split into tetrahedra, ferrovol gets it as it is and as
-VTK's split), point and cell scalars, opaque geometry; the blend modes VTK's mappers lack
+quantity ferrovol integrates) on tests/regression/meshes.py's tetrahedralised wavelet,
+mixed mesh and prism honeycomb (VTK gets the mixed and prism meshes split into tetrahedra,
+ferrovol gets them as they are and the mixed mesh also as VTK's split), point and cell scalars, opaque geometry; the blend modes VTK's mappers lack
 draw; Shade lights the mesh as vtkGPUVolumeRayCastMapper lights the image it came from;
 clipping planes and the array selection apply; bad input (an empty grid, unsupported
 cells, two components, no scalars, a gradient opacity) is an ErrorEvent naming why, not a
@@ -70,6 +70,7 @@ class AgainstVtk(unittest.TestCase):
         cls.wavelet = meshes.tet_wavelet(10)
         cls.mixed = meshes.mixed()
         cls.mixed_tets = meshes.tetrahedralised(cls.mixed)
+        cls.prisms = meshes.prisms()
 
     def check(self, name, ours_grid, vtk_grid, floor=(FLOOR_SSIM, FLOOR_PSNR), actors=None):
         mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
@@ -97,6 +98,11 @@ class AgainstVtk(unittest.TestCase):
         # ferrovol's own split (hexahedra into 12 about their centroid) against
         # vtkDataSetTriangleFilter's: the interpolants differ inside the cells
         self.check("mixed", self.mixed, self.mixed_tets)
+
+    def test_prisms_as_is(self):
+        # pentagonal and hexagonal prisms (and wedges) split by ferrovol about their
+        # centroids, against vtkDataSetTriangleFilter's split drawn by the ray caster
+        self.check("prisms", self.prisms, meshes.tetrahedralised(self.prisms))
 
     def test_opaque_geometry(self):
         """An opaque sphere half inside the mesh: the rays stop at its depth, as the ray

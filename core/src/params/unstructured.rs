@@ -5,15 +5,15 @@
 //! # Rules
 //!
 //! * **Cell types.** The renderer's cells are VTK's linear 3D cells [`CellType`]: tetra
-//!   (10), voxel (11), hexahedron (12), wedge (13) and pyramid (14), with VTK's point
-//!   order. [`UnstructuredVolume::from_vtk`] also takes VTK's quadratic 3D cells and
+//!   (10), voxel (11), hexahedron (12), wedge (13), pyramid (14), pentagonal prism (15)
+//!   and hexagonal prism (16), with VTK's point order. [`UnstructuredVolume::from_vtk`] also takes VTK's quadratic 3D cells and
 //!   linearises each by keeping its corner points (VTK lists them first) as the linear cell
 //!   of the same shape: quadratic tetra (24) → tetra, quadratic (25), tri-quadratic (29)
 //!   and bi-quadratic-quadratic (33) hexahedron → hexahedron, quadratic (26),
 //!   quadratic-linear (31) and bi-quadratic-quadratic (32) wedge → wedge, quadratic (27)
 //!   and tri-quadratic (37) pyramid → pyramid. One cell stays one cell, so cell scalars
-//!   keep their meaning. Every other type (0D–2D cells, pentagonal and hexagonal prisms,
-//!   polyhedra, Lagrange and Bézier cells) is refused with an error naming the type and
+//!   keep their meaning. Every other type (0D–2D cells, polyhedra, Lagrange and Bézier
+//!   cells) is refused with an error naming the type and
 //!   the first cell that has it.
 //! * **Degenerate cells.** A cell that lists a point twice (a "collapsed" hexahedron
 //!   standing in for a wedge, say) is refused, naming the cell and the point: the
@@ -31,8 +31,8 @@ use std::collections::HashMap;
 use super::volume::{beyond_f32, ScalarType, Scalars};
 use crate::error::{Error, Result};
 
-/// A cell type the renderer takes. VTK numbers these five consecutively, from VTK_TETRA
-/// (10) to VTK_PYRAMID (14), in the order the variants are declared.
+/// A cell type the renderer takes. VTK numbers these seven consecutively, from VTK_TETRA
+/// (10) to VTK_HEXAGONAL_PRISM (16), in the order the variants are declared.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CellType {
     /// VTK_TETRA: 4 points.
@@ -45,6 +45,10 @@ pub enum CellType {
     Wedge,
     /// VTK_PYRAMID: 5 points, the base quad (0–3) and the apex (4).
     Pyramid,
+    /// VTK_PENTAGONAL_PRISM: 10 points, two pentagons (0–4, 5–9), i + 5 above i.
+    PentagonalPrism,
+    /// VTK_HEXAGONAL_PRISM: 12 points, two hexagons (0–5, 6–11), i + 6 above i.
+    HexagonalPrism,
 }
 
 /// VTK's code of the first type the renderer takes (VTK_TETRA).
@@ -52,12 +56,14 @@ const FIRST_VTK_CODE: u8 = 10;
 
 impl CellType {
     /// Every type the renderer takes, in VTK's code order.
-    pub const ALL: [CellType; 5] = [
+    pub const ALL: [CellType; 7] = [
         CellType::Tetra,
         CellType::Voxel,
         CellType::Hexahedron,
         CellType::Wedge,
         CellType::Pyramid,
+        CellType::PentagonalPrism,
+        CellType::HexagonalPrism,
     ];
 
     /// The type VTK calls `code`, if the renderer takes it.
@@ -78,6 +84,8 @@ impl CellType {
             CellType::Voxel | CellType::Hexahedron => 8,
             CellType::Wedge => 6,
             CellType::Pyramid => 5,
+            CellType::PentagonalPrism => 10,
+            CellType::HexagonalPrism => 12,
         }
     }
 
@@ -114,6 +122,25 @@ impl CellType {
                 &[1, 2, 4],
                 &[2, 3, 4],
                 &[3, 0, 4],
+            ],
+            CellType::PentagonalPrism => &[
+                &[0, 4, 3, 2, 1],
+                &[5, 6, 7, 8, 9],
+                &[0, 1, 6, 5],
+                &[1, 2, 7, 6],
+                &[2, 3, 8, 7],
+                &[3, 4, 9, 8],
+                &[4, 0, 5, 9],
+            ],
+            CellType::HexagonalPrism => &[
+                &[0, 5, 4, 3, 2, 1],
+                &[6, 7, 8, 9, 10, 11],
+                &[0, 1, 7, 6],
+                &[1, 2, 8, 7],
+                &[2, 3, 9, 8],
+                &[3, 4, 10, 9],
+                &[4, 5, 11, 10],
+                &[5, 0, 6, 11],
             ],
         }
     }
@@ -409,16 +436,16 @@ impl UnstructuredVolume {
 
     /// No face is shared by more than two cells (the cells are valid).
     fn check_faces(&self) -> Result<()> {
-        // Each face as its sorted points (a triangle padded with u32::MAX), and the first
-        // cell seen with it and how many have it.
-        let mut seen: HashMap<[u32; 4], (usize, u8)> = HashMap::new();
+        // Each face as its sorted points (padded with u32::MAX to a hexagon's six), and the
+        // first cell seen with it and how many have it.
+        let mut seen: HashMap<[u32; 6], (usize, u8)> = HashMap::new();
         for c in 0..self.num_cells() {
             let cell = self.cell(c);
             let Some(ty) = self.cell_type(c) else {
                 continue;
             };
             for face in ty.faces() {
-                let mut key = [u32::MAX; 4];
+                let mut key = [u32::MAX; 6];
                 for (k, &i) in face.iter().enumerate() {
                     key[k] = cell[i];
                 }

@@ -97,8 +97,31 @@ const WEDGE_TURNS: [[usize; 6]; 6] = [
     [5, 4, 3, 2, 1, 0],
 ];
 
+/// The triangles of polygon `p` (global point indices, in cycle order): a fan from its
+/// smallest point, so the two cells that share a face split it alike, whichever way each
+/// goes round it (for a quad, [`split_quad`]'s diagonal).
+fn split_polygon(p: &[u32]) -> Vec<[u32; 3]> {
+    let n = p.len();
+    let k = (0..n).min_by_key(|&k| p[k]).expect("a polygon has points");
+    (1..n - 1)
+        .map(|i| [p[k], p[(k + i) % n], p[(k + i + 1) % n]])
+        .collect()
+}
+
+/// Whether a cell of type `ty` is split around a point added at its centroid.
+fn splits_around_centroid(ty: CellType) -> bool {
+    matches!(
+        ty,
+        CellType::Hexahedron
+            | CellType::Voxel
+            | CellType::PentagonalPrism
+            | CellType::HexagonalPrism
+    )
+}
+
 /// The tetrahedra of cell `c` of `cell` points (global indices), as the module's rules
-/// split it; a hexahedron's or voxel's centroid is point `centroid`.
+/// split it; the centroid of a cell split around it ([`splits_around_centroid`]) is point
+/// `centroid`.
 pub(crate) fn cell_tets(ty: CellType, cell: &[u32], centroid: u32) -> Vec<[u32; 4]> {
     match ty {
         CellType::Tetra => vec![[cell[0], cell[1], cell[2], cell[3]]],
@@ -137,6 +160,12 @@ pub(crate) fn cell_tets(ty: CellType, cell: &[u32], centroid: u32) -> Vec<[u32; 
                 .map(|t| [t[0], t[1], t[2], centroid])
                 .collect()
         }
+        CellType::PentagonalPrism | CellType::HexagonalPrism => ty
+            .faces()
+            .iter()
+            .flat_map(|f| split_polygon(&f.iter().map(|&i| cell[i]).collect::<Vec<_>>()))
+            .map(|t| [t[0], t[1], t[2], centroid])
+            .collect(),
     }
 }
 
@@ -167,7 +196,8 @@ pub(crate) const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], 
 /// coordinates: what the renderer uploads, and what a CPU reference needs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tetrahedra {
-    /// The mesh's points, then one centroid per hexahedron or voxel.
+    /// The mesh's points, then one centroid per hexahedron, voxel or pentagonal or
+    /// hexagonal prism.
     pub points: Vec<[f64; 3]>,
     /// Per point, the first component's scalar (point scalars; 0 for cell scalars).
     pub point_scalars: Vec<f64>,
@@ -181,8 +211,10 @@ pub struct Tetrahedra {
 
 /// Splits a mesh into tetrahedra as the renderer does. Each quad face is split along its
 /// diagonal through its smallest point index (neighbours' triangles match); a tetra stays
-/// itself, a pyramid becomes 2 tetrahedra, a wedge 3, a hexahedron or voxel 12 around a
-/// point added at its centroid (its point scalars the corners' mean), so scalars are
+/// itself, a pyramid becomes 2 tetrahedra, a wedge 3, a hexahedron or voxel 12, a
+/// pentagonal prism 16 and a hexagonal prism 20 around a point added at its centroid (its
+/// point scalars the corners' mean; each pentagon or hexagon split into a fan from its
+/// smallest point), so scalars are
 /// linear per tetrahedron: exact for tetrahedra, an approximation of the other cells'
 /// interpolants that agrees at their corners. Tetrahedra with a volume of at most 1e-7
 /// times the cube of their longest edge are left out ([`Tetrahedra::flat`] counts them);
@@ -206,7 +238,7 @@ pub fn tetrahedralize(v: &UnstructuredVolume) -> Result<Tetrahedra> {
         let ty = v.cell_type(c).expect("validated");
         let cell = v.cell(c);
         let mut centroid = u32::MAX;
-        if matches!(ty, CellType::Hexahedron | CellType::Voxel) {
+        if splits_around_centroid(ty) {
             let n = cell.len() as f64;
             let mut m = [0.0; 3];
             for &p in cell {

@@ -32,12 +32,81 @@ fn every_cell_type_splits_into_tetrahedra_of_its_volume() {
         .all(|q| signed_volume6(q.map(|i| t.points[i as usize])) > 0.0));
 }
 
+/// Two prisms of `sides` sides (VTK_PENTAGONAL_PRISM or VTK_HEXAGONAL_PRISM), regular
+/// polygons of circumradius 1 stacked along z (heights 0, 1, 2), sharing the middle
+/// polygon. Each level's points are numbered turned by two, so no cell lists a shared
+/// face's smallest point first.
+fn stacked_prisms(sides: usize) -> UnstructuredVolume {
+    let index = |level: usize, i: usize| (level * sides + (i + 2 * level) % sides) as u32;
+    let mut points = vec![[0.0; 3]; 3 * sides];
+    for level in 0..3 {
+        for i in 0..sides {
+            let a = std::f64::consts::TAU * i as f64 / sides as f64;
+            points[index(level, i) as usize] = [a.cos(), a.sin(), level as f64];
+        }
+    }
+    let connectivity: Vec<u32> = (0..2)
+        .flat_map(|layer| (0..2 * sides).map(move |k| index(layer + k / sides, k % sides)))
+        .collect();
+    let scalars = points.iter().map(|p| (p[0] + p[2]) as f32).collect();
+    UnstructuredVolume::from_vtk(
+        points,
+        connectivity,
+        vec![0, 2 * sides as u32, 4 * sides as u32],
+        vec![if sides == 5 { 15 } else { 16 }; 2],
+        ScalarLocation::Points,
+        1,
+        Scalars::F32(scalars),
+    )
+    .unwrap()
+}
+
+#[test]
+fn prisms_split_into_tetrahedra_of_their_volume_around_their_centroids() {
+    for (sides, per_cell) in [(5, 16), (6, 20)] {
+        let v = stacked_prisms(sides);
+        let t = tetrahedralize(&v).unwrap();
+        assert_eq!(t.tets.len(), 2 * per_cell, "{sides} sides");
+        assert_eq!(t.points.len(), 3 * sides + 2, "a centroid per prism");
+        assert!((t.points[3 * sides][2] - 0.5).abs() < 1e-12);
+        let area = sides as f64 / 2.0 * (std::f64::consts::TAU / sides as f64).sin();
+        for cell in 0..2 {
+            let vol: f64 = (0..t.tets.len())
+                .filter(|&k| t.tet_cell[k] == cell)
+                .map(|k| signed_volume6(t.tets[k].map(|i| t.points[i as usize])) / 6.0)
+                .sum();
+            assert!(
+                (vol - area).abs() < 1e-12,
+                "{sides} sides: {vol} against {area}"
+            );
+        }
+        assert!(t
+            .tets
+            .iter()
+            .all(|q| signed_volume6(q.map(|i| t.points[i as usize])) > 0.0));
+        // the shared polygon is split alike from both sides: only the outer faces' triangles
+        // are on the boundary (two end polygons, 2 × sides quads)
+        let m = TetMesh::prepare(&v).unwrap();
+        assert_eq!(
+            m.boundary.len(),
+            2 * (sides - 2) + 2 * sides * 2,
+            "{sides} sides"
+        );
+    }
+    assert_eq!(
+        split_polygon(&[7, 3, 9, 4, 8]),
+        [[3, 9, 4], [3, 4, 8], [3, 8, 7]]
+    );
+}
+
 #[test]
 fn neighbours_agree_and_the_boundary_is_closed() {
     for v in [
         synth::house(),
         synth::mixed_cells(3, ScalarLocation::Points),
         synth::hollow_cylinder(2, 8, 2),
+        stacked_prisms(5),
+        stacked_prisms(6),
     ] {
         let m = TetMesh::prepare(&v).unwrap();
         let mut boundary = 0;
