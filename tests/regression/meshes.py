@@ -264,8 +264,8 @@ def prisms(cols=6, rows=5, layers=5, radius=2.0, height=4.0):
     `layers` layers of `height`: hexagonal prisms (corners counter-clockwise seen from
     above), except that every hexagon with (col + row) even is cut along the chord from its
     corner 0 to its corner 2 into a pentagonal prism and a wedge (whose quads meet the
-    pentagonal prism's). Corners are shared, so cells meet face to face. Point scalars: a smooth field of position on the
-    wavelet's range."""
+    pentagonal prism's). Corners are shared, so cells meet face to face. Point scalars: a
+    smooth field of position on the wavelet's range."""
     ids, pts = {}, []
 
     def pid(x, y, level):
@@ -276,11 +276,11 @@ def prisms(cols=6, rows=5, layers=5, radius=2.0, height=4.0):
         return ids[key]
 
     cells = {HEXAGONAL_PRISM: [], PENTAGONAL_PRISM: [], WEDGE: []}
+    angles = np.pi / 3 * np.arange(6)
     for c in range(cols):
         for r in range(rows):
             cx = 1.5 * radius * c
             cy = np.sqrt(3.0) * radius * (r + 0.5 * (c % 2))
-            angles = np.pi / 3 * np.arange(6)
             corners = list(zip(cx + radius * np.cos(angles), cy + radius * np.sin(angles)))
             for level in range(layers):
                 lo = [pid(x, y, level) for x, y in corners]

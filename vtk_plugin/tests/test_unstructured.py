@@ -2,8 +2,9 @@
 (vtkUnstructuredGridVolumeRayCastMapper, one ray per pixel, its linear integrator: the
 quantity ferrovol integrates) on tests/regression/meshes.py's tetrahedralised wavelet,
 mixed mesh and prism honeycomb (VTK gets the mixed and prism meshes split into tetrahedra,
-ferrovol gets them as they are and the mixed mesh also as VTK's split), point and cell scalars, opaque geometry; the blend modes VTK's mappers lack
-draw; Shade lights the mesh as vtkGPUVolumeRayCastMapper lights the image it came from;
+ferrovol gets them as they are and the mixed mesh also as VTK's split), point and cell
+scalars, opaque geometry; the blend modes VTK's mappers lack draw; Shade lights the mesh as
+vtkGPUVolumeRayCastMapper lights the image it came from;
 clipping planes and the array selection apply; bad input (an empty grid, unsupported
 cells, two components, no scalars, a gradient opacity) is an ErrorEvent naming why, not a
 crash, and a good input renders again after it."""

@@ -6,15 +6,14 @@
 //!
 //! * **Cell types.** The renderer's cells are VTK's linear 3D cells [`CellType`]: tetra
 //!   (10), voxel (11), hexahedron (12), wedge (13), pyramid (14), pentagonal prism (15)
-//!   and hexagonal prism (16), with VTK's point order. [`UnstructuredVolume::from_vtk`] also takes VTK's quadratic 3D cells and
-//!   linearises each by keeping its corner points (VTK lists them first) as the linear cell
+//!   and hexagonal prism (16), with VTK's point order. [`UnstructuredVolume::from_vtk`]
+//!   also takes VTK's quadratic 3D cells and linearises each by keeping its corner points (VTK lists them first) as the linear cell
 //!   of the same shape: quadratic tetra (24) → tetra, quadratic (25), tri-quadratic (29)
 //!   and bi-quadratic-quadratic (33) hexahedron → hexahedron, quadratic (26),
 //!   quadratic-linear (31) and bi-quadratic-quadratic (32) wedge → wedge, quadratic (27)
 //!   and tri-quadratic (37) pyramid → pyramid. One cell stays one cell, so cell scalars
 //!   keep their meaning. Every other type (0D–2D cells, polyhedra, Lagrange and Bézier
-//!   cells) is refused with an error naming the type and
-//!   the first cell that has it.
+//!   cells) is refused with an error naming the type and the first cell that has it.
 //! * **Degenerate cells.** A cell that lists a point twice (a "collapsed" hexahedron
 //!   standing in for a wedge, say) is refused, naming the cell and the point: the
 //!   renderer's ray–face tests need cells with distinct corners. Cells whose distinct
@@ -89,7 +88,11 @@ impl CellType {
         }
     }
 
-    /// The faces, as indices into the cell's points (VTK's face order).
+    /// The most points a face of any type has (a hexagonal prism's hexagons).
+    pub const MAX_FACE_POINTS: usize = 6;
+
+    /// The faces, as indices into the cell's points (VTK's face order), each of at most
+    /// [`CellType::MAX_FACE_POINTS`] points.
     pub fn faces(self) -> &'static [&'static [usize]] {
         match self {
             CellType::Tetra => &[&[0, 1, 3], &[1, 2, 3], &[2, 0, 3], &[0, 2, 1]],
@@ -436,16 +439,16 @@ impl UnstructuredVolume {
 
     /// No face is shared by more than two cells (the cells are valid).
     fn check_faces(&self) -> Result<()> {
-        // Each face as its sorted points (padded with u32::MAX to a hexagon's six), and the
-        // first cell seen with it and how many have it.
-        let mut seen: HashMap<[u32; 6], (usize, u8)> = HashMap::new();
+        // Each face as its sorted points (padded with u32::MAX), and the first cell seen
+        // with it and how many have it.
+        let mut seen: HashMap<[u32; CellType::MAX_FACE_POINTS], (usize, u8)> = HashMap::new();
         for c in 0..self.num_cells() {
             let cell = self.cell(c);
             let Some(ty) = self.cell_type(c) else {
                 continue;
             };
             for face in ty.faces() {
-                let mut key = [u32::MAX; 6];
+                let mut key = [u32::MAX; CellType::MAX_FACE_POINTS];
                 for (k, &i) in face.iter().enumerate() {
                     key[k] = cell[i];
                 }

@@ -79,6 +79,7 @@ fn one_of_each_cell_type_is_valid() {
         );
         for f in ty.faces() {
             assert!(f.iter().all(|&i| i < ty.num_points()));
+            assert!(f.len() <= CellType::MAX_FACE_POINTS);
         }
     }
 }

@@ -214,8 +214,7 @@ pub struct Tetrahedra {
 /// itself, a pyramid becomes 2 tetrahedra, a wedge 3, a hexahedron or voxel 12, a
 /// pentagonal prism 16 and a hexagonal prism 20 around a point added at its centroid (its
 /// point scalars the corners' mean; each pentagon or hexagon split into a fan from its
-/// smallest point), so scalars are
-/// linear per tetrahedron: exact for tetrahedra, an approximation of the other cells'
+/// smallest point), so scalars are linear per tetrahedron: exact for tetrahedra, an approximation of the other cells'
 /// interpolants that agrees at their corners. Tetrahedra with a volume of at most 1e-7
 /// times the cube of their longest edge are left out ([`Tetrahedra::flat`] counts them);
 /// every tetrahedron is positively oriented. An error for a mesh that does not validate,

@@ -53,7 +53,14 @@ fn stacked_prisms(sides: usize) -> UnstructuredVolume {
         points,
         connectivity,
         vec![0, 2 * sides as u32, 4 * sides as u32],
-        vec![if sides == 5 { 15 } else { 16 }; 2],
+        vec![
+            if sides == 5 {
+                CellType::PentagonalPrism.vtk_code()
+            } else {
+                CellType::HexagonalPrism.vtk_code()
+            };
+            2
+        ],
         ScalarLocation::Points,
         1,
         Scalars::F32(scalars),
