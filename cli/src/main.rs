@@ -504,6 +504,34 @@ fn render_params(a: &RenderArgs, bounds: [f64; 6]) -> RenderParams {
     params
 }
 
+/// `--mode pathtrace`'s settings and environment, None in the other modes.
+fn path_tracing_setup(a: &RenderArgs) -> Result<Option<(PathTraceParams, Environment)>, CliError> {
+    if a.mode != Mode::Pathtrace {
+        return Ok(None);
+    }
+    let p =
+        a.pt.params(a.iso.env_light.unwrap_or(1.0), a.iso.env_background)?;
+    Ok(Some((p, environment_setup(&a.iso)?)))
+}
+
+/// Path-traced frames until `paths` paths per pixel have accumulated, counted on `pb`.
+fn trace_paths(
+    r: &mut Renderer,
+    view: &View,
+    params: &RenderParams,
+    paths: u32,
+    pb: &indicatif::ProgressBar,
+) -> Result<(), CliError> {
+    while r.accumulated_samples() < paths {
+        pb.set_message(format!(
+            "path tracing: {} of {paths} paths per pixel",
+            r.accumulated_samples()
+        ));
+        r.render(view, params, None)?;
+    }
+    Ok(())
+}
+
 fn render(a: RenderArgs) -> Result<(), CliError> {
     if let Some(p) = a.input.as_ref().filter(|p| mesh::is_vtu(p)) {
         return mesh::render(&a, p);
@@ -540,13 +568,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     } else {
         None
     };
-    let path_tracing = if a.mode == Mode::Pathtrace {
-        let p =
-            a.pt.params(a.iso.env_light.unwrap_or(1.0), a.iso.env_background)?;
-        Some((p, environment_setup(&a.iso)?))
-    } else {
-        None
-    };
+    let path_tracing = path_tracing_setup(&a)?;
     pb.set_message("starting the GPU");
     let mut r = Renderer::new(Context::new()?)?;
     pb.set_message("uploading");
@@ -585,14 +607,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     let t0 = std::time::Instant::now();
     let mut img = r.render_image(&view, &params)?;
     if path_tracing.is_some() {
-        while r.accumulated_samples() < a.pt.paths() {
-            pb.set_message(format!(
-                "path tracing: {} of {} paths per pixel",
-                r.accumulated_samples(),
-                a.pt.paths()
-            ));
-            r.render(&view, &params, None)?;
-        }
+        trace_paths(&mut r, &view, &params, a.pt.paths(), &pb)?;
         img = r.read_image()?;
         eprintln!(
             "ferrovol: {} paths per pixel in {:.2} s",
@@ -610,9 +625,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
             view.camera.azimuth(a.orbit);
             if path_tracing.is_some() {
                 r.reset_accumulation();
-                while r.accumulated_samples() < a.pt.paths() {
-                    r.render(&view, &params, None)?;
-                }
+                trace_paths(&mut r, &view, &params, a.pt.paths(), &pb)?;
             } else {
                 r.render(&view, &params, None)?;
             }

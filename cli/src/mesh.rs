@@ -2,7 +2,9 @@
 //! the same camera, blend mode and transfer-function flags as a volume.
 
 use crate::presets;
-use crate::{render_params, spinner, view_of, CliError, RenderArgs};
+use crate::{
+    path_tracing_setup, render_params, spinner, trace_paths, view_of, CliError, RenderArgs,
+};
 use ferrovol_core::{
     tetrahedralize, vtk_cell_type_name, Context, Renderer, ScalarLocation, UnstructuredVolume,
 };
@@ -53,18 +55,32 @@ pub fn render(a: &RenderArgs, path: &Path) -> Result<(), CliError> {
     let t0 = std::time::Instant::now();
     r.set_unstructured(&m)?;
     r.set_transfer_function(&tf)?;
+    let path_tracing = path_tracing_setup(a)?;
+    if let Some((p, env)) = &path_tracing {
+        r.set_path_tracing(p)?;
+        r.set_environment(env)?;
+    }
     let mut view = view_of(a, m.bounds())?;
     let params = render_params(a, m.bounds());
     r.prepare(&view, &params)?;
     let prepared = t0.elapsed().as_secs_f64();
     pb.set_message("rendering");
     let mut img = r.render_image(&view, &params)?;
+    if path_tracing.is_some() {
+        trace_paths(&mut r, &view, &params, a.pt.paths(), &pb)?;
+        img = r.read_image()?;
+    }
     let mut timing = None;
     if a.repeat > 1 {
         let t0 = std::time::Instant::now();
         for _ in 1..a.repeat {
             view.camera.azimuth(a.orbit);
-            r.render(&view, &params, None)?;
+            if path_tracing.is_some() {
+                r.reset_accumulation();
+                trace_paths(&mut r, &view, &params, a.pt.paths(), &pb)?;
+            } else {
+                r.render(&view, &params, None)?;
+            }
             r.finish()?;
         }
         timing = Some(t0.elapsed().as_secs_f64() * 1e3 / (a.repeat - 1) as f64);

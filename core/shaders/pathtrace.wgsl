@@ -41,22 +41,12 @@
 #include "lib/envmap.wgsl"
 #include "lib/phase.wgsl"
 #include "lib/bsdf.wgsl"
+#include "lib/pathtrace.wgsl"
 
-struct PathTrace {
-    env_rotation: mat4x4<f32>,  // world → environment directions
-    medium: vec4<f32>,          // x largest block majorant (per world unit), y anisotropy g, z 1 / unit distance, w environment weight
-    surface: vec4<f32>,         // x gradient threshold ψ (world units; 3e38: none), y stochastic blend rate k (0: the hard switch), z GGX roughness, w Fresnel reflectance at normal incidence
-    lobe: vec4<f32>,            // x transmitted share of the BSDF's non-specular part, y its Phong exponent, z the intermixed volumes' summed majorant (per world unit), w unused
-    counts: vec4<u32>,          // x paths per primary ray, y paths accumulated before this one, z most scattering events, w seed
-    options: vec4<u32>,         // x flags (PT_FLAG_*), y texels per edge of env_cdf's cube faces, z scattering regions (PT_SCATTER_*), w pixels traced: stride | x offset << 8 | y offset << 16 within rect
-    rect: vec4<u32>,            // the frame's pixels: x0, y0, x1, y1 (exclusive)
-}
-
-// Pipeline constants: the code of the BSDF and of the scattering regions (HYBRID) and of
-// the denoiser's guide (GUIDE) is compiled only into the pipelines that use it (on
-// lavapipe a path tracer carrying unused code runs markedly slower).
+// Pipeline constants: the code of the BSDF and of the scattering regions (HYBRID) is
+// compiled only into the pipelines that use it (on lavapipe a path tracer carrying unused
+// code runs markedly slower).
 override HYBRID: bool = true;
-override GUIDE: bool = true;
 // VTK's cropping regions: the medium is empty in the regions cropped away.
 override CROP: bool = false;
 
@@ -68,97 +58,11 @@ override CROP: bool = false;
 // majorant of 9.2 per unit over thousands of units: never reached in practice).
 const PT_MAX_STEPS: u32 = 1000000u;
 
-// Per pixel: the sums of radiance (rgb) and of coverage (a) over all paths so far.
-@group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
-// Per pixel: x the paths so far, y the sum of their squared luminances, z the window depth
-// where the centre ray enters the medium's segment (1 until a path met the medium).
-@group(0) @binding(5) var<storage, read_write> moments: array<vec4<f32>>;
-@group(0) @binding(7) var<uniform> pt_ubo: PathTrace;
-// A private copy filled by the entry point, as lib/common.wgsl's `frame`.
-var<private> pt: PathTrace;
-@group(0) @binding(11) var env_cube: texture_cube<f32>;
-@group(0) @binding(13) var env_sampler: sampler;
-// The environment's sampling distribution over the texels of a small cube (options.y² per
-// face, faces +X … −Z, rows top to bottom): the cumulative probabilities, last = 1
-// (core/src/passes/pathtrace.rs: luminance × solid angle, with a tenth spread uniformly).
-@group(0) @binding(14) var<storage, read> env_cdf: array<f32>;
 // Per min–max block (march.wgsl: block_coord): the largest extinction (per world unit) its
 // scalar range can take under the transfer function, or where that is 0, minus the block's
 // Chebyshev distance to the nearest block with extinction (core/src/resources/tables.rs,
 // empty_distances): a ray leaps the cube of blocks without it (leap_exit).
 @group(0) @binding(15) var majorants: texture_3d<f32>;
-// Per pixel (PT_FLAG_GUIDE), summed over the paths: the unit normal at the camera path's
-// first collision (facing the camera; the gradient's direction) and its distance along
-// the ray (denoise.wgsl reads them).
-@group(0) @binding(16) var<storage, read_write> guide: array<vec4<f32>>;
-
-// This path's contribution to `guide` (zero when it met nothing).
-var<private> path_guide: vec4<f32> = vec4<f32>(0.0);
-
-fn env_radiance(d: vec3<f32>) -> vec3<f32> {
-    let e = (pt.env_rotation * vec4<f32>(d, 0.0)).xyz;
-    return pt.medium.w * textureSampleLevel(env_cube, env_sampler, e, 0.0).rgb;
-}
-
-// Face (x) and face coordinates sc, tc ∈ [−1, 1] (yz) of a direction, the inverse of
-// cube_direction (environment.rs: cube_face_coords).
-fn cube_face_coords(d: vec3<f32>) -> vec3<f32> {
-    let a = abs(d);
-    if (a.x >= a.y && a.x >= a.z) {
-        if (d.x > 0.0) {
-            return vec3<f32>(0.0, -d.z / a.x, -d.y / a.x);
-        }
-        return vec3<f32>(1.0, d.z / a.x, -d.y / a.x);
-    }
-    if (a.y >= a.z) {
-        if (d.y > 0.0) {
-            return vec3<f32>(2.0, d.x / a.y, d.z / a.y);
-        }
-        return vec3<f32>(3.0, d.x / a.y, -d.z / a.y);
-    }
-    if (d.z > 0.0) {
-        return vec3<f32>(4.0, d.x / a.z, -d.y / a.z);
-    }
-    return vec3<f32>(5.0, -d.x / a.z, -d.y / a.z);
-}
-
-// Density over directions (per steradian) of env_sample for the world direction d: the
-// texel's probability spread uniformly over its face coordinates, whose solid angle per
-// unit area is (1 + sc² + tc²)^(−3/2).
-fn env_pdf(d: vec3<f32>) -> f32 {
-    let n = pt.options.y;
-    let f = cube_face_coords((pt.env_rotation * vec4<f32>(d, 0.0)).xyz);
-    let ij = min(vec2<u32>((f.yz + 1.0) * 0.5 * f32(n)), vec2<u32>(n - 1u));
-    let i = (u32(f.x) * n + ij.y) * n + ij.x;
-    let p = env_cdf[i] - select(0.0, env_cdf[max(i, 1u) - 1u], i > 0u);
-    let q = 1.0 + f.y * f.y + f.z * f.z;
-    return p * f32(n * n) * q * sqrt(q) * 0.25;
-}
-
-// A world direction drawn from the environment's distribution (pdf: env_pdf).
-fn env_sample(u: vec3<f32>) -> vec3<f32> {
-    let n = pt.options.y;
-    let count = 6u * n * n;
-    // the first texel whose cumulative probability exceeds u.x
-    var lo = 0u;
-    var hi = count - 1u;
-    while (lo < hi) {
-        let mid = (lo + hi) / 2u;
-        if (env_cdf[mid] > u.x) {
-            hi = mid;
-        } else {
-            lo = mid + 1u;
-        }
-    }
-    let face = lo / (n * n);
-    let rest = lo % (n * n);
-    let st = (vec2<f32>(f32(rest % n), f32(rest / n)) + u.yz) / f32(n);
-    let e = normalize(cube_direction(face, st));
-    // environment → world: the rotation's transpose
-    let m = mat3x3<f32>(pt.env_rotation[0].xyz, pt.env_rotation[1].xyz, pt.env_rotation[2].xyz);
-    return transpose(m) * e;
-}
-
 // The part of ray r inside the medium's box: the volume's, or with intermixed volumes the
 // world box holding them all.
 fn medium_box(r: Ray) -> vec2<f32> {
@@ -454,10 +358,6 @@ fn transmittance(r: Ray, t0: f32, t1: f32, rng: ptr<function, Rng>) -> f32 {
     return tr;
 }
 
-fn power_heuristic(a: f32, b: f32) -> f32 {
-    return a * a / max(a * a + b * b, 1e-30);
-}
-
 // One path through the pixel: (radiance, met the medium ? 1 : 0). `secondary` is the
 // stream the path continues with after its first collision.
 fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng) -> vec4<f32> {
@@ -558,27 +458,13 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         // ... and the lights: directional (the headlight along the camera ray) and
         // positional, with VTK's attenuation and spot cone.
         for (var i = 0u; i < frame.light_count; i = i + 1u) {
-            let light = frame.lights[i];
-            var l = select(light.position.xyz, -camera_ray.dir, light.position.w > 1.5);
-            var reach = 3.0e38;
-            var k = 1.0;
-            if (light.position.w > 0.5 && light.position.w < 1.5) {
-                let to_light = light.position.xyz - x;
-                reach = length(to_light);
-                l = to_light / max(reach, 1e-30);
-                let a3 = light.attenuation;
-                k = 1.0 / max(a3.x + a3.y * reach + a3.z * reach * reach, 1e-20);
-                if (light.spot.w > -1.5) {
-                    let cos_a = dot(-l, light.spot.xyz);
-                    k = select(0.0, k * pow(max(cos_a, 0.0), light.diffuse.w), cos_a > light.spot.w);
-                }
-            }
-            let ed = scatter_eval(sc, r.dir, l);
-            if (k > 0.0 && any(ed.rgb > vec3<f32>(0.0))) {
-                let rd = ray_from(x, l);
+            let ld = light_dir(i, x, camera_ray.dir);
+            let ed = scatter_eval(sc, r.dir, ld.l);
+            if (ld.k > 0.0 && any(ed.rgb > vec3<f32>(0.0))) {
+                let rd = ray_from(x, ld.l);
                 let sd = inner_segment(rd);
-                let td = transmittance(rd, sd.x, min(sd.y, reach), rng);
-                radiance = radiance + beta * ed.rgb * (td * k) * light.diffuse.rgb;
+                let td = transmittance(rd, sd.x, min(sd.y, ld.reach), rng);
+                radiance = radiance + beta * ed.rgb * (td * ld.k) * frame.lights[i].diffuse.rgb;
             }
         }
         // Continue along a sampled direction, weighted by value / density.
@@ -607,40 +493,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
     enter_volume();
     pt = pt_ubo;
-    let lattice = pt.options.w;
-    let offset = vec2<u32>((lattice >> 8u) & 0xffu, (lattice >> 16u) & 0xffu);
-    let px = pt.rect.xy + offset + gid.xy * (lattice & 0xffu);
-    if (px.x >= pt.rect.z || px.y >= pt.rect.w) {
+    let px = traced_pixel(gid);
+    if (px.x == 0xffffffffu) {
         return;
     }
     let idx = px.y * frame.width + px.x;
-    // the primary ray's stream, shared by the counts.x paths of one primary ray
-    var rng = rng_seed(idx, pcg_hash(pt.counts.w) ^ (pt.counts.y / pt.counts.x));
-    let secondary = rng_seed(idx, pcg_hash(pt.counts.w ^ 0x68e31da4u) ^ pt.counts.y);
+    var rng = primary_stream(idx);
     let ray = ray_through(image_ndc(vec2<f32>(px) + rand2(&rng)));
-    let path = trace(ray, px, &rng, secondary);
-    let lum = dot(path.rgb, vec3<f32>(0.2126, 0.7152, 0.0722));
-    var sum = path;
-    var m = vec4<f32>(1.0, lum * lum, 1.0, 0.0);
-    if (pt.counts.y > 0u) {
-        sum = sum + accum[idx];
-        m = vec4<f32>(m.xy + moments[idx].xy, 1.0, 0.0);
-    }
-    accum[idx] = sum;
-    if (GUIDE && (pt.options.x & PT_FLAG_GUIDE) != 0u) {
-        var gs = path_guide;
-        if (pt.counts.y > 0u) {
-            gs = gs + guide[idx];
-        }
-        guide[idx] = gs;
-    }
-    // Depth: where the pixel's centre ray enters the medium's segment, once any path met it.
-    if (sum.a > 0.0) {
-        let centre = make_ray(px);
-        let seg = camera_segment(centre, px);
-        if (seg.x < seg.y) {
-            m.z = distance_to_depth(centre, seg.x);
-        }
-    }
-    moments[idx] = m;
+    let path = trace(ray, px, &rng, secondary_stream(idx));
+    // depth: where the pixel's centre ray enters the medium's segment
+    let centre = make_ray(px);
+    let seg = camera_segment(centre, px);
+    accumulate(idx, path, select(1.0, distance_to_depth(centre, seg.x), seg.x < seg.y));
 }

@@ -421,10 +421,18 @@ impl Renderer {
             purpose,
         };
         if res.mesh.is_some() {
-            let pass = ensure(&mut self.unstructured, || {
-                Ok(Box::new(UnstructuredPass::new(ctx)?))
-            })?;
-            let done = pass.render(input(res));
+            let done = if params.blend == BlendMode::PathTrace {
+                let brick_bgl = &res.brick_bgl;
+                let pass = ensure(&mut self.pt, || {
+                    Ok(Box::new(PathTracePass::new(ctx, brick_bgl)?))
+                })?;
+                pass.render(input(res), &self.pt_params)
+            } else {
+                let pass = ensure(&mut self.unstructured, || {
+                    Ok(Box::new(UnstructuredPass::new(ctx)?))
+                })?;
+                pass.render(input(res))
+            };
             if done.is_ok() && purpose == Purpose::Draw {
                 self.previous_frame =
                     std::mem::replace(&mut self.last_frame, ctx.last_submission());

@@ -286,17 +286,13 @@ fn bad_meshes_get_errors_naming_the_cell() {
 }
 
 #[test]
-fn modes_not_drawn_yet_are_refused_and_images_come_back() {
+fn what_is_not_drawn_is_refused_and_images_come_back() {
     let mut r = renderer();
     let v = synth::house();
     r.set_unstructured(&v).unwrap();
     r.set_transfer_function(&tf(0.0, 2.0, 1.0)).unwrap();
     let view = view_of(&v, 32);
-    for blend in [
-        BlendMode::Isosurface,
-        BlendMode::PathTrace,
-        BlendMode::Slice,
-    ] {
+    for blend in [BlendMode::Isosurface, BlendMode::Slice] {
         let p = RenderParams {
             slice_plane: Some(ClipPlane {
                 origin: glam::DVec3::ZERO,
@@ -307,6 +303,18 @@ fn modes_not_drawn_yet_are_refused_and_images_come_back() {
         let e = r.render_image(&view, &p);
         assert!(matches!(e, Err(Error::Unsupported(_))), "{blend:?}: {e:?}");
     }
+    // path tracing scatters a mesh by Henyey–Greenstein alone
+    r.set_path_tracing(&PathTraceParams {
+        gradient_threshold: 0.5,
+        ..Default::default()
+    })
+    .unwrap();
+    assert_error(
+        r.render_image(&view, &params(BlendMode::PathTrace)),
+        "a hybrid path-traced mesh",
+        &["surface scattering", "Henyey–Greenstein"],
+    );
+    r.set_path_tracing(&PathTraceParams::default()).unwrap();
     let mut graded = tf(0.0, 2.0, 1.0);
     graded.components[0].gradient_opacity =
         Some(Piecewise::new(vec![(0.0, [0.2]), (1.0, [1.0])]).unwrap());

@@ -64,6 +64,11 @@ pub const FILES: &[(&str, &str)] = &[
         "lib/classify.wgsl",
         include_str!("../../shaders/lib/classify.wgsl"),
     ),
+    ("lib/mesh.wgsl", include_str!("../../shaders/lib/mesh.wgsl")),
+    (
+        "lib/pathtrace.wgsl",
+        include_str!("../../shaders/lib/pathtrace.wgsl"),
+    ),
     ("dvr.wgsl", include_str!("../../shaders/dvr.wgsl")),
     (
         "unstructured.wgsl",
@@ -78,6 +83,10 @@ pub const FILES: &[(&str, &str)] = &[
     (
         "pathtrace.wgsl",
         include_str!("../../shaders/pathtrace.wgsl"),
+    ),
+    (
+        "pathtrace_mesh.wgsl",
+        include_str!("../../shaders/pathtrace_mesh.wgsl"),
     ),
     (
         "phase_test.wgsl",
@@ -104,6 +113,7 @@ pub const PASSES: &[&str] = &[
     "deferred.wgsl",
     "environment.wgsl",
     "pathtrace.wgsl",
+    "pathtrace_mesh.wgsl",
     "pathtrace_show.wgsl",
     "depth_changed.wgsl",
     "denoise.wgsl",

@@ -50,6 +50,16 @@ pub const TABLES_2D: u32 = 24;
 pub const DEPTH_NEAR: u32 = 25;
 /// An unstructured volume's gradient per point (unstructured.wgsl).
 pub const MESH_GRADIENTS: u32 = 26;
+/// The path tracers' own (lib/pathtrace.wgsl): the accumulated sums and moments, the
+/// uniforms (one block per dispatch), the environment's cube, its sampler and its sampling
+/// distribution, the denoiser's guide sums.
+pub const PT_ACCUM: u32 = 2;
+pub const PT_MOMENTS: u32 = 5;
+pub const PT_UNIFORMS: u32 = 7;
+pub const PT_ENV_CUBE: u32 = 27;
+pub const PT_ENV_SAMPLER: u32 = 28;
+pub const PT_ENV_CDF: u32 = 29;
+pub const PT_GUIDE: u32 = 30;
 
 /// Group 1, a volume's bricks (lib/volume.wgsl): the pool's uniforms, the pool texture and
 /// its sampler, the precomputed gradients, the page table, the non-resident bricks'
@@ -83,6 +93,13 @@ pub const WGSL_SLOTS: &[(&str, u32)] = &[
     ("SLOT_MESH_NODES", MESH_NODES),
     ("SLOT_MESH_BOUNDARY", MESH_BOUNDARY),
     ("SLOT_MESH_GRADIENTS", MESH_GRADIENTS),
+    ("SLOT_PT_ACCUM", PT_ACCUM),
+    ("SLOT_PT_MOMENTS", PT_MOMENTS),
+    ("SLOT_PT_UNIFORMS", PT_UNIFORMS),
+    ("SLOT_PT_ENV_CUBE", PT_ENV_CUBE),
+    ("SLOT_PT_ENV_SAMPLER", PT_ENV_SAMPLER),
+    ("SLOT_PT_ENV_CDF", PT_ENV_CDF),
+    ("SLOT_PT_GUIDE", PT_GUIDE),
     ("SLOT_INTERMIX", INTERMIX),
     ("SLOT_INTERMIX_ATLAS", INTERMIX_ATLAS),
     ("SLOT_INTERMIX_TABLES", INTERMIX_TABLES),

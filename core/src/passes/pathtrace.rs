@@ -33,6 +33,8 @@ use super::depth_check::DepthCheck;
 use super::frame::{self, groups, FrameInput, Purpose};
 use super::medium;
 use super::pathtrace_variant::{self, PathTraceFacts, PathTraceVariant};
+use super::unstructured::{self, MeshTransfer};
+use super::unstructured_variant::{self, MeshPathTraceVariant, UnstructuredFacts};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, bind_block, bind_view, buffer_entry, dynamic_uniform_entry, group_layout,
@@ -51,8 +53,8 @@ use crate::gpu::uniforms::{
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, Convergence, PathTraceParams, RenderParams, ScatterRegions, Shading,
-    TransferFunction,
+    BlendMode, Convergence, PathTraceParams, RenderParams, ScalarLocation, ScatterRegions, Shading,
+    TransferFunction, View,
 };
 use crate::resources::intermix::IntermixBinding;
 use crate::resources::tables::{empty_distances, tables_2d_layout_entry, Tables};
@@ -144,37 +146,130 @@ pub(crate) struct PathTracePass {
     timer: GpuTimer,
     /// The pixels the accumulation covers (x0, y0, x1, y1).
     rect: [u32; 4],
+    /// The mesh's path tracer, created with the first mesh traced.
+    mesh: Option<MeshTracer>,
+}
+
+/// The mesh's path tracer: its layout, pipelines and mesh uniforms.
+struct MeshTracer {
+    bgl: wgpu::BindGroupLayout,
+    pipelines: PipelineCache<MeshPathTraceVariant>,
+    transfer: MeshTransfer,
+}
+
+impl MeshTracer {
+    fn new(ctx: &Context) -> Result<MeshTracer> {
+        let bgl = group_layout(
+            &ctx.device,
+            "path tracing a mesh",
+            &PathTracePass::mesh_layout_entries(),
+        );
+        let pipelines =
+            PipelineCache::new(ctx, "pathtrace_mesh.wgsl", "path tracing a mesh", &[&bgl])?;
+        Ok(MeshTracer {
+            bgl,
+            pipelines,
+            transfer: MeshTransfer::new(ctx),
+        })
+    }
+}
+
+/// What a frame's path tracing is given.
+struct Setup<'a> {
+    ctx: &'a Context,
+    view: &'a View,
+    params: &'a RenderParams,
+    depth: DepthSource<'a>,
+    pp: PathTraceParams,
+    /// The denoiser runs (now or until a number of paths).
+    guided: bool,
+}
+
+/// One medium's frame, ready to trace: what its accumulation converges to (a different
+/// key starts over), its pipeline and bind groups (the first with the uniform blocks),
+/// uniforms, pixels, and the distance the denoiser compares depths per.
+struct Medium {
+    key: String,
+    pipeline: wgpu::ComputePipeline,
+    groups: Vec<wgpu::BindGroup>,
+    u: PathTraceUniforms,
+    rect: [u32; 4],
+    scale: f32,
+}
+
+/// The render parameters a path tracer's frame uniforms are built with: the view's lights
+/// light the medium whatever `shading.enabled` says.
+fn lit(params: &RenderParams) -> RenderParams {
+    RenderParams {
+        blend: BlendMode::PathTrace,
+        shading: Shading {
+            enabled: true,
+            ..params.shading
+        },
+        ..params.clone()
+    }
+}
+
+/// What the accumulated paths converge to: the view, the parameters (but the paths per
+/// frame, the budget and the preview), the volume or mesh, its tables, level, environment,
+/// mask, intermixed volumes and the host's depth.
+fn accumulation_key(f: &Setup<'_>, res: &Resources) -> String {
+    let converges_to = PathTraceParams {
+        samples_per_frame: 0,
+        max_samples: 0,
+        time_budget: 0.0,
+        denoise_until: 0,
+        ..f.pp
+    };
+    format!(
+        "{:?}|{:?}|{converges_to:?}|{:?}|{}|{}|{:?}|{}",
+        f.view,
+        f.params,
+        (
+            res.stats.volume_uploads,
+            res.stats.table_uploads,
+            res.drawn_level,
+        ),
+        res.environment.generation,
+        res.generation,
+        (res.mask_generation, res.intermix_generation),
+        !matches!(f.depth, DepthSource::None)
+    )
 }
 
 impl PathTracePass {
     /// The path tracer's bind group (group 0 of pathtrace.wgsl; the volume's is group 1).
     pub fn layout_entries(filterable: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
-        use wgpu::BufferBindingType as B;
         use wgpu::TextureViewDimension as V;
-        [
-            buffer_entry(slots::FRAME, B::Uniform),
-            texture_entry(slots::TABLES, false, V::D2),
-            buffer_entry(2, B::Storage { read_only: false }),
-            texture_entry(slots::DEPTH_IN, false, V::D2),
-            buffer_entry(5, B::Storage { read_only: false }),
-            dynamic_uniform_entry::<PathTraceUniforms>(7),
-            texture_entry(11, true, V::Cube),
-            sampler_entry(13),
-            buffer_entry(14, B::Storage { read_only: true }),
-            sampled_texture_entry(
-                15,
-                wgpu::TextureSampleType::Float { filterable: false },
-                V::D3,
-            ),
-            buffer_entry(16, B::Storage { read_only: false }),
-            sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
-            blanking_layout_entry(),
-            grid_lookup_layout_entry(),
-            tables_2d_layout_entry(),
-        ]
-        .into_iter()
-        .chain(IntermixBinding::layout_entries(filterable))
-        .collect()
+        Self::shared_layout_entries()
+            .into_iter()
+            .chain([
+                texture_entry(slots::DEPTH_IN, false, V::D2),
+                sampled_texture_entry(
+                    15,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    V::D3,
+                ),
+                sampled_texture_entry(17, wgpu::TextureSampleType::Uint, V::D3),
+                blanking_layout_entry(),
+                grid_lookup_layout_entry(),
+                tables_2d_layout_entry(),
+            ])
+            .chain(IntermixBinding::layout_entries(filterable))
+            .collect()
+    }
+
+    /// The mesh's path tracer's bind group (pathtrace_mesh.wgsl, its only group).
+    pub fn mesh_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        Self::shared_layout_entries()
+            .into_iter()
+            .chain([texture_entry(
+                slots::DEPTH_IN,
+                false,
+                wgpu::TextureViewDimension::D2,
+            )])
+            .chain(MeshTransfer::layout_entries())
+            .collect()
     }
 
     /// The bind group of pathtrace_show.wgsl, which turns the accumulation into the image.
@@ -226,6 +321,7 @@ impl PathTracePass {
             units: 0,
             timer: GpuTimer::new(ctx, ctx.info.timestamps),
             rect: [0; 4],
+            mesh: None,
         })
     }
 
@@ -307,17 +403,130 @@ impl PathTracePass {
         Ok(max)
     }
 
-    /// One path-traced frame: `samples_per_frame` more paths per pixel.
+    /// One path-traced frame: `samples_per_frame` more paths per pixel, through the image
+    /// volume or the mesh the resources hold.
     pub fn render(&mut self, input: FrameInput<'_>, pp: &PathTraceParams) -> Result<()> {
         let purpose = input.purpose;
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
-        let pp = *pp;
         pp.validate()?;
+        frame::check_light_count(view)?;
+        let f = Setup {
+            ctx,
+            view,
+            params,
+            depth,
+            pp: *pp,
+            guided: pp.denoise || pp.denoise_until > 0,
+        };
+        let medium = if res.mesh.is_some() {
+            self.prepare_mesh(&f, res, purpose)?
+        } else {
+            self.prepare_image(&f, res, purpose)?
+        };
+        match medium {
+            Some(m) => self.trace(&f, res, m),
+            None => Ok(()),
+        }
+    }
+
+    /// What every medium's frame needs before its own: the environment and its sampling
+    /// distribution, the output images, the host's depth, the accumulation, the denoiser.
+    fn prepare_common(&mut self, f: &Setup<'_>, res: &mut Resources) -> Result<()> {
+        let ctx = f.ctx;
+        res.ensure_environment(ctx)?;
+        res.ensure_targets(ctx, f.view.width, f.view.height)?;
+        res.write_depth_input(ctx, f.view, f.depth)?;
+        let generation = res.environment.generation;
+        if self.env_dist.as_ref().map(|d| d.0) != Some(generation) {
+            let (size, buf) = medium::environment_distribution(ctx, res)?;
+            self.env_dist = Some((generation, size, buf));
+        }
+        self.ensure_accum(ctx, f.view.width, f.view.height)?;
+        if f.guided && self.denoise.is_none() {
+            self.denoise = Some(DenoisePass::new(ctx)?);
+        }
+        Ok(())
+    }
+
+    /// The bindings both path tracers declare (lib/pathtrace.wgsl).
+    fn shared_layout_entries() -> [wgpu::BindGroupLayoutEntry; 9] {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        [
+            buffer_entry(slots::FRAME, B::Uniform),
+            texture_entry(slots::TABLES, false, V::D2),
+            buffer_entry(slots::PT_ACCUM, B::Storage { read_only: false }),
+            buffer_entry(slots::PT_MOMENTS, B::Storage { read_only: false }),
+            dynamic_uniform_entry::<PathTraceUniforms>(slots::PT_UNIFORMS),
+            texture_entry(slots::PT_ENV_CUBE, true, V::Cube),
+            sampler_entry(slots::PT_ENV_SAMPLER),
+            buffer_entry(slots::PT_ENV_CDF, B::Storage { read_only: true }),
+            buffer_entry(slots::PT_GUIDE, B::Storage { read_only: false }),
+        ]
+    }
+
+    /// What they bind (after prepare_common).
+    fn shared_entries<'a>(&'a self, res: &'a Resources) -> Result<Vec<wgpu::BindGroupEntry<'a>>> {
+        let (_, tables) = res.tables.as_ref().expect("tables built before binding");
+        let acc = self.accum.as_ref().expect("allocated in prepare_common");
+        let (_, _, dist) = self.env_dist.as_ref().expect("built in prepare_common");
+        let env = res.current_environment()?;
+        Ok(vec![
+            bind(slots::FRAME, res.frame_buf.as_entire_binding()),
+            bind_view(slots::TABLES, &tables.view),
+            bind(slots::PT_ACCUM, acc.sums.as_entire_binding()),
+            bind(slots::PT_MOMENTS, acc.moments.as_entire_binding()),
+            bind_block::<PathTraceUniforms>(slots::PT_UNIFORMS, &self.uniforms),
+            bind_view(slots::PT_ENV_CUBE, &env.cube_view),
+            bind(
+                slots::PT_ENV_SAMPLER,
+                wgpu::BindingResource::Sampler(res.cube_sampler()?),
+            ),
+            bind(slots::PT_ENV_CDF, dist.as_entire_binding()),
+            bind(slots::PT_GUIDE, acc.guide.as_entire_binding()),
+        ])
+    }
+
+    /// The uniforms both path tracers read, but the image's majorants and surface model.
+    fn base_uniforms(
+        &self,
+        f: &Setup<'_>,
+        res: &Resources,
+        unit: f64,
+    ) -> Result<PathTraceUniforms> {
+        let pp = &f.pp;
+        let env = res.current_environment()?;
+        let mut u = PathTraceUniforms::zeroed();
+        u.env_rotation = DMat4::from_mat3(env.rotation).as_mat4().to_cols_array();
+        u.medium = [
+            0.0,
+            pp.anisotropy,
+            (1.0 / unit) as f32,
+            pp.environment_light,
+        ];
+        u.counts = [pp.secondary_rays, 0, pp.max_bounces, pp.seed];
+        let (_, dist_size, _) = self.env_dist.as_ref().expect("built in prepare_common");
+        let flags = flag_bits(&[
+            (pp.background, PT_FLAG_BACKGROUND),
+            (pp.attenuation, PT_FLAG_ATTENUATION),
+            (f.guided, PT_FLAG_GUIDE),
+        ]);
+        u.options = [flags, *dist_size, pp.scatter.code(), 0];
+        Ok(u)
+    }
+
+    /// An image volume's frame (pathtrace.wgsl), None when only preparing.
+    fn prepare_image(
+        &mut self,
+        f: &Setup<'_>,
+        res: &mut Resources,
+        purpose: Purpose,
+    ) -> Result<Option<Medium>> {
+        let (ctx, view, params, pp) = (f.ctx, f.view, f.params, &f.pp);
         let vol = res.volume()?;
         let intermix = res.intermix.as_ref().map_or(0, |m| m.volumes.len() as u32);
         let table_2d = res.tf.as_ref().is_some_and(TransferFunction::has_2d);
-        let guided = pp.denoise || pp.denoise_until > 0;
         let variant = pathtrace_variant::select(&PathTraceFacts {
             interpolation: params.interpolation,
             gradient: params.gradient,
@@ -333,11 +542,10 @@ impl PathTracePass {
             hybrid: pp.gradient_threshold.is_finite()
                 || pp.stochastic_blend > 0.0
                 || pp.scatter != ScatterRegions::Everywhere,
-            guided,
+            guided: f.guided,
             intermix,
             float32_filterable: ctx.info.float32_filterable,
         })?;
-        frame::check_light_count(view)?;
         let unit = res
             .tf
             .as_ref()
@@ -349,60 +557,169 @@ impl PathTracePass {
         }
         res.ensure_occupancy(ctx, step)?;
         res.ensure_resident(ctx, Needed::Occupied)?;
-        res.ensure_environment(ctx)?;
-        res.ensure_targets(ctx, view.width, view.height)?;
-        res.write_depth_input(ctx, view, depth)?;
-        let generation = res.environment.generation;
-        if self.env_dist.as_ref().map(|d| d.0) != Some(generation) {
-            let (size, buf) = medium::environment_distribution(ctx, res)?;
-            self.env_dist = Some((generation, size, buf));
-        }
+        self.prepare_common(f, res)?;
         let majorant = self.ensure_majorants(ctx, res)?;
-        // The view's directional lights light the medium whatever `shading.enabled` says.
-        let lit = RenderParams {
-            blend: BlendMode::PathTrace,
-            shading: Shading {
-                enabled: true,
-                ..params.shading
-            },
-            ..params.clone()
-        };
-        let depth_input = !matches!(depth, DepthSource::None);
-        let frame = frame::frame(res, view, &lit, step, depth_input)?.uniforms;
-        // (the paths per frame, the budget and the preview are not part of what the image
-        // converges to)
-        let converges_to = PathTraceParams {
-            samples_per_frame: 0,
-            max_samples: 0,
-            time_budget: 0.0,
-            denoise_until: 0,
-            ..pp
-        };
-        let key = format!(
-            "{view:?}|{params:?}|{converges_to:?}|{:?}|{}|{}|{:?}|{depth_input}",
-            (
-                res.stats.volume_uploads,
-                res.stats.table_uploads,
-                res.drawn_level,
-            ),
-            res.environment.generation,
-            res.generation,
-            (res.mask_generation, res.intermix_generation)
-        );
+        let depth_input = !matches!(f.depth, DepthSource::None);
+        let frame = frame::frame(res, view, &lit(params), step, depth_input)?.uniforms;
+        let key = accumulation_key(f, res);
         let pipeline = self.pipelines.get(ctx, variant)?;
-        self.ensure_accum(ctx, view.width, view.height)?;
-        if guided && self.denoise.is_none() {
-            self.denoise = Some(DenoisePass::new(ctx)?);
-        }
         if purpose == Purpose::Prepare {
-            return Ok(());
+            return Ok(None);
         }
+        let rect = frame::prepare_intermix(ctx, res, params, view, step, frame.rect)?;
+        let others = res.intermix.as_ref().map_or(0.0, |m| m.majorant());
+        let mut u = self.base_uniforms(f, res, unit)?;
+        // Nothing scatters and nothing absorbs: no collisions at all.
+        let transparent = pp.scatter == ScatterRegions::Nowhere && !pp.attenuation;
+        u.medium[0] = if transparent { 0.0 } else { majorant + others };
+        u.surface = [
+            pp.gradient_threshold.min(f32::MAX),
+            pp.stochastic_blend,
+            pp.bsdf.roughness,
+            pp.bsdf.fresnel,
+        ];
+        u.lobe = [pp.bsdf.transmission, pp.bsdf.lobe_exponent(), others, 0.0];
+        ctx.queue
+            .write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
+        let (_, majorant_buf, _) = self.majorants.as_ref().expect("built above");
+        let depth_in_view = res
+            .targets
+            .as_ref()
+            .expect("allocated in prepare_common")
+            .depth_in
+            .create_view(&Default::default());
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("path tracing"),
+            layout: &self.bgl,
+            entries: &self
+                .shared_entries(res)?
+                .into_iter()
+                .chain([
+                    bind_view(slots::DEPTH_IN, &depth_in_view),
+                    bind_view(15, majorant_buf),
+                    bind(
+                        17,
+                        wgpu::BindingResource::TextureView(
+                            res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
+                        ),
+                    ),
+                    res.blanking_entry(&self.no_mask),
+                    res.grid_lookup_entry(&self.no_grid_lookup)?,
+                    res.tables_2d_entry(table_2d, &self.no_tables_2d),
+                ])
+                .chain(self.intermix_binding.entries(res.intermix.as_ref()))
+                .collect::<Vec<_>>(),
+        });
+        let brick = res.volume()?.bind_group(variant.nearest).clone();
+        Ok(Some(Medium {
+            key,
+            pipeline,
+            groups: vec![group, brick],
+            u,
+            rect,
+            scale: step as f32,
+        }))
+    }
+
+    /// A mesh's frame (pathtrace_mesh.wgsl), None when only preparing.
+    fn prepare_mesh(
+        &mut self,
+        f: &Setup<'_>,
+        res: &mut Resources,
+        purpose: Purpose,
+    ) -> Result<Option<Medium>> {
+        let (ctx, view, params, pp) = (f.ctx, f.view, f.params, &f.pp);
+        let tf = res.transfer_function()?.clone();
+        let ct = tf.component(0);
+        let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
+        let facts = UnstructuredFacts {
+            blend: BlendMode::PathTrace,
+            components: mesh.components,
+            cell_scalars: mesh.location == ScalarLocation::Cells,
+            shade: false,
+            lights: 0,
+            positional_lights: false,
+            gradient_opacity: ct.gradient_opacity.is_some(),
+            tables_2d: ct.table_2d.is_some(),
+            cropping: params.cropping.is_some(),
+            average_range: false,
+            whole_box: params.whole_box.is_some(),
+            volumetric: false,
+            depth_range: matches!(f.depth, DepthSource::Range(..)),
+            intermix: res.intermix.is_some(),
+            hybrid: pp.gradient_threshold.is_finite()
+                || pp.stochastic_blend > 0.0
+                || pp.scatter != ScatterRegions::Everywhere,
+        };
+        let variant = MeshPathTraceVariant {
+            cell_scalars: unstructured_variant::select(&facts)
+                .map_err(Error::from)?
+                .cell_scalars,
+            guide: f.guided,
+        };
+        res.ensure_tables(ctx, 1.0)?;
+        self.prepare_common(f, res)?;
+        let depth_input = !matches!(f.depth, DepthSource::None);
+        let frame = unstructured::frame_uniforms(res, view, &lit(params), depth_input)?;
+        let key = accumulation_key(f, res);
+        let tracer = match &mut self.mesh {
+            Some(t) => t,
+            None => self.mesh.insert(MeshTracer::new(ctx)?),
+        };
+        let pipeline = tracer.pipelines.get(ctx, variant)?;
+        if purpose == Purpose::Prepare {
+            return Ok(None);
+        }
+        let mesh = res.mesh.as_ref().expect("checked above");
+        tracer.transfer.write(ctx, mesh, ct);
+        ctx.queue
+            .write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
+        let tracer = self.mesh.as_ref().expect("created above");
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("path tracing a mesh"),
+            layout: &tracer.bgl,
+            entries: &self
+                .shared_entries(res)?
+                .into_iter()
+                .chain([bind_view(
+                    slots::DEPTH_IN,
+                    &res.targets
+                        .as_ref()
+                        .expect("allocated in prepare_common")
+                        .depth_in
+                        .create_view(&Default::default()),
+                )])
+                .chain(tracer.transfer.entries(mesh))
+                .collect::<Vec<_>>(),
+        });
+        let mut u = self.base_uniforms(f, res, ct.unit_distance)?;
+        // (the denoiser compares depths per cell: the box's diagonal over the tetrahedra's
+        // cube root)
+        let b = mesh.bounds;
+        let diagonal =
+            ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
+        let cell = diagonal / (mesh.uniforms.counts[0].max(1) as f64).cbrt();
+        u.medium[0] = 1.0;
+        Ok(Some(Medium {
+            key,
+            pipeline,
+            groups: vec![group],
+            u,
+            rect: frame.rect,
+            scale: cell as f32,
+        }))
+    }
+
+    /// Traces the frame's paths into the accumulation and shows it.
+    fn trace(&mut self, f: &Setup<'_>, res: &mut Resources, m: Medium) -> Result<()> {
+        let (ctx, view, pp) = (f.ctx, f.view, &f.pp);
+        let depth_input = !matches!(f.depth, DepthSource::None);
         // (a host's depth may change from frame to frame without telling: compare it)
         let depth_changed = if depth_input {
             if self.depth_check.is_none() {
                 self.depth_check = Some(DepthCheck::new(ctx)?);
             }
-            let t = res.targets.as_ref().expect("allocated above");
+            let t = res.targets.as_ref().expect("allocated in prepare_common");
             self.depth_check
                 .as_mut()
                 .expect("created above")
@@ -410,8 +727,8 @@ impl PathTracePass {
         } else {
             false
         };
-        if self.key != key || depth_changed {
-            self.key = key;
+        if self.key != m.key || depth_changed {
+            self.key = m.key;
             self.units = 0;
             res.stats.accumulation_restarts += 1;
         }
@@ -428,76 +745,14 @@ impl PathTracePass {
             return Ok(());
         }
         let full = [0, 0, view.width, view.height];
-        let rect = frame::prepare_intermix(ctx, res, params, view, step, frame.rect)?;
-        let rect = if pp.background { full } else { rect };
-        let others = res.intermix.as_ref().map_or(0.0, |m| m.majorant());
-        let env = res.current_environment()?;
-        let mut u = PathTraceUniforms::zeroed();
-        u.env_rotation = DMat4::from_mat3(env.rotation).as_mat4().to_cols_array();
-        // Nothing scatters and nothing absorbs: no collisions at all.
-        let transparent = pp.scatter == ScatterRegions::Nowhere && !pp.attenuation;
-        u.medium = [
-            if transparent { 0.0 } else { majorant + others },
-            pp.anisotropy,
-            (1.0 / unit) as f32,
-            pp.environment_light,
-        ];
-        u.surface = [
-            pp.gradient_threshold.min(f32::MAX),
-            pp.stochastic_blend,
-            pp.bsdf.roughness,
-            pp.bsdf.fresnel,
-        ];
-        u.lobe = [pp.bsdf.transmission, pp.bsdf.lobe_exponent(), others, 0.0];
-        u.counts = [pp.secondary_rays, 0, pp.max_bounces, pp.seed];
-        let (_, dist_size, dist) = self.env_dist.as_ref().expect("built above");
-        let (_, majorant_buf, _) = self.majorants.as_ref().expect("built above");
-        let flags = flag_bits(&[
-            (pp.background, PT_FLAG_BACKGROUND),
-            (pp.attenuation, PT_FLAG_ATTENUATION),
-            (guided, PT_FLAG_GUIDE),
-        ]);
-        u.options = [flags, *dist_size, pp.scatter.code(), 0];
+        let rect = if pp.background { full } else { m.rect };
+        let mut u = m.u;
         u.rect = rect;
         let q = &ctx.queue;
-        q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
-        let t = res.targets.as_ref().expect("allocated above");
-        let (_, tables) = res.tables.as_ref().expect("built above");
-        let acc = self.accum.as_ref().expect("allocated above");
-        let cube_sampler = res.cube_sampler()?;
-        let depth_in_view = t.depth_in.create_view(&Default::default());
+        let t = res.targets.as_ref().expect("allocated in prepare_common");
+        let acc = self.accum.as_ref().expect("allocated in prepare_common");
         let color_view = t.color.create_view(&Default::default());
         let depth_view = t.depth.create_view(&Default::default());
-        let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("path tracing"),
-            layout: &self.bgl,
-            entries: &[
-                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind_view(slots::TABLES, &tables.view),
-                bind(2, acc.sums.as_entire_binding()),
-                bind_view(slots::DEPTH_IN, &depth_in_view),
-                bind(5, acc.moments.as_entire_binding()),
-                bind_block::<PathTraceUniforms>(7, &self.uniforms),
-                bind_view(11, &env.cube_view),
-                bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
-                bind(14, dist.as_entire_binding()),
-                bind_view(15, majorant_buf),
-                bind(16, acc.guide.as_entire_binding()),
-                bind(
-                    17,
-                    wgpu::BindingResource::TextureView(
-                        res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
-                    ),
-                ),
-                res.blanking_entry(&self.no_mask),
-                res.grid_lookup_entry(&self.no_grid_lookup)?,
-                res.tables_2d_entry(table_2d, &self.no_tables_2d),
-            ]
-            .into_iter()
-            .chain(self.intermix_binding.entries(res.intermix.as_ref()))
-            .collect::<Vec<_>>(),
-        });
-        let brick = res.volume()?.bind_group(variant.nearest);
         // Sixteenths this frame traces: all that are wanted without a budget, else as many
         // as the budget holds at the rate measured on the device at an earlier frame (read
         // without waiting; at most twice the sixteenths measured), one before any
@@ -518,7 +773,7 @@ impl PathTracePass {
         if before == 0 {
             // A new accumulation: no pixel has paths (the shown image reads the counts).
             enc.clear_buffer(&acc.moments, 0, None);
-            if guided {
+            if f.guided {
                 enc.clear_buffer(&acc.guide, 0, None);
             }
         }
@@ -538,10 +793,12 @@ impl PathTracePass {
                 label: Some("path tracing"),
                 timestamp_writes: self.timer.pass_writes(),
             });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(1, brick, &[]);
+            pass.set_pipeline(&m.pipeline);
+            for (i, g) in m.groups.iter().enumerate().skip(1) {
+                pass.set_bind_group(i as u32, g, &[]);
+            }
             for (i, d) in dispatches.iter().enumerate() {
-                pass.set_bind_group(0, &bg, &[(UNIFORM_STRIDE * i as u64) as u32]);
+                pass.set_bind_group(0, &m.groups[0], &[(UNIFORM_STRIDE * i as u64) as u32]);
                 let gr = d.groups(rect);
                 pass.dispatch_workgroups(gr[0], gr[1], 1);
             }
@@ -585,14 +842,10 @@ impl PathTracePass {
                     images: [&acc.images[0], &acc.images[1]],
                     color: &color_view,
                 };
-                self.denoise.as_ref().expect("created above").encode(
-                    ctx,
-                    &mut enc,
-                    &out,
-                    rect,
-                    view.width,
-                    step as f32,
-                );
+                self.denoise
+                    .as_ref()
+                    .expect("created above")
+                    .encode(ctx, &mut enc, &out, rect, view.width, m.scale);
             }
         }
         ctx.checked("rendering the path-traced frame", || {

@@ -23,6 +23,7 @@ use crate::gpu::uniforms::{
 };
 use crate::gpu::Context;
 use crate::params::{build_tables, ComponentTransfer, ScalarLocation, TABLE_SIZE};
+use crate::resources::mesh::gpu::GpuMesh;
 use crate::resources::targets::{clear_outputs, DepthSource};
 use crate::resources::Resources;
 use bytemuck::Zeroable;
@@ -31,52 +32,28 @@ use glam::{DMat4, DVec3};
 /// The table entries with opacity (`MeshUniforms::opaque`) of a component's transfer.
 type OpaqueBits = [[u32; 4]; MESH_OPAQUE_WORDS / 4];
 
-/// The unstructured pass: its pipelines (one per variant), its uniforms, and the opaque
-/// entries of the last transfer function it drew (rebuilt only when that changes).
+/// The unstructured pass: its pipelines (one per variant) and the mesh's uniforms.
 pub(crate) struct UnstructuredPass {
     bgl: wgpu::BindGroupLayout,
     pipelines: PipelineCache<UnstructuredVariant>,
-    mesh_buf: wgpu::Buffer,
+    transfer: MeshTransfer,
+}
+
+/// A mesh pass's mesh uniforms (lib/mesh.wgsl: Mesh) and the opaque entries of the last
+/// transfer function it wrote (rebuilt only when that changes).
+pub(crate) struct MeshTransfer {
+    buf: wgpu::Buffer,
     opaque: Option<(ComponentTransfer, OpaqueBits)>,
 }
 
-impl UnstructuredPass {
-    /// The bind group of unstructured.wgsl.
-    pub fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-        use wgpu::BufferBindingType as B;
-        use wgpu::TextureViewDimension as V;
-        let read = B::Storage { read_only: true };
-        vec![
-            buffer_entry(slots::FRAME, B::Uniform),
-            texture_entry(slots::TABLES, false, V::D2),
-            texture_entry(slots::DEPTH_IN, false, V::D2),
-            storage_texture_entry(slots::OUT_COLOR, wgpu::TextureFormat::Rgba8Unorm, V::D2),
-            storage_texture_entry(slots::OUT_DEPTH, wgpu::TextureFormat::R32Float, V::D2),
-            buffer_entry(slots::MESH, B::Uniform),
-            buffer_entry(slots::MESH_POINTS, read),
-            buffer_entry(slots::MESH_TETS, read),
-            buffer_entry(slots::MESH_NEIGHBOURS, read),
-            buffer_entry(slots::MESH_CELL_SCALARS, read),
-            buffer_entry(slots::MESH_NODES, read),
-            buffer_entry(slots::MESH_BOUNDARY, read),
-            buffer_entry(slots::MESH_GRADIENTS, read),
-        ]
-    }
-
-    pub fn new(ctx: &Context) -> Result<UnstructuredPass> {
-        let bgl = group_layout(&ctx.device, "unstructured", &Self::layout_entries());
-        let pipelines = PipelineCache::new(ctx, "unstructured.wgsl", "unstructured", &[&bgl])?;
-        let mesh_buf = uniform_buffer(
+impl MeshTransfer {
+    pub fn new(ctx: &Context) -> MeshTransfer {
+        let buf = uniform_buffer(
             ctx,
             "mesh uniforms",
             std::mem::size_of::<MeshUniforms>() as u64,
         );
-        Ok(UnstructuredPass {
-            bgl,
-            pipelines,
-            mesh_buf,
-            opaque: None,
-        })
+        MeshTransfer { buf, opaque: None }
     }
 
     /// `opaque_entries` of `ct`, from the last frame's when its transfer is the same.
@@ -89,6 +66,78 @@ impl UnstructuredPass {
                 bits
             }
         }
+    }
+
+    /// The mesh's uniforms for the transfer `ct` (its unit distance, knots and opaque
+    /// entries), written to the buffer.
+    pub fn write(&mut self, ctx: &Context, mesh: &GpuMesh, ct: &ComponentTransfer) {
+        let mut mu = mesh.uniforms;
+        mu.unit[0] = (1.0 / ct.unit_distance) as f32;
+        set_knots(&mut mu, ct);
+        mu.opaque = self.opaque_bits(ct);
+        ctx.queue
+            .write_buffer(&self.buf, 0, bytemuck::bytes_of(&mu));
+    }
+
+    /// The mesh's bindings (lib/mesh.wgsl).
+    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 8] {
+        use wgpu::BufferBindingType as B;
+        let read = B::Storage { read_only: true };
+        [
+            buffer_entry(slots::MESH, B::Uniform),
+            buffer_entry(slots::MESH_POINTS, read),
+            buffer_entry(slots::MESH_TETS, read),
+            buffer_entry(slots::MESH_NEIGHBOURS, read),
+            buffer_entry(slots::MESH_CELL_SCALARS, read),
+            buffer_entry(slots::MESH_NODES, read),
+            buffer_entry(slots::MESH_BOUNDARY, read),
+            buffer_entry(slots::MESH_GRADIENTS, read),
+        ]
+    }
+
+    /// What they bind.
+    pub fn entries<'a>(&'a self, mesh: &'a GpuMesh) -> [wgpu::BindGroupEntry<'a>; 8] {
+        [
+            bind(slots::MESH, self.buf.as_entire_binding()),
+            bind(slots::MESH_POINTS, mesh.points.as_entire_binding()),
+            bind(slots::MESH_TETS, mesh.tets.as_entire_binding()),
+            bind(slots::MESH_NEIGHBOURS, mesh.neighbours.as_entire_binding()),
+            bind(
+                slots::MESH_CELL_SCALARS,
+                mesh.cell_scalars.as_entire_binding(),
+            ),
+            bind(slots::MESH_NODES, mesh.nodes.as_entire_binding()),
+            bind(slots::MESH_BOUNDARY, mesh.boundary.as_entire_binding()),
+            bind(slots::MESH_GRADIENTS, mesh.gradients.as_entire_binding()),
+        ]
+    }
+}
+
+impl UnstructuredPass {
+    /// The bind group of unstructured.wgsl.
+    pub fn layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        use wgpu::BufferBindingType as B;
+        use wgpu::TextureViewDimension as V;
+        [
+            buffer_entry(slots::FRAME, B::Uniform),
+            texture_entry(slots::TABLES, false, V::D2),
+            texture_entry(slots::DEPTH_IN, false, V::D2),
+            storage_texture_entry(slots::OUT_COLOR, wgpu::TextureFormat::Rgba8Unorm, V::D2),
+            storage_texture_entry(slots::OUT_DEPTH, wgpu::TextureFormat::R32Float, V::D2),
+        ]
+        .into_iter()
+        .chain(MeshTransfer::layout_entries())
+        .collect()
+    }
+
+    pub fn new(ctx: &Context) -> Result<UnstructuredPass> {
+        let bgl = group_layout(&ctx.device, "unstructured", &Self::layout_entries());
+        let pipelines = PipelineCache::new(ctx, "unstructured.wgsl", "unstructured", &[&bgl])?;
+        Ok(UnstructuredPass {
+            bgl,
+            pipelines,
+            transfer: MeshTransfer::new(ctx),
+        })
     }
 
     /// One frame of the renderer's mesh.
@@ -115,13 +164,9 @@ impl UnstructuredPass {
             volumetric: params.shading.volumetric_blending > 0.0 && params.shading.enabled,
             depth_range: matches!(depth, DepthSource::Range(..)),
             intermix: res.intermix.is_some(),
+            hybrid: false,
         })
         .map_err(Error::from)?;
-        let mesh = res.mesh.as_ref().expect("checked above");
-        let mut mu = mesh.uniforms;
-        mu.unit[0] = (1.0 / ct.unit_distance) as f32;
-        set_knots(&mut mu, ct);
-        mu.opaque = self.opaque_bits(ct);
         res.ensure_tables(ctx, 1.0)?;
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
@@ -132,9 +177,9 @@ impl UnstructuredPass {
         let mesh = res.mesh.as_ref().expect("checked above");
         let t = res.targets.as_ref().expect("targets allocated above");
         let (_, tables) = res.tables.as_ref().expect("tables built above");
-        let q = &ctx.queue;
-        q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
-        q.write_buffer(&self.mesh_buf, 0, bytemuck::bytes_of(&mu));
+        ctx.queue
+            .write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&u));
+        self.transfer.write(ctx, mesh, ct);
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
         let depth_view = t.depth.create_view(&Default::default());
@@ -147,18 +192,10 @@ impl UnstructuredPass {
                 bind_view(slots::DEPTH_IN, &depth_in_view),
                 bind_view(slots::OUT_COLOR, &color_view),
                 bind_view(slots::OUT_DEPTH, &depth_view),
-                bind(slots::MESH, self.mesh_buf.as_entire_binding()),
-                bind(slots::MESH_POINTS, mesh.points.as_entire_binding()),
-                bind(slots::MESH_TETS, mesh.tets.as_entire_binding()),
-                bind(slots::MESH_NEIGHBOURS, mesh.neighbours.as_entire_binding()),
-                bind(
-                    slots::MESH_CELL_SCALARS,
-                    mesh.cell_scalars.as_entire_binding(),
-                ),
-                bind(slots::MESH_NODES, mesh.nodes.as_entire_binding()),
-                bind(slots::MESH_BOUNDARY, mesh.boundary.as_entire_binding()),
-                bind(slots::MESH_GRADIENTS, mesh.gradients.as_entire_binding()),
-            ],
+            ]
+            .into_iter()
+            .chain(self.transfer.entries(mesh))
+            .collect::<Vec<_>>(),
         });
         let rect = u.rect;
         let gr = groups(rect);
@@ -239,7 +276,7 @@ fn opaque_entries(ct: &ComponentTransfer) -> OpaqueBits {
 /// The frame uniforms of a frame of the renderer's mesh: the camera, the mesh's coordinates
 /// (relative to its centre) as the index space, the first component's table range, the
 /// material and lights, the clipping planes and the pixels the mesh's box covers.
-fn frame_uniforms(
+pub(crate) fn frame_uniforms(
     res: &Resources,
     view: &crate::params::View,
     params: &crate::params::RenderParams,

@@ -17,6 +17,16 @@ pipeline_variant! {
     }
 }
 
+pipeline_variant! {
+    /// The pipeline constants of one specialisation of the mesh's path tracer
+    /// (pathtrace_mesh.wgsl).
+    pub(crate) struct MeshPathTraceVariant {
+        cell_scalars: bool => "CELL_SCALARS",
+        /// The denoiser's guide.
+        guide: bool => "GUIDE",
+    }
+}
+
 /// What a frame of an unstructured volume is.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct UnstructuredFacts {
@@ -36,6 +46,9 @@ pub(crate) struct UnstructuredFacts {
     /// Rays limited to a range of depths (Renderer::render_between).
     pub depth_range: bool,
     pub intermix: bool,
+    /// Path tracing's surface scattering: a gradient threshold, the stochastic blend or
+    /// scattering regions other than everywhere.
+    pub hybrid: bool,
 }
 
 /// A setting the unstructured pass does not draw.
@@ -53,8 +66,8 @@ impl From<UnstructuredRefusal> for Error {
         Error::Unsupported(match r {
             R::Blend(b) => format!(
                 "unstructured volumes are drawn in the composite, maximum, minimum, average \
-                 and additive blend modes, not {b:?}: use one of those, or resample the mesh \
-                 to an image"
+                 and additive blend modes and path traced, not {b:?}: use one of those, or \
+                 resample the mesh to an image"
             ),
             R::Components(n) => format!(
                 "unstructured volumes are drawn from one scalar component, and this mesh has \
@@ -76,7 +89,8 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         | BlendMode::Maximum
         | BlendMode::Minimum
         | BlendMode::Average
-        | BlendMode::Additive => {}
+        | BlendMode::Additive
+        | BlendMode::PathTrace => {}
         b => return Err(R::Blend(b)),
     }
     if x.components != 1 {
@@ -91,6 +105,11 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         (x.volumetric, "volumetric shadows"),
         (x.depth_range, "a depth range"),
         (x.intermix, "intermixed volumes"),
+        (
+            x.hybrid && x.blend == BlendMode::PathTrace,
+            "surface scattering (a gradient threshold, the stochastic blend or scattering \
+             regions; path tracing scatters meshes by Henyey–Greenstein everywhere)",
+        ),
     ];
     if let Some((_, what)) = settings.iter().find(|(on, _)| *on) {
         return Err(R::Setting(what));
@@ -127,6 +146,7 @@ pub(crate) mod tests {
             volumetric: false,
             depth_range: false,
             intermix: false,
+            hybrid: false,
         }
     }
 
@@ -142,7 +162,7 @@ pub(crate) mod tests {
                         ..facts()
                     };
                     each(&x);
-                    for k in 0..9 {
+                    for k in 0..10 {
                         let mut y = x;
                         *[
                             &mut y.shade,
@@ -154,6 +174,7 @@ pub(crate) mod tests {
                             &mut y.volumetric,
                             &mut y.depth_range,
                             &mut y.intermix,
+                            &mut y.hybrid,
                         ][k] = true;
                         each(&y);
                     }
@@ -166,12 +187,13 @@ pub(crate) mod tests {
     pub(crate) fn when(r: UnstructuredRefusal) -> (u8, &'static str) {
         use UnstructuredRefusal as R;
         match r {
-            R::Blend(_) => (0, "the isosurface, path-tracing or slice blend mode"),
+            R::Blend(_) => (0, "the isosurface or slice blend mode"),
             R::Components(_) => (1, "a mesh of several components"),
             R::Setting(_) => (
                 2,
                 "gradient opacity, 2D transfer functions, cropping, an average range, \
-                 a whole box, volumetric shadows, a depth range or intermixed volumes",
+                 a whole box, volumetric shadows, a depth range, intermixed volumes, or \
+                 surface scattering when path tracing",
             ),
         }
     }
@@ -206,6 +228,6 @@ pub(crate) mod tests {
                 }
             }
         });
-        assert_eq!(seen, 8 * 4 * 2 * 10);
+        assert_eq!(seen, 8 * 4 * 2 * 11);
     }
 }
