@@ -243,6 +243,15 @@ fn a_vtu_mesh_renders_is_described_and_refuses_what_meshes_do_not_draw() {
     let img = image::open(&png).unwrap().to_rgb8();
     let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
     assert!(lit > 100, "{lit} pixels drawn");
+    // path traced: the thin medium (two cells deep) scatters the sky dimly where the
+    // maximum intensity projection drew
+    let (png, _, _) = render_ok(
+        "house-pathtrace",
+        &[path, "--mode", "pathtrace", "--spp", "32", "--size", "32x32"],
+    );
+    let img = image::open(&png).unwrap().to_rgb8();
+    let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 4)).count();
+    assert!(lit > 60, "path traced: {lit} pixels drawn");
     let (code, out, _) = ferrovol(&["info", path]);
     assert_eq!(code, 0);
     assert!(

@@ -264,9 +264,10 @@ pub unsafe extern "C" fn fv_unstructured_volume_free(volume: *mut FvUnstructured
 
 /// Uploads an unstructured volume, replacing the renderer's volume or mesh
 /// (fv_renderer_set_volume goes back to an image volume): its cells split into tetrahedra,
-/// their neighbours and a hierarchy over the boundary. Frames then ray cast it with the
-/// same camera, parameters and transfer function; what its pass does not draw (isosurfaces,
-/// path tracing, shading, several components, …) fails at render with
+/// their neighbours and a hierarchy over the boundary. Frames then ray cast it, or path
+/// trace it (FV_BLEND_MODE_PATH_TRACE: Henyey–Greenstein scattering), with the same camera,
+/// parameters and transfer function; what its passes do not draw (isosurfaces, the slice
+/// mode, several components, surface scattering, …) fails at render with
 /// FV_STATUS_UNSUPPORTED naming it. A mesh too large for the device's buffers is refused
 /// with the sizes.
 #[no_mangle]
