@@ -247,7 +247,15 @@ fn a_vtu_mesh_renders_is_described_and_refuses_what_meshes_do_not_draw() {
     // maximum intensity projection drew
     let (png, _, _) = render_ok(
         "house-pathtrace",
-        &[path, "--mode", "pathtrace", "--spp", "32", "--size", "32x32"],
+        &[
+            path,
+            "--mode",
+            "pathtrace",
+            "--spp",
+            "32",
+            "--size",
+            "32x32",
+        ],
     );
     let img = image::open(&png).unwrap().to_rgb8();
     let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 4)).count();

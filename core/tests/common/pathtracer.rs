@@ -1,16 +1,25 @@
 //! The f64 CPU reference path tracer, written independently of the shader, of the model the
 //! GPU path tracer renders (shaders/pathtrace.wgsl).
 //!
-//! The model: extinction σ(x) = −ln(1 − min(α(s(x)), 0.9999)) / unit distance, α the transfer
-//! function's opacity (a linear ramp over [0, 1] here) and s(x) the trilinearly interpolated
-//! scalar (index coordinates = world coordinates: unit spacing, origin 0, voxel centres at
-//! integers, the medium inside [0, dims − 1]); single-scattering albedo the transfer
-//! function's colour; Henyey–Greenstein scattering with anisotropy g; at most `max_bounces`
-//! scattering events; the environment (weighted by `environment_light`) and the view's
-//! directional lights (the headlight shining along each camera path) light it; paths that
-//! miss the medium bring nothing (no background), and coverage is the fraction of paths
-//! that met it. Intermixed volumes ([`Intermixed`], each placed by its own matrix) add
-//! their media: the extinctions add up, and a collision scatters as the medium it met.
+//! The model: the main medium ([`Medium`]) is an image volume or an unstructured mesh. An
+//! image volume's extinction is σ(x) = −ln(1 − min(α(s(x)), 0.9999)) / unit distance, α the
+//! transfer function's opacity (a linear ramp over [0, 1] here) and s(x) the trilinearly
+//! interpolated scalar (index coordinates = world coordinates: unit spacing, origin 0, voxel
+//! centres at integers, the medium inside [0, dims − 1]). A mesh ([`MeshMedium`]) is split
+//! into tetrahedra as the ray caster's reference splits it ([`super::mesh::Tets`]), the
+//! scalar linear in each (the points' scalars weighted by the barycentric coordinates, or
+//! the cell's constant scalar), and its extinction is VTK's unstructured convention,
+//! σ(x) = α(s(x)) / unit distance (attenuation = opacity / unit distance, no logarithm), α a
+//! linear opacity ramp over the mesh's scalar range [lo, hi] (clamped outside it), zero
+//! outside every tetrahedron; its medium box is the mesh's bounding box, and it has no
+//! hybrid model (HG everywhere). Either way the single-scattering albedo is the transfer
+//! function's (constant) colour; Henyey–Greenstein scattering with anisotropy g; at most
+//! `max_bounces` scattering events; the environment (weighted by `environment_light`) and
+//! the view's directional lights (the headlight shining along each camera path) light it;
+//! paths that miss the medium bring nothing (no background), and coverage is the fraction
+//! of paths that met it. Intermixed volumes ([`Intermixed`], each placed by its own
+//! matrix) add their media: the extinctions add up, and a collision scatters as the medium
+//! it met.
 //!
 //! The hybrid model: at a collision the gradient ∇s by central differences one voxel apart
 //! of the interpolated scalar (lib/volume.wgsl: gradient_at) gives the BSDF's share P (1 if
@@ -34,9 +43,10 @@
 //! Russian roulette) must converge to the same image. Sampling and the gradient are the
 //! ray caster's reference's ([`super::raycast`]).
 
+use super::mesh::Tets;
 use super::raycast::{box_interval, gradient, index_box, trilinear};
 use ferrovol_core::*;
-use glam::{DMat4, DVec3, DVec4};
+use glam::{DMat3, DMat4, DVec3, DVec4};
 use std::f64::consts::PI;
 
 /// The hybrid model, as the CPU reference sees it.
@@ -156,21 +166,192 @@ fn ramp_extinction(alpha: [f64; 2], s: f64, inv_unit: f64) -> f64 {
 /// uniformly over the sphere (the last keeps every direction possible).
 const PROPOSAL: [f64; 4] = [0.3, 0.3, 0.25, 0.15];
 
-/// The scene, as the CPU reference sees it (everything in f64, world = index space).
+/// The main medium.
+pub enum Medium {
+    /// An image volume, its index space the world's, its extinction −ln(1 − α) / unit
+    /// distance; the hybrid model applies.
+    Grid(VolumeData),
+    /// An unstructured mesh, its extinction α / unit distance; no hybrid model.
+    Mesh(MeshMedium),
+}
+
+impl Medium {
+    /// The medium's box (lo, hi): the grid's index box, or the mesh's bounding box.
+    fn bounds(&self) -> (DVec3, DVec3) {
+        match self {
+            Medium::Grid(v) => index_box(v),
+            Medium::Mesh(m) => (m.lo, m.hi),
+        }
+    }
+}
+
+/// How far outside a tetrahedron (in barycentric coordinates) a point still counts as in it:
+/// a point on a face shared by two may be found in either.
+const INSIDE_TOLERANCE: f64 = 1e-9;
+
+/// An unstructured mesh as a medium: its tetrahedra ([`Tets::of`]) with their scalars, and
+/// for point location a uniform grid of bins over its bounding box, each listing the
+/// tetrahedra whose bounding boxes meet it.
+pub struct MeshMedium {
+    /// Per tetrahedron: its first point and the inverse of the matrix of its edges from
+    /// there (x − p0 ↦ its barycentric coordinates 1 to 3).
+    frames: Vec<(DVec3, DMat3)>,
+    /// Per tetrahedron: the scalar at its four points (the cell's, four times, with cell
+    /// scalars).
+    scalars: Vec<[f64; 4]>,
+    /// The scalars over which the opacity ramps from `Scene::alpha[0]` to `alpha[1]`.
+    pub range: [f64; 2],
+    /// The bounding box.
+    lo: DVec3,
+    hi: DVec3,
+    /// Bins per axis and each bin's size.
+    bins: [usize; 3],
+    bin_size: DVec3,
+    /// Bin b's tetrahedra are `items[start[b]..start[b + 1]]`.
+    start: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl MeshMedium {
+    /// The mesh `v` (its first scalar component), its opacity ramp over the scalars `range`.
+    pub fn new(v: &UnstructuredVolume, range: [f64; 2]) -> MeshMedium {
+        let t = Tets::of(v);
+        let mut frames = Vec::with_capacity(t.tets.len());
+        let mut scalars = Vec::with_capacity(t.tets.len());
+        let mut boxes = Vec::with_capacity(t.tets.len());
+        for (k, ids) in t.tets.iter().enumerate() {
+            let p = ids.map(|i| t.points[i as usize]);
+            let edges = DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+            frames.push((p[0], edges.inverse()));
+            scalars.push(if t.cell_scalars.is_empty() {
+                ids.map(|i| t.point_scalars[i as usize])
+            } else {
+                [t.cell_scalars[k]; 4]
+            });
+            boxes.push(
+                p.iter()
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &q| {
+                        (a.min(q), b.max(q))
+                    }),
+            );
+        }
+        let (lo, hi) = boxes
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &(c, d)| {
+                (a.min(c), b.max(d))
+            });
+        // about as many bins as tetrahedra, as near to cubes as the box allows
+        let size = hi - lo;
+        let edge = (size.x * size.y * size.z / t.tets.len() as f64).cbrt();
+        let bins = size.to_array().map(|e| ((e / edge).ceil() as usize).max(1));
+        let bin_size = size / DVec3::from_array(bins.map(|b| b as f64));
+        let mut mesh = MeshMedium {
+            frames,
+            scalars,
+            range,
+            lo,
+            hi,
+            bins,
+            bin_size,
+            start: vec![],
+            items: vec![],
+        };
+        // each tetrahedron in the bins its box meets, by a counting sort
+        let spans: Vec<_> = boxes
+            .iter()
+            .map(|&(a, b)| (mesh.bin(a), mesh.bin(b)))
+            .collect();
+        let index = |c: [usize; 3]| c[0] + bins[0] * (c[1] + bins[1] * c[2]);
+        let each = |(a, b): ([usize; 3], [usize; 3]), f: &mut dyn FnMut(usize)| {
+            for z in a[2]..=b[2] {
+                for y in a[1]..=b[1] {
+                    for x in a[0]..=b[0] {
+                        f(index([x, y, z]));
+                    }
+                }
+            }
+        };
+        let mut count = vec![0usize; bins.iter().product::<usize>() + 1];
+        for &span in &spans {
+            each(span, &mut |b| count[b + 1] += 1);
+        }
+        for b in 1..count.len() {
+            count[b] += count[b - 1];
+        }
+        let mut items = vec![0u32; count[count.len() - 1]];
+        let mut next = count.clone();
+        for (k, &span) in spans.iter().enumerate() {
+            each(span, &mut |b| {
+                items[next[b]] = k as u32;
+                next[b] += 1;
+            });
+        }
+        mesh.start = count;
+        mesh.items = items;
+        mesh
+    }
+
+    /// The number of tetrahedra.
+    pub fn tetrahedra(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// The bin holding point p (clamped to the grid of bins).
+    fn bin(&self, p: DVec3) -> [usize; 3] {
+        let c = ((p - self.lo) / self.bin_size).to_array();
+        [0, 1, 2].map(|a| (c[a].floor().max(0.0) as usize).min(self.bins[a] - 1))
+    }
+
+    /// The scalar at p, linear in the tetrahedron holding it; None outside every one.
+    fn scalar(&self, p: DVec3) -> Option<f64> {
+        if p.cmplt(self.lo).any() || p.cmpgt(self.hi).any() {
+            return None;
+        }
+        let c = self.bin(p);
+        let b = c[0] + self.bins[0] * (c[1] + self.bins[1] * c[2]);
+        self.items[self.start[b]..self.start[b + 1]]
+            .iter()
+            .find_map(|&k| {
+                let (p0, inv) = &self.frames[k as usize];
+                let l = *inv * (p - *p0);
+                let w = [1.0 - l.x - l.y - l.z, l.x, l.y, l.z];
+                if w.iter().any(|&x| x < -INSIDE_TOLERANCE) {
+                    return None;
+                }
+                let s = self.scalars[k as usize];
+                Some((0..4).map(|i| w[i] * s[i]).sum())
+            })
+    }
+
+    /// σ = α / unit distance at p for the opacity ramp `alpha` over [`MeshMedium::range`]
+    /// (clamped beyond it); 0 outside the mesh.
+    fn sigma(&self, p: DVec3, alpha: [f64; 2], inv_unit: f64) -> f64 {
+        let Some(s) = self.scalar(p) else {
+            return 0.0;
+        };
+        let [lo, hi] = self.range;
+        let u = ((s - lo) / (hi - lo)).clamp(0.0, 1.0);
+        (alpha[0] + (alpha[1] - alpha[0]) * u) * inv_unit
+    }
+}
+
+/// The scene, as the CPU reference sees it (everything in f64; an image volume's index space
+/// is the world).
 pub struct Scene {
     /// Image size (pixels, square).
     pub size: u32,
-    /// The volume as the GPU holds it.
-    pub volume: VolumeData,
-    /// Opacity at scalar 0 and 1 (the transfer function's linear ramp over [0, 1]).
+    /// The main medium: the volume as the GPU holds it, or a mesh.
+    pub medium: Medium,
+    /// Opacity at the ends of the transfer function's linear ramp: scalars 0 and 1 for an
+    /// image volume, the mesh's [`MeshMedium::range`] for a mesh.
     pub alpha: [f64; 2],
     pub inv_unit: f64,
     pub albedo: DVec3,
     pub g: f64,
     pub hybrid: Option<Hybrid>,
     pub max_bounces: u32,
-    /// The largest σ anywhere (the opacity ramps rise, so at scalar 1; the intermixed
-    /// volumes' added).
+    /// The largest σ anywhere (the opacity ramps rise, so at scalar 1, or a mesh's at the
+    /// top of its range, max(α) / unit; the intermixed volumes' added).
     pub majorant: f64,
     /// Volumes intermixed with the main one.
     pub intermixed: Vec<Intermixed>,
@@ -204,30 +385,29 @@ fn around(z: DVec3, cos: f64, phi: f64) -> DVec3 {
 }
 
 impl Scene {
-    /// The trilinearly interpolated scalar at world point p (clamped to the box, as the
-    /// texture's clamp-to-edge addressing does).
-    fn scalar(&self, p: DVec3) -> f64 {
-        trilinear(&self.volume, p)
-    }
-
     /// The gradient the hybrid model sees at p: half the difference of the interpolated
     /// scalar one voxel ahead and one behind along each axis (index = world units here).
     fn gradient(&self, p: DVec3) -> DVec3 {
-        gradient(
-            &self.volume,
-            p,
-            Interpolation::Linear,
-            GradientMethod::Central,
-        )
+        let Medium::Grid(volume) = &self.medium else {
+            panic!("the hybrid model is an image volume's, not a mesh's");
+        };
+        gradient(volume, p, Interpolation::Linear, GradientMethod::Central)
     }
 
-    /// The main medium's extinction at p (empty outside its grid).
+    /// The main medium's extinction at p (empty outside its grid or mesh): the image
+    /// volume's trilinearly interpolated scalar (clamped to the box, as the texture's
+    /// clamp-to-edge addressing does) through −ln(1 − α), or the mesh's α.
     fn sigma(&self, p: DVec3) -> f64 {
-        let (lo, hi) = index_box(&self.volume);
-        if p.cmplt(lo).any() || p.cmpgt(hi).any() {
-            return 0.0;
+        match &self.medium {
+            Medium::Grid(volume) => {
+                let (lo, hi) = index_box(volume);
+                if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+                    return 0.0;
+                }
+                ramp_extinction(self.alpha, trilinear(volume, p), self.inv_unit)
+            }
+            Medium::Mesh(mesh) => mesh.sigma(p, self.alpha, self.inv_unit),
         }
-        ramp_extinction(self.alpha, self.scalar(p), self.inv_unit)
     }
 
     /// The share of an intermixed medium's collisions that happen: its gradient taken as
@@ -472,16 +652,14 @@ impl Scene {
         (w, self.kernel_value(k, d, w) / pdf)
     }
 
-    /// Parameter interval of the ray o + t·d inside the medium's box (the volume's, or the
-    /// world box holding every volume), from t = 0 on.
+    /// Parameter interval of the ray o + t·d inside the medium's box (the volume's or the
+    /// mesh's, or the world box holding every volume), from t = 0 on.
     fn box_interval(&self, o: DVec3, d: DVec3) -> (f64, f64) {
         let (lo, hi) = self
             .intermixed
             .iter()
             .map(Intermixed::world_box)
-            .fold(index_box(&self.volume), |(a, b), (c, e)| {
-                (a.min(c), b.max(e))
-            });
+            .fold(self.medium.bounds(), |(a, b), (c, e)| (a.min(c), b.max(e)));
         let (t0, t1) = box_interval(o, d, lo, hi);
         (t0.max(0.0), t1)
     }
@@ -626,6 +804,10 @@ pub struct Reference {
 
 /// `spp` reference paths per pixel, on two threads.
 pub fn reference(scene: &Scene, spp: u32) -> Reference {
+    assert!(
+        scene.hybrid.is_none() || matches!(scene.medium, Medium::Grid(_)),
+        "the hybrid model is an image volume's: a mesh scatters by Henyey–Greenstein"
+    );
     let size = scene.size;
     let n = (size * size) as usize;
     let threads = 2;
