@@ -10,7 +10,8 @@
 // piece's exact optical depth (σ is linear along a piece between the table's knots, so its
 // integral is a quadratic in the distance, inverted in closed form where τ* is reached);
 // transparent tetrahedra are stepped over without integrating. Transmittance toward the
-// environment and the lights is exp(−τ) of the same walk, exact (no tracking noise). Paths
+// environment and the lights is exp(−τ) of the same walk (no tracking noise), with Russian
+// roulette once it is below 0.1 (as the image's ratio tracking plays it). Paths
 // leave a non-convex mesh and enter it again through the boundary hierarchy. Otherwise as
 // pathtrace.wgsl: next-event estimates toward the environment (multiple importance
 // sampling with the phase function) and the view's lights, Russian roulette after 3
@@ -22,6 +23,11 @@
 
 // Optical depth past which a shadow ray's transmittance is taken as 0 (e^−30 ≈ 1e−13).
 const OPAQUE_DEPTH: f32 = 30.0;
+// Shadow rays play Russian roulette past this optical depth (a transmittance of 0.1): half
+// of them stop (transmittance 0), the others go on with twice the weight (the depth less
+// ln 2), an unbiased estimate that stops walking where little light gets through.
+const ROULETTE_DEPTH: f32 = 2.302585;
+const LN_2: f32 = 0.693147;
 
 // Where a flight ended: at a collision (tet the tetrahedron, s the scalar there) or, with
 // tet NO_HIT, at the end of its segment; and the optical depth it crossed.
@@ -32,8 +38,15 @@ struct Flight {
     depth: f32,
 }
 
-// Flies along r, walking w, over [seg.x, seg.y) until the optical depth reaches `goal`.
-fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32) -> Flight {
+// The attenuation τ (per world unit) at table coordinate x, linear between entries.
+fn tau_at(x: f32) -> f32 {
+    return row_lookup(tables, 1, x / f32(TABLE_N - 1u), false).x * mesh.unit.x;
+}
+
+// Flies along r, walking w, over [seg.x, seg.y) until the optical depth reaches `goal`;
+// with `roulette` (shadow rays) it plays Russian roulette past ROULETTE_DEPTH after each
+// tetrahedron, a stopped ray ending as if it had reached the goal.
+fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32, roulette: bool, rng: ptr<function, Rng>) -> Flight {
     var w = start;
     var out: Flight;
     out.t = seg.y;
@@ -65,11 +78,11 @@ fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32) -> Flight {
             let up = x1 > x0;
             var xa = x0;
             var ua = 0.0;
-            var sa = colour_tau(xa).a;
+            var sa = tau_at(xa);
             for (var i = 0u; i <= TABLE_N + 1u; i = i + 1u) {
                 let xb = next_cut(xa, x1, up);
                 let ub = select((xb - x0) / (x1 - x0), 1.0, xb == x1);
-                let sb = colour_tau(xb).a;
+                let sb = tau_at(xb);
                 // optical depth a·v + b·v² at the fraction v of the piece
                 let plen = (ub - ua) * len;
                 let a = sa * plen;
@@ -92,6 +105,14 @@ fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32) -> Flight {
                 ua = ub;
                 sa = sb;
             }
+            if (roulette && out.depth > ROULETTE_DEPTH) {
+                if (rand(rng) < 0.5) {
+                    out.tet = tet;
+                    out.depth = goal;
+                    return out;
+                }
+                out.depth = out.depth - LN_2;
+            }
         }
         if (ex.t >= seg.y) {
             break;
@@ -101,15 +122,16 @@ fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32) -> Flight {
     return out;
 }
 
-// The transmittance along r from its origin, inside tetrahedron `tet` where the scalar is
-// s, to `reach` (or out of the mesh), on the kept side of the clipping planes.
-fn transmittance_from(r: Ray, tet: u32, s: f32, reach: f32) -> f32 {
+// An unbiased estimate of the transmittance along r from its origin, inside tetrahedron
+// `tet` where the scalar is s, to `reach` (or out of the mesh), on the kept side of the
+// clipping planes: exp(−τ) of the walk, with Russian roulette where it is small.
+fn transmittance_from(r: Ray, tet: u32, s: f32, reach: f32, rng: ptr<function, Rng>) -> f32 {
     var seg = clip_interval(r, vec2<f32>(0.0, 3.0e38));
     seg.y = min(seg.y, reach);
     if (!(seg.x < seg.y)) {
         return 1.0;
     }
-    let f = fly(r, seg, walk_inside(r.index_origin, r.index_dir, tet, 0.0, s), OPAQUE_DEPTH);
+    let f = fly(r, seg, walk_inside(r.index_origin, r.index_dir, tet, 0.0, s), OPAQUE_DEPTH, true, rng);
     return select(exp(-f.depth), 0.0, f.tet != NO_HIT);
 }
 
@@ -142,7 +164,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         var f: Flight;
         f.tet = NO_HIT;
         if (seg.x < seg.y) {
-            f = fly(r, seg, w, flight_depth(rng));
+            f = fly(r, seg, w, flight_depth(rng), false, rng);
         }
         if (f.tet == NO_HIT) {
             if (bounce == 0u) {
@@ -179,7 +201,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         let pl = env_pdf(wl);
         let hl = hg_pdf(dot(r.dir, wl), g);
         if (pl > 0.0 && any(albedo > vec3<f32>(0.0))) {
-            let tl = transmittance_from(ray_from(x, wl), f.tet, f.s, 3.0e38);
+            let tl = transmittance_from(ray_from(x, wl), f.tet, f.s, 3.0e38, rng);
             radiance = radiance + beta * albedo * hl * (tl * power_heuristic(pl, hl) / pl) * env_radiance(wl);
         }
         // ... and the lights: directional (the headlight along the camera ray) and
@@ -187,7 +209,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         for (var i = 0u; i < frame.light_count; i = i + 1u) {
             let ld = light_dir(i, x, camera_ray.dir);
             if (ld.k > 0.0 && any(albedo > vec3<f32>(0.0))) {
-                let td = transmittance_from(ray_from(x, ld.l), f.tet, f.s, ld.reach);
+                let td = transmittance_from(ray_from(x, ld.l), f.tet, f.s, ld.reach, rng);
                 let hd = hg_pdf(dot(r.dir, ld.l), g);
                 radiance = radiance + beta * albedo * hd * (td * ld.k) * frame.lights[i].diffuse.rgb;
             }
