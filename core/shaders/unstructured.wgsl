@@ -16,6 +16,9 @@
 // points' (gradient_in): the lighting is then a constant affine map of the emitted colour
 // along the segment, so its integral stays in closed form (the clamp to [0, 1] applied to
 // a piece's mean colour rather than to each point's).
+// GRAD_OPACITY: each segment's attenuation is scaled by the gradient opacity of the
+// gradient's magnitude (world units) at its middle, the gradient SHADE lights it by: a
+// constant factor along the segment, so the closed forms hold.
 #include "lib/output.wgsl"
 #include "lib/march.wgsl"
 #include "lib/shading.wgsl"
@@ -23,6 +26,7 @@
 
 override BLEND: u32 = BLEND_COMPOSITE;
 override SHADE: bool = false;
+override GRAD_OPACITY: bool = false;
 
 // ---- integration ----
 
@@ -84,12 +88,14 @@ fn psi(a: f32, b: f32) -> f32 {
 var<private> st: PixelState;
 // SHADE: the lighting of the tetrahedron being integrated.
 var<private> lit: Lighting;
+// GRAD_OPACITY: the factor of its attenuation.
+var<private> opacity_scale: f32 = 1.0;
 
 // Composites a piece of length len whose colour and attenuation run linearly from cf to cb
 // (rgb colour, a attenuation), starting at distance t0.
 fn composite_piece(r: Ray, cf: vec4<f32>, cb: vec4<f32>, len: f32, t0: f32) {
-    let a = cf.a * len;
-    let b = 0.5 * (cb.a - cf.a) * len;
+    let a = cf.a * opacity_scale * len;
+    let b = 0.5 * (cb.a - cf.a) * opacity_scale * len;
     if (a + b <= 0.0 && a <= 0.0) {
         return;
     }
@@ -221,11 +227,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 break;
             }
             if (!empty_tet(w.k, ex.tf >> 2u)) {
-                if (SHADE) {
+                if (SHADE || GRAD_OPACITY) {
                     let mid = 0.5 * (max(w.hit.t, seg.x) + min(ex.t, seg.y));
                     let g = gradient_in(w.k, o + mid * d);
                     let gw = (frame.gradient_to_world * vec4<f32>(g, 0.0)).xyz;
-                    lit = lighting(gw, ray.origin + mid * ray.dir, ray.dir, frame.material);
+                    if (SHADE) {
+                        lit = lighting(gw, ray.origin + mid * ray.dir, ray.dir, frame.material);
+                    }
+                    if (GRAD_OPACITY) {
+                        opacity_scale = gradient_opacity(0u, length(gw));
+                    }
                 }
                 integrate_within(ray, seg, w.hit.t, ex.t, w.hit.s, ex.s);
             }

@@ -152,6 +152,46 @@ fn mixed_distorted_cells_match_the_reference_with_point_and_cell_scalars() {
     agrees("mixed_cells_additive", &cells, BlendMode::Additive, 0.8);
 }
 
+/// Gradient opacity on composite, point and cell scalars, against the reference (each
+/// segment's opacity scaled by the function at its middle's gradient magnitude); and it
+/// shows: the image differs from the one without it by more than the comparison's error.
+#[test]
+fn gradient_opacity_matches_the_reference_with_point_and_cell_scalars() {
+    for (name, v, max_opacity) in [
+        ("wavelet_gradient_opacity", synth::tet_wavelet(12), 0.3),
+        (
+            "mixed_cells_gradient_opacity",
+            synth::mixed_cells(4, ScalarLocation::Cells),
+            0.8,
+        ),
+    ] {
+        let (lo, hi) = range(&v);
+        let plain = tf(lo, hi, max_opacity);
+        // the gradient magnitudes the mesh has (scalar units per world unit), from the
+        // reference's points: the function rises over the lower half of them
+        let steepest = mesh::Tets::of(&v)
+            .point_gradients
+            .iter()
+            .map(|g| g.length())
+            .fold(0.0, f64::max);
+        let mut graded = plain.clone();
+        graded.components[0].gradient_opacity =
+            Some(Piecewise::new(vec![(0.0, [0.1]), (0.5 * steepest, [1.0])]).unwrap());
+        let view = view_of(&v, 64);
+        let p = params(BlendMode::Composite);
+        let (mean, psnr, max) = compare(name, &v, &graded, &view, &p);
+        assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0, "{name}");
+        let without = draw(&v, &plain, &view, &p);
+        let with = draw(&v, &graded, &view, &p);
+        let changed = pixels_off_by_more(&with, &mesh::render(&v, &plain, &view, &p), 3.0);
+        println!("{name}: {changed} pixels differ from the image without it by over 3 levels");
+        assert!(
+            changed > footprint(&without) / 4,
+            "{name}: gradient opacity changes {changed} pixels"
+        );
+    }
+}
+
 /// Shaded composite (VTK's default material, the headlight) against the reference, which
 /// lights a segment by the gradient interpolated from the points' (at its middle as the
 /// shader does, and at every point); and the shading shows:
@@ -315,16 +355,16 @@ fn what_is_not_drawn_is_refused_and_images_come_back() {
         &["surface scattering", "Henyey–Greenstein"],
     );
     r.set_path_tracing(&PathTraceParams::default()).unwrap();
-    let mut graded = tf(0.0, 2.0, 1.0);
-    graded.components[0].gradient_opacity =
-        Some(Piecewise::new(vec![(0.0, [0.2]), (1.0, [1.0])]).unwrap());
-    r.set_transfer_function(&graded).unwrap();
+    let mut cropped = params(BlendMode::Composite);
+    cropped.cropping = Some(Cropping {
+        planes: [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0],
+        regions: Cropping::SUBVOLUME,
+    });
     assert_error(
-        r.render_image(&view, &params(BlendMode::Composite)),
-        "gradient opacity",
-        &["without gradient opacity"],
+        r.render_image(&view, &cropped),
+        "cropping",
+        &["without cropping"],
     );
-    r.set_transfer_function(&tf(0.0, 2.0, 1.0)).unwrap();
     let several = UnstructuredVolume {
         components: 2,
         scalars: Scalars::F32(vec![0.0; 18]),

@@ -30,6 +30,7 @@
 #include "vtkWeakPointer.h"
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,6 +98,7 @@ public:
   vtkVolumeProperty* Property = nullptr;
   vtkMTimeType PropertyMTime = 0;
   std::array<double, 2> TablesRange{};
+  double TablesGradientScale = 0.0;
   int MeshUploads = 0;
   int TableUploads = 0;
 
@@ -248,17 +250,25 @@ public:
   }
 
   // The property's colour and scalar opacity over the scalars' range, when either changed.
-  bool UpdateTables(vtkVolumeProperty* prop)
+  bool UpdateTables(vtkVolume* vol)
   {
+    vtkVolumeProperty* prop = vol->GetProperty();
+    // A gradient opacity reads gradient magnitudes in scalar units per world unit of the
+    // mesh's own coordinates (vtkGPUVolumeRayCastMapper's, per voxel, on an image of unit
+    // spacing), under the vtkVolume's scale.
+    const double matrixScale = vtkFerroVolumeLookupTables::MatrixScale(vol);
+    const double gradientScale =
+      matrixScale > 0.0 && std::isfinite(matrixScale) ? 1.0 / matrixScale : 1.0;
     if (this->Property == prop && this->PropertyMTime == prop->GetMTime() &&
-      this->TablesRange == this->Range)
+      this->TablesRange == this->Range && this->TablesGradientScale == gradientScale)
     {
       return true;
     }
     this->Property = nullptr;
     std::unique_ptr<ferrovol::TransferFunction> tf;
     if (!vtkFerroVolumeLookupTables::BuildFirstComponent(prop, this->Range,
-          vtkFerroVolumeLookupTables::RangeTypes(), "meshes", tf, this->Report) ||
+          vtkFerroVolumeLookupTables::RangeTypes(), "meshes", gradientScale, tf,
+          this->Report) ||
       !vtkFerroVolumeCall("set the transfer function", this->Report,
         [&] { this->Slot.Renderer->set_transfer_function(*tf); }))
     {
@@ -267,6 +277,7 @@ public:
     this->Property = prop;
     this->PropertyMTime = prop->GetMTime();
     this->TablesRange = this->Range;
+    this->TablesGradientScale = gradientScale;
     ++this->TableUploads;
     return true;
   }
@@ -333,7 +344,7 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   bool cells = false;
   const bool ready = SelectScalars(this, grid, scalars, cells, report) &&
     in->MakeRenderer(win) && in->Upload(grid, scalars, cells) &&
-    in->UpdateTables(vol->GetProperty());
+    in->UpdateTables(vol);
   this->MeshUploadCount = in->MeshUploads;
   this->TableUploadCount = in->TableUploads;
   if (!ready)

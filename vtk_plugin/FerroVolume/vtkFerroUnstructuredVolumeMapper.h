@@ -24,8 +24,11 @@
  * composite is lit by the renderer's lights with the property's ambient, diffuse, specular
  * and specular power, as vtkGPUVolumeRayCastMapper lights image data, each ray segment by
  * the scalar's gradient interpolated from the mesh's points (each point's the mean of its
- * tetrahedra's; from the neighbours across faces for cell scalars). A gradient opacity or
- * 2D transfer function is refused with an error naming it. Errors from ferrovol reach vtkErrorMacro with its message.
+ * tetrahedra's; from the neighbours across faces for cell scalars). A gradient opacity
+ * (which VTK's unstructured mappers ignore too) scales composite's opacity as
+ * vtkGPUVolumeRayCastMapper's does, each ray segment by its function of that gradient's
+ * magnitude at the segment's middle. A 2D transfer function is refused with an error naming
+ * it. Errors from ferrovol reach vtkErrorMacro with its message.
  */
 #ifndef vtkFerroUnstructuredVolumeMapper_h
 #define vtkFerroUnstructuredVolumeMapper_h

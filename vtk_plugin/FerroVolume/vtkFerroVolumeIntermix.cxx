@@ -180,7 +180,7 @@ bool vtkFerroVolumeIntermix::Update(vtkVolumeMapper* self, vtkMultiVolume* multi
   {
     Port& p = this->Ports[i];
     if (!vtkFerroVolumeLookupTables::BuildFirstComponent(
-          p.Property, p.Range, types, "intermixed volumes", tfs[i], report))
+          p.Property, p.Range, types, "intermixed volumes", 0.0, tfs[i], report))
     {
       report.PrefixError("port " + std::to_string(p.Index) + ": ");
       p.Property = nullptr;

@@ -530,21 +530,24 @@ double vtkFerroVolumeLookupTables::MatrixScale(vtkVolume* volume)
 
 bool vtkFerroVolumeLookupTables::BuildFirstComponent(vtkVolumeProperty* prop,
   const std::array<double, 2>& range, const RangeTypes& types, const char* what,
-  std::unique_ptr<ferrovol::TransferFunction>& tf, vtkFerroVolumeReport& report)
+  double gradientScale, std::unique_ptr<ferrovol::TransferFunction>& tf,
+  vtkFerroVolumeReport& report)
 {
   if (prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D)
   {
     return report.Fail(std::string("its property has a 2D transfer function: ") + what +
       " are classified by 1D colour and scalar opacity functions");
   }
-  if (prop->HasGradientOpacity(0) && !prop->GetDisableGradientOpacity(0))
+  if (!(gradientScale > 0.0) && prop->HasGradientOpacity(0) &&
+    !prop->GetDisableGradientOpacity(0))
   {
     return report.Fail(std::string("its property has a gradient opacity function: ") + what +
       " are classified by colour and scalar opacity only (DisableGradientOpacityOn)");
   }
   vtkFerroVolumeInputHelper::Ranges ranges{};
   ranges[0] = range;
-  return BuildTransferFunction(prop, 1, ranges, types, 1.0, tf, report);
+  return BuildTransferFunction(
+    prop, 1, ranges, types, gradientScale > 0.0 ? gradientScale : 1.0, tf, report);
 }
 
 bool vtkFerroVolumeLookupTables::Update(vtkVolume* volume,

@@ -49,12 +49,13 @@ public:
     const RangeTypes& rangeTypes, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   // The transfer function of `prop`'s first component over the data range `range`, for a
-  // volume intermixed with the main one or a mesh (colour and scalar opacity: a gradient
-  // opacity or 2D function is refused, saying that `what`, "intermixed volumes", are drawn
-  // without); false with the reason.
+  // volume intermixed with the main one or a mesh: colour and scalar opacity, and a
+  // gradient opacity read at gradient magnitudes times `gradientScale` (as Update's
+  // GradientScale), or refused where that is 0; a 2D function is refused. A refusal says
+  // that `what` ("intermixed volumes") are drawn without it; false with the reason.
   static bool BuildFirstComponent(vtkVolumeProperty* prop, const std::array<double, 2>& range,
-    const RangeTypes& types, const char* what, std::unique_ptr<ferrovol::TransferFunction>& tf,
-    vtkFerroVolumeReport& report);
+    const RangeTypes& types, const char* what, double gradientScale,
+    std::unique_ptr<ferrovol::TransferFunction>& tf, vtkFerroVolumeReport& report);
 
   // Forget the upload (the renderer is gone).
   void Reset() { this->Uploaded.reset(); }

@@ -2,7 +2,7 @@
 //! pixel traversing the tetrahedra from face to face (resources/mesh). Composite integrates
 //! each segment exactly for the transfer tables as VTK's unstructured ray caster's
 //! integrators model it (colour · attenuation emitted, attenuation = opacity / unit
-//! distance); MIP and MinIP take the exact extrema of the linear segments, average and
+//! distance, scaled by the gradient opacity at the segment's middle); MIP and MinIP take the exact extrema of the linear segments, average and
 //! additive the exact integrals of opacity × normalised scalar.
 
 use super::frame::{
@@ -301,6 +301,9 @@ pub(crate) fn frame_uniforms(
     let [lo, hi] = ct.table_range();
     u.tf_lo[0] = lo as f32;
     u.tf_inv_width[0] = (1.0 / (hi - lo)) as f32;
+    let [glo, ghi] = ct.gradient_range();
+    u.go_lo[0] = glo as f32;
+    u.go_inv_width[0] = (1.0 / (ghi - glo)) as f32;
     u.weights[0] = ct.weight;
     u.termination = params.termination_threshold;
     u.depth_threshold = params.depth_threshold;

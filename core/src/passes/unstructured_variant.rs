@@ -14,6 +14,7 @@ pipeline_variant! {
         shade: bool => "SHADE",
         lights: u32 => "NUM_LIGHTS",
         positional_lights: bool => "POSITIONAL_LIGHTS",
+        gradient_opacity: bool => "GRAD_OPACITY",
     }
 }
 
@@ -97,7 +98,6 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         return Err(R::Components(x.components));
     }
     let settings = [
-        (x.gradient_opacity, "gradient opacity"),
         (x.tables_2d, "2D transfer functions"),
         (x.cropping, "cropping"),
         (x.average_range, "an average range"),
@@ -116,6 +116,8 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
     }
     // Shading lights composite alone, as VTK's ray casters shade (the projections are of
     // the scalar); a frame without lights is ambient only, as an image volume's is.
+    // Gradient opacity scales the opacity composite accumulates, as for images (path
+    // tracing reads the opacity alone, as for images).
     let shade = x.shade && x.blend == BlendMode::Composite;
     Ok(UnstructuredVariant {
         blend: x.blend.code(),
@@ -123,6 +125,7 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         shade,
         lights: if shade { x.lights } else { 0 },
         positional_lights: shade && x.positional_lights,
+        gradient_opacity: x.gradient_opacity && x.blend == BlendMode::Composite,
     })
 }
 
@@ -191,9 +194,9 @@ pub(crate) mod tests {
             R::Components(_) => (1, "a mesh of several components"),
             R::Setting(_) => (
                 2,
-                "gradient opacity, 2D transfer functions, cropping, an average range, \
-                 a whole box, volumetric shadows, a depth range, intermixed volumes, or \
-                 surface scattering when path tracing",
+                "2D transfer functions, cropping, an average range, a whole box, \
+                 volumetric shadows, a depth range, intermixed volumes, or surface \
+                 scattering when path tracing",
             ),
         }
     }
@@ -210,6 +213,10 @@ pub(crate) mod tests {
                     assert_eq!(x.components, 1);
                     assert_eq!(v.shade, x.shade && x.blend == BlendMode::Composite);
                     assert!(v.shade || (v.lights == 0 && !v.positional_lights));
+                    assert_eq!(
+                        v.gradient_opacity,
+                        x.gradient_opacity && x.blend == BlendMode::Composite
+                    );
                 }
                 Err(UnstructuredRefusal::Blend(b)) => assert_eq!(b, x.blend),
                 Err(UnstructuredRefusal::Components(n)) => {

@@ -6,7 +6,8 @@
 //! themselves and composite Gauss–Legendre quadrature instead of closed forms. Shaded
 //! composite lights every point of a segment by the gradient interpolated there from the
 //! points' (each the volume-weighted mean of its tetrahedra's; the headlight,
-//! raycast::shade, clamped point by point).
+//! raycast::shade, clamped point by point). Gradient opacity scales a segment's opacity in
+//! composite by its function of that gradient's magnitude at the segment's middle.
 
 use super::raycast::{eval_pw, pixel_ray, shade, to_pixel, Ray};
 use ferrovol_core::*;
@@ -264,6 +265,8 @@ pub struct Table {
     hi: f64,
     pub inv_unit: f64,
     pub shading: Option<(Shading, LightAt)>,
+    /// Composite with gradient opacity.
+    pub gradient_opacity: bool,
 }
 
 impl Table {
@@ -276,6 +279,15 @@ impl Table {
             lo,
             hi,
             shading: None,
+            gradient_opacity: false,
+        }
+    }
+
+    /// The gradient opacity's factor for gradient magnitude m (1 without one).
+    fn gradient_factor(&self, m: f64) -> f64 {
+        match &self.tf.gradient_opacity {
+            Some(go) if self.gradient_opacity => eval_pw(go, m)[0].clamp(0.0, 1.0),
+            _ => 1.0,
         }
     }
 
@@ -393,11 +405,13 @@ pub fn integrate(segs: &[Segment], table: &Table, blend: BlendMode, termination:
     for s in segs {
         let (x0, x1) = (s.s0, s.s1);
         let l = s.t1 - s.t0;
+        let go = table.gradient_factor(s.g0.lerp(s.g1, 0.5).length());
         for (u0, u1) in table.pieces(x0, x1) {
             let d = l * (u1 - u0);
             let at = |u: f64| {
                 let f = u0 + (u1 - u0) * u;
-                let e = table.at(x0 + (x1 - x0) * f);
+                let mut e = table.at(x0 + (x1 - x0) * f);
+                e[3] *= go;
                 let Some((sh, at)) = &table.shading else {
                     return e;
                 };
@@ -454,6 +468,7 @@ pub fn render_lit(
     if params.shading.enabled && params.blend == BlendMode::Composite {
         table.shading = Some((params.shading, at));
     }
+    table.gradient_opacity = params.blend == BlendMode::Composite;
     tets.segments(view)
         .iter()
         .map(|segs| {
