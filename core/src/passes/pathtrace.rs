@@ -33,8 +33,6 @@ use super::depth_check::DepthCheck;
 use super::frame::{self, groups, FrameInput, Purpose};
 use super::medium;
 use super::pathtrace_variant::{self, PathTraceFacts, PathTraceVariant};
-use super::unstructured::{self, MeshTransfer};
-use super::unstructured_variant::{self, MeshPathTraceVariant, UnstructuredFacts};
 use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, bind_block, bind_view, buffer_entry, dynamic_uniform_entry, group_layout,
@@ -53,7 +51,7 @@ use crate::gpu::uniforms::{
 use crate::gpu::Context;
 use crate::params::pathtrace::MAX_SAMPLES_PER_FRAME;
 use crate::params::{
-    BlendMode, Convergence, PathTraceParams, RenderParams, ScalarLocation, ScatterRegions, Shading,
+    BlendMode, Convergence, PathTraceParams, RenderParams, ScatterRegions, Shading,
     TransferFunction, View,
 };
 use crate::resources::intermix::IntermixBinding;
@@ -64,6 +62,9 @@ use crate::resources::volume::{blanking_layout_entry, grid_lookup_layout_entry, 
 use crate::resources::Resources;
 use bytemuck::Zeroable;
 use glam::DMat4;
+
+mod mesh;
+use mesh::MeshTracer;
 
 /// Subsets of a pass: the pixels of each 4×4 cell in Bayer order (every 4th pixel first,
 /// then the rest of every 2nd, ...), as (x, y) offsets in the cell.
@@ -150,30 +151,6 @@ pub(crate) struct PathTracePass {
     mesh: Option<MeshTracer>,
 }
 
-/// The mesh's path tracer: its layout, pipelines and mesh uniforms.
-struct MeshTracer {
-    bgl: wgpu::BindGroupLayout,
-    pipelines: PipelineCache<MeshPathTraceVariant>,
-    transfer: MeshTransfer,
-}
-
-impl MeshTracer {
-    fn new(ctx: &Context) -> Result<MeshTracer> {
-        let bgl = group_layout(
-            &ctx.device,
-            "path tracing a mesh",
-            &PathTracePass::mesh_layout_entries(),
-        );
-        let pipelines =
-            PipelineCache::new(ctx, "pathtrace_mesh.wgsl", "path tracing a mesh", &[&bgl])?;
-        Ok(MeshTracer {
-            bgl,
-            pipelines,
-            transfer: MeshTransfer::new(ctx),
-        })
-    }
-}
-
 /// What a frame's path tracing is given.
 struct Setup<'a> {
     ctx: &'a Context,
@@ -256,19 +233,6 @@ impl PathTracePass {
                 tables_2d_layout_entry(),
             ])
             .chain(IntermixBinding::layout_entries(filterable))
-            .collect()
-    }
-
-    /// The mesh's path tracer's bind group (pathtrace_mesh.wgsl, its only group).
-    pub fn mesh_layout_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-        Self::shared_layout_entries()
-            .into_iter()
-            .chain([texture_entry(
-                slots::DEPTH_IN,
-                false,
-                wgpu::TextureViewDimension::D2,
-            )])
-            .chain(MeshTransfer::layout_entries())
             .collect()
     }
 
@@ -618,95 +582,6 @@ impl PathTracePass {
             u,
             rect,
             scale: step as f32,
-        }))
-    }
-
-    /// A mesh's frame (pathtrace_mesh.wgsl), None when only preparing.
-    fn prepare_mesh(
-        &mut self,
-        f: &Setup<'_>,
-        res: &mut Resources,
-        purpose: Purpose,
-    ) -> Result<Option<Medium>> {
-        let (ctx, view, params, pp) = (f.ctx, f.view, f.params, &f.pp);
-        let tf = res.transfer_function()?.clone();
-        let ct = tf.component(0);
-        let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
-        let facts = UnstructuredFacts {
-            blend: BlendMode::PathTrace,
-            components: mesh.components,
-            cell_scalars: mesh.location == ScalarLocation::Cells,
-            shade: false,
-            lights: 0,
-            positional_lights: false,
-            gradient_opacity: ct.gradient_opacity.is_some(),
-            tables_2d: ct.table_2d.is_some(),
-            cropping: params.cropping.is_some(),
-            average_range: false,
-            whole_box: params.whole_box.is_some(),
-            volumetric: false,
-            depth_range: matches!(f.depth, DepthSource::Range(..)),
-            intermix: res.intermix.is_some(),
-            hybrid: pp.gradient_threshold.is_finite()
-                || pp.stochastic_blend > 0.0
-                || pp.scatter != ScatterRegions::Everywhere,
-        };
-        let variant = MeshPathTraceVariant {
-            cell_scalars: unstructured_variant::select(&facts)
-                .map_err(Error::from)?
-                .cell_scalars,
-            guide: f.guided,
-        };
-        res.ensure_tables(ctx, 1.0)?;
-        self.prepare_common(f, res)?;
-        let depth_input = !matches!(f.depth, DepthSource::None);
-        let frame = unstructured::frame_uniforms(res, view, &lit(params), depth_input)?;
-        let key = accumulation_key(f, res);
-        let tracer = match &mut self.mesh {
-            Some(t) => t,
-            None => self.mesh.insert(MeshTracer::new(ctx)?),
-        };
-        let pipeline = tracer.pipelines.get(ctx, variant)?;
-        if purpose == Purpose::Prepare {
-            return Ok(None);
-        }
-        let mesh = res.mesh.as_ref().expect("checked above");
-        tracer.transfer.write(ctx, mesh, ct);
-        ctx.queue
-            .write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
-        let tracer = self.mesh.as_ref().expect("created above");
-        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("path tracing a mesh"),
-            layout: &tracer.bgl,
-            entries: &self
-                .shared_entries(res)?
-                .into_iter()
-                .chain([bind_view(
-                    slots::DEPTH_IN,
-                    &res.targets
-                        .as_ref()
-                        .expect("allocated in prepare_common")
-                        .depth_in
-                        .create_view(&Default::default()),
-                )])
-                .chain(tracer.transfer.entries(mesh))
-                .collect::<Vec<_>>(),
-        });
-        let mut u = self.base_uniforms(f, res, ct.unit_distance)?;
-        // (the denoiser compares depths per cell: the box's diagonal over the tetrahedra's
-        // cube root)
-        let b = mesh.bounds;
-        let diagonal =
-            ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
-        let cell = diagonal / (mesh.uniforms.counts[0].max(1) as f64).cbrt();
-        u.medium[0] = 1.0;
-        Ok(Some(Medium {
-            key,
-            pipeline,
-            groups: vec![group],
-            u,
-            rect: frame.rect,
-            scale: cell as f32,
         }))
     }
 
