@@ -14,6 +14,7 @@
 #include "vtkFerroVolumeInputHelper.h"
 #include "vtkFerroVolumeLookupTables.h"
 #include "vtkFerroVolumeOutput.h"
+#include "vtkFerroVolumeRefinement.h"
 #include "vtkFerroVolumeReport.h"
 #include "vtkFerroVolumeSettings.h"
 #include "vtkCellArray.h"
@@ -78,6 +79,9 @@ public:
   vtkFerroVolumeRendererSlot Slot;
   vtkFerroVolumeOutput Output;
   vtkFerroVolumeReport Report;
+  // Path tracing: the environment given to the renderer, and the progressive refinement.
+  vtkFerroVolumeSettings Settings;
+  vtkFerroVolumeRefinement Refinement;
 
   // What the uploaded mesh and tables were made from.
   struct MeshKey
@@ -115,9 +119,11 @@ public:
 
   void FreeRenderer()
   {
+    this->Refinement.Stop();
     this->Slot.Renderer.reset();
     this->HaveMesh = false;
     this->Property = nullptr;
+    this->Settings.Reset();
   }
 
   // `input` as a vtkUnstructuredGrid: itself, or its copy (made again only when the input
@@ -292,12 +298,45 @@ vtkFerroUnstructuredVolumeMapper::vtkFerroUnstructuredVolumeMapper()
 vtkFerroUnstructuredVolumeMapper::~vtkFerroUnstructuredVolumeMapper()
 {
   delete this->Internals;
+  this->SetEnvironmentMap(nullptr);
+}
+
+int vtkFerroUnstructuredVolumeMapper::GetAccumulatedSamples()
+{
+  if (!this->Internals->Slot.Renderer)
+  {
+    return -1;
+  }
+  int samples = -1;
+  vtkFerroVolumeReport quiet;
+  vtkFerroVolumeCall("count the accumulated paths", quiet, [&] {
+    samples = static_cast<int>(this->Internals->Slot.Renderer->accumulated_samples());
+  });
+  return samples;
 }
 
 void vtkFerroUnstructuredVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "LastRenderDrew: " << this->LastRenderDrew << "\n";
+  os << indent << "LastRenderProgressive: " << this->LastRenderProgressive << "\n";
+  os << indent << "RenderMode: "
+     << (this->RenderMode == RENDER_MODE_PATH_TRACE ? "path trace" : "ray cast") << "\n";
+  os << indent << "SamplesPerPixel: " << this->SamplesPerPixel << "\n";
+  os << indent << "InteractiveSamplesPerPixel: " << this->InteractiveSamplesPerPixel << "\n";
+  os << indent << "PathTracingBounces: " << this->PathTracingBounces << "\n";
+  os << indent << "SecondaryRays: " << this->SecondaryRays << "\n";
+  os << indent << "PathTracingDenoise: " << this->PathTracingDenoise << "\n";
+  os << indent << "PathTracingDenoiseUntil: " << this->PathTracingDenoiseUntil << "\n";
+  os << indent << "ProgressiveMode: " << this->ProgressiveMode << "\n";
+  os << indent << "PathTracingTimeBudget: " << this->PathTracingTimeBudget << "\n";
+  os << indent << "EnvironmentMap: " << (this->EnvironmentMap ? this->EnvironmentMap : "(sky)")
+     << "\n";
+  os << indent << "EnvironmentUp: " << this->EnvironmentUp[0] << " " << this->EnvironmentUp[1]
+     << " " << this->EnvironmentUp[2] << "\n";
+  os << indent << "EnvironmentAzimuth: " << this->EnvironmentAzimuth << "\n";
+  os << indent << "EnvironmentIntensity: " << this->EnvironmentIntensity << "\n";
+  os << indent << "EnvironmentBackground: " << this->EnvironmentBackground << "\n";
 }
 
 void vtkFerroUnstructuredVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
@@ -310,7 +349,9 @@ void vtkFerroUnstructuredVolumeMapper::ReleaseGraphicsResources(vtkWindow* windo
 void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   this->LastRenderDrew = 0;
+  this->LastRenderProgressive = 0;
   vtkInternals* in = this->Internals;
+  in->Refinement.Begin();
   vtkFerroVolumeReport& report = in->Report;
   report.ClearError();
   if (!ren || !vol || !vol->GetProperty())
@@ -324,9 +365,11 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
                      "(vtkOpenGLRenderWindow)");
     return;
   }
-  uint32_t blend = FV_BLEND_MODE_COMPOSITE;
-  if (!vtkFerroVolumeSettings::ToFvBlend(this->BlendMode, blend) ||
-    blend == FV_BLEND_MODE_ISOSURFACE || blend == FV_BLEND_MODE_SLICE)
+  const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
+  uint32_t blend = FV_BLEND_MODE_PATH_TRACE;
+  if (!pathTrace &&
+    (!vtkFerroVolumeSettings::ToFvBlend(this->BlendMode, blend) ||
+      blend == FV_BLEND_MODE_ISOSURFACE || blend == FV_BLEND_MODE_SLICE))
   {
     vtkErrorMacro(<< "blend mode " << this->BlendMode
                   << " is not supported by vtkFerroUnstructuredVolumeMapper (composite, "
@@ -358,6 +401,22 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   if (!req.ForViewport(ren, vol, win))
   {
     return;
+  }
+  // Path tracing: its settings, and for a progressive render what is left of its budget.
+  const vtkFerroVolumeRefinement::Settings refining = vtkFerroVolumeSettings::Refining(this);
+  double traceBudget = 0.0;
+  if (pathTrace)
+  {
+    if (!in->Refinement.BeginTracing(refining, win, *in->Slot.Renderer, report, traceBudget) ||
+      !in->Settings.SetUpPathTracing(this, ren, vol, *in->Slot.Renderer, traceBudget, report))
+    {
+      vtkErrorMacro(<< report.GetError());
+      return;
+    }
+  }
+  else
+  {
+    in->Refinement.Stop();
   }
   FvRenderParams params;
   if (!vtkFerroVolumeCall(
@@ -393,4 +452,21 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   this->LastRenderDrew = 1;
+  if (pathTrace && in->Refinement.IsTracing())
+  {
+    // Refine while the accumulation is short of SamplesPerPixel.
+    unsigned int samples = 0;
+    bool stalled = false;
+    if (!in->Refinement.EndTracing(
+          refining, win, req.RenderW, req.RenderH, *in->Slot.Renderer, report, samples, stalled))
+    {
+      vtkErrorMacro(<< report.GetError());
+      return;
+    }
+    if (stalled && report.FirstTime("restarts"))
+    {
+      vtkWarningMacro(<< vtkFerroVolumeRefinement::StalledMessage(samples));
+    }
+    this->LastRenderProgressive = 1;
+  }
 }

@@ -29,10 +29,20 @@
  * vtkGPUVolumeRayCastMapper's does, each ray segment by its function of that gradient's
  * magnitude at the segment's middle. A 2D transfer function is refused with an error naming
  * it. Errors from ferrovol reach vtkErrorMacro with its message.
+ *
+ * Path tracing (SetRenderModeToPathTrace): the mesh as a scattering medium, as
+ * vtkFerroVolumeMapper path traces image data, with the same settings and meaning
+ * (SamplesPerPixel, InteractiveSamplesPerPixel, PathTracingBounces, SecondaryRays, the
+ * progressive refinement and its time budget, the preview denoiser, the environment light
+ * and background; the property's ScatteringAnisotropy): extinction the scalar opacity per
+ * ScalarOpacityUnitDistance (the ray caster's attenuation), albedo the colour,
+ * Henyey-Greenstein scattering. In a window whose interactor runs timers the view refines
+ * itself toward SamplesPerPixel while it rests; otherwise a still render traces them all.
  */
 #ifndef vtkFerroUnstructuredVolumeMapper_h
 #define vtkFerroUnstructuredVolumeMapper_h
 
+#include "vtkFerroVolumeEnums.h"  // For the mode constants
 #include "vtkFerroVolumeModule.h" // For export macro
 #include "vtkUnstructuredGridVolumeMapper.h"
 #include "vtkVolumeMapper.h" // For the blend mode numbers
@@ -44,6 +54,8 @@ public:
   static vtkFerroUnstructuredVolumeMapper* New();
   vtkTypeMacro(vtkFerroUnstructuredVolumeMapper, vtkUnstructuredGridVolumeMapper);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  vtkFerroVolumeEnumsMacro;
 
   ///@{
   /**
@@ -61,10 +73,79 @@ public:
   void SetBlendModeToAdditive() { this->SetBlendMode(vtkVolumeMapper::ADDITIVE_BLEND); }
   ///@}
 
+  ///@{
   /**
-   * Whether the last Render drew the mesh (0 after an error or before the first render).
+   * RENDER_MODE_RAY_CAST (the default): ray casting in the blend mode. RENDER_MODE_PATH_TRACE:
+   * progressive Monte Carlo path tracing of the mesh (the blend mode is not used).
+   */
+  vtkSetClampMacro(RenderMode, int, RENDER_MODE_RAY_CAST, RENDER_MODE_PATH_TRACE);
+  vtkGetMacro(RenderMode, int);
+  void SetRenderModeToRayCast() { this->SetRenderMode(RENDER_MODE_RAY_CAST); }
+  void SetRenderModeToPathTrace() { this->SetRenderMode(RENDER_MODE_PATH_TRACE); }
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing, as vtkFerroVolumeMapper's settings of the same names: paths per pixel the
+   * accumulation converges to (default 64), paths an interactive render adds when not
+   * progressive (default 1), scattering events per path (default 64), paths sharing a
+   * camera ray (default 1), the preview denoiser (PathTracingDenoise, default off; until
+   * PathTracingDenoiseUntil paths, default 16), ProgressiveMode (default AUTOMATIC) and a
+   * progressive render's PathTracingTimeBudget (0: 1/DesiredUpdateRate, at most 0.1 s).
+   */
+  vtkSetClampMacro(SamplesPerPixel, int, 1, 1000000);
+  vtkGetMacro(SamplesPerPixel, int);
+  vtkSetClampMacro(InteractiveSamplesPerPixel, int, 1, 4096);
+  vtkGetMacro(InteractiveSamplesPerPixel, int);
+  vtkSetClampMacro(PathTracingBounces, int, 0, 100000);
+  vtkGetMacro(PathTracingBounces, int);
+  vtkSetClampMacro(SecondaryRays, int, 1, 4096);
+  vtkGetMacro(SecondaryRays, int);
+  vtkSetMacro(PathTracingDenoise, vtkTypeBool);
+  vtkGetMacro(PathTracingDenoise, vtkTypeBool);
+  vtkBooleanMacro(PathTracingDenoise, vtkTypeBool);
+  vtkSetClampMacro(PathTracingDenoiseUntil, int, 0, 1000000);
+  vtkGetMacro(PathTracingDenoiseUntil, int);
+  vtkSetClampMacro(ProgressiveMode, int, PROGRESSIVE_AUTOMATIC, PROGRESSIVE_OFF);
+  vtkGetMacro(ProgressiveMode, int);
+  void SetProgressiveModeToAutomatic() { this->SetProgressiveMode(PROGRESSIVE_AUTOMATIC); }
+  void SetProgressiveModeToOn() { this->SetProgressiveMode(PROGRESSIVE_ON); }
+  void SetProgressiveModeToOff() { this->SetProgressiveMode(PROGRESSIVE_OFF); }
+  vtkSetClampMacro(PathTracingTimeBudget, double, 0.0, 3600.0);
+  vtkGetMacro(PathTracingTimeBudget, double);
+  ///@}
+
+  ///@{
+  /**
+   * The environment that lights path-traced meshes, as vtkFerroVolumeMapper's: an image file
+   * (EnvironmentMap; none: the procedural sky), its up direction, azimuth and intensity, and
+   * whether it is the background (EnvironmentBackground, default off).
+   */
+  vtkSetStringMacro(EnvironmentMap);
+  vtkGetStringMacro(EnvironmentMap);
+  vtkSetVector3Macro(EnvironmentUp, double);
+  vtkGetVector3Macro(EnvironmentUp, double);
+  vtkSetMacro(EnvironmentAzimuth, double);
+  vtkGetMacro(EnvironmentAzimuth, double);
+  vtkSetClampMacro(EnvironmentIntensity, double, 0.0, 1.0e6);
+  vtkGetMacro(EnvironmentIntensity, double);
+  vtkSetClampMacro(EnvironmentBackground, vtkTypeBool, 0, 1);
+  vtkGetMacro(EnvironmentBackground, vtkTypeBool);
+  vtkBooleanMacro(EnvironmentBackground, vtkTypeBool);
+  ///@}
+
+  /**
+   * Path tracing: the paths per pixel every pixel has (0 before the first path-traced
+   * render, or -1 without a renderer).
+   */
+  int GetAccumulatedSamples();
+
+  /**
+   * Whether the last Render drew the mesh (0 after an error or before the first render),
+   * and whether it path traced within a time budget (progressive).
    */
   vtkGetMacro(LastRenderDrew, int);
+  vtkGetMacro(LastRenderProgressive, int);
 
   ///@{
   /**
@@ -90,7 +171,22 @@ protected:
   ~vtkFerroUnstructuredVolumeMapper() override;
 
   int LastRenderDrew = 0;
+  int LastRenderProgressive = 0;
   int MeshUploadCount = 0;
+  int RenderMode = RENDER_MODE_RAY_CAST;
+  int SamplesPerPixel = 64;
+  int InteractiveSamplesPerPixel = 1;
+  int PathTracingBounces = 64;
+  int SecondaryRays = 1;
+  vtkTypeBool PathTracingDenoise = 0;
+  int PathTracingDenoiseUntil = 16;
+  int ProgressiveMode = PROGRESSIVE_AUTOMATIC;
+  double PathTracingTimeBudget = 0.0;
+  char* EnvironmentMap = nullptr;
+  double EnvironmentUp[3] = { 0.0, 1.0, 0.0 };
+  double EnvironmentAzimuth = 0.0;
+  double EnvironmentIntensity = 1.0;
+  vtkTypeBool EnvironmentBackground = 0;
   int TableUploadCount = 0;
 
 private:

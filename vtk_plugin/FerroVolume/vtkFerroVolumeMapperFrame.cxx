@@ -152,38 +152,21 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   // validation.
   this->CloneInput(image, 0);
   // Progressive path tracing: what is left of the render's budget for the tracing.
-  const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
-  const bool progressive = pathTrace && in->Refinement.IsProgressive(this->ProgressiveMode, win);
-  if (!progressive)
-  {
-    in->Refinement.Stop();
-  }
-  // The preview is denoised while the accumulation is short of PathTracingDenoiseUntil, as
-  // it is after a change (which interactive renders usually follow).
-  const uint32_t denoiseUntil = vtkFerroVolumeSettings::DenoiseUntil(this);
+  const vtkFerroVolumeRefinement::Settings refining = in->Settings.Refining(this);
   double traceBudget = 0.0;
-  // (restarts of the accumulation before this render: the refinement stops when the renders
-  // it asks for keep starting over)
-  FvStats statsBefore{};
-  if (progressive && !in->Stats(statsBefore))
+  if (this->RenderMode == RENDER_MODE_PATH_TRACE)
   {
-    vtkErrorMacro(<< "the renderer's counters are unavailable: " << fv_last_error());
-    return;
-  }
-  if (progressive)
-  {
-    uint32_t before = 0;
-    if (!vtkFerroVolumeCall("count the accumulated paths", report,
-          [&] { before = in->Slot.Renderer->accumulated_samples(); }))
+    if (!in->Refinement.BeginTracing(refining, win, *in->Slot.Renderer, report, traceBudget))
     {
       vtkErrorMacro(<< report.GetError());
       return;
     }
-    const bool denoised = this->PathTracingDenoise ||
-      (denoiseUntil > 0 && (before < denoiseUntil || win->GetDesiredUpdateRate() > 1.0));
-    traceBudget = in->Refinement.TraceBudget(
-      vtkFerroVolumeRefinement::FrameBudget(this->PathTracingTimeBudget, win), denoised);
   }
+  else
+  {
+    in->Refinement.Stop();
+  }
+  const bool progressive = this->RenderMode == RENDER_MODE_PATH_TRACE && in->Refinement.IsTracing();
   in->Settings.SetIntermixing(multi != nullptr);
   switch (
     in->Settings.Apply(this, ren, main, in->Input, *in->Slot.Renderer, traceBudget, report))
@@ -326,29 +309,17 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   if (progressive)
   {
     // Refine while the accumulation is short of SamplesPerPixel.
-    uint32_t samples = 0;
-    if (!vtkFerroVolumeCall("count the accumulated paths", report,
-          [&] { samples = in->Slot.Renderer->accumulated_samples(); }))
+    unsigned int samples = 0;
+    bool stalled = false;
+    if (!in->Refinement.EndTracing(
+          refining, win, req.RenderW, req.RenderH, *in->Slot.Renderer, report, samples, stalled))
     {
       vtkErrorMacro(<< report.GetError());
-      in->Refinement.Stop();
       return;
     }
-    const uint32_t target = static_cast<uint32_t>(this->SamplesPerPixel);
-    in->Refinement.End(samples < target, this->PathTracingDenoise || samples < denoiseUntil,
-      req.RenderW, req.RenderH);
-    FvStats statsAfter{};
-    const bool restarted =
-      !in->Stats(statsAfter) || statsAfter.accumulation_restarts != statsBefore.accumulation_restarts;
-    if (!in->Refinement.Continue(win, samples, target, restarted) &&
-      report.FirstTime("restarts"))
+    if (stalled && report.FirstTime("restarts"))
     {
-      vtkWarningMacro(<< "path tracing starts over at every render (something the image "
-                         "depends on changes each time, such as opaque geometry moved on "
-                         "every render), so the view stops refining itself at "
-                      << samples
-                      << " paths per pixel; render with ProgressiveModeToOff for "
-                         "SamplesPerPixel paths");
+      vtkWarningMacro(<< vtkFerroVolumeRefinement::StalledMessage(samples));
     }
     this->LastRenderProgressive = 1;
   }

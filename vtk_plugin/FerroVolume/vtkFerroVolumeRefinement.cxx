@@ -2,7 +2,9 @@
 
 #include "vtkCallbackCommand.h"
 #include "vtkCommand.h"
+#include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeEnums.h"
+#include "vtkFerroVolumeReport.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderWindowInteractor.h"
 
@@ -174,4 +176,57 @@ void vtkFerroVolumeRefinement::OnTimer(vtkObject*, unsigned long, void* self, vo
     // (nothing of `r` is used after this: the render may end the mapper)
     iren->Render();
   }
+}
+
+bool vtkFerroVolumeRefinement::BeginTracing(const Settings& s, vtkRenderWindow* win,
+  ferrovol::Renderer& renderer, vtkFerroVolumeReport& report, double& traceBudget)
+{
+  traceBudget = 0.0;
+  this->Tracing = this->IsProgressive(s.Mode, win);
+  if (!this->Tracing)
+  {
+    this->Stop();
+    return true;
+  }
+  uint32_t before = 0;
+  if (!vtkFerroVolumeCall("count the accumulated paths", report, [&] {
+        before = renderer.accumulated_samples();
+        this->RestartsBefore = renderer.stats().accumulation_restarts;
+      }))
+  {
+    this->Tracing = false;
+    return false;
+  }
+  const bool denoised = s.Denoise ||
+    (s.DenoiseUntil > 0 && (before < s.DenoiseUntil || win->GetDesiredUpdateRate() > 1.0));
+  traceBudget = this->TraceBudget(FrameBudget(s.Budget, win), denoised);
+  return true;
+}
+
+bool vtkFerroVolumeRefinement::EndTracing(const Settings& s, vtkRenderWindow* win, int width,
+  int height, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report, unsigned int& samples,
+  bool& stalled)
+{
+  stalled = false;
+  uint64_t restarts = 0;
+  if (!vtkFerroVolumeCall("count the accumulated paths", report, [&] {
+        samples = renderer.accumulated_samples();
+        restarts = renderer.stats().accumulation_restarts;
+      }))
+  {
+    this->Stop();
+    return false;
+  }
+  this->End(samples < s.Target, s.Denoise || samples < s.DenoiseUntil, width, height);
+  stalled = !this->Continue(win, samples, s.Target, restarts != this->RestartsBefore);
+  return true;
+}
+
+std::string vtkFerroVolumeRefinement::StalledMessage(unsigned int samples)
+{
+  return "path tracing starts over at every render (something the image depends on changes "
+         "each time, such as opaque geometry moved on every render), so the view stops "
+         "refining itself at " +
+    std::to_string(samples) +
+    " paths per pixel; render with ProgressiveModeToOff for SamplesPerPixel paths";
 }

@@ -11,8 +11,15 @@
 #include "vtkWeakPointer.h"
 
 #include <chrono>
+#include <cstdint>
+#include <string>
 
+namespace ferrovol
+{
+class Renderer;
+}
 class vtkCallbackCommand;
+class vtkFerroVolumeReport;
 class vtkObject;
 class vtkRenderWindow;
 class vtkRenderWindowInteractor;
@@ -69,6 +76,37 @@ public:
   // Cancels the pending timer and stops observing the interactor.
   void Stop();
 
+  // A mapper's path tracing settings as the refinement reads them: ProgressiveMode,
+  // PathTracingTimeBudget, PathTracingDenoise, the paths below which the preview is
+  // denoised (vtkFerroVolumeSettings::DenoiseUntil) and SamplesPerPixel.
+  struct Settings
+  {
+    int Mode = 0;
+    double Budget = 0.0;
+    bool Denoise = false;
+    uint32_t DenoiseUntil = 0;
+    uint32_t Target = 1;
+  };
+
+  // A path-traced render into `win`, after Begin: whether it is progressive (IsProgressive;
+  // if not, the refinement stops) and then the seconds its tracing may take (TraceBudget;
+  // `traceBudget` stays 0 otherwise), the preview taken as denoised while the accumulation
+  // is short of DenoiseUntil or the window renders interactively. False when `renderer`
+  // cannot count its paths (the reason in `report`).
+  bool BeginTracing(const Settings& s, vtkRenderWindow* win, ferrovol::Renderer& renderer,
+    vtkFerroVolumeReport& report, double& traceBudget);
+  // The warning for a refinement that stalled at `samples` paths per pixel.
+  static std::string StalledMessage(unsigned int samples);
+  // Whether the render BeginTracing began is progressive.
+  bool IsTracing() const { return this->Tracing; }
+  // After that progressive render of `width` × `height` pixels was drawn: End, then
+  // Continue toward Target with the paths it has (`samples`). False when `renderer` cannot
+  // count them (the reason in `report`; the refinement stops); `stalled` when it stops
+  // because every render starts the accumulation over.
+  bool EndTracing(const Settings& s, vtkRenderWindow* win, int width, int height,
+    ferrovol::Renderer& renderer, vtkFerroVolumeReport& report, unsigned int& samples,
+    bool& stalled);
+
 private:
   using Clock = std::chrono::steady_clock;
 
@@ -92,6 +130,10 @@ private:
   // row started the accumulation over.
   bool TimerRender = false;
   int Stalled = 0;
+  // Whether the render under way traces progressively, and the accumulation's restarts
+  // before it.
+  bool Tracing = false;
+  uint64_t RestartsBefore = 0;
 
   vtkWeakPointer<vtkRenderWindowInteractor> Probed;
   bool ProbedCanRefine = false;

@@ -674,7 +674,7 @@ bool vtkFerroVolumeSettings::ApplyShading(vtkObject* self, vtkRenderer* ren,
   params.shade = prop->GetShade(0) != 0 && params.blend_mode == FV_BLEND_MODE_COMPOSITE;
   SetMaterial(prop, ren, params);
   std::vector<FvLight> lights;
-  if (params.shade)
+  if (params.shade || params.blend_mode == FV_BLEND_MODE_PATH_TRACE)
   {
     lights = SceneLights(self, ren, report);
   }
@@ -733,11 +733,6 @@ void vtkFerroVolumeSettings::WarnUnsupported(
   }
 }
 
-uint32_t vtkFerroVolumeSettings::DenoiseUntil(vtkFerroVolumeMapper* self)
-{
-  return static_cast<uint32_t>(
-    std::min(self->GetPathTracingDenoiseUntil(), self->GetSamplesPerPixel()));
-}
 
 void vtkFerroVolumeSettings::Reset()
 {

@@ -7,6 +7,7 @@
 #define vtkFerroVolumeSettings_h
 
 #include "ferrovol.hpp"
+#include "vtkFerroVolumeRefinement.h"
 
 #include <string>
 
@@ -63,8 +64,8 @@ public:
   // two-sided lighting.
   static void SetMaterial(vtkVolumeProperty* prop, vtkRenderer* ren, FvRenderParams& params);
   // For a mapper whose only shaded mode is composite (params.blend_mode set): Shade from the
-  // property, the material, and the renderer's lights given to `renderer` when shaded (none
-  // otherwise). `self` warns, once, past FV_MAX_LIGHTS lights.
+  // property, the material, and the renderer's lights given to `renderer` when shaded or
+  // path traced (none otherwise). `self` warns, once, past FV_MAX_LIGHTS lights.
   static bool ApplyShading(vtkObject* self, vtkRenderer* ren, vtkVolumeProperty* prop,
     FvRenderParams& params, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
   static int SetUpClippingPlanes(
@@ -72,7 +73,18 @@ public:
 
   // Paths per pixel below which the path-traced image shown is denoised as a preview:
   // PathTracingDenoiseUntil, never past SamplesPerPixel (a converged image is unfiltered).
-  static uint32_t DenoiseUntil(vtkFerroVolumeMapper* self);
+  // (Mapper: vtkFerroVolumeMapper or vtkFerroUnstructuredVolumeMapper, which path trace
+  // with the same settings.)
+  template <class Mapper>
+  static uint32_t DenoiseUntil(Mapper* self);
+  // The mapper's path tracing settings as its refinement reads them.
+  template <class Mapper>
+  static vtkFerroVolumeRefinement::Settings Refining(Mapper* self);
+  // Gives the renderer the mapper's path tracing settings and environment (the surface
+  // model for an image volume; meshes scatter by Henyey-Greenstein alone).
+  template <class Mapper>
+  bool SetUpPathTracing(Mapper* self, vtkRenderer* ren, vtkVolume* vol,
+    ferrovol::Renderer& renderer, double traceBudget, vtkFerroVolumeReport& report);
 
   // Whether the last frame shows the environment behind the volume: it then covers the
   // whole viewport.
@@ -116,14 +128,13 @@ private:
   void SetUpQuadrature(vtkFerroVolumeMapper* self, vtkFerroVolumeReport& report);
   // The modes (vtkFerroVolumeSettingsModes.cxx): the environment light, path tracing and
   // the isosurfaces.
-  bool UseEnvironment(vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer);
+  template <class Mapper>
+  bool UseEnvironment(Mapper* self, ferrovol::Renderer& renderer);
   // AutoAdjustSampleDistances: the factor (1, 1/2, 1/5 or 1/10) the smallest world spacing
   // is divided by to make the step, from the time the last render took against the time
   // allocated to this one (vtkVolume::GetAllocatedRenderTime, from the window's
   // DesiredUpdateRate), as vtkOpenGLGPUVolumeRayCastMapper::ComputeReductionFactor sets it.
   double UpdateReductionFactor(vtkFerroVolumeMapper* self, double allocatedTime);
-  bool SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren, vtkVolume* vol,
-    ferrovol::Renderer& renderer, double traceBudget, vtkFerroVolumeReport& report);
   Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol, int components,
     ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 

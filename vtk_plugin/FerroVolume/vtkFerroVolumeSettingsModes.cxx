@@ -5,6 +5,7 @@
 
 #include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
+#include "vtkFerroUnstructuredVolumeMapper.h"
 #include "vtkFerroVolumeContext.h"
 #include "vtkFerroVolumeMapper.h"
 #include "vtkFerroVolumeReport.h"
@@ -23,8 +24,8 @@
 //------------------------------------------------------------------------------------------
 // Gives the renderer the mapper's environment when the map or its placement changed since
 // the last frame; false (said once per setting with vtkErrorMacro) when it cannot be used.
-bool vtkFerroVolumeSettings::UseEnvironment(
-  vtkFerroVolumeMapper* self, ferrovol::Renderer& renderer)
+template <class Mapper>
+bool vtkFerroVolumeSettings::UseEnvironment(Mapper* self, ferrovol::Renderer& renderer)
 {
   const char* file = self->GetEnvironmentMap();
   const bool sky = !file || !*file;
@@ -52,14 +53,57 @@ bool vtkFerroVolumeSettings::UseEnvironment(
   return this->EnvironmentKey.rfind("failed:", 0) != 0;
 }
 
+template <class Mapper>
+uint32_t vtkFerroVolumeSettings::DenoiseUntil(Mapper* self)
+{
+  return static_cast<uint32_t>(
+    std::min(self->GetPathTracingDenoiseUntil(), self->GetSamplesPerPixel()));
+}
+
+template <class Mapper>
+vtkFerroVolumeRefinement::Settings vtkFerroVolumeSettings::Refining(Mapper* self)
+{
+  vtkFerroVolumeRefinement::Settings s;
+  s.Mode = self->GetProgressiveMode();
+  s.Budget = self->GetPathTracingTimeBudget();
+  s.Denoise = self->GetPathTracingDenoise() != 0;
+  s.DenoiseUntil = DenoiseUntil(self);
+  s.Target = static_cast<uint32_t>(self->GetSamplesPerPixel());
+  return s;
+}
+
+namespace
+{
+// The surface model of an image volume's path tracing: the hybrid model's threshold or
+// stochastic blend, the scattering regions, attenuation and the BSDF.
+void SetSurfaceModel(vtkFerroVolumeMapper* self, FvPathTraceParams& pt)
+{
+  const double psi = self->GetGradientThreshold();
+  pt.gradient_threshold = psi >= static_cast<double>(FLT_MAX)
+    ? std::numeric_limits<float>::infinity()
+    : static_cast<float>(psi);
+  pt.stochastic_blend = static_cast<float>(std::min(self->GetStochasticBlend(), 1e30));
+  pt.scatter_regions = static_cast<uint32_t>(self->GetScatterRegions());
+  pt.attenuation = self->GetAttenuation() != 0;
+  pt.roughness = static_cast<float>(self->GetBsdfRoughness());
+  pt.fresnel = static_cast<float>(self->GetBsdfFresnel());
+  pt.transmission = static_cast<float>(self->GetTransmission());
+  pt.cone_angle = static_cast<float>(self->GetTransmissionConeAngle());
+}
+
+// Meshes scatter by Henyey-Greenstein everywhere (the defaults).
+void SetSurfaceModel(vtkFerroUnstructuredVolumeMapper*, FvPathTraceParams&) {}
+}
+
 // Gives the renderer the path tracing settings: the property's ScatteringAnisotropy, the
 // mapper's budget (progressive: `traceBudget` seconds of paths toward SamplesPerPixel;
 // otherwise the still budget, or InteractiveSamplesPerPixel per frame while the window
 // renders interactively), the preview denoising (until PathTracingDenoiseUntil paths, never
-// past SamplesPerPixel), bounces and environment (weight 1; background when
-// EnvironmentBackground is on).
-bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRenderer* ren,
-  vtkVolume* vol, ferrovol::Renderer& renderer, double traceBudget, vtkFerroVolumeReport& report)
+// past SamplesPerPixel), bounces, the surface model and environment (weight 1; background
+// when EnvironmentBackground is on).
+template <class Mapper>
+bool vtkFerroVolumeSettings::SetUpPathTracing(Mapper* self, vtkRenderer* ren, vtkVolume* vol,
+  ferrovol::Renderer& renderer, double traceBudget, vtkFerroVolumeReport& report)
 {
   FvPathTraceParams pt;
   if (!vtkFerroVolumeCall("use the path tracing settings", report,
@@ -87,18 +131,8 @@ bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper* self, vtkRen
   }
   pt.denoise_until = DenoiseUntil(self);
   pt.max_bounces = static_cast<uint32_t>(self->GetPathTracingBounces());
-  const double psi = self->GetGradientThreshold();
-  pt.gradient_threshold = psi >= static_cast<double>(FLT_MAX)
-    ? std::numeric_limits<float>::infinity()
-    : static_cast<float>(psi);
-  pt.stochastic_blend = static_cast<float>(std::min(self->GetStochasticBlend(), 1e30));
-  pt.scatter_regions = static_cast<uint32_t>(self->GetScatterRegions());
-  pt.attenuation = self->GetAttenuation() != 0;
+  SetSurfaceModel(self, pt);
   pt.denoise = self->GetPathTracingDenoise() != 0;
-  pt.roughness = static_cast<float>(self->GetBsdfRoughness());
-  pt.fresnel = static_cast<float>(self->GetBsdfFresnel());
-  pt.transmission = static_cast<float>(self->GetTransmission());
-  pt.cone_angle = static_cast<float>(self->GetTransmissionConeAngle());
   // (|g| = 1 is a delta, which a Monte Carlo estimate cannot sample: clamp inside)
   pt.anisotropy =
     std::max(-0.99f, std::min(0.99f, vol->GetProperty()->GetScatteringAnisotropy()));
@@ -249,3 +283,13 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
   }
   return Result::Ready;
 }
+
+// The two mappers that path trace.
+template vtkFerroVolumeRefinement::Settings vtkFerroVolumeSettings::Refining(
+  vtkFerroVolumeMapper*);
+template vtkFerroVolumeRefinement::Settings vtkFerroVolumeSettings::Refining(
+  vtkFerroUnstructuredVolumeMapper*);
+template bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper*, vtkRenderer*,
+  vtkVolume*, ferrovol::Renderer&, double, vtkFerroVolumeReport&);
+template bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroUnstructuredVolumeMapper*,
+  vtkRenderer*, vtkVolume*, ferrovol::Renderer&, double, vtkFerroVolumeReport&);

@@ -3,7 +3,8 @@
 quantity ferrovol integrates) on tests/regression/meshes.py's tetrahedralised wavelet,
 mixed mesh and prism honeycomb (VTK gets the mixed and prism meshes split into tetrahedra,
 ferrovol gets them as they are and the mixed mesh also as VTK's split), point and cell
-scalars, opaque geometry; the blend modes VTK's mappers lack draw; Shade and a gradient
+scalars, opaque geometry; the blend modes VTK's mappers lack draw; path tracing (a still
+render, and a view that refines itself); Shade and a gradient
 opacity apply to the mesh as vtkGPUVolumeRayCastMapper applies them to the image it came
 from; clipping planes and the array selection apply; bad input (an empty grid, unsupported
 cells, two components, no scalars) is an ErrorEvent naming why, not a crash, and a good
@@ -243,6 +244,81 @@ class Uploads(unittest.TestCase):
         scene.volume.GetProperty().GetRGBTransferFunction().AddRGBPoint(100.0, 1.0, 0.0, 0.0)
         scene.render()
         self.assertEqual((mapper.GetMeshUploadCount(), mapper.GetTableUploadCount()), (2, 2))
+
+
+class PathTraced(unittest.TestCase):
+    """SetRenderModeToPathTrace: the mesh as a scattering medium, with vtkFerroVolumeMapper's
+    path tracing settings. Images: build/vtk/test-images/unstructured-pathtrace-*.png."""
+    @classmethod
+    def setUpClass(cls):
+        cls.grid = meshes.tet_wavelet(6)
+
+    def scene(self, spp, mode):
+        mapper = ferrovol.vtkFerroUnstructuredVolumeMapper()
+        mapper.SetRenderModeToPathTrace()
+        mapper.SetSamplesPerPixel(spp)
+        getattr(mapper, "SetProgressiveModeTo" + mode)()
+        errors = Errors(mapper)
+        return Scene(mapper, self.grid, wavelet_property(), size=(64, 64), camera=view), errors
+
+    def test_still_render_traces_every_path(self):
+        """Not progressive: one render traces SamplesPerPixel paths; the medium scatters the
+        sky and the headlight (lit, and not the ray-cast image); changing the camera starts
+        over."""
+        s, errors = self.scene(16, "Off")
+        traced = s.render()
+        self.assertEqual(errors.messages, [])
+        self.assertTrue(s.mapper.GetLastRenderDrew())
+        self.assertFalse(s.mapper.GetLastRenderProgressive())
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 16)
+        cast, _ = render(ferrovol.vtkFerroUnstructuredVolumeMapper(), self.grid, size=(64, 64))
+        fvtest.save("unstructured-pathtrace-still", traced, cast)
+        fvtest.log("path-traced mesh: coverage %.2f, mean %.1f levels where drawn; ray cast "
+                   "%.2f" % (coverage(traced), traced[traced.max(axis=2) > 4].mean(),
+                             coverage(cast)))
+        self.assertGreater(coverage(traced), 0.2)
+        self.assertGreater(traced[traced.max(axis=2) > 4].mean(), 10.0)
+        self.assertGreater(np.abs(traced - cast).mean(), 2.0)
+        s.renderer.GetActiveCamera().Azimuth(10.0)
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 16)
+
+    def test_view_refines_itself(self):
+        """Progressive, in a window whose application runs the interactor's timers: each
+        render traces within its budget, and the timers render again until the accumulation
+        holds SamplesPerPixel, then stop."""
+        s, errors = self.scene(3, "On")
+        s.mapper.SetPathTracingTimeBudget(0.05)
+        iren = vtk.vtkGenericRenderWindowInteractor()
+        iren.SetInteractorStyle(None)
+        iren.SetRenderWindow(s.window)
+        live = set()
+
+        @vtk.calldata_type(vtk.VTK_INT)
+        def created(_obj, _event, timer):
+            live.add(timer)
+
+        @vtk.calldata_type(vtk.VTK_INT)
+        def destroyed(_obj, _event, timer):
+            live.discard(timer)
+
+        iren.AddObserver("CreateTimerEvent", created)
+        iren.AddObserver("DestroyTimerEvent", destroyed)
+        iren.Initialize()
+        counts = []
+        s.window.AddObserver("EndEvent",
+                             lambda *_: counts.append(s.mapper.GetAccumulatedSamples()))
+        s.window.Render()
+        while live and len(counts) < 1000:
+            iren.InvokeEvent("TimerEvent", live.pop())
+        fvtest.log("a path-traced mesh refining itself: paths per pixel after each render %s"
+                   % counts)
+        self.assertEqual(errors.messages, [])
+        self.assertTrue(s.mapper.GetLastRenderProgressive())
+        self.assertEqual(counts[-1], 3)
+        self.assertGreater(len(counts), 1)
+        self.assertTrue(all(b >= a for a, b in zip(counts, counts[1:])))
+        self.assertEqual(live, set())
 
 
 class BadInput(unittest.TestCase):
