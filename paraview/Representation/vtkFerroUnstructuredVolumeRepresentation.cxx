@@ -110,6 +110,61 @@ void vtkFerroUnstructuredVolumeRepresentation::UpdateMapperParameters()
 }
 
 //------------------------------------------------------------------------------------------
+void vtkFerroUnstructuredVolumeRepresentation::SetRenderMode(int mode)
+{
+  this->FerroMapper->SetRenderMode(mode);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetSamplesPerPixel(int samples)
+{
+  this->FerroMapper->SetSamplesPerPixel(samples);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetPathTracingBounces(int bounces)
+{
+  this->FerroMapper->SetPathTracingBounces(bounces);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetPathTracingDenoise(int on)
+{
+  this->FerroMapper->SetPathTracingDenoise(on);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetPathTracingDenoiseUntil(int samples)
+{
+  this->FerroMapper->SetPathTracingDenoiseUntil(samples);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetProgressiveMode(int mode)
+{
+  this->FerroMapper->SetProgressiveMode(mode);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetPathTracingTimeBudget(double seconds)
+{
+  this->FerroMapper->SetPathTracingTimeBudget(seconds);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetSecondaryRays(int rays)
+{
+  this->FerroMapper->SetSecondaryRays(rays);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetEnvironmentMap(const char* file)
+{
+  this->FerroMapper->SetEnvironmentMap(file);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetEnvironmentBackground(int on)
+{
+  this->FerroMapper->SetEnvironmentBackground(on);
+}
+
+int vtkFerroUnstructuredVolumeRepresentation::GetFerrovolAccumulatedSamples()
+{
+  return this->FerroMapper->GetAccumulatedSamples();
+}
+
 int vtkFerroUnstructuredVolumeRepresentation::GetFerrovolLastRenderDrew()
 {
   return this->FerroMapper->GetLastRenderDrew();

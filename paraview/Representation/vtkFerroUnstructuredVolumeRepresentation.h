@@ -22,10 +22,12 @@
  *   refused with an error and the mode stays. Under MPI the ranks' images are composited in
  *   visibility order, which is exact for composite only; the other modes give a warning
  *   there.
+ * - Path tracing (FerrovolRenderMode and the settings "Ferrovol Volume" of image data has
+ *   for it), forwarded to the mapper.
  *
  * What the mapper refuses (more than one component, a separate opacity array, a 2D
- * transfer function or a gradient opacity, cells other than linear and quadratic 3D
- * cells) is reported by vtkErrorMacro, naming why, and nothing is drawn.
+ * transfer function, cells other than linear and quadratic 3D cells) is reported by
+ * vtkErrorMacro, naming why, and nothing is drawn.
  */
 
 #ifndef vtkFerroUnstructuredVolumeRepresentation_h
@@ -79,6 +81,26 @@ public:
   void SetDiffuse(double value);
   void SetSpecular(double value);
   void SetSpecularPower(double value);
+  ///@}
+
+  ///@{
+  /**
+   * Path tracing, as "Ferrovol Volume" of image data has it: the mapper's RenderMode,
+   * SamplesPerPixel, PathTracingBounces, PathTracingDenoise, PathTracingDenoiseUntil,
+   * ProgressiveMode, PathTracingTimeBudget, SecondaryRays, EnvironmentMap and
+   * EnvironmentBackground; and the paths per pixel accumulated (-1 before the first frame).
+   */
+  void SetRenderMode(int mode);
+  void SetSamplesPerPixel(int samples);
+  void SetPathTracingBounces(int bounces);
+  void SetPathTracingDenoise(int on);
+  void SetPathTracingDenoiseUntil(int samples);
+  void SetProgressiveMode(int mode);
+  void SetPathTracingTimeBudget(double seconds);
+  void SetSecondaryRays(int rays);
+  void SetEnvironmentMap(const char* file);
+  void SetEnvironmentBackground(int on);
+  int GetFerrovolAccumulatedSamples();
   ///@}
 
   /**

@@ -6,7 +6,8 @@ ParaView's own "Volume" of the same data, serial and under MPI.
       the grid drawn by "Ferrovol Volume" and by "Volume" with each of its mappers
       (MAPPERS); the multiblock (its blocks merged by the representation, as "Volume" merges
       them) against the single grid; the mesh uploaded once for renders that change only the
-      camera; Shade lights it (drawn, unlike the unshaded image); a three-component array
+      camera; Shade lights it (drawn, unlike the unshaded image); Path Trace draws it as a
+      scattering medium, every path in a still render; a three-component array
       refused (nothing drawn). Writes the references the
       distributed step compares with.
   mpiexec -n N pvbatch --symmetric test_unstructured.py distributed
@@ -180,6 +181,20 @@ def serial(failures):
     if ferrovol_info(disp)["FerrovolLastRenderDrew"] != 1:
         failures.append("ferrovol did not draw the shaded grid")
     T.compare("control: shaded vs unshaded", lit, refs["oblique"], *SAME, failures,
+              expect_fail=True)
+    # Path Trace: the mesh as a scattering medium; pvbatch's still render traces every path
+    # (two per pixel: drawn and lit, and not the ray-cast image)
+    disp.FerrovolRenderMode = "Path Trace"
+    disp.FerrovolSamplesPerPixel = 2
+    traced = shot(view, "ugrid-serial-ferrovol-pathtrace", "oblique")
+    disp.UpdatePropertyInformation()
+    paths = disp.GetProperty("FerrovolAccumulatedSamples").GetData()
+    disp.FerrovolRenderMode = "Ray Cast"
+    T.log("  path traced: %s paths per pixel" % paths)
+    check_drawn(traced, "ferrovol path traced", failures)
+    if paths != 2:
+        failures.append("path tracing accumulated %s paths per pixel, not 2" % paths)
+    T.compare("control: path traced vs ray cast", traced, refs["oblique"], *SAME, failures,
               expect_fail=True)
 
     disp.Representation = "Volume"
