@@ -372,14 +372,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
     for (var bounce = 0u; bounce <= pt.counts.z; bounce = bounce + 1u) {
         let t = free_flight(r, seg.x, seg.y, rng);
         if (t >= seg.y) {
-            if (bounce == 0u) {
-                if (background) {
-                    radiance = env_radiance(r.dir);
-                }
-            } else {
-                let w = power_heuristic(dir_pdf, env_pdf(r.dir));
-                radiance = radiance + beta * w * env_radiance(r.dir);
-            }
+            radiance = radiance + escaped(r.dir, bounce, beta, dir_pdf);
             break;
         }
         if (bounce == 0u) {
@@ -392,12 +385,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
                     let q0 = grid_point(p0);
                     g0 = world_gradient(gradient_at(q0, sample_scalars(q0)), 0u);
                 }
-                var n0 = -r.dir;
-                if (dot(g0, g0) > 1e-20) {
-                    n0 = normalize(g0);
-                    n0 = select(n0, -n0, dot(n0, r.dir) > 0.0);
-                }
-                path_guide = vec4<f32>(n0, t);
+                set_guide(g0, r.dir, t);
             }
         }
         if (bounce == pt.counts.z) {
@@ -477,12 +465,8 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         dir_pdf = en.a;
         r = ray_from(x, wn);
         seg = inner_segment(r);
-        if (bounce >= 3u) {
-            let q = clamp(max(max(beta.x, beta.y), beta.z), 0.05, 1.0);
-            if (rand(rng) >= q) {
-                break;
-            }
-            beta = beta / q;
+        if (!survives(&beta, bounce, rng)) {
+            break;
         }
     }
     return vec4<f32>(radiance, select(hit, 1.0, background));

@@ -167,14 +167,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
             f = fly(r, seg, w, flight_depth(rng), false, rng);
         }
         if (f.tet == NO_HIT) {
-            if (bounce == 0u) {
-                if (background) {
-                    radiance = env_radiance(r.dir);
-                }
-            } else {
-                let mis = power_heuristic(dir_pdf, env_pdf(r.dir));
-                radiance = radiance + beta * mis * env_radiance(r.dir);
-            }
+            radiance = radiance + escaped(r.dir, bounce, beta, dir_pdf);
             break;
         }
         let x = r.origin + f.t * r.dir;
@@ -184,12 +177,7 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
             if (GUIDE && (pt.options.x & PT_FLAG_GUIDE) != 0u) {
                 let gi = gradient_in(load_tet(f.tet), r.index_origin + f.t * r.index_dir);
                 let g0 = (frame.gradient_to_world * vec4<f32>(gi, 0.0)).xyz;
-                var n0 = -r.dir;
-                if (dot(g0, g0) > 1e-20) {
-                    n0 = normalize(g0);
-                    n0 = select(n0, -n0, dot(n0, r.dir) > 0.0);
-                }
-                path_guide = vec4<f32>(n0, f.t);
+                set_guide(g0, r.dir, f.t);
             }
         }
         if (bounce == pt.counts.z) {
@@ -224,12 +212,8 @@ fn trace(camera_ray: Ray, px: vec2<u32>, rng: ptr<function, Rng>, secondary: Rng
         r = ray_from(x, wn);
         seg = clip_interval(r, vec2<f32>(0.0, 3.0e38));
         w = walk_inside(r.index_origin, r.index_dir, f.tet, 0.0, f.s);
-        if (bounce >= 3u) {
-            let q = clamp(max(max(beta.x, beta.y), beta.z), 0.05, 1.0);
-            if (rand(rng) >= q) {
-                break;
-            }
-            beta = beta / q;
+        if (!survives(&beta, bounce, rng)) {
+            break;
         }
     }
     return vec4<f32>(radiance, select(hit, 1.0, background));

@@ -455,17 +455,11 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   if (pathTrace && in->Refinement.IsTracing())
   {
     // Refine while the accumulation is short of SamplesPerPixel.
-    unsigned int samples = 0;
-    bool stalled = false;
     if (!in->Refinement.EndTracing(
-          refining, win, req.RenderW, req.RenderH, *in->Slot.Renderer, report, samples, stalled))
+          refining, this, win, req.RenderW, req.RenderH, *in->Slot.Renderer, report))
     {
       vtkErrorMacro(<< report.GetError());
       return;
-    }
-    if (stalled && report.FirstTime("restarts"))
-    {
-      vtkWarningMacro(<< vtkFerroVolumeRefinement::StalledMessage(samples));
     }
     this->LastRenderProgressive = 1;
   }

@@ -309,17 +309,11 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   if (progressive)
   {
     // Refine while the accumulation is short of SamplesPerPixel.
-    unsigned int samples = 0;
-    bool stalled = false;
     if (!in->Refinement.EndTracing(
-          refining, win, req.RenderW, req.RenderH, *in->Slot.Renderer, report, samples, stalled))
+          refining, this, win, req.RenderW, req.RenderH, *in->Slot.Renderer, report))
     {
       vtkErrorMacro(<< report.GetError());
       return;
-    }
-    if (stalled && report.FirstTime("restarts"))
-    {
-      vtkWarningMacro(<< vtkFerroVolumeRefinement::StalledMessage(samples));
     }
     this->LastRenderProgressive = 1;
   }

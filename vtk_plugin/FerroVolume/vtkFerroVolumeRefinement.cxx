@@ -203,11 +203,11 @@ bool vtkFerroVolumeRefinement::BeginTracing(const Settings& s, vtkRenderWindow* 
   return true;
 }
 
-bool vtkFerroVolumeRefinement::EndTracing(const Settings& s, vtkRenderWindow* win, int width,
-  int height, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report, unsigned int& samples,
-  bool& stalled)
+bool vtkFerroVolumeRefinement::EndTracing(const Settings& s, vtkObject* self,
+  vtkRenderWindow* win, int width, int height, ferrovol::Renderer& renderer,
+  vtkFerroVolumeReport& report)
 {
-  stalled = false;
+  unsigned int samples = 0;
   uint64_t restarts = 0;
   if (!vtkFerroVolumeCall("count the accumulated paths", report, [&] {
         samples = renderer.accumulated_samples();
@@ -218,15 +218,16 @@ bool vtkFerroVolumeRefinement::EndTracing(const Settings& s, vtkRenderWindow* wi
     return false;
   }
   this->End(samples < s.Target, s.Denoise || samples < s.DenoiseUntil, width, height);
-  stalled = !this->Continue(win, samples, s.Target, restarts != this->RestartsBefore);
+  if (!this->Continue(win, samples, s.Target, restarts != this->RestartsBefore) &&
+    report.FirstTime("restarts"))
+  {
+    vtkWarningWithObjectMacro(self, << "path tracing starts over at every render (something "
+                                       "the image depends on changes each time, such as "
+                                       "opaque geometry moved on every render), so the view "
+                                       "stops refining itself at "
+                                    << samples
+                                    << " paths per pixel; render with ProgressiveModeToOff "
+                                       "for SamplesPerPixel paths");
+  }
   return true;
-}
-
-std::string vtkFerroVolumeRefinement::StalledMessage(unsigned int samples)
-{
-  return "path tracing starts over at every render (something the image depends on changes "
-         "each time, such as opaque geometry moved on every render), so the view stops "
-         "refining itself at " +
-    std::to_string(samples) +
-    " paths per pixel; render with ProgressiveModeToOff for SamplesPerPixel paths";
 }

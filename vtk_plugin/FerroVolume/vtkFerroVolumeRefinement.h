@@ -12,7 +12,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <string>
 
 namespace ferrovol
 {
@@ -95,17 +94,14 @@ public:
   // cannot count its paths (the reason in `report`).
   bool BeginTracing(const Settings& s, vtkRenderWindow* win, ferrovol::Renderer& renderer,
     vtkFerroVolumeReport& report, double& traceBudget);
-  // The warning for a refinement that stalled at `samples` paths per pixel.
-  static std::string StalledMessage(unsigned int samples);
   // Whether the render BeginTracing began is progressive.
   bool IsTracing() const { return this->Tracing; }
   // After that progressive render of `width` × `height` pixels was drawn: End, then
-  // Continue toward Target with the paths it has (`samples`). False when `renderer` cannot
-  // count them (the reason in `report`; the refinement stops); `stalled` when it stops
-  // because every render starts the accumulation over.
-  bool EndTracing(const Settings& s, vtkRenderWindow* win, int width, int height,
-    ferrovol::Renderer& renderer, vtkFerroVolumeReport& report, unsigned int& samples,
-    bool& stalled);
+  // Continue toward Target with the paths it has; when it stops because every render starts
+  // the accumulation over, `self` (the mapper) warns once (`report`). False when `renderer`
+  // cannot count the paths (the reason in `report`; the refinement stops).
+  bool EndTracing(const Settings& s, vtkObject* self, vtkRenderWindow* win, int width,
+    int height, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
 private:
   using Clock = std::chrono::steady_clock;

@@ -282,3 +282,36 @@ def compare(name, ours, theirs):
     log("  %-28s SSIM %.4f  PSNR %5.1f dB  (%s: ferrovol | VTK | 4x difference)"
         % (name, s, p, os.path.basename(path)))
     return s, p
+
+
+def timer_interactor(window):
+    """A vtkGenericRenderWindowInteractor on `window` whose one-shot timers the test fires
+    itself (as toolkit embeddings run them): returns it, initialised, and the set of its
+    pending timers (fire them with fire_timers)."""
+    iren = vtk.vtkGenericRenderWindowInteractor()
+    iren.SetInteractorStyle(None)
+    iren.SetRenderWindow(window)
+    live = set()
+
+    @vtk.calldata_type(vtk.VTK_INT)
+    def created(_obj, _event, timer):
+        live.add(timer)
+
+    @vtk.calldata_type(vtk.VTK_INT)
+    def destroyed(_obj, _event, timer):
+        live.discard(timer)
+
+    iren.AddObserver("CreateTimerEvent", created)
+    iren.AddObserver("DestroyTimerEvent", destroyed)
+    iren.Initialize()
+    return iren, live
+
+
+def fire_timers(iren, live, done):
+    """Fires the pending timers, one at a time, until none is left or done() says to stop;
+    returns the most that were pending at once."""
+    most = 0
+    while live and not done():
+        most = max(most, len(live))
+        iren.InvokeEvent("TimerEvent", live.pop())  # a one-shot timer fires once
+    return most

@@ -109,36 +109,12 @@ class Progressive(Scenes):
         destructor leave neither a timer nor an observer."""
         spp = 8
         s = self.scene(path_tracing(spp, 0.02), size=(64, 64))
-        iren = vtk.vtkGenericRenderWindowInteractor()
-        iren.SetInteractorStyle(None)
-        iren.SetRenderWindow(s.window)
-        live = set()
-
-        @vtk.calldata_type(vtk.VTK_INT)
-        def created(_obj, _event, timer):
-            live.add(timer)
-
-        @vtk.calldata_type(vtk.VTK_INT)
-        def destroyed(_obj, _event, timer):
-            live.discard(timer)
-
-        iren.AddObserver("CreateTimerEvent", created)
-        iren.AddObserver("DestroyTimerEvent", destroyed)
-        iren.Initialize()
+        iren, live = fvtest.timer_interactor(s.window)
         counts = []
         s.window.AddObserver("EndEvent",
                              lambda *_: counts.append(s.mapper.GetAccumulatedSamples()))
-
-        def run_timers():
-            most = 0
-            while live and len(counts) < 1000:
-                most = max(most, len(live))
-                timer = live.pop()  # a one-shot timer fires once
-                iren.InvokeEvent("TimerEvent", timer)
-            return most
-
         s.window.Render()
-        most = run_timers()
+        most = fvtest.fire_timers(iren, live, lambda: len(counts) >= 1000)
         refined = list(counts)
         converged = (list(live), iren.HasObserver("TimerEvent"))
         s.renderer.GetActiveCamera().Azimuth(5.0)

@@ -289,28 +289,12 @@ class PathTraced(unittest.TestCase):
         holds SamplesPerPixel, then stop."""
         s, errors = self.scene(3, "On")
         s.mapper.SetPathTracingTimeBudget(0.05)
-        iren = vtk.vtkGenericRenderWindowInteractor()
-        iren.SetInteractorStyle(None)
-        iren.SetRenderWindow(s.window)
-        live = set()
-
-        @vtk.calldata_type(vtk.VTK_INT)
-        def created(_obj, _event, timer):
-            live.add(timer)
-
-        @vtk.calldata_type(vtk.VTK_INT)
-        def destroyed(_obj, _event, timer):
-            live.discard(timer)
-
-        iren.AddObserver("CreateTimerEvent", created)
-        iren.AddObserver("DestroyTimerEvent", destroyed)
-        iren.Initialize()
+        iren, live = fvtest.timer_interactor(s.window)
         counts = []
         s.window.AddObserver("EndEvent",
                              lambda *_: counts.append(s.mapper.GetAccumulatedSamples()))
         s.window.Render()
-        while live and len(counts) < 1000:
-            iren.InvokeEvent("TimerEvent", live.pop())
+        fvtest.fire_timers(iren, live, lambda: len(counts) >= 1000)
         fvtest.log("a path-traced mesh refining itself: paths per pixel after each render %s"
                    % counts)
         self.assertEqual(errors.messages, [])

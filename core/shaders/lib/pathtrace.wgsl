@@ -187,3 +187,39 @@ fn accumulate(idx: u32, path: vec4<f32>, entry: f32) {
     }
     moments[idx] = m;
 }
+
+// The light a path brings back when it leaves the medium along d after `bounce` scattering
+// events, its throughput beta and the density dir_pdf its direction was drawn with: the
+// environment, where the camera ray leaves it only as the background, else weighted
+// against its next-event estimate by multiple importance sampling.
+fn escaped(d: vec3<f32>, bounce: u32, beta: vec3<f32>, dir_pdf: f32) -> vec3<f32> {
+    if (bounce == 0u) {
+        return select(vec3<f32>(0.0), env_radiance(d), (pt.options.x & PT_FLAG_BACKGROUND) != 0u);
+    }
+    return beta * power_heuristic(dir_pdf, env_pdf(d)) * env_radiance(d);
+}
+
+// The denoiser's guide for a camera path's first collision at distance t along d, where
+// the world gradient is g: its direction facing the camera (−d where there is none).
+fn set_guide(g: vec3<f32>, d: vec3<f32>, t: f32) {
+    var n = -d;
+    if (dot(g, g) > 1e-20) {
+        n = normalize(g);
+        n = select(n, -n, dot(n, d) > 0.0);
+    }
+    path_guide = vec4<f32>(n, t);
+}
+
+// Whether a path goes on after scattering event `bounce`: from the fourth on, Russian
+// roulette with its largest throughput (0.05 to 1) as the probability, the survivors'
+// throughput divided by it.
+fn survives(beta: ptr<function, vec3<f32>>, bounce: u32, rng: ptr<function, Rng>) -> bool {
+    if (bounce >= 3u) {
+        let q = clamp(max(max((*beta).x, (*beta).y), (*beta).z), 0.05, 1.0);
+        if (rand(rng) >= q) {
+            return false;
+        }
+        *beta = *beta / q;
+    }
+    return true;
+}
