@@ -452,7 +452,7 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   this->LastRenderDrew = 1;
-  if (pathTrace && in->Refinement.IsTracing())
+  if (in->Refinement.IsTracing())
   {
     // Refine while the accumulation is short of SamplesPerPixel.
     if (!in->Refinement.EndTracing(

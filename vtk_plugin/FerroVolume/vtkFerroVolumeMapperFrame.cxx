@@ -166,7 +166,7 @@ void vtkFerroVolumeMapper::GPURender(vtkRenderer* ren, vtkVolume* vol)
   {
     in->Refinement.Stop();
   }
-  const bool progressive = this->RenderMode == RENDER_MODE_PATH_TRACE && in->Refinement.IsTracing();
+  const bool progressive = in->Refinement.IsTracing();
   in->Settings.SetIntermixing(multi != nullptr);
   switch (
     in->Settings.Apply(this, ren, main, in->Input, *in->Slot.Renderer, traceBudget, report))

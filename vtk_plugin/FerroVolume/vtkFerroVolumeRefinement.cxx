@@ -153,6 +153,7 @@ void vtkFerroVolumeRefinement::Stop()
   this->ObserverTag = 0;
   this->TimerId = 0;
   this->FiredId = 0;
+  this->Tracing = false;
 }
 
 void vtkFerroVolumeRefinement::OnTimer(vtkObject*, unsigned long, void* self, void* timerId)

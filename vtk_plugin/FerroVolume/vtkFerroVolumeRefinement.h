@@ -94,7 +94,7 @@ public:
   // cannot count its paths (the reason in `report`).
   bool BeginTracing(const Settings& s, vtkRenderWindow* win, ferrovol::Renderer& renderer,
     vtkFerroVolumeReport& report, double& traceBudget);
-  // Whether the render BeginTracing began is progressive.
+  // Whether the render BeginTracing began is progressive (false once stopped).
   bool IsTracing() const { return this->Tracing; }
   // After that progressive render of `width` × `height` pixels was drawn: End, then
   // Continue toward Target with the paths it has; when it stops because every render starts

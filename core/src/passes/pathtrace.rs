@@ -160,6 +160,9 @@ struct Setup<'a> {
     pp: PathTraceParams,
     /// The denoiser runs (now or until a number of paths).
     guided: bool,
+    /// The surface model or scattering regions are asked for (not Henyey–Greenstein
+    /// everywhere).
+    hybrid: bool,
 }
 
 /// One medium's frame, ready to trace: what its accumulation converges to (a different
@@ -382,6 +385,9 @@ impl PathTracePass {
             depth,
             pp: *pp,
             guided: pp.denoise || pp.denoise_until > 0,
+            hybrid: pp.gradient_threshold.is_finite()
+                || pp.stochastic_blend > 0.0
+                || pp.scatter != ScatterRegions::Everywhere,
         };
         let medium = if res.mesh.is_some() {
             self.prepare_mesh(&f, res, purpose)?
@@ -503,9 +509,7 @@ impl PathTracePass {
                 && res.tf.as_ref().is_some_and(|tf| tf.max_label() > 0),
             blanking: res.blanking.is_some(),
             tables_2d: table_2d,
-            hybrid: pp.gradient_threshold.is_finite()
-                || pp.stochastic_blend > 0.0
-                || pp.scatter != ScatterRegions::Everywhere,
+            hybrid: f.hybrid,
             guided: f.guided,
             intermix,
             float32_filterable: ctx.info.float32_filterable,

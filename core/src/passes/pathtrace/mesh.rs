@@ -7,7 +7,7 @@ use crate::gpu::binding::{bind_view, group_layout, texture_entry};
 use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::slots;
 use crate::gpu::Context;
-use crate::params::{BlendMode, ScalarLocation, ScatterRegions};
+use crate::params::{BlendMode, ScalarLocation};
 use crate::passes::frame::Purpose;
 use crate::passes::unstructured::{self, MeshTransfer};
 use crate::passes::unstructured_variant::{self, MeshPathTraceVariant, UnstructuredFacts};
@@ -59,7 +59,7 @@ impl PathTracePass {
         res: &mut Resources,
         purpose: Purpose,
     ) -> Result<Option<Medium>> {
-        let (ctx, view, params, pp) = (f.ctx, f.view, f.params, &f.pp);
+        let (ctx, view, params) = (f.ctx, f.view, f.params);
         let tf = res.transfer_function()?.clone();
         let ct = tf.component(0);
         let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
@@ -78,9 +78,7 @@ impl PathTracePass {
             volumetric: false,
             depth_range: matches!(f.depth, DepthSource::Range(..)),
             intermix: res.intermix.is_some(),
-            hybrid: pp.gradient_threshold.is_finite()
-                || pp.stochastic_blend > 0.0
-                || pp.scatter != ScatterRegions::Everywhere,
+            hybrid: f.hybrid,
         };
         let variant = MeshPathTraceVariant {
             cell_scalars: unstructured_variant::select(&facts)
@@ -123,14 +121,13 @@ impl PathTracePass {
                 .chain(tracer.transfer.entries(mesh))
                 .collect::<Vec<_>>(),
         });
-        let mut u = self.base_uniforms(f, res, ct.unit_distance)?;
+        let u = self.base_uniforms(f, res, ct.unit_distance)?;
         // (the denoiser compares depths per cell: the box's diagonal over the tetrahedra's
         // cube root)
         let b = mesh.bounds;
         let diagonal =
             ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
         let cell = diagonal / (mesh.uniforms.counts[0].max(1) as f64).cbrt();
-        u.medium[0] = 1.0;
         Ok(Some(Medium {
             key,
             pipeline,
