@@ -173,13 +173,14 @@ fn parse_range(s: &str) -> Result<[f64; 2], String> {
     Ok([lo, hi])
 }
 
-/// The isosurface parameters and environment the flags describe.
+/// The isosurface parameters and environment the flags describe; without --iso, the middle
+/// of the data's `range`.
 pub(crate) fn iso_setup(
     a: &IsoArgs,
-    vol: &VolumeData,
+    range: impl FnOnce() -> Result<[f64; 2], CliError>,
 ) -> Result<(IsoParams, Environment), CliError> {
     let specs: Vec<IsoSpec> = if a.values.is_empty() {
-        let [lo, hi] = vol.try_range(0)?;
+        let [lo, hi] = range()?;
         let mid = 0.5 * (lo + hi);
         eprintln!("ferrovol: no --iso given; using the middle of the data range, {mid}");
         vec![(mid, None, None)]

@@ -564,7 +564,7 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     let vol = Arc::new(vol);
     let tf = presets::transfer_function(a.tf.as_deref().unwrap_or(default_tf), &vol)?;
     let iso = if a.mode == Mode::Iso {
-        Some(iso_setup(&a.iso, &vol)?)
+        Some(iso_setup(&a.iso, || Ok(vol.try_range(0)?))?)
     } else {
         None
     };

@@ -1,9 +1,10 @@
 //! `ferrovol render mesh.vtu`: an unstructured volume (VTK XML UnstructuredGrid) drawn with
 //! the same camera, blend mode and transfer-function flags as a volume.
 
+use crate::iso::iso_setup;
 use crate::presets;
 use crate::{
-    path_tracing_setup, render_params, spinner, trace_paths, view_of, CliError, RenderArgs,
+    path_tracing_setup, render_params, spinner, trace_paths, view_of, CliError, Mode, RenderArgs,
 };
 use ferrovol_core::{
     tetrahedralize, vtk_cell_type_name, Context, Renderer, ScalarLocation, UnstructuredVolume,
@@ -60,7 +61,15 @@ pub fn render(a: &RenderArgs, path: &Path) -> Result<(), CliError> {
         r.set_path_tracing(p)?;
         r.set_environment(env)?;
     }
+    if a.mode == Mode::Iso {
+        let (p, env) = iso_setup(&a.iso, || Ok(range(&m)))?;
+        r.set_isosurface(&p)?;
+        r.set_environment(&env)?;
+    }
     let mut view = view_of(a, m.bounds())?;
+    if a.iso.no_lights {
+        view.lights.clear();
+    }
     let params = render_params(a, m.bounds());
     r.prepare(&view, &params)?;
     let prepared = t0.elapsed().as_secs_f64();

@@ -266,9 +266,17 @@ fn a_vtu_mesh_renders_is_described_and_refuses_what_meshes_do_not_draw() {
         out.contains("1 VTK_HEXAHEDRON (12)") && out.contains("tetrahedra: 14"),
         "{out}"
     );
-    let (code, _, err) = ferrovol(&[
-        "render", path, "--mode", "iso", "--iso", "1", "--size", "8x8",
-    ]);
+    // the isosurface height 0.5 (the cube's middle) and 1.5 (inside the roof)
+    let (png, _, _) = render_ok(
+        "house-iso",
+        &[
+            path, "--mode", "iso", "--iso", "0.5", "--iso", "1.5", "--size", "32x32",
+        ],
+    );
+    let img = image::open(&png).unwrap().to_rgb8();
+    let lit = img.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
+    assert!(lit > 100, "isosurfaces: {lit} pixels drawn");
+    let (code, _, err) = ferrovol(&["render", path, "--mode", "slice", "--size", "8x8"]);
     assert_eq!(code, 1);
     assert!(
         err.contains("unstructured volumes are drawn in the composite"),

@@ -1,5 +1,5 @@
-// Deferred shading of the G-buffer firsthit.wgsl wrote. Per pixel, its surface layers front
-// to back, each
+// Deferred shading of the G-buffer firsthit.wgsl (or, for a mesh, firsthit_mesh.wgsl) wrote. Per
+// pixel, its surface layers front to back, each
 //   - lit by the scene's lights (Blinn–Phong, lib/surface.wgsl), ambient scaled by AO;
 //   - lit by the environment: diffuse from the irradiance cube at the normal, specular from
 //     the environment cube on the Phong lobe cos^s around the reflection vector (the simple
@@ -33,6 +33,9 @@
 override SCATTER: u32 = 0u;
 // The component whose isosurfaces are drawn (core/src/passes/iso.rs, iso_component).
 override ISO_COMP: u32 = 0u;
+// The surfaces of an unstructured volume (firsthit_mesh.wgsl wrote them): no image volume is
+// bound (group 1 is not read), and the scattering between the surfaces is not drawn.
+override MESH: bool = false;
 
 @group(0) @binding(2) var<storage, read> state: array<PixelState>;
 @group(0) @binding(SLOT_OUT_COLOR) var out_color: texture_storage_2d<rgba8unorm, write>;
@@ -189,7 +192,9 @@ fn scattered_light(x1: vec3<f32>, n1: vec3<f32>, c1: vec3<f32>, t_in: f32, px: v
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     frame = frame_ubo;
-    enter_volume();
+    if (!MESH) {
+        enter_volume();
+    }
     iso = iso_ubo;
     let r = iso.shade_rect;
     let px = gid.xy + r.xy;
@@ -207,7 +212,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var color = vec4<f32>(0.0);
     var depth = 1.0;
     var depth_set = false;
-    if (SCATTER > 0u && layers > 0u) {
+    if (!MESH && SCATTER > 0u && layers > 0u) {
         let gp = textureLoad(g_position, c, 0, 0);
         let gn = textureLoad(g_normal, c, 0, 0);
         let ge = textureLoad(g_extra, c, 0, 0);

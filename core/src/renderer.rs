@@ -427,6 +427,12 @@ impl Renderer {
                     Ok(Box::new(PathTracePass::new(ctx, brick_bgl)?))
                 })?;
                 pass.render(input(res), &self.pt_params)
+            } else if params.blend == BlendMode::Isosurface {
+                let brick_bgl = &res.brick_bgl;
+                let pass = ensure(&mut self.iso, || {
+                    Ok(Box::new(IsoPass::new(ctx, brick_bgl)?))
+                })?;
+                pass.render_mesh(input(res), self.iso_params.as_ref())
             } else {
                 let pass = ensure(&mut self.unstructured, || {
                     Ok(Box::new(UnstructuredPass::new(ctx)?))

@@ -1,6 +1,7 @@
 //! Unstructured volumes on a real wgpu device against the f64 CPU reference
 //! (common/mesh.rs): every generated mesh, every blend mode drawn, point and cell scalars;
-//! a ray that leaves the hollow cylinder and enters it again; the errors bad meshes get.
+//! a ray that leaves the hollow cylinder and enters it again; isosurfaces' G-buffers against
+//! the exact crossings; the errors bad meshes get.
 //! Images go to `target/test-images/unstructured_*.png` for inspection.
 
 use ferrovol_core::*;
@@ -332,17 +333,23 @@ fn what_is_not_drawn_is_refused_and_images_come_back() {
     r.set_unstructured(&v).unwrap();
     r.set_transfer_function(&tf(0.0, 2.0, 1.0)).unwrap();
     let view = view_of(&v, 32);
-    for blend in [BlendMode::Isosurface, BlendMode::Slice] {
-        let p = RenderParams {
-            slice_plane: Some(ClipPlane {
-                origin: glam::DVec3::ZERO,
-                normal: glam::DVec3::Z,
-            }),
-            ..params(blend)
-        };
-        let e = r.render_image(&view, &p);
-        assert!(matches!(e, Err(Error::Unsupported(_))), "{blend:?}: {e:?}");
-    }
+    let p = RenderParams {
+        slice_plane: Some(ClipPlane {
+            origin: glam::DVec3::ZERO,
+            normal: glam::DVec3::Z,
+        }),
+        ..params(BlendMode::Slice)
+    };
+    assert_error(r.render_image(&view, &p), "a sliced mesh", &["not Slice"]);
+    // isosurfaces are shaded as layers: no scattering between them
+    let mut iso = IsoParams::with_values(vec![IsoValue::new(1.0, [1.0; 3], 1.0)]);
+    iso.scattering = Some(IsoScattering::default());
+    r.set_isosurface(&iso).unwrap();
+    assert_error(
+        r.render_image(&view, &params(BlendMode::Isosurface)),
+        "scattering between a mesh's isosurfaces",
+        &["without scattering between isosurfaces"],
+    );
     // path tracing scatters a mesh by Henyey–Greenstein alone
     r.set_path_tracing(&PathTraceParams {
         gradient_threshold: 0.5,
@@ -512,4 +519,131 @@ fn composite_depth_is_where_the_ray_first_gathers_opacity() {
     }
     println!("{checked} pixels: depth off by {worst:.2e} at most");
     assert!(checked > 300 && worst < 1e-4);
+}
+
+/// The first hit of two isosurfaces (one translucent) against the exact crossings of the
+/// f64 reference, pixel by pixel and layer by layer: on the tetrahedral wavelet, the hollow
+/// cylinder (rays leave and enter it again) and mixed cells with cell scalars (surfaces on
+/// the faces between cells). A pixel may differ in its layers where a ray grazes an edge.
+#[test]
+fn isosurfaces_are_the_exact_crossings_with_point_and_cell_scalars() {
+    let meshes = [
+        ("wavelet", synth::tet_wavelet(8)),
+        ("cylinder", synth::hollow_cylinder(2, 24, 4)),
+        ("cells", synth::mixed_cells(4, ScalarLocation::Cells)),
+    ];
+    for (name, v) in meshes {
+        let (lo, hi) = range(&v);
+        let values = [(lo + 0.35 * (hi - lo), 0.5), (lo + 0.7 * (hi - lo), 1.0)];
+        let iso = IsoParams::with_values(vec![
+            IsoValue::new(values[0].0, [0.9, 0.6, 0.2], values[0].1 as f32),
+            IsoValue::new(values[1].0, [0.2, 0.5, 0.9], values[1].1 as f32),
+        ]);
+        let view = view_of(&v, 64);
+        let p = params(BlendMode::Isosurface);
+        let mut r = renderer();
+        r.set_unstructured(&v).unwrap();
+        r.set_isosurface(&iso).unwrap();
+        let img = r.render_image(&view, &p).unwrap();
+        save_enlarged(&img, &format!("unstructured_iso_{name}"));
+        let gb = r.read_gbuffer().unwrap();
+        let segs = mesh::Tets::of(&v).segments(&view);
+        let b = v.bounds();
+        let diagonal =
+            ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
+        let (mut differ, mut hits, mut worst_t, mut worst_n) = (0, 0, 0.0f64, 1.0f64);
+        for y in 0..view.height {
+            for x in 0..view.width {
+                let want = mesh::crossings(
+                    &segs[(y * view.width + x) as usize],
+                    &values,
+                    iso.max_layers as usize,
+                    p.termination_threshold as f64,
+                );
+                let got = gb.hits(x, y);
+                if got.len() != want.len()
+                    || got.iter().zip(&want).any(|(g, w)| g.iso_index != w.which)
+                {
+                    differ += 1;
+                    continue;
+                }
+                for (g, w) in got.iter().zip(&want) {
+                    hits += 1;
+                    worst_t = worst_t.max((g.distance - w.t).abs() / diagonal);
+                    let n = if w.below { -w.gradient } else { w.gradient };
+                    if n.length() > 0.0 {
+                        worst_n = worst_n.min(g.normal.dot(n.normalize()));
+                    }
+                }
+            }
+        }
+        let covered = footprint(&img);
+        println!(
+            "iso {name}: {hits} hits in {covered} pixels; {differ} pixels' layers differ; \
+             distance off by at most {worst_t:.2e} of the diagonal; normals within \
+             {:.3} degrees",
+            worst_n.clamp(-1.0, 1.0).acos().to_degrees()
+        );
+        assert!(
+            covered > (view.width * view.height / 16) as usize,
+            "{name}: nearly nothing drawn"
+        );
+        assert!(
+            hits > covered,
+            "{name}: the translucent surface shows another behind it"
+        );
+        assert!(differ * 100 <= covered, "{name}: {differ} pixels differ");
+        assert!(worst_t < 1e-4 && worst_n > 0.9995, "{name}");
+    }
+}
+
+/// Ambient occlusion of a mesh's isosurfaces walks the mesh, against the accessibility of
+/// a slab: s = |x| on a box, the surfaces x = ±2 seen along +x. The first (from outside,
+/// its hemisphere toward rising s) is open; the second, from inside the slab, faces the
+/// first 4 units away, so a direction at θ from its normal reaches it within the radius R
+/// where 4 / cos θ ≤ R: open with probability 4 / R over the hemisphere (0.5 for R = 8).
+/// The centre pixels' rays lie in the planes of the grid's faces, the centre one along an
+/// edge: the walk crosses them too.
+#[test]
+fn isosurface_ambient_occlusion_walks_the_mesh() {
+    let mut v = synth::tet_wavelet(17);
+    v.scalars = Scalars::F32(v.points.iter().map(|p| p[0].abs() as f32).collect());
+    let mut iso = IsoParams::with_values(vec![IsoValue::new(2.0, [0.8; 3], 0.5)]);
+    iso.ambient_occlusion = Some(AmbientOcclusion {
+        samples: 16,
+        steps: 8,
+        radius: Some(8.0),
+    });
+    let mut view = View::fit(v.bounds(), 33, 33);
+    view.camera.position = glam::DVec3::new(-60.0, 0.0, 0.0);
+    view.camera.focal_point = glam::DVec3::ZERO;
+    view.camera.view_up = glam::DVec3::Z;
+    view.camera.view_angle = 10.0;
+    view.camera.reset_clipping_range(v.bounds());
+    let mut r = renderer();
+    r.set_unstructured(&v).unwrap();
+    r.set_isosurface(&iso).unwrap();
+    let img = r
+        .render_image(&view, &params(BlendMode::Isosurface))
+        .unwrap();
+    save_enlarged(&img, "unstructured_iso_ao");
+    let gb = r.read_gbuffer().unwrap();
+    let mut seen = [Vec::new(), Vec::new()];
+    for y in 14..19 {
+        for x in 14..19 {
+            let hits = gb.hits(x, y);
+            assert_eq!(hits.len(), 2, "pixel ({x}, {y}) crosses both walls");
+            for (l, h) in hits.iter().enumerate() {
+                seen[l].push(h.ambient_access);
+            }
+        }
+    }
+    println!(
+        "iso AO of the slab's walls, centre pixels: outer {:?}, inner {:?}",
+        seen[0], seen[1]
+    );
+    assert!(seen[0].iter().all(|&a| a == 1.0));
+    assert!(seen[1]
+        .iter()
+        .all(|&a| (a - 0.5).abs() <= 1.0 / 16.0 + 1e-6));
 }

@@ -1,5 +1,6 @@
 #include "vtkFerroUnstructuredVolumeRepresentation.h"
 
+#include "vtkContourValues.h"
 #include "vtkFerroUnstructuredVolumeMapper.h"
 #include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
@@ -70,11 +71,11 @@ void vtkFerroUnstructuredVolumeRepresentation::SetSpecularPower(double value)
 
 void vtkFerroUnstructuredVolumeRepresentation::SetFerrovolBlendMode(int mode)
 {
-  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ADDITIVE_BLEND)
+  if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ISOSURFACE_BLEND)
   {
     vtkErrorMacro(<< "blend mode " << mode
                   << " is not drawn on unstructured grids (composite 0, maximum 1, minimum 2, "
-                     "average 3, additive 4 are): the blend mode stays "
+                     "average 3, additive 4, isosurface 5 are): the blend mode stays "
                   << this->FerrovolBlendMode);
     return;
   }
@@ -83,6 +84,16 @@ void vtkFerroUnstructuredVolumeRepresentation::SetFerrovolBlendMode(int mode)
     this->FerrovolBlendMode = mode;
     this->Modified();
   }
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetIsosurfaceValue(int i, double value)
+{
+  this->Property->GetIsoSurfaceValues()->SetValue(i, value);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetNumberOfIsosurfaces(int number)
+{
+  this->Property->GetIsoSurfaceValues()->SetNumberOfContours(number);
 }
 
 //------------------------------------------------------------------------------------------
@@ -98,13 +109,14 @@ void vtkFerroUnstructuredVolumeRepresentation::UpdateMapperParameters()
   this->FerroMapper->SetBlendMode(this->FerrovolBlendMode);
   auto* controller = vtkMultiProcessController::GetGlobalController();
   const bool distributed = controller && controller->GetNumberOfProcesses() > 1;
-  if (distributed && this->FerrovolBlendMode != vtkVolumeMapper::COMPOSITE_BLEND &&
-    this->WarnedBlendMode != this->FerrovolBlendMode)
+  const bool ordered = this->FerrovolBlendMode == vtkVolumeMapper::COMPOSITE_BLEND ||
+    this->FerrovolBlendMode == vtkVolumeMapper::ISOSURFACE_BLEND;
+  if (distributed && !ordered && this->WarnedBlendMode != this->FerrovolBlendMode)
   {
     vtkWarningMacro(<< "blend mode " << this->FerrovolBlendMode
                     << " under MPI: each rank draws its piece of the mesh with it and IceT "
                        "composites the pieces' images in visibility order (\"over\"), which "
-                       "is exact for composite only");
+                       "is exact for composite and isosurfaces only");
   }
   this->WarnedBlendMode = this->FerrovolBlendMode;
 }

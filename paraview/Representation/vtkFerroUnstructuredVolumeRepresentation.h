@@ -18,10 +18,10 @@
  * "Volume" there except the mapper selection ("Select Mapper"). Its own settings:
  *
  * - FerrovolBlendMode: composite (VTK's unstructured mappers' only mode), maximum, minimum
- *   or average intensity, or additive (vtkVolumeMapper's numbers 0-4); other values are
- *   refused with an error and the mode stays. Under MPI the ranks' images are composited in
- *   visibility order, which is exact for composite only; the other modes give a warning
- *   there.
+ *   or average intensity, additive, or isosurfaces of IsosurfaceValues (vtkVolumeMapper's
+ *   numbers 0-5); other values are refused with an error and the mode stays. Under MPI the
+ *   ranks' images are composited in visibility order, which is exact for composite and
+ *   isosurfaces only; the other modes give a warning there.
  * - Path tracing (FerrovolRenderMode and the settings "Ferrovol Volume" of image data has
  *   for it), forwarded to the mapper.
  *
@@ -62,11 +62,20 @@ public:
   ///@{
   /**
    * The blend mode: vtkVolumeMapper's COMPOSITE_BLEND (0, the default),
-   * MAXIMUM_INTENSITY_BLEND (1), MINIMUM_INTENSITY_BLEND (2), AVERAGE_INTENSITY_BLEND (3)
-   * or ADDITIVE_BLEND (4). Other values are refused with an error.
+   * MAXIMUM_INTENSITY_BLEND (1), MINIMUM_INTENSITY_BLEND (2), AVERAGE_INTENSITY_BLEND (3),
+   * ADDITIVE_BLEND (4) or ISOSURFACE_BLEND (5). Other values are refused with an error.
    */
   void SetFerrovolBlendMode(int mode);
   vtkGetMacro(FerrovolBlendMode, int);
+  ///@}
+
+  ///@{
+  /**
+   * The isosurface blend mode's values, as "Volume" of image data sets them (ParaView's
+   * unstructured "Volume" has none): into the volume's vtkVolumeProperty.
+   */
+  void SetIsosurfaceValue(int i, double value);
+  void SetNumberOfIsosurfaces(int number);
   ///@}
 
   ///@{

@@ -6,7 +6,8 @@ ParaView's own "Volume" of the same data, serial and under MPI.
       the grid drawn by "Ferrovol Volume" and by "Volume" with each of its mappers
       (MAPPERS); the multiblock (its blocks merged by the representation, as "Volume" merges
       them) against the single grid; the mesh uploaded once for renders that change only the
-      camera; Shade lights it (drawn, unlike the unshaded image); Path Trace draws it as a
+      camera; Shade lights it (drawn, unlike the unshaded image); Isosurface draws the
+      Isosurface Values (drawn, unlike the composite image); Path Trace draws it as a
       scattering medium, every path in a still render; a three-component array
       refused (nothing drawn). Writes the references the
       distributed step compares with.
@@ -181,6 +182,17 @@ def serial(failures):
     if ferrovol_info(disp)["FerrovolLastRenderDrew"] != 1:
         failures.append("ferrovol did not draw the shaded grid")
     T.compare("control: shaded vs unshaded", lit, refs["oblique"], *SAME, failures,
+              expect_fail=True)
+    # Isosurface (which "Volume" on unstructured grids lacks): the Isosurface Values, drawn,
+    # and not the composite image
+    disp.IsosurfaceValues = [150.0]
+    disp.FerrovolBlendMode = "Isosurface"
+    iso = shot(view, "ugrid-serial-ferrovol-isosurface", "oblique")
+    disp.FerrovolBlendMode = "Composite"
+    check_drawn(iso, "ferrovol isosurface", failures)
+    if ferrovol_info(disp)["FerrovolLastRenderDrew"] != 1:
+        failures.append("ferrovol did not draw the isosurface")
+    T.compare("control: isosurface vs composite", iso, refs["oblique"], *SAME, failures,
               expect_fail=True)
     # Path Trace: the mesh as a scattering medium; pvbatch's still render traces every path
     # (two per pixel: drawn and lit, and not the ray-cast image)

@@ -337,6 +337,20 @@ void vtkFerroUnstructuredVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EnvironmentAzimuth: " << this->EnvironmentAzimuth << "\n";
   os << indent << "EnvironmentIntensity: " << this->EnvironmentIntensity << "\n";
   os << indent << "EnvironmentBackground: " << this->EnvironmentBackground << "\n";
+  os << indent << "EnvironmentLighting: " << this->EnvironmentLighting << "\n";
+  os << indent << "SpecularSampling: "
+     << (this->SpecularSampling == SPECULAR_CONE ? "cone" : "importance") << "\n";
+  os << indent << "SpecularSamples: " << this->SpecularSamples << "\n";
+  os << indent << "AmbientOcclusionSamples: " << this->AmbientOcclusionSamples << "\n";
+  os << indent << "AmbientOcclusionSteps: " << this->AmbientOcclusionSteps << "\n";
+  os << indent << "AmbientOcclusionRadius: " << this->AmbientOcclusionRadius << "\n";
+  os << indent << "ShininessFromGradient: " << this->ShininessFromGradient << "\n";
+  os << indent << "ShininessRange: " << this->ShininessRange[0] << " "
+     << this->ShininessRange[1] << "\n";
+  os << indent << "ShininessGradientRange: " << this->ShininessGradientRange[0] << " "
+     << this->ShininessGradientRange[1] << "\n";
+  os << indent << "Fresnel: " << this->Fresnel << "\n";
+  os << indent << "IsosurfaceLayers: " << this->IsosurfaceLayers << "\n";
 }
 
 void vtkFerroUnstructuredVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
@@ -368,12 +382,12 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   const bool pathTrace = this->RenderMode == RENDER_MODE_PATH_TRACE;
   uint32_t blend = FV_BLEND_MODE_PATH_TRACE;
   if (!pathTrace &&
-    (!vtkFerroVolumeSettings::ToFvBlend(this->BlendMode, blend) ||
-      blend == FV_BLEND_MODE_ISOSURFACE || blend == FV_BLEND_MODE_SLICE))
+    (!vtkFerroVolumeSettings::ToFvBlend(this->BlendMode, blend) || blend == FV_BLEND_MODE_SLICE))
   {
     vtkErrorMacro(<< "blend mode " << this->BlendMode
                   << " is not supported by vtkFerroUnstructuredVolumeMapper (composite, "
-                     "maximum, minimum, average and additive are): nothing is drawn");
+                     "maximum, minimum, average, additive and isosurface are): nothing is "
+                     "drawn");
     return;
   }
   // The input: a vtkUnstructuredGrid, or another vtkUnstructuredGridBase copied into one.
@@ -428,10 +442,28 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   params.blend_mode = blend;
   vtkFerroVolumeSettings::SetVolumeMatrix(vol, params);
   vtkFerroVolumeSettings::SetUpClippingPlanes(this->ClippingPlanes, params, report);
-  std::string warning;
   if (!vtkFerroVolumeSettings::ApplyShading(
-        this, ren, vol->GetProperty(), params, *in->Slot.Renderer, report) ||
-    !vtkFerroVolumeCall(
+        this, ren, vol->GetProperty(), params, *in->Slot.Renderer, report))
+  {
+    vtkErrorMacro(<< report.GetError());
+    return;
+  }
+  if (blend == FV_BLEND_MODE_ISOSURFACE)
+  {
+    using Result = vtkFerroVolumeSettings::Result;
+    const Result iso =
+      in->Settings.SetUpIsosurfaces(this, vol, 1, params, *in->Slot.Renderer, report);
+    if (iso == Result::Failed)
+    {
+      vtkErrorMacro(<< report.GetError());
+    }
+    if (iso != Result::Ready)
+    {
+      return;
+    }
+  }
+  std::string warning;
+  if (!vtkFerroVolumeCall(
       "use the mapper's settings", report, [&] { in->Slot.Renderer->set_params(params); }) ||
     !vtkFerroVolumeSettings::ApplyCamera(
       ren, req.ViewportW, req.ViewportH, *in->Slot.Renderer, report) ||

@@ -30,6 +30,14 @@
  * magnitude at the segment's middle. A 2D transfer function is refused with an error naming
  * it. Errors from ferrovol reach vtkErrorMacro with its message.
  *
+ * Isosurfaces (SetBlendModeToIsoSurface): the property's iso-values (GetIsoSurfaceValues),
+ * coloured and made translucent by its colour and scalar opacity functions there, as
+ * vtkFerroVolumeMapper draws image data's: each crossing exact (linear in each tetrahedron;
+ * with cell scalars, on the faces between cells on either side of a value), its normal the
+ * points' gradients interpolated there, shaded with the renderer's lights and the
+ * environment, translucent layers composited front to back; ambient occlusion by walks
+ * through the mesh. The property's Shade off draws flat colours.
+ *
  * Path tracing (SetRenderModeToPathTrace): the mesh as a scattering medium, as
  * vtkFerroVolumeMapper path traces image data, with the same settings and meaning
  * (SamplesPerPixel, InteractiveSamplesPerPixel, PathTracingBounces, SecondaryRays, the
@@ -71,6 +79,45 @@ public:
     this->SetBlendMode(vtkVolumeMapper::AVERAGE_INTENSITY_BLEND);
   }
   void SetBlendModeToAdditive() { this->SetBlendMode(vtkVolumeMapper::ADDITIVE_BLEND); }
+  void SetBlendModeToIsoSurface() { this->SetBlendMode(vtkVolumeMapper::ISOSURFACE_BLEND); }
+  ///@}
+
+  ///@{
+  /**
+   * Isosurface blend mode, as vtkFerroVolumeMapper's settings of the same names: the
+   * environment's share of the surfaces' light (EnvironmentLighting, default 0), its
+   * specular sampling (SpecularSampling, default SPECULAR_IMPORTANCE; SpecularSamples,
+   * default 16), ambient occlusion (AmbientOcclusionSamples, default 0: off; its
+   * AmbientOcclusionRadius, 0: 8 typical cell sizes, the mesh box's diagonal over the cube
+   * root of its tetrahedra; a direction is occluded where its walk through the mesh meets
+   * the far side of the iso-value beyond the first of AmbientOcclusionSteps steps), the
+   * shininess from the gradient magnitude (ShininessFromGradient, ShininessRange,
+   * ShininessGradientRange: by default 0 to a quarter of the data range per typical cell
+   * size), Fresnel and the translucent layers kept (IsosurfaceLayers, 1 to 8, default 4).
+   */
+  vtkSetClampMacro(EnvironmentLighting, double, 0.0, 100.0);
+  vtkGetMacro(EnvironmentLighting, double);
+  vtkSetClampMacro(SpecularSampling, int, SPECULAR_CONE, SPECULAR_IMPORTANCE);
+  vtkGetMacro(SpecularSampling, int);
+  vtkSetClampMacro(SpecularSamples, int, 1, 1024);
+  vtkGetMacro(SpecularSamples, int);
+  vtkSetClampMacro(AmbientOcclusionSamples, int, 0, 1024);
+  vtkGetMacro(AmbientOcclusionSamples, int);
+  vtkSetClampMacro(AmbientOcclusionSteps, int, 1, 256);
+  vtkGetMacro(AmbientOcclusionSteps, int);
+  vtkSetClampMacro(AmbientOcclusionRadius, double, 0.0, 1.0e30);
+  vtkGetMacro(AmbientOcclusionRadius, double);
+  vtkSetClampMacro(ShininessFromGradient, vtkTypeBool, 0, 1);
+  vtkGetMacro(ShininessFromGradient, vtkTypeBool);
+  vtkBooleanMacro(ShininessFromGradient, vtkTypeBool);
+  vtkSetVector2Macro(ShininessRange, double);
+  vtkGetVector2Macro(ShininessRange, double);
+  vtkSetVector2Macro(ShininessGradientRange, double);
+  vtkGetVector2Macro(ShininessGradientRange, double);
+  vtkSetClampMacro(Fresnel, double, -1.0, 1.0);
+  vtkGetMacro(Fresnel, double);
+  vtkSetClampMacro(IsosurfaceLayers, int, 1, 8);
+  vtkGetMacro(IsosurfaceLayers, int);
   ///@}
 
   ///@{
@@ -117,7 +164,8 @@ public:
 
   ///@{
   /**
-   * The environment that lights path-traced meshes, as vtkFerroVolumeMapper's: an image file
+   * The environment that lights path-traced meshes and isosurfaces, as vtkFerroVolumeMapper's:
+   * an image file
    * (EnvironmentMap; none: the procedural sky), its up direction, azimuth and intensity, and
    * whether it is the background (EnvironmentBackground, default off).
    */
@@ -187,6 +235,17 @@ protected:
   double EnvironmentAzimuth = 0.0;
   double EnvironmentIntensity = 1.0;
   vtkTypeBool EnvironmentBackground = 0;
+  double EnvironmentLighting = 0.0;
+  int SpecularSampling = SPECULAR_IMPORTANCE;
+  int SpecularSamples = 16;
+  int AmbientOcclusionSamples = 0;
+  int AmbientOcclusionSteps = 8;
+  double AmbientOcclusionRadius = 0.0;
+  vtkTypeBool ShininessFromGradient = 0;
+  double ShininessRange[2] = { 8.0, 64.0 };
+  double ShininessGradientRange[2] = { 0.0, 0.0 };
+  double Fresnel = -1.0;
+  int IsosurfaceLayers = 4;
   int TableUploadCount = 0;
 
 private:

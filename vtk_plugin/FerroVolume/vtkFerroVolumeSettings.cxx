@@ -293,7 +293,8 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::Apply(vtkFerroVolumeMappe
   this->Background = false;
   if (this->Blend == FV_BLEND_MODE_ISOSURFACE)
   {
-    const Result iso = this->SetUpIsosurfaces(self, vol, input.GetComponents(), renderer, report);
+    const Result iso = this->SetUpIsosurfaces(
+      self, vol, input.GetComponents(), this->Params, renderer, report);
     if (iso != Result::Ready)
     {
       return iso;
@@ -636,11 +637,19 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
   {
     return false;
   }
+  const std::vector<FvLight> lights =
+    FrameLights(self, ren, this->Blend, this->Params.shade, report);
+  return vtkFerroVolumeCall(
+    "use the renderer's lights", report, [&] { renderer.set_lights(lights); });
+}
+
+std::vector<FvLight> vtkFerroVolumeSettings::FrameLights(
+  vtkObject* self, vtkRenderer* ren, uint32_t blend, bool shade, vtkFerroVolumeReport& report)
+{
   std::vector<FvLight> lights;
-  if (this->Blend == FV_BLEND_MODE_ISOSURFACE && !this->Params.shade)
+  if (blend == FV_BLEND_MODE_ISOSURFACE && !shade)
   {
-    // Flat isosurfaces (Shade off), as vtkGPUVolumeRayCastMapper draws them: the surface
-    // colour alone, through one purely ambient light (SetUpIsosurfaces set the material).
+    // (SetUpIsosurfaces made the material flat: the surface colour alone)
     FvLight l;
     std::memset(&l, 0, sizeof(l));
     l.space = FV_LIGHT_SPACE_HEADLIGHT;
@@ -649,12 +658,11 @@ bool vtkFerroVolumeSettings::ApplyView(vtkFerroVolumeMapper* self, vtkRenderer* 
     l.attenuation[0] = 1.0f;
     lights.push_back(l);
   }
-  else if (this->Params.shade || this->Blend == FV_BLEND_MODE_PATH_TRACE)
+  else if (shade || blend == FV_BLEND_MODE_PATH_TRACE)
   {
     lights = SceneLights(self, ren, report);
   }
-  return vtkFerroVolumeCall(
-    "use the renderer's lights", report, [&] { renderer.set_lights(lights); });
+  return lights;
 }
 
 void vtkFerroVolumeSettings::SetMaterial(
@@ -671,13 +679,11 @@ bool vtkFerroVolumeSettings::ApplyShading(vtkObject* self, vtkRenderer* ren,
   vtkVolumeProperty* prop, FvRenderParams& params, ferrovol::Renderer& renderer,
   vtkFerroVolumeReport& report)
 {
-  params.shade = prop->GetShade(0) != 0 && params.blend_mode == FV_BLEND_MODE_COMPOSITE;
+  params.shade = prop->GetShade(0) != 0 &&
+    (params.blend_mode == FV_BLEND_MODE_COMPOSITE || params.blend_mode == FV_BLEND_MODE_ISOSURFACE);
   SetMaterial(prop, ren, params);
-  std::vector<FvLight> lights;
-  if (params.shade || params.blend_mode == FV_BLEND_MODE_PATH_TRACE)
-  {
-    lights = SceneLights(self, ren, report);
-  }
+  const std::vector<FvLight> lights =
+    FrameLights(self, ren, params.blend_mode, params.shade, report);
   return vtkFerroVolumeCall(
     "use the renderer's lights", report, [&] { renderer.set_lights(lights); });
 }

@@ -63,11 +63,22 @@ public:
   // The property's material (ambient, diffuse, specular, specular power) and the renderer's
   // two-sided lighting.
   static void SetMaterial(vtkVolumeProperty* prop, vtkRenderer* ren, FvRenderParams& params);
-  // For a mapper whose only shaded mode is composite (params.blend_mode set): Shade from the
-  // property, the material, and the renderer's lights given to `renderer` when shaded or
-  // path traced (none otherwise). `self` warns, once, past FV_MAX_LIGHTS lights.
+  // For a mapper without the image mapper's shading settings (params.blend_mode set): Shade
+  // from the property (composite and isosurfaces), the material, and FrameLights given to
+  // `renderer`. `self` warns, once, past FV_MAX_LIGHTS lights.
   static bool ApplyShading(vtkObject* self, vtkRenderer* ren, vtkVolumeProperty* prop,
     FvRenderParams& params, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
+  // The lights of a frame in `blend`: flat isosurfaces (not `shade`) one purely ambient
+  // light, as vtkGPUVolumeRayCastMapper draws them; shaded or path-traced frames the
+  // renderer's; none otherwise.
+  static std::vector<FvLight> FrameLights(
+    vtkObject* self, vtkRenderer* ren, uint32_t blend, bool shade, vtkFerroVolumeReport& report);
+  // The isosurfaces (ISOSURFACE_BLEND) of either mapper: the property's iso-values and the
+  // mapper's isosurface shading given to `renderer`, with `params`' material (set, Shade
+  // taken) made flat when Shade is off (vtkFerroVolumeSettingsModes.cxx).
+  template <class Mapper>
+  Result SetUpIsosurfaces(Mapper* self, vtkVolume* vol, int components, FvRenderParams& params,
+    ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
   static int SetUpClippingPlanes(
     vtkPlaneCollection* planes, FvRenderParams& params, vtkFerroVolumeReport& report);
 
@@ -135,8 +146,6 @@ private:
   // allocated to this one (vtkVolume::GetAllocatedRenderTime, from the window's
   // DesiredUpdateRate), as vtkOpenGLGPUVolumeRayCastMapper::ComputeReductionFactor sets it.
   double UpdateReductionFactor(vtkFerroVolumeMapper* self, double allocatedTime);
-  Result SetUpIsosurfaces(vtkFerroVolumeMapper* self, vtkVolume* vol, int components,
-    ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
 
   uint32_t Blend = FV_BLEND_MODE_COMPOSITE;
   FvRenderParams Params{};

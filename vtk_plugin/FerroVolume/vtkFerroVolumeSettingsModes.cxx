@@ -147,15 +147,35 @@ bool vtkFerroVolumeSettings::SetUpPathTracing(Mapper* self, vtkRenderer* ren, vt
     "use the path tracing settings", report, [&] { renderer.set_path_tracing(pt); });
 }
 
+namespace
+{
+// The scattering between the isosurfaces (the image mapper's IsosurfaceScattering*).
+void SetScattering(vtkFerroVolumeMapper* self, FvIsoParams& iso)
+{
+  iso.scatter_mode = static_cast<uint32_t>(self->GetIsosurfaceScattering());
+  iso.scatter_samples = static_cast<uint32_t>(self->GetIsosurfaceScatteringSamples());
+  iso.scatter_absorption =
+    static_cast<float>(std::min(self->GetIsosurfaceScatteringAbsorption(), 1e30));
+  if (self->GetFresnel() >= 0.0)
+  {
+    iso.scatter_fresnel = static_cast<float>(self->GetFresnel());
+  }
+}
+
+// A mesh's surfaces are shaded as layers, without scattering between them.
+void SetScattering(vtkFerroUnstructuredVolumeMapper*, FvIsoParams&) {}
+}
+
 // Gives the renderer the property's iso-values and the mapper's isosurface shading, and the
 // environment when it changed. The surfaces' colours and opacities are the property's
 // colour and scalar opacity functions at the iso-values, as vtkGPUVolumeRayCastMapper's:
 // those of the component the surfaces are of (independent components: the one of the
-// largest weight, the first of equal ones, as ferrovol's core picks it; else the first); Shade off draws flat colours (ambient 1, no diffuse or
-// specular light, no environment light). Without iso-values nothing is drawn, silently, as
-// vtkGPUVolumeRayCastMapper does.
-vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
-  vtkFerroVolumeMapper* self, vtkVolume* vol, int components, ferrovol::Renderer& renderer,
+// largest weight, the first of equal ones, as ferrovol's core picks it; else the first);
+// Shade off draws flat colours (ambient 1, no diffuse or specular light, no environment
+// light). Without iso-values nothing is drawn, silently, as vtkGPUVolumeRayCastMapper does.
+template <class Mapper>
+vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(Mapper* self,
+  vtkVolume* vol, int components, FvRenderParams& params, ferrovol::Renderer& renderer,
   vtkFerroVolumeReport& report)
 {
   vtkVolumeProperty* prop = vol->GetProperty();
@@ -170,7 +190,6 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
       }
     }
   }
-  FvRenderParams& params = this->Params;
   vtkContourValues* contours = prop->GetIsoSurfaceValues();
   const int n = contours ? contours->GetNumberOfContours() : 0;
   if (n < 1)
@@ -250,14 +269,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
     iso.shininess[0] = iso.shininess[1] = params.specular_power;
   }
   iso.fresnel = static_cast<float>(self->GetFresnel());
-  iso.scatter_mode = static_cast<uint32_t>(self->GetIsosurfaceScattering());
-  iso.scatter_samples = static_cast<uint32_t>(self->GetIsosurfaceScatteringSamples());
-  iso.scatter_absorption =
-    static_cast<float>(std::min(self->GetIsosurfaceScatteringAbsorption(), 1e30));
-  if (self->GetFresnel() >= 0.0)
-  {
-    iso.scatter_fresnel = static_cast<float>(self->GetFresnel());
-  }
+  SetScattering(self, iso);
   iso.ao_samples = static_cast<uint32_t>(self->GetAmbientOcclusionSamples());
   iso.ao_steps = static_cast<uint32_t>(self->GetAmbientOcclusionSteps());
   iso.ao_radius = self->GetAmbientOcclusionRadius();
@@ -284,7 +296,7 @@ vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
   return Result::Ready;
 }
 
-// The two mappers that path trace.
+// The two mappers that path trace and draw isosurfaces.
 template vtkFerroVolumeRefinement::Settings vtkFerroVolumeSettings::Refining(
   vtkFerroVolumeMapper*);
 template vtkFerroVolumeRefinement::Settings vtkFerroVolumeSettings::Refining(
@@ -293,3 +305,9 @@ template bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroVolumeMapper*, vt
   vtkVolume*, ferrovol::Renderer&, double, vtkFerroVolumeReport&);
 template bool vtkFerroVolumeSettings::SetUpPathTracing(vtkFerroUnstructuredVolumeMapper*,
   vtkRenderer*, vtkVolume*, ferrovol::Renderer&, double, vtkFerroVolumeReport&);
+template vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
+  vtkFerroVolumeMapper*, vtkVolume*, int, FvRenderParams&, ferrovol::Renderer&,
+  vtkFerroVolumeReport&);
+template vtkFerroVolumeSettings::Result vtkFerroVolumeSettings::SetUpIsosurfaces(
+  vtkFerroUnstructuredVolumeMapper*, vtkVolume*, int, FvRenderParams&, ferrovol::Renderer&,
+  vtkFerroVolumeReport&);

@@ -226,7 +226,7 @@ fn gradient_in(k: Tet, x: vec3<f32>) -> vec3<f32> {
 // The faces (1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1) are outward (resources/mesh orients
 // every tetrahedron positively), and the ray leaves through the one whose three edges'
 // products are ≥ 0, which are then its exit point's barycentric weights. Of the faces but
-// f_in, the one whose least product is largest (ties at an edge or rounding: the nearest
+// f_in and those whose products do not sum above 0, the one whose least product is largest (ties at an edge or rounding: the nearest
 // miss); tf NO_HIT where the ray does not leave through it (a ray along a face).
 fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> Hit {
     let e = o + t_in * d;
@@ -254,7 +254,12 @@ fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> 
         min(min(e13, -e03), e01),
         min(min(-e12, e02), -e01),
     );
-    m = select(m, vec4<f32>(-3.0e38), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in));
+    // A face whose weights do not sum above 0 is not crossed (a ray in its plane, as along
+    // the faces of a grid's tetrahedra, touches it everywhere with weights 0): never the exit.
+    let sums = vec4<f32>(w0.y + w0.z + w0.w, w1.x + w1.z + w1.w, w2.x + w2.y + w2.w,
+                         w3.x + w3.y + w3.z);
+    let out_of_play = (vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(f_in)) | !(sums > vec4<f32>(0.0));
+    m = select(m, vec4<f32>(-3.0e38), out_of_play);
     let best = max(max(m.x, m.y), max(m.z, m.w));
     let f = select(select(select(3u, 2u, m.z == best), 1u, m.y == best), 0u, m.x == best);
     let w = select(select(select(w3, w2, f == 2u), w1, f == 1u), w0, f == 0u);

@@ -77,6 +77,10 @@ pub const FILES: &[(&str, &str)] = &[
     ("firsthit.wgsl", include_str!("../../shaders/firsthit.wgsl")),
     ("deferred.wgsl", include_str!("../../shaders/deferred.wgsl")),
     (
+        "firsthit_mesh.wgsl",
+        include_str!("../../shaders/firsthit_mesh.wgsl"),
+    ),
+    (
         "environment.wgsl",
         include_str!("../../shaders/environment.wgsl"),
     ),
@@ -111,6 +115,7 @@ pub const PASSES: &[&str] = &[
     "unstructured.wgsl",
     "firsthit.wgsl",
     "deferred.wgsl",
+    "firsthit_mesh.wgsl",
     "environment.wgsl",
     "pathtrace.wgsl",
     "pathtrace_mesh.wgsl",

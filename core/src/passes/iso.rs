@@ -22,6 +22,8 @@
 //! [`Renderer::set_environment`](crate::Renderer::set_environment)
 //! (see [`crate::params::environment`]).
 
+mod mesh;
+
 use super::frame::{self, bricks_in_view, groups, visibility_order, FrameInput, Purpose};
 use super::iso_variant::{self, DeferredVariant, FirstHitVariant, IsoFacts};
 use crate::error::{Error, Result};
@@ -78,6 +80,29 @@ struct GBufferTargets {
     extra: wgpu::Texture,
 }
 
+/// The G-buffer's textures as the passes bind them (all layers).
+struct GBufferViews {
+    position: wgpu::TextureView,
+    normal: wgpu::TextureView,
+    extra: wgpu::TextureView,
+}
+
+impl GBufferTargets {
+    fn views(&self) -> GBufferViews {
+        let array_view = |tex: &wgpu::Texture| {
+            tex.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        GBufferViews {
+            position: array_view(&self.position),
+            normal: array_view(&self.normal),
+            extra: array_view(&self.extra),
+        }
+    }
+}
+
 /// The bricks a frame of the isosurfaces `iso` needs when its rays leave the pixels' lines
 /// (ambient occlusion, scattering between the surfaces), so that past the budget it draws a
 /// coarser level (`levels.rs`); none for a frame that streams.
@@ -132,6 +157,32 @@ pub(crate) struct IsoPass {
     no_mask: wgpu::TextureView,
     /// Bound in place of a rectilinear grid's lookup for a uniform grid.
     no_grid_lookup: wgpu::TextureView,
+    /// The passes of a mesh's surfaces, created on first use.
+    mesh: Option<mesh::MeshSurfaces>,
+}
+
+/// The iso-values a frame draws: an error without them.
+fn required(iso: Option<&IsoParams>) -> Result<&IsoParams> {
+    let iso = iso.ok_or_else(|| {
+        Error::InvalidParameter(
+            "BlendMode::Isosurface needs iso-values: call Renderer::set_isosurface first".into(),
+        )
+    })?;
+    iso.validate()?;
+    Ok(iso)
+}
+
+/// The frame's settings lit: lighting is the point of this mode, so the material applies
+/// whatever `enabled` says.
+fn lit(params: &RenderParams) -> RenderParams {
+    RenderParams {
+        blend: BlendMode::Isosurface,
+        shading: Shading {
+            enabled: true,
+            ..params.shading
+        },
+        ..params.clone()
+    }
 }
 
 /// `n` unit vectors uniform over the sphere from a fixed seed (PCG), as vec4s.
@@ -252,6 +303,7 @@ impl IsoPass {
             last_rect: [0; 4],
             no_mask: block_grid(ctx, "no mask", [1; 3], &[1u8]),
             no_grid_lookup: no_grid_lookup(ctx),
+            mesh: None,
         })
     }
 
@@ -378,13 +430,7 @@ impl IsoPass {
         let purpose = input.purpose;
         let (ctx, res, view, params, depth) = input.parts();
         params.validate()?;
-        let iso = iso.ok_or_else(|| {
-            Error::InvalidParameter(
-                "BlendMode::Isosurface needs iso-values: call Renderer::set_isosurface first"
-                    .into(),
-            )
-        })?;
-        iso.validate()?;
+        let iso = required(iso)?;
         frame::check_light_count(view)?;
         let rectilinear = res.volume()?.grid_lookup.is_some();
         res.ensure_environment(ctx)?;
@@ -450,16 +496,7 @@ impl IsoPass {
         res.ensure_targets(ctx, view.width, view.height)?;
         res.write_depth_input(ctx, view, depth)?;
         let depth_input = !matches!(depth, DepthSource::None);
-        // Lighting is the point of this mode: the material applies whatever `enabled` says.
-        let lit = RenderParams {
-            blend: BlendMode::Isosurface,
-            shading: Shading {
-                enabled: true,
-                ..params.shading
-            },
-            ..params.clone()
-        };
-        let f = frame::frame(res, view, &lit, step, depth_input)?;
+        let f = frame::frame(res, view, &lit(params), step, depth_input)?;
         let vol = res.volume()?;
         let data_range = vol.minmax.ranges.chunks(vol.components as usize).fold(
             [f32::INFINITY, f32::NEG_INFINITY],
@@ -469,11 +506,6 @@ impl IsoPass {
             },
         );
         let single_brick = vol.single_brick();
-        let unit = res
-            .tf
-            .as_ref()
-            .map_or(1.0, |tf| tf.component(component as usize).unit_distance);
-        let full = [0, 0, view.width, view.height];
         let occupied = self.occupancy.as_ref().map_or(1.0, |o| o.fraction);
         let step_voxels = match plan {
             Some(_) => step_in_voxels(res, params, step)?,
@@ -511,64 +543,12 @@ impl IsoPass {
         }
         let frame = f.uniforms;
         self.last_rect = frame.rect;
-        let env = res.current_environment()?;
-        let cube_sampler = res.cube_sampler()?;
-        // The uniforms.
-        let mut u = IsoUniforms::zeroed();
-        u.env_rotation = mat(DMat4::from_mat3(env.rotation));
-        for (i, v) in iso.values.iter().enumerate() {
-            u.values[i / 4][i % 4] = v.value as f32;
-            let opacity = if iso.scattering.is_some() {
-                0.0
-            } else {
-                v.opacity
-            };
-            u.colors[i] = [v.color[0], v.color[1], v.color[2], opacity];
-        }
-        u.shininess = match iso.shininess {
-            Shininess::Constant(s) => [0.0, 0.0, s, s],
-            Shininess::GradientMagnitude { range, exponents } => {
-                let [lo, hi] = range.unwrap_or_else(|| {
-                    let w = (data_range[1] - data_range[0]).max(0.0) as f64;
-                    [0.0, (w / (4.0 * spacing)).max(1e-30)]
-                });
-                [
-                    lo as f32,
-                    (1.0 / (hi - lo)) as f32,
-                    exponents[0],
-                    exponents[1],
-                ]
-            }
-        };
-        let ao = iso.ambient_occlusion;
-        u.ao = [
-            ao.map_or(0.0, |a| a.radius.unwrap_or(8.0 * spacing) as f32),
-            0.0,
-            0.0,
-            0.0,
-        ];
-        u.env = [
-            iso.environment_light,
-            iso.fresnel.unwrap_or(-1.0),
-            texel_solid_angle(env.size) as f32,
-            (env.mips - 1) as f32,
-        ];
-        u.counts = [
-            iso.values.len() as u32,
-            iso.bisection_steps,
-            layers,
-            ao.map_or(0, |a| a.samples),
-        ];
-        u.options = [
-            ao.map_or(1, |a| a.steps),
-            iso.specular_samples,
-            iso.specular.code(),
-            if iso.background {
-                ISO_FLAG_BACKGROUND
-            } else {
-                0
-            },
-        ];
+        let unit = res
+            .tf
+            .as_ref()
+            .map_or(1.0, |tf| tf.component(component as usize).unit_distance);
+        let full = [0, 0, view.width, view.height];
+        let mut u = iso_uniforms(res, iso, layers, data_range, spacing, full, frame.rect)?;
         if let Some(sc) = &iso.scattering {
             u.scatter = [
                 (sc.absorption as f64 / unit) as f32,
@@ -578,30 +558,13 @@ impl IsoPass {
             ];
         }
         let rect = frame.rect;
-        u.shade_rect = if iso.background { full } else { rect };
-        let shade_rect = u.shade_rect;
         let q = &ctx.queue;
         q.write_buffer(&res.frame_buf, 0, bytemuck::bytes_of(&frame));
         q.write_buffer(&self.iso_buf, 0, bytemuck::bytes_of(&u));
         let t = res.targets.as_ref().expect("allocated above");
         let occupancy = &self.occupancy.as_ref().expect("built above").grid;
-        // (the tables only matter with scattering; otherwise a one-texel table fills the slot)
-        let tables = res.tables.as_ref().map_or(&self.no_tables, |(_, t)| t);
-        let gb = self.gbuffer.as_ref().expect("allocated above");
-        let array_view = |tex: &wgpu::Texture| {
-            tex.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            })
-        };
-        let (gp, gn, ge) = (
-            array_view(&gb.position),
-            array_view(&gb.normal),
-            array_view(&gb.extra),
-        );
+        let gb = self.gbuffer.as_ref().expect("allocated above").views();
         let depth_in_view = t.depth_in.create_view(&Default::default());
-        let color_view = t.color.create_view(&Default::default());
-        let depth_view = t.depth.create_view(&Default::default());
         let d = &ctx.device;
         let firsthit_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("first hit"),
@@ -612,9 +575,9 @@ impl IsoPass {
                 bind_view(slots::OCCUPANCY, occupancy),
                 bind_view(slots::DEPTH_IN, &depth_in_view),
                 bind(slots::ISO, self.iso_buf.as_entire_binding()),
-                bind_view(8, &gp),
-                bind_view(9, &gn),
-                bind_view(10, &ge),
+                bind_view(8, &gb.position),
+                bind_view(9, &gb.normal),
+                bind_view(10, &gb.extra),
                 bind(11, wgpu::BindingResource::Sampler(&res.nearest)),
                 bind(
                     12,
@@ -626,39 +589,12 @@ impl IsoPass {
                 res.grid_lookup_entry(&self.no_grid_lookup)?,
             ],
         });
-        let deferred_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("deferred"),
-            layout: &self.deferred_bgl,
-            entries: &[
-                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind(2, t.state(ctx).as_entire_binding()),
-                bind_view(slots::OUT_COLOR, &color_view),
-                bind_view(slots::OUT_DEPTH, &depth_view),
-                bind(slots::ISO, self.iso_buf.as_entire_binding()),
-                bind_view(8, &gp),
-                bind_view(9, &gn),
-                bind_view(10, &ge),
-                bind_view(11, &env.cube_view),
-                bind_view(12, &env.irradiance_view),
-                bind(13, wgpu::BindingResource::Sampler(cube_sampler)),
-                bind(14, self.lobe_dirs.as_entire_binding()),
-                bind(
-                    15,
-                    wgpu::BindingResource::TextureView(
-                        res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
-                    ),
-                ),
-                bind_view(slots::TABLES, &tables.view),
-                res.blanking_entry(&self.no_mask),
-                res.grid_lookup_entry(&self.no_grid_lookup)?,
-            ],
-        });
+        let shading =
+            self.deferred_inputs(ctx, res, &gb, res.grid_lookup_entry(&self.no_grid_lookup)?)?;
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("isosurface frame"),
         });
-        if shade_rect != full {
-            clear_outputs(&mut enc, &color_view, &depth_view);
-        }
+        shading.clear_outside(&mut enc, u.shade_rect, full);
         let first_hit = |enc: &mut wgpu::CommandEncoder, volume: &wgpu::BindGroup| {
             let gr = groups(rect);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -688,18 +624,12 @@ impl IsoPass {
                 enc = d.create_command_encoder(&Default::default());
             }
         }
-        let volume = res.volume()?.bind_group(false);
-        {
-            let gs = groups(shade_rect);
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("deferred shading"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&deferred);
-            pass.set_bind_group(0, &deferred_bg, &[]);
-            pass.set_bind_group(1, volume, &[]);
-            pass.dispatch_workgroups(gs[0], gs[1], 1);
-        }
+        shading.dispatch(
+            &mut enc,
+            &deferred,
+            Some(res.volume()?.bind_group(false)),
+            u.shade_rect,
+        );
         ctx.checked("rendering the isosurface frame", || {
             ctx.submit([enc.finish()]);
         })?;
@@ -709,6 +639,166 @@ impl IsoPass {
         res.stats.frames += 1;
         Ok(())
     }
+
+    /// The deferred pass's bind group, shading the G-buffer `gb` into the frame's colour and
+    /// depth; `grid_lookup` binds the rectilinear grid's lookup (or its placeholder).
+    fn deferred_inputs(
+        &self,
+        ctx: &Context,
+        res: &Resources,
+        gb: &GBufferViews,
+        grid_lookup: wgpu::BindGroupEntry<'_>,
+    ) -> Result<DeferredInputs> {
+        let t = res.targets.as_ref().expect("allocated by the frame");
+        let env = res.current_environment()?;
+        // (the tables only matter with scattering; otherwise a one-texel table fills the slot)
+        let tables = res.tables.as_ref().map_or(&self.no_tables, |(_, t)| t);
+        let color = t.color.create_view(&Default::default());
+        let depth = t.depth.create_view(&Default::default());
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("deferred"),
+            layout: &self.deferred_bgl,
+            entries: &[
+                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
+                bind(2, t.state(ctx).as_entire_binding()),
+                bind_view(slots::OUT_COLOR, &color),
+                bind_view(slots::OUT_DEPTH, &depth),
+                bind(slots::ISO, self.iso_buf.as_entire_binding()),
+                bind_view(8, &gb.position),
+                bind_view(9, &gb.normal),
+                bind_view(10, &gb.extra),
+                bind_view(11, &env.cube_view),
+                bind_view(12, &env.irradiance_view),
+                bind(13, wgpu::BindingResource::Sampler(res.cube_sampler()?)),
+                bind(14, self.lobe_dirs.as_entire_binding()),
+                bind(
+                    15,
+                    wgpu::BindingResource::TextureView(
+                        res.mask.as_ref().map_or(&self.no_mask, |(m, _)| m),
+                    ),
+                ),
+                bind_view(slots::TABLES, &tables.view),
+                res.blanking_entry(&self.no_mask),
+                grid_lookup,
+            ],
+        });
+        Ok(DeferredInputs {
+            group,
+            color,
+            depth,
+        })
+    }
+}
+
+/// The deferred pass's inputs for one frame: its bind group and the frame's outputs.
+struct DeferredInputs {
+    group: wgpu::BindGroup,
+    color: wgpu::TextureView,
+    depth: wgpu::TextureView,
+}
+
+impl DeferredInputs {
+    /// Clears the outputs when the pixels shaded (`shade_rect`) are not all of them.
+    fn clear_outside(&self, enc: &mut wgpu::CommandEncoder, shade_rect: [u32; 4], full: [u32; 4]) {
+        if shade_rect != full {
+            clear_outputs(enc, &self.color, &self.depth);
+        }
+    }
+
+    /// Shades `shade_rect`'s pixels with `pipeline` (and the image volume's group, where the
+    /// surfaces are an image volume's).
+    fn dispatch(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        volume: Option<&wgpu::BindGroup>,
+        shade_rect: [u32; 4],
+    ) {
+        let gs = groups(shade_rect);
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("deferred shading"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        if let Some(volume) = volume {
+            pass.set_bind_group(1, volume, &[]);
+        }
+        pass.dispatch_workgroups(gs[0], gs[1], 1);
+    }
+}
+
+/// The isosurface uniforms of `iso` drawn in `layers` layers (its scattering aside): the
+/// shininess range by default from the scalars' `data_range` over four times the `spacing`
+/// of the samples or cells, the occlusion radius 8 `spacing`; the deferred pass shades the
+/// whole image (`full`) when the environment fills the background, else `rect`.
+fn iso_uniforms(
+    res: &Resources,
+    iso: &IsoParams,
+    layers: u32,
+    data_range: [f32; 2],
+    spacing: f64,
+    full: [u32; 4],
+    rect: [u32; 4],
+) -> Result<IsoUniforms> {
+    let env = res.current_environment()?;
+    let mut u = IsoUniforms::zeroed();
+    u.env_rotation = mat(DMat4::from_mat3(env.rotation));
+    for (i, v) in iso.values.iter().enumerate() {
+        u.values[i / 4][i % 4] = v.value as f32;
+        let opacity = if iso.scattering.is_some() {
+            0.0
+        } else {
+            v.opacity
+        };
+        u.colors[i] = [v.color[0], v.color[1], v.color[2], opacity];
+    }
+    u.shininess = match iso.shininess {
+        Shininess::Constant(s) => [0.0, 0.0, s, s],
+        Shininess::GradientMagnitude { range, exponents } => {
+            let [lo, hi] = range.unwrap_or_else(|| {
+                let w = (data_range[1] - data_range[0]).max(0.0) as f64;
+                [0.0, (w / (4.0 * spacing)).max(1e-30)]
+            });
+            [
+                lo as f32,
+                (1.0 / (hi - lo)) as f32,
+                exponents[0],
+                exponents[1],
+            ]
+        }
+    };
+    let ao = iso.ambient_occlusion;
+    u.ao = [
+        ao.map_or(0.0, |a| a.radius.unwrap_or(8.0 * spacing) as f32),
+        0.0,
+        0.0,
+        0.0,
+    ];
+    u.env = [
+        iso.environment_light,
+        iso.fresnel.unwrap_or(-1.0),
+        texel_solid_angle(env.size) as f32,
+        (env.mips - 1) as f32,
+    ];
+    u.counts = [
+        iso.values.len() as u32,
+        iso.bisection_steps,
+        layers,
+        ao.map_or(0, |a| a.samples),
+    ];
+    u.options = [
+        ao.map_or(1, |a| a.steps),
+        iso.specular_samples,
+        iso.specular.code(),
+        if iso.background {
+            ISO_FLAG_BACKGROUND
+        } else {
+            0
+        },
+    ];
+    u.shade_rect = if iso.background { full } else { rect };
+    Ok(u)
 }
 
 /// The sample distance `step` in voxels along the direction the volume's grid is stretched

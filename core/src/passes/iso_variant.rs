@@ -44,6 +44,8 @@ pipeline_variant! {
         blanking: bool => "BLANKING",
         /// A rectilinear grid (lib/rectilinear.wgsl).
         rectilinear: bool => "RECTILINEAR",
+        /// An unstructured volume's surfaces (firsthit_mesh.wgsl): no image volume bound.
+        mesh: bool => "MESH",
     }
 }
 
@@ -158,6 +160,7 @@ pub(crate) fn select(x: &IsoFacts) -> Result<(FirstHitVariant, DeferredVariant),
         mask,
         blanking: x.blanking,
         rectilinear: x.rectilinear,
+        mesh: false,
     };
     Ok((first_hit, deferred))
 }

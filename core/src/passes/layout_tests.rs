@@ -199,6 +199,11 @@ fn every_pass_binds_what_its_wgsl_declares() {
         &[UnstructuredPass::layout_entries()],
     );
     check(
+        "firsthit_mesh.wgsl",
+        "main",
+        &[IsoPass::mesh_firsthit_layout_entries()],
+    );
+    check(
         "pathtrace_mesh.wgsl",
         "main",
         &[PathTracePass::mesh_layout_entries()],

@@ -79,6 +79,12 @@ impl MeshTransfer {
             .write_buffer(&self.buf, 0, bytemuck::bytes_of(&mu));
     }
 
+    /// The mesh's uniforms for a pass that walks it without its transfer function.
+    pub fn write_walk(&self, ctx: &Context, mesh: &GpuMesh) {
+        ctx.queue
+            .write_buffer(&self.buf, 0, bytemuck::bytes_of(&mesh.uniforms));
+    }
+
     /// The mesh's bindings (lib/mesh.wgsl).
     pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 8] {
         use wgpu::BufferBindingType as B;
@@ -165,6 +171,7 @@ impl UnstructuredPass {
             depth_range: matches!(depth, DepthSource::Range(..)),
             intermix: res.intermix.is_some(),
             hybrid: false,
+            iso_scattering: false,
         })
         .map_err(Error::from)?;
         res.ensure_tables(ctx, 1.0)?;
@@ -274,8 +281,9 @@ fn opaque_entries(ct: &ComponentTransfer) -> OpaqueBits {
 }
 
 /// The frame uniforms of a frame of the renderer's mesh: the camera, the mesh's coordinates
-/// (relative to its centre) as the index space, the first component's table range, the
-/// material and lights, the clipping planes and the pixels the mesh's box covers.
+/// (relative to its centre) as the index space, the first component's table range (where a
+/// transfer function is set), the material and lights, the clipping planes and the pixels
+/// the mesh's box covers.
 pub(crate) fn frame_uniforms(
     res: &Resources,
     view: &crate::params::View,
@@ -283,7 +291,6 @@ pub(crate) fn frame_uniforms(
     depth_input: bool,
 ) -> Result<FrameUniforms> {
     let mesh = res.mesh.as_ref().ok_or_else(crate::resources::no_volume)?;
-    let tf = res.transfer_function()?;
     let vp = view.camera.view_projection(view.aspect());
     if !vp.is_finite() || vp.determinant().abs() < 1e-300 {
         return Err(Error::InvalidParameter("the camera gives a singular projection (check position, focal point, view up and clipping range)".into()));
@@ -297,14 +304,18 @@ pub(crate) fn frame_uniforms(
     u.gradient_to_world = mat(world_to_index.transpose());
     u.dims = [1.0, 1.0, 1.0, 1.0];
     u.scalar_scale = [1.0; 4];
-    let ct = tf.component(0);
-    let [lo, hi] = ct.table_range();
-    u.tf_lo[0] = lo as f32;
-    u.tf_inv_width[0] = (1.0 / (hi - lo)) as f32;
-    let [glo, ghi] = ct.gradient_range();
-    u.go_lo[0] = glo as f32;
-    u.go_inv_width[0] = (1.0 / (ghi - glo)) as f32;
-    u.weights[0] = ct.weight;
+    u.weights[0] = 1.0;
+    // (the isosurfaces read none)
+    if let Some(tf) = res.tf.as_ref() {
+        let ct = tf.component(0);
+        let [lo, hi] = ct.table_range();
+        u.tf_lo[0] = lo as f32;
+        u.tf_inv_width[0] = (1.0 / (hi - lo)) as f32;
+        let [glo, ghi] = ct.gradient_range();
+        u.go_lo[0] = glo as f32;
+        u.go_inv_width[0] = (1.0 / (ghi - glo)) as f32;
+        u.weights[0] = ct.weight;
+    }
     u.termination = params.termination_threshold;
     u.depth_threshold = params.depth_threshold;
     for (i, p) in params.clip_planes.iter().enumerate() {

@@ -2,8 +2,10 @@
 //! refuses: a pure function of the frame's facts ([`select`]), tested over the combinations
 //! on the CPU; its refusals are listed in docs/REFUSALS.md.
 
+use super::iso_variant::DeferredVariant;
 use crate::error::Error;
 use crate::gpu::pipeline::pipeline_variant;
+use crate::gpu::uniforms::MASK_NONE;
 use crate::params::BlendMode;
 
 pipeline_variant! {
@@ -25,6 +27,14 @@ pipeline_variant! {
         cell_scalars: bool => "CELL_SCALARS",
         /// The denoiser's guide.
         guide: bool => "GUIDE",
+    }
+}
+
+pipeline_variant! {
+    /// The pipeline constants of one specialisation of the mesh's first hit of its
+    /// isosurfaces (firsthit_mesh.wgsl).
+    pub(crate) struct MeshFirstHitVariant {
+        cell_scalars: bool => "CELL_SCALARS",
     }
 }
 
@@ -50,6 +60,8 @@ pub(crate) struct UnstructuredFacts {
     /// Path tracing's surface scattering: a gradient threshold, the stochastic blend or
     /// scattering regions other than everywhere.
     pub hybrid: bool,
+    /// Scattering between isosurfaces (IsoParams::scattering).
+    pub iso_scattering: bool,
 }
 
 /// A setting the unstructured pass does not draw.
@@ -66,9 +78,9 @@ impl From<UnstructuredRefusal> for Error {
         use UnstructuredRefusal as R;
         Error::Unsupported(match r {
             R::Blend(b) => format!(
-                "unstructured volumes are drawn in the composite, maximum, minimum, average \
-                 and additive blend modes and path traced, not {b:?}: use one of those, or \
-                 resample the mesh to an image"
+                "unstructured volumes are drawn in the composite, maximum, minimum, average, \
+                 additive and isosurface blend modes and path traced, not {b:?}: use one of \
+                 those, or resample the mesh to an image"
             ),
             R::Components(n) => format!(
                 "unstructured volumes are drawn from one scalar component, and this mesh has \
@@ -91,24 +103,32 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         | BlendMode::Minimum
         | BlendMode::Average
         | BlendMode::Additive
+        | BlendMode::Isosurface
         | BlendMode::PathTrace => {}
         b => return Err(R::Blend(b)),
     }
     if x.components != 1 {
         return Err(R::Components(x.components));
     }
+    // (isosurfaces read no transfer function, and are not shadowed)
+    let iso = x.blend == BlendMode::Isosurface;
     let settings = [
-        (x.tables_2d, "2D transfer functions"),
+        (x.tables_2d && !iso, "2D transfer functions"),
         (x.cropping, "cropping"),
-        (x.average_range, "an average range"),
+        (x.average_range && !iso, "an average range"),
         (x.whole_box, "a whole box (pieces of a whole)"),
-        (x.volumetric, "volumetric shadows"),
+        (x.volumetric && !iso, "volumetric shadows"),
         (x.depth_range, "a depth range"),
         (x.intermix, "intermixed volumes"),
         (
             x.hybrid && x.blend == BlendMode::PathTrace,
             "surface scattering (a gradient threshold, the stochastic blend or scattering \
              regions; path tracing scatters meshes by Henyey–Greenstein everywhere)",
+        ),
+        (
+            x.iso_scattering && iso,
+            "scattering between isosurfaces (their surfaces are shaded as opaque or \
+             translucent layers)",
         ),
     ];
     if let Some((_, what)) = settings.iter().find(|(on, _)| *on) {
@@ -127,6 +147,29 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         positional_lights: shade && x.positional_lights,
         gradient_opacity: x.gradient_opacity && x.blend == BlendMode::Composite,
     })
+}
+
+/// The variants that draw the isosurfaces of a mesh (its first hit, and the deferred
+/// shading of the G-buffer it writes), or the first reason they cannot be drawn.
+pub(crate) fn select_iso(
+    x: &UnstructuredFacts,
+) -> Result<(MeshFirstHitVariant, DeferredVariant), UnstructuredRefusal> {
+    select(x)?;
+    let deferred = DeferredVariant {
+        lights: x.lights,
+        positional_lights: x.positional_lights,
+        scatter: 0,
+        single_brick: true,
+        component: 0,
+        mask: MASK_NONE,
+        blanking: false,
+        rectilinear: false,
+        mesh: true,
+    };
+    let first_hit = MeshFirstHitVariant {
+        cell_scalars: x.cell_scalars,
+    };
+    Ok((first_hit, deferred))
 }
 
 #[cfg(test)]
@@ -150,6 +193,7 @@ pub(crate) mod tests {
             depth_range: false,
             intermix: false,
             hybrid: false,
+            iso_scattering: false,
         }
     }
 
@@ -165,7 +209,7 @@ pub(crate) mod tests {
                         ..facts()
                     };
                     each(&x);
-                    for k in 0..10 {
+                    for k in 0..11 {
                         let mut y = x;
                         *[
                             &mut y.shade,
@@ -178,6 +222,7 @@ pub(crate) mod tests {
                             &mut y.depth_range,
                             &mut y.intermix,
                             &mut y.hybrid,
+                            &mut y.iso_scattering,
                         ][k] = true;
                         each(&y);
                     }
@@ -190,13 +235,13 @@ pub(crate) mod tests {
     pub(crate) fn when(r: UnstructuredRefusal) -> (u8, &'static str) {
         use UnstructuredRefusal as R;
         match r {
-            R::Blend(_) => (0, "the isosurface or slice blend mode"),
+            R::Blend(_) => (0, "the slice blend mode"),
             R::Components(_) => (1, "a mesh of several components"),
             R::Setting(_) => (
                 2,
                 "2D transfer functions, cropping, an average range, a whole box, \
-                 volumetric shadows, a depth range, intermixed volumes, or surface \
-                 scattering when path tracing",
+                 volumetric shadows, a depth range, intermixed volumes, surface \
+                 scattering when path tracing, or scattering between isosurfaces",
             ),
         }
     }
@@ -235,6 +280,31 @@ pub(crate) mod tests {
                 }
             }
         });
-        assert_eq!(seen, 8 * 4 * 2 * 11);
+        assert_eq!(seen, 8 * 4 * 2 * 12);
+    }
+
+    #[test]
+    fn isosurfaces_read_no_transfer_function_and_shade_with_the_frames_lights() {
+        let x = UnstructuredFacts {
+            blend: BlendMode::Isosurface,
+            tables_2d: true,
+            volumetric: true,
+            average_range: true,
+            lights: 3,
+            positional_lights: true,
+            cell_scalars: true,
+            ..facts()
+        };
+        let (fh, df) = select_iso(&x).unwrap();
+        assert!(fh.cell_scalars && df.mesh && df.scatter == 0);
+        assert_eq!((df.lights, df.positional_lights), (3, true));
+        let scattering = UnstructuredFacts {
+            iso_scattering: true,
+            ..x
+        };
+        assert!(matches!(
+            select_iso(&scattering),
+            Err(UnstructuredRefusal::Setting(w)) if w.contains("between isosurfaces")
+        ));
     }
 }

@@ -481,3 +481,58 @@ pub fn render_lit(
         })
         .collect()
 }
+
+/// A crossing of an iso-value along a ray: its distance, which value, the gradient there
+/// (the points' interpolated) and whether the scalar is below the value on the ray's side.
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    pub t: f64,
+    pub which: usize,
+    pub gradient: DVec3,
+    pub below: bool,
+}
+
+/// The crossings of `values` (value, opacity) along a ray's segments, front to back, as
+/// firsthit_mesh.wgsl defines them: within a segment where its linear scalar passes a value,
+/// and, between segments that meet, where the scalar jumps past one (cell scalars); kept
+/// until `max` of them or their accumulated opacity reaches `termination`.
+pub fn crossings(
+    segs: &[Segment],
+    values: &[(f64, f64)],
+    max: usize,
+    termination: f64,
+) -> Vec<Crossing> {
+    let mut out = Vec::new();
+    let mut alpha = 0.0;
+    let mut prev: Option<&Segment> = None;
+    for s in segs {
+        let mut here = Vec::new();
+        let mut piece = |t0: f64, s0: f64, t1: f64, s1: f64, g0: DVec3, g1: DVec3| {
+            for (which, &(v, _)) in values.iter().enumerate() {
+                if (s0 < v) != (s1 < v) {
+                    let u = (v - s0) / (s1 - s0);
+                    here.push(Crossing {
+                        t: t0 + u * (t1 - t0),
+                        which,
+                        gradient: g0.lerp(g1, u),
+                        below: s0 < v,
+                    });
+                }
+            }
+        };
+        if let Some(p) = prev.filter(|p| (s.t0 - p.t1).abs() <= 1e-9 * (1.0 + s.t0.abs())) {
+            piece(s.t0, p.s1, s.t0, s.s0, s.g0, s.g0);
+        }
+        piece(s.t0, s.s0, s.t1, s.s1, s.g0, s.g1);
+        here.sort_by(|a, b| a.t.total_cmp(&b.t));
+        for c in here {
+            if out.len() >= max || alpha >= termination {
+                return out;
+            }
+            alpha += (1.0 - alpha) * values[c.which].1;
+            out.push(c);
+        }
+        prev = Some(s);
+    }
+    out
+}

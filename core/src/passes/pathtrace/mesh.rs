@@ -79,6 +79,7 @@ impl PathTracePass {
             depth_range: matches!(f.depth, DepthSource::Range(..)),
             intermix: res.intermix.is_some(),
             hybrid: f.hybrid,
+            iso_scattering: false,
         };
         let variant = MeshPathTraceVariant {
             cell_scalars: unstructured_variant::select(&facts)
@@ -122,12 +123,8 @@ impl PathTracePass {
                 .collect::<Vec<_>>(),
         });
         let u = self.base_uniforms(f, res, ct.unit_distance)?;
-        // (the denoiser compares depths per cell: the box's diagonal over the tetrahedra's
-        // cube root)
-        let b = mesh.bounds;
-        let diagonal =
-            ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
-        let cell = diagonal / (mesh.uniforms.counts[0].max(1) as f64).cbrt();
+        // (the denoiser compares depths per cell)
+        let cell = mesh.cell_size();
         Ok(Some(Medium {
             key,
             pipeline,

@@ -35,6 +35,32 @@ pub(crate) struct GpuMesh {
     /// Where the device's coordinates are relative to.
     pub origin: [f64; 3],
     pub bounds: [f64; 6],
+    /// The scalars' range (NaN left out; [0, 0] without a number).
+    pub range: [f32; 2],
+}
+
+impl GpuMesh {
+    /// The size of a typical cell: the box's diagonal over the tetrahedra's cube root.
+    pub fn cell_size(&self) -> f64 {
+        let b = self.bounds;
+        let diagonal =
+            ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
+        diagonal / (self.uniforms.counts[0].max(1) as f64).cbrt()
+    }
+}
+
+/// The least and greatest of `values` that are numbers ([0, 0] where none is).
+fn range_of(values: impl Iterator<Item = f32>) -> [f32; 2] {
+    let r = values
+        .filter(|v| !v.is_nan())
+        .fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], v| {
+            [lo.min(v), hi.max(v)]
+        });
+    if r[0] <= r[1] {
+        r
+    } else {
+        [0.0; 2]
+    }
 }
 
 /// An error when the mesh's `label` of `size` bytes exceed `max`, the most one storage
@@ -112,7 +138,12 @@ impl GpuMesh {
             knots: [[0.0; 4]; MESH_KNOTS / 4],
             opaque: [[u32::MAX; 4]; MESH_OPAQUE_WORDS / 4],
         };
+        let range = match m.location {
+            ScalarLocation::Cells => range_of(m.cell_scalars.iter().copied()),
+            ScalarLocation::Points => range_of(m.points.iter().map(|p| p[3])),
+        };
         Ok(GpuMesh {
+            range,
             points,
             gradients,
             tets,
