@@ -35,7 +35,8 @@ pub struct BenchArgs {
     /// Transfer-function preset or JSON for --input.
     #[arg(long, default_value = "auto")]
     tf: String,
-    /// Write the last frame of each configuration to DIR/ferrovol-{unshaded,shaded}.png.
+    /// Write the last frame of each configuration to DIR/ferrovol-{unshaded,shaded}.png
+    /// (a mesh's to DIR/ferrovol-mesh-{unshaded,shaded}.png).
     #[arg(long)]
     png_dir: Option<std::path::PathBuf>,
     /// Bench an unstructured mesh instead: the wavelet on N points per axis, each cube split
@@ -183,6 +184,20 @@ fn peak_host_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
+/// With --png-dir, the renderer's last frame as DIR/ferrovol-{name}.png.
+fn write_frame(a: &BenchArgs, r: &Renderer, name: &str) -> Result<(), CliError> {
+    if let Some(dir) = &a.png_dir {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
+        ferrovol_io::image::write_png(
+            &r.read_image()?,
+            &dir.join(format!("ferrovol-{name}.png")),
+            [0.0; 3],
+        )?;
+    }
+    Ok(())
+}
+
 /// `--mesh-points N`: the tetrahedralised wavelet through the unstructured pass.
 fn run_mesh(a: &BenchArgs, n: u32) -> Result<(), CliError> {
     if n < 2 || a.frames == 0 {
@@ -252,6 +267,7 @@ fn run_mesh(a: &BenchArgs, n: u32) -> Result<(), CliError> {
             1e3 * mean,
             1e3 * times[times.len() / 2]
         );
+        write_frame(a, &r, &format!("mesh-{name}"))?;
     }
     Ok(())
 }
@@ -323,15 +339,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
                 "ferrovol {name} ms_per_frame={:.1} median_ms={:.1} samples_per_s={:.3e} {skip_note}",
                 f.ms_per_frame, f.median_ms, f.samples_per_s
             );
-            if let Some(dir) = &a.png_dir {
-                std::fs::create_dir_all(dir)
-                    .map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
-                ferrovol_io::image::write_png(
-                    &r.read_image()?,
-                    &dir.join(format!("ferrovol-{name}.png")),
-                    [0.0; 3],
-                )?;
-            }
+            write_frame(&a, &r, name)?;
             ours.push((f.ms_per_frame, f.median_ms));
         }
     }

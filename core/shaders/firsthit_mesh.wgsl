@@ -59,7 +59,7 @@ fn occluded(p: vec3<f32>, d: vec3<f32>, tet: u32, v: f32, front_below: bool) -> 
             return true;
         }
         let t = ex.tf >> 2u;
-        if (ex.t >= reach || neighbours[t][ex.tf & 3u] == NO_NEIGHBOUR) {
+        if (ex.t >= reach || neighbours_of(t)[ex.tf & 3u] == NO_NEIGHBOUR) {
             return false;
         }
         walk_across(&w, p, d, ex, reach);
@@ -190,7 +190,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (full || ex.t >= seg.y) {
                 break;
             }
-            have_prev = inside && neighbours[tet][ex.tf & 3u] != NO_NEIGHBOUR;
+            have_prev = inside && neighbours_of(tet)[ex.tf & 3u] != NO_NEIGHBOUR;
             prev = tet;
             walk_across(&w, o, d, ex, seg.y);
         }

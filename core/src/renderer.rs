@@ -108,9 +108,10 @@ impl Renderer {
     /// over the boundary; a triangle shared by more than two tetrahedra is an error naming
     /// their cells. Drawn from its first scalar component. [`Renderer::render`] and [`Renderer::render_image`] then draw
     /// it with the same view, parameters and transfer function as an image volume;
-    /// [`Renderer::set_volume`] goes back to an image. A mesh whose buffers exceed the
-    /// device's storage-buffer binding size is refused with the sizes (about 38 bytes per
-    /// tetrahedron).
+    /// [`Renderer::set_volume`] goes back to an image. The tetrahedra (16 bytes each, and 16
+    /// of neighbours) may take two of the device's storage-buffer bindings; a mesh past them,
+    /// or whose points exceed one, is refused with the sizes (about 38 bytes per
+    /// tetrahedron in all).
     pub fn set_unstructured(&mut self, v: &UnstructuredVolume) -> Result<()> {
         self.res.set_mesh(&self.ctx, v)
     }

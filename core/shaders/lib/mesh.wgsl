@@ -15,6 +15,7 @@ struct Mesh {
     split: vec4<u32>,   // x: knots, or MESH_EVERY_ENTRY (pieces end at every table entry)
     knots: array<vec4<f32>, MESH_KNOTS / 4>, // table coordinates where pieces end, ascending
     opaque: array<vec4<u32>, MESH_OPAQUE_WORDS / 4>, // a bit per table entry of opacity > 0
+    halves: vec4<u32>,  // x: the tetrahedra in the first binding of tets and neighbours
 }
 
 struct BvhNode {
@@ -28,10 +29,13 @@ struct BvhNode {
 // (read once into private memory, as `frame`: lavapipe gathers uniforms read in loops)
 var<private> mesh: Mesh;
 @group(0) @binding(SLOT_MESH_POINTS) var<storage, read> points: array<vec4<f32>>;
+// (tetrahedra from mesh.halves.x on in the second binding: tet_ids)
 @group(0) @binding(SLOT_MESH_TETS) var<storage, read> tets: array<vec4<u32>>;
+@group(0) @binding(SLOT_MESH_TETS_HI) var<storage, read> tets_hi: array<vec4<u32>>;
 // across face f of tetrahedron t (opposite its point f): 4 · neighbour + its face, or
-// NO_NEIGHBOUR on the boundary
+// NO_NEIGHBOUR on the boundary (neighbours_of)
 @group(0) @binding(SLOT_MESH_NEIGHBOURS) var<storage, read> neighbours: array<vec4<u32>>;
+@group(0) @binding(SLOT_MESH_NEIGHBOURS_HI) var<storage, read> neighbours_hi: array<vec4<u32>>;
 @group(0) @binding(SLOT_MESH_CELL_SCALARS) var<storage, read> cell_scalars: array<f32>;
 // the scalar's gradient at each point (xyz; SHADE)
 @group(0) @binding(SLOT_MESH_GRADIENTS) var<storage, read> gradients: array<vec4<f32>>;
@@ -41,6 +45,22 @@ var<private> mesh: Mesh;
 
 const NO_NEIGHBOUR: u32 = 0xffffffffu;
 const NO_HIT: u32 = 0xffffffffu;
+
+// Tetrahedron t's point indices.
+fn tet_ids(t: u32) -> vec4<u32> {
+    if (t < mesh.halves.x) {
+        return tets[t];
+    }
+    return tets_hi[t - mesh.halves.x];
+}
+
+// Across each face of tetrahedron t: 4 · neighbour + its face, or NO_NEIGHBOUR.
+fn neighbours_of(t: u32) -> vec4<u32> {
+    if (t < mesh.halves.x) {
+        return neighbours[t];
+    }
+    return neighbours_hi[t - mesh.halves.x];
+}
 
 // Where a ray crosses a face: distance, the face as 4 · tet + face, the scalar there.
 struct Hit {
@@ -61,7 +81,7 @@ struct Face {
 }
 
 fn face_of(t: u32, f: u32) -> Face {
-    let ids = tets[t];
+    let ids = tet_ids(t);
     let pa = points[ids[(f + 1u) % 4u]];
     let pb = points[ids[(f + 2u) % 4u]];
     let pc = points[ids[(f + 3u) % 4u]];
@@ -171,7 +191,7 @@ struct Tet {
 
 fn load_tet(t: u32) -> Tet {
     var out: Tet;
-    out.ids = tets[t];
+    out.ids = tet_ids(t);
     out.p0 = points[out.ids.x];
     out.p1 = points[out.ids.y];
     out.p2 = points[out.ids.z];
@@ -191,7 +211,7 @@ fn shared_point(old: Tet, id: u32) -> vec4<f32> {
 // of its points are old's, one load brings the fourth.
 fn next_tet(old: Tet, t: u32, f: u32) -> Tet {
     var out: Tet;
-    out.ids = tets[t];
+    out.ids = tet_ids(t);
     let fresh = points[out.ids[f]];
     out.p0 = select(shared_point(old, out.ids.x), fresh, f == 0u);
     out.p1 = select(shared_point(old, out.ids.y), fresh, f == 1u);
@@ -361,7 +381,7 @@ fn walk_exit(w: ptr<function, Walk>, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> 
 // rounding error back. Where the ray leaves the hierarchy's box no triangle faces it beyond.
 fn walk_across(w: ptr<function, Walk>, o: vec3<f32>, d: vec3<f32>, ex: Hit, t_max: f32) {
     let t = (*w).hit.tf >> 2u;
-    let nb = neighbours[t][ex.tf & 3u];
+    let nb = neighbours_of(t)[ex.tf & 3u];
     let slack = 1e-5 * (abs(ex.t) + length(o));
     if (nb == NO_NEIGHBOUR) {
         if (ex.t >= (*w).root_far - slack) {

@@ -92,6 +92,9 @@ pub struct Context {
     /// The device memory (bytes) allocations may reach before they fail as out of memory;
     /// `u64::MAX` for no cap ([`Context::limit_device_memory`]).
     memory_cap: std::sync::Arc<std::sync::atomic::AtomicU64>,
+    /// The bytes one storage binding may hold below the device's limit; `u64::MAX` for the
+    /// device's own ([`Context::limit_binding_size`]).
+    binding_cap: std::sync::Arc<std::sync::atomic::AtomicU64>,
     /// The shader modules and compute pipelines of every renderer on this device.
     pub(crate) shaders: std::sync::Arc<ShaderStore>,
     /// The latest submission to the queue ([`Context::submit`]).
@@ -234,6 +237,7 @@ impl Context {
             info,
             lost,
             memory_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
+            binding_cap: std::sync::Arc::new(std::sync::atomic::AtomicU64::new(u64::MAX)),
             shaders: std::sync::Arc::new(ShaderStore {
                 parsed: Default::default(),
                 pipelines: Default::default(),
@@ -377,6 +381,25 @@ impl Context {
             bytes.unwrap_or(u64::MAX),
             std::sync::atomic::Ordering::Relaxed,
         );
+    }
+
+    /// Caps the bytes one storage buffer binding holds, as a device with that limit would
+    /// (lavapipe binds 128 MiB, many GPUs 2 or 4 GiB): a mesh whose tetrahedra exceed it
+    /// splits them over two bindings, and one past two is refused. For testing how meshes
+    /// are laid out on any device; `None` gives the device's own limit back. Applies to
+    /// meshes uploaded after the call.
+    pub fn limit_binding_size(&self, bytes: Option<u64>) {
+        self.binding_cap.store(
+            bytes.unwrap_or(u64::MAX),
+            std::sync::atomic::Ordering::Relaxed,
+        );
+    }
+
+    /// The bytes one storage buffer binding may hold: the device's limit, or less
+    /// ([`Context::limit_binding_size`]).
+    pub fn max_binding_size(&self) -> u64 {
+        let cap = self.binding_cap.load(std::sync::atomic::Ordering::Relaxed);
+        self.info.limits.max_storage_buffer_binding_size.min(cap)
     }
 
     /// [`Error::DeviceLost`] once the driver has reported the device lost.

@@ -50,6 +50,10 @@ pub const TABLES_2D: u32 = 24;
 pub const DEPTH_NEAR: u32 = 25;
 /// An unstructured volume's gradient per point (unstructured.wgsl).
 pub const MESH_GRADIENTS: u32 = 26;
+/// The second binding of an unstructured volume's tetrahedra and neighbours (lib/mesh.wgsl),
+/// where one binding of the device holds fewer than the mesh's.
+pub const MESH_TETS_HI: u32 = 31;
+pub const MESH_NEIGHBOURS_HI: u32 = 32;
 /// The path tracers' own (lib/pathtrace.wgsl): the accumulated sums and moments, the
 /// uniforms (one block per dispatch), the environment's cube, its sampler and its sampling
 /// distribution, the denoiser's guide sums.
@@ -93,6 +97,8 @@ pub const WGSL_SLOTS: &[(&str, u32)] = &[
     ("SLOT_MESH_NODES", MESH_NODES),
     ("SLOT_MESH_BOUNDARY", MESH_BOUNDARY),
     ("SLOT_MESH_GRADIENTS", MESH_GRADIENTS),
+    ("SLOT_MESH_TETS_HI", MESH_TETS_HI),
+    ("SLOT_MESH_NEIGHBOURS_HI", MESH_NEIGHBOURS_HI),
     ("SLOT_PT_ACCUM", PT_ACCUM),
     ("SLOT_PT_MOMENTS", PT_MOMENTS),
     ("SLOT_PT_UNIFORMS", PT_UNIFORMS),

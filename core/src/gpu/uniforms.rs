@@ -113,6 +113,9 @@ pub struct MeshUniforms {
     /// Bit i (word i / 32, bit i mod 32) set where table entry i's opacity is above 0:
     /// composite skips the integral of a tetrahedron whose scalars reach no set entry.
     pub opaque: [[u32; 4]; MESH_OPAQUE_WORDS / 4],
+    /// x: the tetrahedra the first binding of the tetrahedra and of the neighbours holds;
+    /// the rest are in the second (a device whose one binding holds fewer than the mesh's).
+    pub halves: [u32; 4],
 }
 
 /// The 32-bit words of [`MeshUniforms::opaque`]: a bit per table entry.
@@ -550,7 +553,7 @@ mod layout_tests {
             m,
             "Mesh",
             MeshUniforms,
-            [counts, unit, split, knots, opaque]
+            [counts, unit, split, knots, opaque, halves]
         );
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);

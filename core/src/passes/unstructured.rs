@@ -86,14 +86,16 @@ impl MeshTransfer {
     }
 
     /// The mesh's bindings (lib/mesh.wgsl).
-    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 8] {
+    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 10] {
         use wgpu::BufferBindingType as B;
         let read = B::Storage { read_only: true };
         [
             buffer_entry(slots::MESH, B::Uniform),
             buffer_entry(slots::MESH_POINTS, read),
             buffer_entry(slots::MESH_TETS, read),
+            buffer_entry(slots::MESH_TETS_HI, read),
             buffer_entry(slots::MESH_NEIGHBOURS, read),
+            buffer_entry(slots::MESH_NEIGHBOURS_HI, read),
             buffer_entry(slots::MESH_CELL_SCALARS, read),
             buffer_entry(slots::MESH_NODES, read),
             buffer_entry(slots::MESH_BOUNDARY, read),
@@ -102,12 +104,20 @@ impl MeshTransfer {
     }
 
     /// What they bind.
-    pub fn entries<'a>(&'a self, mesh: &'a GpuMesh) -> [wgpu::BindGroupEntry<'a>; 8] {
+    pub fn entries<'a>(&'a self, mesh: &'a GpuMesh) -> [wgpu::BindGroupEntry<'a>; 10] {
         [
             bind(slots::MESH, self.buf.as_entire_binding()),
             bind(slots::MESH_POINTS, mesh.points.as_entire_binding()),
-            bind(slots::MESH_TETS, mesh.tets.as_entire_binding()),
-            bind(slots::MESH_NEIGHBOURS, mesh.neighbours.as_entire_binding()),
+            bind(slots::MESH_TETS, mesh.tets[0].as_entire_binding()),
+            bind(slots::MESH_TETS_HI, mesh.tets[1].as_entire_binding()),
+            bind(
+                slots::MESH_NEIGHBOURS,
+                mesh.neighbours[0].as_entire_binding(),
+            ),
+            bind(
+                slots::MESH_NEIGHBOURS_HI,
+                mesh.neighbours[1].as_entire_binding(),
+            ),
             bind(
                 slots::MESH_CELL_SCALARS,
                 mesh.cell_scalars.as_entire_binding(),

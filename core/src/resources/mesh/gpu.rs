@@ -2,7 +2,8 @@
 //! tetrahedra, neighbours, cell scalars, the boundary triangles and their hierarchy
 //! (shaders/unstructured.wgsl).
 //!
-//! Per tetrahedron the device holds 16 bytes of points indices, 16 of neighbours and, with
+//! Per tetrahedron the device holds 16 bytes of points indices, 16 of neighbours (each split
+//! over two bindings where one binding of the device holds fewer) and, with
 //! cell scalars, 4 of scalar; per point 32 bytes (position and scalar, gradient); per
 //! boundary triangle 4 bytes and about half a 32-byte hierarchy node. A tetrahedral mesh of
 //! n tetrahedra has about n / 5 to n / 6 points, so about 38 bytes per tetrahedron.
@@ -23,8 +24,10 @@ pub(crate) const TET_BYTES: u64 = 16;
 pub(crate) struct GpuMesh {
     pub points: wgpu::Buffer,
     pub gradients: wgpu::Buffer,
-    pub tets: wgpu::Buffer,
-    pub neighbours: wgpu::Buffer,
+    /// The tetrahedra and their neighbours, each in two bindings: the first
+    /// `uniforms.halves[0]` tetrahedra, and the rest (a placeholder where none are left).
+    pub tets: [wgpu::Buffer; 2],
+    pub neighbours: [wgpu::Buffer; 2],
     /// One value per tetrahedron (cell scalars), or a placeholder of one.
     pub cell_scalars: wgpu::Buffer,
     pub nodes: wgpu::Buffer,
@@ -67,25 +70,49 @@ fn range_of(values: impl Iterator<Item = f32>) -> [f32; 2] {
 /// buffer binding holds on the device.
 pub(crate) fn check_binding_size(label: &str, size: u64, max: u64) -> Result<()> {
     if size > max {
-        return Err(Error::OutOfMemory(format!(
-            "the mesh's {label} take {size} bytes, but this device binds at most {max} bytes \
-             in one storage buffer (max_storage_buffer_binding_size): the mesh is too large \
-             for it; decimate or split it (the tetrahedra and their neighbours take \
-             {TET_BYTES} bytes per tetrahedron)"
-        )));
+        return Err(too_large(
+            label,
+            size,
+            &format!("{max} bytes in one storage buffer"),
+        ));
     }
     Ok(())
 }
 
-/// A storage buffer holding `data` (at least 4 bytes), refused with the sizes when it exceeds
+fn too_large(label: &str, size: u64, binds: &str) -> Error {
+    Error::OutOfMemory(format!(
+        "the mesh's {label} take {size} bytes, but this device binds at most {binds} \
+         (max_storage_buffer_binding_size): the mesh is too large for it; decimate or split \
+         it (the tetrahedra and their neighbours take {TET_BYTES} bytes per tetrahedron, each \
+         over two bindings)"
+    ))
+}
+
+/// How many of `n` tetrahedra the first of their two bindings holds, where one binding
+/// holds at most `max` bytes: all of them when they fit, else as many as fit (the rest in
+/// the second); an error past two bindings.
+pub(crate) fn first_half(n: u64, max: u64) -> Result<u32> {
+    let per = max / TET_BYTES;
+    if n > 2 * per {
+        return Err(too_large(
+            "tetrahedra",
+            n * TET_BYTES,
+            &format!("two storage buffers of {max} bytes"),
+        ));
+    }
+    Ok(n.min(per) as u32)
+}
+
+/// A storage buffer holding `data` (at least 16 bytes: an element of any of the mesh's
+/// arrays), refused with the sizes when it exceeds
 /// what one binding can hold.
 fn storage(ctx: &Context, label: &str, data: &[u8]) -> Result<wgpu::Buffer> {
     use wgpu::util::DeviceExt;
-    let max = ctx.info.limits.max_storage_buffer_binding_size;
+    let max = ctx.max_binding_size();
     check_binding_size(label, data.len() as u64, max)?;
     let padded;
-    let contents = if data.len() < 4 {
-        padded = [0u8; 4];
+    let contents = if data.len() < 16 {
+        padded = [0u8; 16];
         &padded[..]
     } else {
         data
@@ -116,8 +143,16 @@ impl GpuMesh {
         };
         let points = storage(ctx, "points", cast::<[f32; 4], u8>(&m.points))?;
         let gradients = storage(ctx, "gradients", cast::<[f32; 4], u8>(&m.point_gradients))?;
-        let tets = storage(ctx, "tetrahedra", cast::<[u32; 4], u8>(&m.tets))?;
-        let neighbours = storage(ctx, "neighbours", cast::<[u32; 4], u8>(&m.neighbours))?;
+        let half = first_half(m.tets.len() as u64, ctx.max_binding_size())?;
+        let halves = |label: &str, all: &[[u32; 4]]| -> Result<[wgpu::Buffer; 2]> {
+            let (lo, hi) = all.split_at(half as usize);
+            Ok([
+                storage(ctx, label, cast::<[u32; 4], u8>(lo))?,
+                storage(ctx, label, cast::<[u32; 4], u8>(hi))?,
+            ])
+        };
+        let tets = halves("tetrahedra", &m.tets)?;
+        let neighbours = halves("neighbours", &m.neighbours)?;
         let cell_scalars = storage(ctx, "cell scalars", cast::<f32, u8>(cells))?;
         let nodes_data: &[BvhNode] = &m.bvh.nodes;
         let nodes = storage(ctx, "boundary hierarchy", cast::<BvhNode, u8>(nodes_data))?;
@@ -137,6 +172,7 @@ impl GpuMesh {
             split: [MESH_EVERY_ENTRY, 0, 0, 0],
             knots: [[0.0; 4]; MESH_KNOTS / 4],
             opaque: [[u32::MAX; 4]; MESH_OPAQUE_WORDS / 4],
+            halves: [half, 0, 0, 0],
         };
         let range = match m.location {
             ScalarLocation::Cells => range_of(m.cell_scalars.iter().copied()),

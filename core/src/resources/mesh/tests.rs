@@ -221,3 +221,17 @@ fn a_mesh_past_the_binding_size_is_refused_with_the_sizes() {
     );
     assert!(gpu::check_binding_size("tetrahedra", 128, 128).is_ok());
 }
+
+#[test]
+fn tetrahedra_past_one_binding_split_over_two_and_past_two_are_refused() {
+    // 16 bytes each: a binding of 160 bytes holds 10
+    assert_eq!(gpu::first_half(7, 160).unwrap(), 7);
+    assert_eq!(gpu::first_half(10, 160).unwrap(), 10);
+    assert_eq!(gpu::first_half(11, 160).unwrap(), 10);
+    assert_eq!(gpu::first_half(20, 160).unwrap(), 10);
+    let e = gpu::first_half(21, 160).unwrap_err().to_string();
+    assert!(
+        e.contains("336 bytes") && e.contains("two storage buffers of 160 bytes"),
+        "{e}"
+    );
+}
