@@ -38,11 +38,6 @@ struct Flight {
     depth: f32,
 }
 
-// The attenuation τ (per world unit) at table coordinate x, linear between entries.
-fn tau_at(x: f32) -> f32 {
-    return row_lookup(tables, 1, x / f32(TABLE_N - 1u), false).x * mesh.unit.x;
-}
-
 // Flies along r, walking w, over [seg.x, seg.y) until the optical depth reaches `goal`;
 // with `roulette` (shadow rays) it plays Russian roulette past ROULETTE_DEPTH after each
 // tetrahedron, a stopped ray ending as if it had reached the goal.

@@ -69,6 +69,21 @@ void vtkFerroUnstructuredVolumeRepresentation::SetSpecularPower(double value)
   this->Property->SetSpecularPower(value);
 }
 
+void vtkFerroUnstructuredVolumeRepresentation::SetVolumeAnisotropy(double anisotropy)
+{
+  this->Property->SetScatteringAnisotropy(anisotropy);
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetGlobalIlluminationReach(double reach)
+{
+  this->FerroMapper->SetGlobalIlluminationReach(static_cast<float>(reach));
+}
+
+void vtkFerroUnstructuredVolumeRepresentation::SetVolumetricScatteringBlending(double blending)
+{
+  this->FerroMapper->SetVolumetricScatteringBlending(static_cast<float>(blending));
+}
+
 void vtkFerroUnstructuredVolumeRepresentation::SetFerrovolBlendMode(int mode)
 {
   if (mode < vtkVolumeMapper::COMPOSITE_BLEND || mode > vtkVolumeMapper::ISOSURFACE_BLEND)

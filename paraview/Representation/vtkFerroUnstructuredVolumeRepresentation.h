@@ -94,6 +94,17 @@ public:
 
   ///@{
   /**
+   * Volumetric shadows in shaded composite, as "Volume" of image data has them: the
+   * scattering anisotropy (into the vtkVolumeProperty), the reach and the blending (to the
+   * mapper).
+   */
+  void SetVolumeAnisotropy(double anisotropy);
+  void SetGlobalIlluminationReach(double reach);
+  void SetVolumetricScatteringBlending(double blending);
+  ///@}
+
+  ///@{
+  /**
    * Path tracing, as "Ferrovol Volume" of image data has it: the mapper's RenderMode,
    * SamplesPerPixel, PathTracingBounces, PathTracingDenoise, PathTracingDenoiseUntil,
    * ProgressiveMode, PathTracingTimeBudget, SecondaryRays, EnvironmentMap and

@@ -6,7 +6,8 @@ ParaView's own "Volume" of the same data, serial and under MPI.
       the grid drawn by "Ferrovol Volume" and by "Volume" with each of its mappers
       (MAPPERS); the multiblock (its blocks merged by the representation, as "Volume" merges
       them) against the single grid; the mesh uploaded once for renders that change only the
-      camera; Shade lights it (drawn, unlike the unshaded image); Isosurface draws the
+      camera; Shade lights it (drawn, unlike the unshaded image) and Volumetric Scattering
+      Blending shadows it (unlike the shaded image); Isosurface draws the
       Isosurface Values (drawn, unlike the composite image); Path Trace draws it as a
       scattering medium, every path in a still render; a three-component array
       refused (nothing drawn). Writes the references the
@@ -177,6 +178,15 @@ def serial(failures):
     # the unshaded image
     disp.Shade = 1
     lit = shot(view, "ugrid-serial-ferrovol-shaded", "oblique")
+    # Volumetric Scattering Blending (with Global Illumination Reach): shadows, drawn, and
+    # not the image lit by gradients alone
+    disp.VolumetricScatteringBlending = 1.0
+    disp.GlobalIlluminationReach = 0.1
+    shadowed = shot(view, "ugrid-serial-ferrovol-volumetric", "oblique")
+    disp.VolumetricScatteringBlending = 0.0
+    check_drawn(shadowed, "ferrovol volumetric shadows", failures)
+    T.compare("control: volumetric vs shaded", shadowed, lit, *SAME, failures,
+              expect_fail=True)
     disp.Shade = 0
     check_drawn(lit, "ferrovol shaded", failures)
     if ferrovol_info(disp)["FerrovolLastRenderDrew"] != 1:

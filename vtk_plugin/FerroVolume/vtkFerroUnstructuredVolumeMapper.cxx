@@ -337,6 +337,9 @@ void vtkFerroUnstructuredVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EnvironmentAzimuth: " << this->EnvironmentAzimuth << "\n";
   os << indent << "EnvironmentIntensity: " << this->EnvironmentIntensity << "\n";
   os << indent << "EnvironmentBackground: " << this->EnvironmentBackground << "\n";
+  os << indent << "VolumetricScatteringBlending: " << this->VolumetricScatteringBlending
+     << "\n";
+  os << indent << "GlobalIlluminationReach: " << this->GlobalIlluminationReach << "\n";
   os << indent << "EnvironmentLighting: " << this->EnvironmentLighting << "\n";
   os << indent << "SpecularSampling: "
      << (this->SpecularSampling == SPECULAR_CONE ? "cone" : "importance") << "\n";
@@ -447,6 +450,11 @@ void vtkFerroUnstructuredVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     vtkErrorMacro(<< report.GetError());
     return;
+  }
+  if (params.shade && blend == FV_BLEND_MODE_COMPOSITE)
+  {
+    vtkFerroVolumeSettings::SetVolumetric(this->VolumetricScatteringBlending,
+      this->GlobalIlluminationReach, vol->GetProperty(), params);
   }
   if (blend == FV_BLEND_MODE_ISOSURFACE)
   {

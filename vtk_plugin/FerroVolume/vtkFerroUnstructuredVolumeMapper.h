@@ -24,7 +24,9 @@
  * composite is lit by the renderer's lights with the property's ambient, diffuse, specular
  * and specular power, as vtkGPUVolumeRayCastMapper lights image data, each ray segment by
  * the scalar's gradient interpolated from the mesh's points (each point's the mean of its
- * tetrahedra's; from the neighbours across faces for cell scalars). A gradient opacity
+ * tetrahedra's; from the neighbours across faces for cell scalars), with volumetric shadows
+ * as vtkGPUVolumeRayCastMapper's VolumetricScatteringBlending and GlobalIlluminationReach
+ * give them (the same settings here; shadow rays walk the mesh). A gradient opacity
  * (which VTK's unstructured mappers ignore too) scales composite's opacity as
  * vtkGPUVolumeRayCastMapper's does, each ray segment by its function of that gradient's
  * magnitude at the segment's middle. A 2D transfer function is refused with an error naming
@@ -80,6 +82,22 @@ public:
   }
   void SetBlendModeToAdditive() { this->SetBlendMode(vtkVolumeMapper::ADDITIVE_BLEND); }
   void SetBlendModeToIsoSurface() { this->SetBlendMode(vtkVolumeMapper::ISOSURFACE_BLEND); }
+  ///@}
+
+  ///@{
+  /**
+   * Volumetric shadows in shaded composite, as vtkGPUVolumeRayCastMapper's settings of the
+   * same names give them to image data: VolumetricScatteringBlending (0, the default: none;
+   * up to 2, where the volumetric term replaces the gradient lighting) and
+   * GlobalIlluminationReach (0, the default: about a cell; 1: across the mesh's box), with
+   * the property's ScatteringAnisotropy. Each ray segment is lit as at its middle, its
+   * shadow rays walking the mesh toward each light with the attenuation integrated
+   * exactly.
+   */
+  vtkSetClampMacro(VolumetricScatteringBlending, float, 0.0f, 2.0f);
+  vtkGetMacro(VolumetricScatteringBlending, float);
+  vtkSetClampMacro(GlobalIlluminationReach, float, 0.0f, 1.0f);
+  vtkGetMacro(GlobalIlluminationReach, float);
   ///@}
 
   ///@{
@@ -235,6 +253,8 @@ protected:
   double EnvironmentAzimuth = 0.0;
   double EnvironmentIntensity = 1.0;
   vtkTypeBool EnvironmentBackground = 0;
+  float VolumetricScatteringBlending = 0.0f;
+  float GlobalIlluminationReach = 0.0f;
   double EnvironmentLighting = 0.0;
   int SpecularSampling = SPECULAR_IMPORTANCE;
   int SpecularSamples = 16;

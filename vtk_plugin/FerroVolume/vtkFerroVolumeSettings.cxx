@@ -489,12 +489,17 @@ void vtkFerroVolumeSettings::SetUpShading(vtkFerroVolumeMapper* self, vtkRendere
   SetMaterial(prop, ren, params);
   if (!isosurface)
   {
-    params.volumetric_scattering_blending =
-      static_cast<float>(self->GetVolumetricScatteringBlending());
-    params.global_illumination_reach = static_cast<float>(self->GetGlobalIlluminationReach());
-    params.scattering_anisotropy =
-      std::max(-1.0f, std::min(1.0f, prop->GetScatteringAnisotropy()));
+    SetVolumetric(self->GetVolumetricScatteringBlending(), self->GetGlobalIlluminationReach(),
+      prop, params);
   }
+}
+
+void vtkFerroVolumeSettings::SetVolumetric(
+  float blending, float reach, vtkVolumeProperty* prop, FvRenderParams& params)
+{
+  params.volumetric_scattering_blending = blending;
+  params.global_illumination_reach = reach;
+  params.scattering_anisotropy = std::max(-1.0f, std::min(1.0f, prop->GetScatteringAnisotropy()));
 }
 
 void vtkFerroVolumeSettings::SetUpCroppingAndClipping(vtkFerroVolumeMapper* self,

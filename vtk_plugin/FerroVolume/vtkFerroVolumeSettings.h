@@ -68,6 +68,10 @@ public:
   // `renderer`. `self` warns, once, past FV_MAX_LIGHTS lights.
   static bool ApplyShading(vtkObject* self, vtkRenderer* ren, vtkVolumeProperty* prop,
     FvRenderParams& params, ferrovol::Renderer& renderer, vtkFerroVolumeReport& report);
+  // Volumetric shadows (vtkGPUVolumeRayCastMapper's VolumetricScatteringBlending and
+  // GlobalIlluminationReach, the property's ScatteringAnisotropy) into `params`.
+  static void SetVolumetric(
+    float blending, float reach, vtkVolumeProperty* prop, FvRenderParams& params);
   // The lights of a frame in `blend`: flat isosurfaces (not `shade`) one purely ambient
   // light, as vtkGPUVolumeRayCastMapper draws them; shaded or path-traced frames the
   // renderer's; none otherwise.

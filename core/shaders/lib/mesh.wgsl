@@ -16,6 +16,10 @@ struct Mesh {
     knots: array<vec4<f32>, MESH_KNOTS / 4>, // table coordinates where pieces end, ascending
     opaque: array<vec4<u32>, MESH_OPAQUE_WORDS / 4>, // a bit per table entry of opacity > 0
     halves: vec4<u32>,  // x: the tetrahedra in the first binding of tets and neighbours
+    // xyz: 1 / the box's extent per axis (index space → the unit cube, where VTK measures
+    // the shadows' reach); w: a typical cell's size (the box's diagonal over the cube root of
+    // the tetrahedra), the step volumetric shadows take the opacity of
+    shadow: vec4<f32>,
 }
 
 struct BvhNode {
@@ -405,10 +409,38 @@ fn entry_of(s: f32) -> f32 {
 
 // Colour (rgb) and attenuation τ (a) at table coordinate x, linear between entries.
 fn colour_tau(x: f32) -> vec4<f32> {
-    let u = x / f32(TABLE_N - 1u);
-    let c = row_lookup(tables, 0, u, false);
-    let a = row_lookup(tables, 1, u, false).x;
-    return vec4<f32>(c.rgb, a * mesh.unit.x);
+    let c = row_lookup(tables, 0, x / f32(TABLE_N - 1u), false);
+    return vec4<f32>(c.rgb, tau_at(x));
+}
+
+// The attenuation τ (per world unit) at table coordinate x, linear between entries.
+fn tau_at(x: f32) -> f32 {
+    return row_lookup(tables, 1, x / f32(TABLE_N - 1u), false).x * mesh.unit.x;
+}
+
+// The optical depth ∫ τ of a segment of length len along which the scalar runs linearly from
+// s0 to s1: exact, τ being linear between the knots (or table entries).
+fn segment_depth(s0: f32, s1: f32, len: f32) -> f32 {
+    let x0 = entry_of(s0);
+    let x1 = entry_of(s1);
+    let up = x1 > x0;
+    var xa = x0;
+    var ua = 0.0;
+    var ta = tau_at(xa);
+    var depth = 0.0;
+    for (var i = 0u; i <= TABLE_N + 1u; i = i + 1u) {
+        let xb = next_cut(xa, x1, up);
+        let ub = select((xb - x0) / (x1 - x0), 1.0, xb == x1);
+        let tb = tau_at(xb);
+        depth = depth + 0.5 * (ta + tb) * (ub - ua) * len;
+        if (xb == x1) {
+            break;
+        }
+        xa = xb;
+        ua = ub;
+        ta = tb;
+    }
+    return depth;
 }
 
 // Where the piece from table coordinate xa toward x1 (up: increasing) ends: the next knot

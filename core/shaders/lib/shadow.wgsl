@@ -12,6 +12,7 @@
 #include "lib/common.wgsl"
 #include "lib/volume.wgsl"
 #include "lib/shading.wgsl"
+#include "lib/volumetric.wgsl"
 
 // The shadow and jitter offset of the current pixel (dvr.wgsl sets it: VTK reuses the
 // primary ray's jitter, 0 without jittering).
@@ -103,16 +104,6 @@ fn shadow_transmittance(p: vec3<f32>, n: vec3<f32>, limit: f32, dt: f32, grad_op
     return tr;
 }
 
-// Henyey–Greenstein over the cosine μ, normalised to 1 for isotropic scattering.
-fn shadow_phase(mu: f32) -> f32 {
-    let g = frame.scatter.y;
-    if (abs(g) < 0.01) {
-        return 1.0;
-    }
-    let d = max(1.0 + g * g - 2.0 * g * mu, 1e-12);
-    return (1.0 - g * g) / (d * sqrt(d));
-}
-
 // VTK's gradient magnitude in the volumetric blending, from the world gradient `grad` that
 // shades the sample: central differences over two voxels per unit length, of the normalised
 // scalar, or of the opacity where the normals come from the opacity (`of_opacity`).
@@ -167,10 +158,5 @@ fn volumetric_shade(color: vec3<f32>, a: f32, gm: f32, surface: vec3<f32>,
             v = v + ka * light.ambient.rgb;
         }
     }
-    let b = frame.scatter.x;
-    var w = b * exp(-b * gm * a);
-    if (b >= 1.0) {
-        w = (2.0 - b) * exp(-b * gm * a) + (b - 1.0);
-    }
-    return clamp(mix(surface, v, w), vec3<f32>(0.0), vec3<f32>(1.0));
+    return clamp(mix(surface, v, volumetric_weight(gm, a)), vec3<f32>(0.0), vec3<f32>(1.0));
 }

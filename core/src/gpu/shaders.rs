@@ -66,6 +66,10 @@ pub const FILES: &[(&str, &str)] = &[
     ),
     ("lib/mesh.wgsl", include_str!("../../shaders/lib/mesh.wgsl")),
     (
+        "lib/volumetric.wgsl",
+        include_str!("../../shaders/lib/volumetric.wgsl"),
+    ),
+    (
         "lib/pathtrace.wgsl",
         include_str!("../../shaders/lib/pathtrace.wgsl"),
     ),

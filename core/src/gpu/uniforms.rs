@@ -116,6 +116,10 @@ pub struct MeshUniforms {
     /// x: the tetrahedra the first binding of the tetrahedra and of the neighbours holds;
     /// the rest are in the second (a device whose one binding holds fewer than the mesh's).
     pub halves: [u32; 4],
+    /// xyz: 1 / the mesh box's extent per axis (index space → the unit cube, where the
+    /// volumetric shadows' reach is measured); w: a typical cell's size (the step whose
+    /// opacity weighs the volumetric term).
+    pub shadow: [f32; 4],
 }
 
 /// The 32-bit words of [`MeshUniforms::opaque`]: a bit per table entry.
@@ -553,7 +557,7 @@ mod layout_tests {
             m,
             "Mesh",
             MeshUniforms,
-            [counts, unit, split, knots, opaque, halves]
+            [counts, unit, split, knots, opaque, halves, shadow]
         );
         let m = module("denoise.wgsl");
         check!(m, "Denoise", DenoiseUniforms, [rect, size, params]);

@@ -6,7 +6,8 @@
 //! additive the exact integrals of opacity × normalised scalar.
 
 use super::frame::{
-    groups, index_plane, positional_lights, screen_rect, set_lights, FrameInput, Purpose,
+    casts_shadows, groups, index_plane, positional_lights, screen_rect, set_lights, FrameInput,
+    Purpose,
 };
 use super::unstructured_variant::{select, UnstructuredFacts, UnstructuredVariant};
 
@@ -177,7 +178,7 @@ impl UnstructuredPass {
             cropping: params.cropping.is_some(),
             average_range: params.average_range.is_some(),
             whole_box: params.whole_box.is_some(),
-            volumetric: params.shading.volumetric_blending > 0.0 && params.shading.enabled,
+            volumetric: casts_shadows(view, params),
             depth_range: matches!(depth, DepthSource::Range(..)),
             intermix: res.intermix.is_some(),
             hybrid: false,
@@ -351,5 +352,22 @@ pub(crate) fn frame_uniforms(
         ]);
     u.clip_planes = params.clip_planes.len() as u32;
     u.components = 1;
+    if casts_shadows(view, params) {
+        let s = &params.shading;
+        // VTK's reach (frame.rs) in the mesh's box mapped to the unit cube, from a typical
+        // cell's size for the step
+        let extent = (0..3).map(|a| b[2 * a + 1] - b[2 * a]).fold(0.0, f64::max);
+        let m = mesh.cell_size() / extent.max(1e-30);
+        let root3 = 3f64.sqrt();
+        let reach = root3 + (m - root3) * (1.0 - s.global_illumination_reach as f64).powf(0.33);
+        let [lo, hi] = mesh.range;
+        let range = if hi > lo { (hi - lo) as f64 } else { 1.0 };
+        u.scatter = [
+            s.volumetric_blending,
+            s.scattering_anisotropy,
+            reach as f32,
+            (2.0 / range) as f32,
+        ];
+    }
     Ok(u)
 }

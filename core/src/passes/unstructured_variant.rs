@@ -17,6 +17,8 @@ pipeline_variant! {
         lights: u32 => "NUM_LIGHTS",
         positional_lights: bool => "POSITIONAL_LIGHTS",
         gradient_opacity: bool => "GRAD_OPACITY",
+        /// Volumetric shadows (shaded composite with lights).
+        volumetric: bool => "VOLUMETRIC",
     }
 }
 
@@ -53,6 +55,7 @@ pub(crate) struct UnstructuredFacts {
     pub cropping: bool,
     pub average_range: bool,
     pub whole_box: bool,
+    /// Volumetric shadows asked for (frame::casts_shadows).
     pub volumetric: bool,
     /// Rays limited to a range of depths (Renderer::render_between).
     pub depth_range: bool,
@@ -110,14 +113,13 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
     if x.components != 1 {
         return Err(R::Components(x.components));
     }
-    // (isosurfaces read no transfer function, and are not shadowed)
+    // (isosurfaces read no transfer function)
     let iso = x.blend == BlendMode::Isosurface;
     let settings = [
         (x.tables_2d && !iso, "2D transfer functions"),
         (x.cropping, "cropping"),
         (x.average_range && !iso, "an average range"),
         (x.whole_box, "a whole box (pieces of a whole)"),
-        (x.volumetric && !iso, "volumetric shadows"),
         (x.depth_range, "a depth range"),
         (x.intermix, "intermixed volumes"),
         (
@@ -146,6 +148,7 @@ pub(crate) fn select(x: &UnstructuredFacts) -> Result<UnstructuredVariant, Unstr
         lights: if shade { x.lights } else { 0 },
         positional_lights: shade && x.positional_lights,
         gradient_opacity: x.gradient_opacity && x.blend == BlendMode::Composite,
+        volumetric: shade && x.volumetric && x.lights > 0,
     })
 }
 
@@ -239,9 +242,9 @@ pub(crate) mod tests {
             R::Components(_) => (1, "a mesh of several components"),
             R::Setting(_) => (
                 2,
-                "2D transfer functions, cropping, an average range, a whole box, \
-                 volumetric shadows, a depth range, intermixed volumes, surface \
-                 scattering when path tracing, or scattering between isosurfaces",
+                "2D transfer functions, cropping, an average range, a whole box, a depth \
+                 range, intermixed volumes, surface scattering when path tracing, or \
+                 scattering between isosurfaces",
             ),
         }
     }
@@ -262,6 +265,7 @@ pub(crate) mod tests {
                         v.gradient_opacity,
                         x.gradient_opacity && x.blend == BlendMode::Composite
                     );
+                    assert_eq!(v.volumetric, v.shade && x.volumetric && x.lights > 0);
                 }
                 Err(UnstructuredRefusal::Blend(b)) => assert_eq!(b, x.blend),
                 Err(UnstructuredRefusal::Components(n)) => {

@@ -8,6 +8,8 @@
 //! points' (each the volume-weighted mean of its tetrahedra's; the headlight,
 //! raycast::shade, clamped point by point). Gradient opacity scales a segment's opacity in
 //! composite by its function of that gradient's magnitude at the segment's middle.
+//! Volumetric shadows (the headlight's, [`Volumetric`]): each segment lit as at its middle,
+//! the transmittance toward the headlight integrated back along the pixel's own segments.
 
 use super::raycast::{eval_pw, pixel_ray, shade, to_pixel, Ray};
 use ferrovol_core::*;
@@ -267,6 +269,68 @@ pub struct Table {
     pub shading: Option<(Shading, LightAt)>,
     /// Composite with gradient opacity.
     pub gradient_opacity: bool,
+    /// Shaded composite with the headlight's volumetric shadows.
+    pub volumetric: Option<Volumetric>,
+}
+
+/// Volumetric shadows under the headlight, as unstructured.wgsl defines them for a mesh:
+/// at a segment's middle the transmittance back toward the eye over the reach, the
+/// Henyey–Greenstein phase at μ = −1, mixed with the gradient lighting by VTK's weight.
+pub struct Volumetric {
+    pub blending: f64,
+    pub anisotropy: f64,
+    /// The reach in the mesh's box mapped to the unit cube.
+    pub reach: f64,
+    /// 1 / the box's extent per axis.
+    pub inv_extent: DVec3,
+    /// A typical cell's size: the step the weight's opacity is taken over.
+    pub cell: f64,
+    /// 2 / the data range (VTK's gradient magnitude scale).
+    pub gradient_scale: f64,
+}
+
+impl Volumetric {
+    /// (the volumetric term's factor of the colour, its weight) for segment j of `segs`.
+    fn at(&self, segs: &[Segment], j: usize, table: &Table, sh: &Shading) -> (f64, f64) {
+        let s = &segs[j];
+        let mid = 0.5 * (s.t0 + s.t1);
+        let reach = self.reach / (s.dir * self.inv_extent).length();
+        let from = mid - reach;
+        // the optical depth from `from` to the middle, along the pixel's segments
+        let mut depth = 0.0;
+        for k in segs.iter().take(j + 1) {
+            let (a, b) = (k.t0.max(from), k.t1.min(mid));
+            if b <= a {
+                continue;
+            }
+            let sv = |t: f64| k.s0 + (k.s1 - k.s0) * (t - k.t0) / (k.t1 - k.t0);
+            let (x0, x1) = (sv(a), sv(b));
+            for (u0, u1) in table.pieces(x0, x1) {
+                depth += (b - a)
+                    * (u1 - u0)
+                    * quad(1, |u| {
+                        table.at(x0 + (x1 - x0) * (u0 + (u1 - u0) * u))[3] * table.inv_unit
+                    });
+            }
+        }
+        let g = self.anisotropy;
+        let phase = if g.abs() < 0.01 {
+            1.0
+        } else {
+            (1.0 - g * g) / (1.0 + g).powi(3)
+        };
+        let factor = (-depth).exp() * phase * sh.diffuse as f64;
+        let tau = table.at(0.5 * (s.s0 + s.s1))[3] * table.inv_unit;
+        let a = 1.0 - (-tau * self.cell).exp();
+        let gm = s.g0.lerp(s.g1, 0.5).length() * self.gradient_scale;
+        let bl = self.blending;
+        let w = if bl >= 1.0 {
+            (2.0 - bl) * (-bl * gm * a).exp() + (bl - 1.0)
+        } else {
+            bl * (-bl * gm * a).exp()
+        };
+        (factor, w)
+    }
 }
 
 impl Table {
@@ -280,6 +344,7 @@ impl Table {
             hi,
             shading: None,
             gradient_opacity: false,
+            volumetric: None,
         }
     }
 
@@ -402,10 +467,14 @@ pub fn integrate(segs: &[Segment], table: &Table, blend: BlendMode, termination:
         }
         _ => {}
     }
-    for s in segs {
+    for (j, s) in segs.iter().enumerate() {
         let (x0, x1) = (s.s0, s.s1);
         let l = s.t1 - s.t0;
         let go = table.gradient_factor(s.g0.lerp(s.g1, 0.5).length());
+        let shadow = match (&table.volumetric, &table.shading) {
+            (Some(v), Some((sh, _))) => Some(v.at(segs, j, table, sh)),
+            _ => None,
+        };
         for (u0, u1) in table.pieces(x0, x1) {
             let d = l * (u1 - u0);
             let at = |u: f64| {
@@ -419,7 +488,12 @@ pub fn integrate(segs: &[Segment], table: &Table, blend: BlendMode, termination:
                     LightAt::EachPoint => s.g0.lerp(s.g1, f),
                     LightAt::Middle => s.g0.lerp(s.g1, 0.5),
                 };
-                let c = shade([e[0], e[1], e[2]], g, s.dir, sh);
+                let mut c = shade([e[0], e[1], e[2]], g, s.dir, sh);
+                if let Some((factor, w)) = shadow {
+                    for ch in 0..3 {
+                        c[ch] = (c[ch] + w * (e[ch] * factor - c[ch])).clamp(0.0, 1.0);
+                    }
+                }
                 [c[0], c[1], c[2], e[3]]
             };
             let (tf, tb) = (at(0.0)[3] * table.inv_unit, at(1.0)[3] * table.inv_unit);
@@ -469,6 +543,29 @@ pub fn render_lit(
         table.shading = Some((params.shading, at));
     }
     table.gradient_opacity = params.blend == BlendMode::Composite;
+    let sh = &params.shading;
+    if table.shading.is_some() && sh.volumetric_blending > 0.0 {
+        let b = v.bounds();
+        let ext = DVec3::new(b[1] - b[0], b[3] - b[2], b[5] - b[4]);
+        let cell = ext.length() / (tets.tets.len() as f64).cbrt();
+        let m = cell / ext.max_element();
+        let root3 = 3f64.sqrt();
+        let scalars = if tets.cell_scalars.is_empty() {
+            &tets.point_scalars
+        } else {
+            &tets.cell_scalars
+        };
+        let lo = scalars.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = scalars.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        table.volumetric = Some(Volumetric {
+            blending: sh.volumetric_blending as f64,
+            anisotropy: sh.scattering_anisotropy as f64,
+            reach: root3 + (m - root3) * (1.0 - sh.global_illumination_reach as f64).powf(0.33),
+            inv_extent: DVec3::ONE / ext,
+            cell,
+            gradient_scale: 2.0 / (hi - lo),
+        });
+    }
     tets.segments(view)
         .iter()
         .map(|segs| {

@@ -43,13 +43,17 @@ pub(crate) struct GpuMesh {
 }
 
 impl GpuMesh {
-    /// The size of a typical cell: the box's diagonal over the tetrahedra's cube root.
+    /// The size of a typical cell ([`cell_size`]).
     pub fn cell_size(&self) -> f64 {
-        let b = self.bounds;
-        let diagonal =
-            ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
-        diagonal / (self.uniforms.counts[0].max(1) as f64).cbrt()
+        cell_size(self.bounds, self.uniforms.counts[0])
     }
+}
+
+/// The size of a typical cell of `tets` tetrahedra in `bounds`: the box's diagonal over the
+/// tetrahedra's cube root.
+fn cell_size(b: [f64; 6], tets: u32) -> f64 {
+    let diagonal = ((b[1] - b[0]).powi(2) + (b[3] - b[2]).powi(2) + (b[5] - b[4]).powi(2)).sqrt();
+    diagonal / (tets.max(1) as f64).cbrt()
 }
 
 /// The least and greatest of `values` that are numbers ([0, 0] where none is).
@@ -173,6 +177,16 @@ impl GpuMesh {
             knots: [[0.0; 4]; MESH_KNOTS / 4],
             opaque: [[u32::MAX; 4]; MESH_OPAQUE_WORDS / 4],
             halves: [half, 0, 0, 0],
+            shadow: {
+                let b = m.bounds;
+                let inv = |lo: f64, hi: f64| (1.0 / (hi - lo).max(1e-30)) as f32;
+                [
+                    inv(b[0], b[1]),
+                    inv(b[2], b[3]),
+                    inv(b[4], b[5]),
+                    cell_size(b, n) as f32,
+                ]
+            },
         };
         let range = match m.location {
             ScalarLocation::Cells => range_of(m.cell_scalars.iter().copied()),
