@@ -434,7 +434,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (!found) {
             break;
         }
-        var th: array<f32, 8>;
+        var th: array<f32, MAX_ISO>;
         for (var i = 0u; i < n_iso; i = i + 1u) {
             if ((crossed & (1u << i)) != 0u) {
                 th[i] = select(refine(ray, t_prev, t, iso_value(i), s_prev < iso_value(i)), t, gap);
@@ -445,16 +445,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (crossed == 0u || done) {
                 break;
             }
-            var which = 0u;
-            var best = 3.4e38;
-            for (var i = 0u; i < n_iso; i = i + 1u) {
-                if ((crossed & (1u << i)) != 0u && th[i] < best) {
-                    best = th[i];
-                    which = i;
-                }
-            }
+            let which = nearest_crossing(crossed, th);
             crossed = crossed & ~(1u << which);
-            write_hit(px, layers, ray, best, which, s_prev < iso_value(which));
+            write_hit(px, layers, ray, th[which], which, s_prev < iso_value(which));
             layers = layers + 1u;
             alpha = alpha + (1.0 - alpha) * iso.colors[which].a;
             done = layers >= max_layers || alpha >= ert;

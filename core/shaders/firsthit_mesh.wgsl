@@ -126,16 +126,9 @@ fn cross_piece(px: vec2<u32>, ray: Ray, ta: f32, sa: f32, tb: f32, sb: f32, k: T
         if (crossed == 0u || full) {
             break;
         }
-        var which = 0u;
-        var best = 3.4e38;
-        for (var i = 0u; i < n_iso; i = i + 1u) {
-            if ((crossed & (1u << i)) != 0u && th[i] < best) {
-                best = th[i];
-                which = i;
-            }
-        }
+        let which = nearest_crossing(crossed, th);
         crossed = crossed & ~(1u << which);
-        write_hit(px, ray, best, which, sa < iso_value(which), k, front);
+        write_hit(px, ray, th[which], which, sa < iso_value(which), k, front);
     }
 }
 
@@ -175,17 +168,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 if (have_prev) {
                     cross_piece(px, ray, w.hit.t, s_prev, w.hit.t, w.hit.s, w.k, prev);
                 }
-                let span = ex.t - w.hit.t;
-                var s0 = w.hit.s;
-                var s1 = ex.s;
-                if (span > 0.0) {
-                    s0 = mix(w.hit.s, ex.s, (lo - w.hit.t) / span);
-                    s1 = mix(w.hit.s, ex.s, (hi - w.hit.t) / span);
-                }
+                let sv = scalars_at(w.hit, ex, lo, hi);
                 if (!full) {
-                    cross_piece(px, ray, lo, s0, hi, s1, w.k, tet);
+                    cross_piece(px, ray, lo, sv.x, hi, sv.y, w.k, tet);
                 }
-                s_prev = s1;
+                s_prev = sv.y;
             }
             if (full || ex.t >= seg.y) {
                 break;

@@ -60,13 +60,9 @@ fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32, roulette: bool, rng: ptr<
         if (hi > lo && !transparent_tet(w.k, tet)) {
             // the part of the tetrahedron's segment within seg, then its pieces between
             // the knots (or table entries), along each of which σ is linear
-            let span = ex.t - w.hit.t;
-            var s0 = w.hit.s;
-            var s1 = ex.s;
-            if (span > 0.0) {
-                s0 = mix(w.hit.s, ex.s, (lo - w.hit.t) / span);
-                s1 = mix(w.hit.s, ex.s, (hi - w.hit.t) / span);
-            }
+            let sv = scalars_at(w.hit, ex, lo, hi);
+            let s0 = sv.x;
+            let s1 = sv.y;
             let len = hi - lo;
             let x0 = entry_of(s0);
             let x1 = entry_of(s1);

@@ -220,7 +220,7 @@ fn transmittance(x: vec3<f32>, d: vec3<f32>, tet: u32, s: f32, limit: f32) -> f3
         }
         let hi = min(ex.t, limit);
         if (hi > w.hit.t && !transparent_tet(w.k, ex.tf >> 2u)) {
-            let s1 = mix(w.hit.s, ex.s, (hi - w.hit.t) / (ex.t - w.hit.t));
+            let s1 = scalars_at(w.hit, ex, hi, hi).y;
             var scale = 1.0;
             if (GRAD_OPACITY) {
                 let g = gradient_in(w.k, x + 0.5 * (w.hit.t + hi) * d);
@@ -313,8 +313,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                         let pos = ray.origin + mid * ray.dir;
                         lit = lighting(gw, pos, ray.dir, frame.material);
                         if (VOLUMETRIC) {
-                            let span = ex.t - w.hit.t;
-                            let sm = select(w.hit.s, mix(w.hit.s, ex.s, (mid - w.hit.t) / span), span > 0.0);
+                            let sm = scalars_at(w.hit, ex, mid, mid).x;
                             let tau = tau_at(entry_of(sm)) * opacity_scale;
                             lit = volumetric_lighting(lit, o + mid * d, ex.tf >> 2u, sm, pos, ray.dir, gw, tau);
                         }

@@ -1535,12 +1535,13 @@ void fv_unstructured_volume_free(struct FvUnstructuredVolume *volume);
 /**
  * Uploads an unstructured volume, replacing the renderer's volume or mesh
  * (fv_renderer_set_volume goes back to an image volume): its cells split into tetrahedra,
- * their neighbours and a hierarchy over the boundary. Frames then ray cast it, or path
- * trace it (FV_BLEND_MODE_PATH_TRACE: Henyey–Greenstein scattering), with the same camera,
- * parameters and transfer function; what its passes do not draw (isosurfaces, the slice
- * mode, several components, surface scattering, …) fails at render with
- * FV_STATUS_UNSUPPORTED naming it. A mesh too large for the device's buffers is refused
- * with the sizes.
+ * their neighbours and a hierarchy over the boundary. Frames then ray cast it (composite,
+ * with volumetric shadows when shaded; the projections; FV_BLEND_MODE_ISOSURFACE: exact
+ * crossings), or path trace it (FV_BLEND_MODE_PATH_TRACE: Henyey–Greenstein scattering),
+ * with the same camera, parameters and transfer function; what its passes do not draw (the
+ * slice mode, several components, surface scattering, scattering between isosurfaces, …)
+ * fails at render with FV_STATUS_UNSUPPORTED naming it. The tetrahedra may take two of the
+ * device's storage bindings; a mesh too large for its buffers is refused with the sizes.
  */
 enum FvStatus fv_renderer_set_unstructured(struct FvRenderer *renderer,
                                            const struct FvUnstructuredVolume *volume);

@@ -26,3 +26,17 @@ var<private> iso: Iso;
 fn iso_value(i: u32) -> f32 {
     return iso.values[i / 4u][i % 4u];
 }
+
+// Of the iso-values whose bits `crossed` holds (crossed at distances th), the nearest.
+fn nearest_crossing(crossed: u32, th: array<f32, MAX_ISO>) -> u32 {
+    var t = th;
+    var which = 0u;
+    var best = 3.4e38;
+    for (var i = 0u; i < MAX_ISO; i = i + 1u) {
+        if ((crossed & (1u << i)) != 0u && t[i] < best) {
+            best = t[i];
+            which = i;
+        }
+    }
+    return which;
+}

@@ -305,6 +305,15 @@ fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> 
     return out;
 }
 
+// The scalars at distances lo and hi of the segment from `entry` to `ex` (linear along it).
+fn scalars_at(entry: Hit, ex: Hit, lo: f32, hi: f32) -> vec2<f32> {
+    let span = ex.t - entry.t;
+    if (span > 0.0) {
+        return mix(vec2<f32>(entry.s), vec2<f32>(ex.s), (vec2<f32>(lo, hi) - entry.t) / span);
+    }
+    return vec2<f32>(entry.s, ex.s);
+}
+
 // A ray's walk through the mesh: the tetrahedron it is in (hit.tf >> 2, its points in k),
 // where it entered it (hit.t, scalar hit.s, through face f_in; 4 when the walk started
 // inside), where the ray leaves the boundary hierarchy's box, and the steps taken. hit.tf

@@ -187,6 +187,26 @@ pub(crate) fn casts_shadows(view: &View, params: &RenderParams) -> bool {
         && params.blend == BlendMode::Composite
 }
 
+/// The volumetric shadows' uniforms (lib/volumetric.wgsl, frame.scatter) of shading `s`:
+/// the blending, the anisotropy, VTK's reach √3 + (m − √3)(1 − R)^0.33 in texture units
+/// (m the step over the largest extent), and 2 over the data range (`range`: VTK's
+/// gradient magnitude scale).
+pub(crate) fn scatter_uniforms(s: &crate::params::Shading, m: f64, range: [f32; 2]) -> [f32; 4] {
+    let root3 = 3f64.sqrt();
+    let reach = root3 + (m - root3) * (1.0 - s.global_illumination_reach as f64).powf(0.33);
+    let width = if range[1] > range[0] {
+        (range[1] - range[0]) as f64
+    } else {
+        1.0
+    };
+    [
+        s.volumetric_blending,
+        s.scattering_anisotropy,
+        reach as f32,
+        (2.0 / width) as f32,
+    ]
+}
+
 pub(crate) fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
     let empty = |r: [u32; 4]| r[0] >= r[2] || r[1] >= r[3];
     match (empty(a), empty(b)) {
@@ -287,7 +307,6 @@ pub(crate) fn frame(
         u.mask = [params.mask_blend, f32::from(max_label), 0.0, 0.0];
         any_go |= params.mask_blend > 0.0 && tf.labels_gradient_opacity();
     }
-    let s = &params.shading;
     let mut flags = set_lights(&mut u, view, params);
     for (c, m) in u.component_materials.iter_mut().enumerate() {
         *m = tf.component(c).material.unwrap_or(u.material);
@@ -354,11 +373,6 @@ pub(crate) fn frame(
                 index_to_world.transform_vector3(*axis).length() * (n.max(2) - 1) as f64
             })
             .fold(0.0, f64::max);
-        // VTK: reach = √3 + (m − √3)(1 − R)^0.33 texture units, m the sample distance
-        // over the largest extent
-        let m = step / extent;
-        let root3 = 3f64.sqrt();
-        let reach = root3 + (m - root3) * (1.0 - s.global_illumination_reach as f64).powf(0.33);
         let (lo, hi) = vol
             .minmax
             .ranges
@@ -367,13 +381,7 @@ pub(crate) fn frame(
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), r| {
                 (lo.min(r[0]), hi.max(r[1]))
             });
-        let range = if hi > lo { (hi - lo) as f64 } else { 1.0 };
-        u.scatter = [
-            s.volumetric_blending,
-            s.scattering_anisotropy,
-            reach as f32,
-            (2.0 / range) as f32,
-        ];
+        u.scatter = scatter_uniforms(&params.shading, step / extent, [lo, hi]);
     }
     u.width = view.width;
     u.height = view.height;

@@ -6,8 +6,8 @@
 //! additive the exact integrals of opacity × normalised scalar.
 
 use super::frame::{
-    casts_shadows, groups, index_plane, positional_lights, screen_rect, set_lights, FrameInput,
-    Purpose,
+    casts_shadows, groups, index_plane, positional_lights, scatter_uniforms, screen_rect,
+    set_lights, FrameInput, Purpose,
 };
 use super::unstructured_variant::{select, UnstructuredFacts, UnstructuredVariant};
 
@@ -353,21 +353,11 @@ pub(crate) fn frame_uniforms(
     u.clip_planes = params.clip_planes.len() as u32;
     u.components = 1;
     if casts_shadows(view, params) {
-        let s = &params.shading;
-        // VTK's reach (frame.rs) in the mesh's box mapped to the unit cube, from a typical
-        // cell's size for the step
+        // (the reach in the mesh's box mapped to the unit cube, a typical cell's size the
+        // step)
         let extent = (0..3).map(|a| b[2 * a + 1] - b[2 * a]).fold(0.0, f64::max);
         let m = mesh.cell_size() / extent.max(1e-30);
-        let root3 = 3f64.sqrt();
-        let reach = root3 + (m - root3) * (1.0 - s.global_illumination_reach as f64).powf(0.33);
-        let [lo, hi] = mesh.range;
-        let range = if hi > lo { (hi - lo) as f64 } else { 1.0 };
-        u.scatter = [
-            s.volumetric_blending,
-            s.scattering_anisotropy,
-            reach as f32,
-            (2.0 / range) as f32,
-        ];
+        u.scatter = scatter_uniforms(&params.shading, m, mesh.range);
     }
     Ok(u)
 }
