@@ -94,7 +94,8 @@ enum GradArg {
 #[derive(clap::Args)]
 struct RenderArgs {
     /// Volume file: .vti, .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr; or an unstructured grid,
-    /// .vtu (composite, mip, minip, average, additive). Without it, a built-in volume.
+    /// .vtu (composite with --shade and --volumetric, mip, minip, average, additive, iso,
+    /// pathtrace). Without it, a built-in volume.
     input: Option<PathBuf>,
     /// Built-in volume to render when no input file is given.
     #[arg(long, value_enum, default_value = "wavelet")]
