@@ -17,7 +17,8 @@ ParaView's own "Volume" of the same data, serial and under MPI.
       the ranks): ParaView redistributes the cells over the ranks by its k-d tree, each rank
       draws its region with ferrovol and IceT composites the images in visibility order.
       Rank 0 checks that the ranks draw disjoint regions and compares the result with the
-      serial images, also from either side of the cut (the order flips).
+      serial images, also from either side of the cut (the order flips), and the
+      isosurfaces with the serial ones.
 """
 import os
 import sys
@@ -285,6 +286,11 @@ def distributed(failures):
     if uploads[-1] != uploads[0]:
         failures.append("rank %d: the mesh was uploaded again for camera changes (%s)"
                         % (T.rank(), uploads))
+    # isosurfaces: each rank's layers lie within its region, composited in visibility order
+    disp.IsosurfaceValues = [150.0]
+    disp.FerrovolBlendMode = "Isosurface"
+    iso = shot(view, "ugrid-n%d-ferrovol-isosurface" % T.nranks(), "oblique")
+    disp.FerrovolBlendMode = "Composite"
     # the regions the ranks draw: the k-d tree's, which overlap at most in a layer of cells
     # (the source's pieces are interleaved slabs, overlapping over the whole z range)
     boxes = gather_boxes(drawn[1])
@@ -305,6 +311,10 @@ def distributed(failures):
         ref = read_ref("ugrid-serial-ferrovol-%s" % cam, failures)
         if ref is not None:
             T.compare("mpi -n %d %s vs serial" % (T.nranks(), cam), img, ref, *SAME, failures)
+    check_drawn(iso, "ferrovol isosurface", failures)
+    ref = read_ref("ugrid-serial-ferrovol-isosurface", failures)
+    if ref is not None:
+        T.compare("mpi -n %d isosurface vs serial" % T.nranks(), iso, ref, *SAME, failures)
     ref = read_ref("ugrid-serial-volume-bunyk-oblique", failures)
     if ref is not None:
         T.compare("mpi -n %d vs serial Volume (Bunyk)" % T.nranks(), imgs["oblique"], ref,
