@@ -22,7 +22,8 @@
 // VOLUMETRIC (shaded composite): volumetric shadows, as the image ray caster draws them
 // (lib/shadow.wgsl, VTK's VolumetricScatteringBlending) with the mesh's own light
 // transport: at each segment's middle, the transmittance toward each light is exp(−τ) of a
-// walk through the mesh (exact: τ linear along each piece), as far as the reach (VTK's,
+// walk through the mesh (exact: τ linear along each piece; a headlight's from the ray's own
+// optical depth, trail_to), as far as the reach (VTK's,
 // measured in the mesh's box mapped to the unit cube) or the light; the volumetric term
 // Σ T·p(μ)·kd·I_diffuse (+ ka·I_ambient but the headlight's), p Henyey–Greenstein over the
 // world cosine, mixed with the gradient lighting by VTK's weight, from the gradient's
@@ -206,10 +207,25 @@ fn integrate_within(r: Ray, seg: vec2<f32>, ta: f32, tb: f32, sa: f32, sb: f32) 
     integrate(r, s0, s1, lo, hi - lo);
 }
 
+// The optical depth over [a, b] of the segment through tetrahedron k from `entry` to `ex`
+// (of a walk from o along d): the attenuation scaled by its gradient opacity at the middle
+// of [a, b] (GRAD_OPACITY); 0 through a transparent tetrahedron.
+fn piece_depth(k: Tet, entry: Hit, ex: Hit, a: f32, b: f32, o: vec3<f32>, d: vec3<f32>) -> f32 {
+    if (b <= a || transparent_tet(k, ex.tf >> 2u)) {
+        return 0.0;
+    }
+    let sv = scalars_at(entry, ex, a, b);
+    var scale = 1.0;
+    if (GRAD_OPACITY) {
+        let g = gradient_in(k, o + 0.5 * (a + b) * d);
+        scale = gradient_opacity(0u, length((frame.gradient_to_world * vec4<f32>(g, 0.0)).xyz));
+    }
+    return scale * segment_depth(sv.x, sv.y, b - a);
+}
+
 // The transmittance from index-space point x, in tetrahedron `tet` where the scalar is s,
-// along d (t world distance) to `limit`: exp(−τ) of the walk, each tetrahedron's
-// attenuation scaled by its gradient opacity at the middle of its piece (GRAD_OPACITY);
-// light passes through the gaps of a non-convex mesh.
+// along d (t world distance) to `limit`: exp(−τ) of the walk; light passes through the gaps
+// of a non-convex mesh.
 fn transmittance(x: vec3<f32>, d: vec3<f32>, tet: u32, s: f32, limit: f32) -> f32 {
     var w = walk_inside(x, d, tet, 0.0, s);
     var depth = 0.0;
@@ -218,16 +234,7 @@ fn transmittance(x: vec3<f32>, d: vec3<f32>, tet: u32, s: f32, limit: f32) -> f3
         if (ex.tf == NO_HIT) {
             break;
         }
-        let hi = min(ex.t, limit);
-        if (hi > w.hit.t && !transparent_tet(w.k, ex.tf >> 2u)) {
-            let s1 = scalars_at(w.hit, ex, hi, hi).y;
-            var scale = 1.0;
-            if (GRAD_OPACITY) {
-                let g = gradient_in(w.k, x + 0.5 * (w.hit.t + hi) * d);
-                scale = gradient_opacity(0u, length((frame.gradient_to_world * vec4<f32>(g, 0.0)).xyz));
-            }
-            depth = depth + scale * segment_depth(w.hit.s, s1, hi - w.hit.t);
-        }
+        depth = depth + piece_depth(w.k, w.hit, ex, w.hit.t, min(ex.t, limit), x, d);
         if (ex.t >= limit || depth > 30.0) {
             break;
         }
@@ -236,12 +243,45 @@ fn transmittance(x: vec3<f32>, d: vec3<f32>, tet: u32, s: f32, limit: f32) -> f3
     return exp(-depth);
 }
 
+// VOLUMETRIC: a headlight's shadow rays run back along the pixel's own ray, so their optical
+// depth is the ray's: ray_depth from the ray's first entry into the mesh to the current
+// tetrahedron's entry, and a second walk of the same ray (trail, leaving its tetrahedron at
+// trail_ex) that trails by the reach, trail_depth to its tetrahedron's entry. Each
+// tetrahedron is walked twice in all, where a shadow walk per segment would walk the reach.
+var<private> ray_depth: f32 = 0.0;
+var<private> trail: Walk;
+var<private> trail_ex: Hit;
+var<private> trail_depth: f32 = 0.0;
+
+// The ray's optical depth from its first entry to distance t (never less than the last
+// call's t): the trailing walk moves on to t.
+fn trail_to(o: vec3<f32>, d: vec3<f32>, t: f32, t_max: f32) -> f32 {
+    // (walks take function-space pointers: the walk moves on in a copy)
+    var w = trail;
+    loop {
+        if (trail_ex.tf == NO_HIT || trail_ex.t > t) {
+            break;
+        }
+        trail_depth = trail_depth + piece_depth(w.k, w.hit, trail_ex, w.hit.t, trail_ex.t, o, d);
+        walk_across(&w, o, d, trail_ex, t_max);
+        trail_ex = walk_exit(&w, o, d, t_max);
+    }
+    trail = w;
+    if (trail_ex.tf == NO_HIT) {
+        return trail_depth;
+    }
+    return trail_depth + piece_depth(w.k, w.hit, trail_ex, w.hit.t, t, o, d);
+}
+
 // VOLUMETRIC: `surface` (the gradient lighting of a segment) mixed with the volumetric term
-// at its middle: index-space point x in tetrahedron `tet`, scalar s, world point pos, world
+// at the segment's middle, distance mid along the ray from o along d (index space) inside
+// tetrahedron k, entered at `entry` and left at `ex`; scalar s, world point pos, world
 // gradient gw; τ the attenuation there (gradient opacity applied).
-fn volumetric_lighting(surface: Lighting, x: vec3<f32>, tet: u32, s: f32, pos: vec3<f32>,
-                       view_dir: vec3<f32>, gw: vec3<f32>, tau: f32) -> Lighting {
+fn volumetric_lighting(surface: Lighting, o: vec3<f32>, d: vec3<f32>, mid: f32, k: Tet,
+                       entry: Hit, ex: Hit, s: f32, pos: vec3<f32>, view_dir: vec3<f32>,
+                       gw: vec3<f32>, tau: f32, t_max: f32) -> Lighting {
     let v = -view_dir;
+    let x = o + mid * d;
     var vol: Lighting;
     vol.scale = vec3<f32>(0.0);
     vol.add = vec3<f32>(0.0);
@@ -252,9 +292,15 @@ fn volumetric_lighting(surface: Lighting, x: vec3<f32>, tet: u32, s: f32, pos: v
         if (light.position.w > 0.5 && light.position.w < 1.5) {
             limit = distance(light.position.xyz, pos);
         }
-        let d = (frame.world_to_index * vec4<f32>(li.xyz, 0.0)).xyz;
-        limit = min(limit, frame.scatter.z / max(length(d * mesh.shadow.xyz), 1e-30));
-        let tr = transmittance(x, d, tet, s, limit);
+        let dl = (frame.world_to_index * vec4<f32>(li.xyz, 0.0)).xyz;
+        limit = min(limit, frame.scatter.z / max(length(dl * mesh.shadow.xyz), 1e-30));
+        var tr = 1.0;
+        if (light.position.w > 1.5) {
+            let here = ray_depth + piece_depth(k, entry, ex, entry.t, mid, o, d);
+            tr = exp(-max(here - trail_to(o, d, mid - limit, t_max), 0.0));
+        } else {
+            tr = transmittance(x, dl, ex.tf >> 2u, s, limit);
+        }
         vol.scale = vol.scale + tr * shadow_phase(dot(-li.xyz, v)) * li.w * frame.material.y *
             light.diffuse.rgb;
         if (light.position.w < 1.5) {
@@ -296,6 +342,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // (from the line's first boundary crossing, behind the camera too: a near plane
         // inside the mesh starts its rays inside, where they are integrated from seg.x)
         var w = walk_in(o, d, -3.0e38, seg.y);
+        if (VOLUMETRIC) {
+            var first = w;
+            trail_ex = walk_exit(&first, o, d, seg.y);
+            trail = first;
+        }
         loop {
             let ex = walk_exit(&w, o, d, seg.y);
             if (ex.tf == NO_HIT) {
@@ -315,11 +366,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                         if (VOLUMETRIC) {
                             let sm = scalars_at(w.hit, ex, mid, mid).x;
                             let tau = tau_at(entry_of(sm)) * opacity_scale;
-                            lit = volumetric_lighting(lit, o + mid * d, ex.tf >> 2u, sm, pos, ray.dir, gw, tau);
+                            lit = volumetric_lighting(lit, o, d, mid, w.k, w.hit, ex, sm, pos,
+                                                      ray.dir, gw, tau, seg.y);
                         }
                     }
                 }
                 integrate_within(ray, seg, w.hit.t, ex.t, w.hit.s, ex.s);
+            }
+            if (VOLUMETRIC) {
+                ray_depth = ray_depth + piece_depth(w.k, w.hit, ex, w.hit.t, ex.t, o, d);
             }
             if (done() || ex.t >= seg.y) {
                 break;
