@@ -33,7 +33,7 @@ FLOOR_SSIM, FLOOR_PSNR = 0.98, 35.0
 # of a voxel, and VTK's sample-spaced steps along them).
 ISO_FLOOR = (0.8, 20.0)
 # Volumetric shadows against vtkGPUVolumeRayCastMapper's (test_volumetric_shadows).
-VOLUMETRIC_FLOOR = (0.9, 27.0)
+VOLUMETRIC_FLOOR = (0.93, 28.0)
 
 
 def wavelet_property(unit_distance=1.0):
@@ -181,9 +181,9 @@ class AgainstVtk(unittest.TestCase):
         """VolumetricScatteringBlending and GlobalIlluminationReach (vtkGPUVolumeRayCastMapper's
         settings, which VTK's unstructured mappers lack): the mesh's volumetric shadows
         against vtkGPUVolumeRayCastMapper's on the image it was split from, a thin medium
-        lit by the headlight (measured 0.934 / 29.9 dB; the same pair shaded without shadows
+        lit by the headlight (measured 0.961 / 30.8 dB; the same pair shaded without shadows
         0.976 / 39.5 dB: each ray segment's shadow is taken at its middle, constant along
-        it, where VTK samples every step), and the shadows show (35 levels)."""
+        it, where VTK samples every step), and the shadows show (38 levels)."""
         src = vtk.vtkRTAnalyticSource()
         src.SetWholeExtent(-10, 10, -10, 10, -10, 10)
         src.Update()
