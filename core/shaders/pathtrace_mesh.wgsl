@@ -70,7 +70,16 @@ fn fly(r: Ray, seg: vec2<f32>, start: Walk, goal: f32, roulette: bool, rng: ptr<
             var xa = x0;
             var ua = 0.0;
             var sa = tau_at(xa);
-            for (var i = 0u; i <= TABLE_N + 1u; i = i + 1u) {
+            // (a tetrahedron the flight crosses whole adds its depth in a few reads: pieces
+            // are walked only where the goal is reached, so that flights stay within
+            // lavapipe's loop budget when pieces end at every table entry)
+            let whole = segment_depth(s0, s1, len);
+            var pieces = TABLE_N + 2u;
+            if (out.depth + whole < goal) {
+                out.depth = out.depth + whole;
+                pieces = 0u;
+            }
+            for (var i = 0u; i < pieces; i = i + 1u) {
                 let xb = next_cut(xa, x1, up);
                 let ub = select((xb - x0) / (x1 - x0), 1.0, xb == x1);
                 let sb = tau_at(xb);

@@ -754,3 +754,57 @@ fn brightness(img: &Image) -> f64 {
         .sum::<f64>()
         / (3 * lit.len().max(1)) as f64
 }
+/// A light other than the headlight walks the mesh from every segment's middle: with a
+/// transfer function of many points (pieces end at every table entry) those walks stay
+/// within lavapipe's loop budget and exact (segment_depth reads the opacity's running
+/// integral, a few reads per tetrahedron), as the headlight's shadows from the ray's own
+/// depth are. A positional light at the eye lights as the headlight does.
+#[test]
+fn shadow_walks_stay_exact_with_a_transfer_function_of_many_points() {
+    let v = synth::tet_wavelet(17);
+    let (lo, hi) = range(&v);
+    let color = Piecewise::new(
+        (0..200)
+            .map(|i| {
+                let f = i as f64 / 199.0;
+                let odd = (i % 2) as f32;
+                (
+                    lo + f * (hi - lo),
+                    [0.2 + 0.6 * f as f32, 0.8 - 0.5 * f as f32, 0.5 + 0.3 * odd],
+                )
+            })
+            .collect(),
+    )
+    .unwrap();
+    let opacity = Piecewise::new(vec![(lo, [0.0]), (hi, [0.3])]).unwrap();
+    let t = TransferFunction::single(ComponentTransfer::new(color, opacity));
+    let mut view = View::fit(v.bounds(), 40, 40);
+    view.camera.azimuth(35.0);
+    view.camera.elevation(25.0);
+    view.camera.reset_clipping_range(v.bounds());
+    let p = RenderParams {
+        shading: Shading {
+            enabled: true,
+            volumetric_blending: 2.0,
+            global_illumination_reach: 0.5,
+            scattering_anisotropy: -0.3,
+            ..Default::default()
+        },
+        ..params(BlendMode::Composite)
+    };
+    let reference = mesh::render_lit(&v, &t, &view, &p, mesh::LightAt::Middle);
+    let mut at_eye = view.clone();
+    let mut l = Light::positional(view.camera.position, view.camera.focal_point, 1.0);
+    l.ambient = [0.0; 3];
+    at_eye.lights = vec![l];
+    for (name, lights) in [
+        ("headlight", &view),
+        ("positional light at the eye", &at_eye),
+    ] {
+        let img = draw(&v, &t, lights, &p);
+        let (mean, psnr, max) = compare_to_reference(&img, &reference);
+        println!("many points, {name}: mean error {mean:.4}, PSNR {psnr:.1} dB, max {max:.1}");
+        assert!(brightness(&img) > 4.0, "{name}: a nearly black image");
+        assert!(mean < 0.5 && psnr > 45.0 && max <= 3.0, "{name}");
+    }
+}

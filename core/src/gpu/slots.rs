@@ -54,6 +54,8 @@ pub const MESH_GRADIENTS: u32 = 26;
 /// where one binding of the device holds fewer than the mesh's.
 pub const MESH_TETS_HI: u32 = 31;
 pub const MESH_NEIGHBOURS_HI: u32 = 32;
+/// The running integral of a mesh's opacity row (lib/mesh.wgsl `segment_depth`).
+pub const MESH_DEPTH: u32 = 33;
 /// The path tracers' own (lib/pathtrace.wgsl): the accumulated sums and moments, the
 /// uniforms (one block per dispatch), the environment's cube, its sampler and its sampling
 /// distribution, the denoiser's guide sums.
@@ -99,6 +101,7 @@ pub const WGSL_SLOTS: &[(&str, u32)] = &[
     ("SLOT_MESH_GRADIENTS", MESH_GRADIENTS),
     ("SLOT_MESH_TETS_HI", MESH_TETS_HI),
     ("SLOT_MESH_NEIGHBOURS_HI", MESH_NEIGHBOURS_HI),
+    ("SLOT_MESH_DEPTH", MESH_DEPTH),
     ("SLOT_PT_ACCUM", PT_ACCUM),
     ("SLOT_PT_MOMENTS", PT_MOMENTS),
     ("SLOT_PT_UNIFORMS", PT_UNIFORMS),

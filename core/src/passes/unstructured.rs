@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::gpu::binding::{
     bind, bind_view, buffer_entry, group_layout, storage_texture_entry, texture_entry,
 };
-use crate::gpu::buffers::uniform_buffer;
+use crate::gpu::buffers::{buffer, uniform_buffer};
 use crate::gpu::pipeline::PipelineCache;
 use crate::gpu::slots;
 use crate::gpu::uniforms::{
@@ -45,6 +45,8 @@ pub(crate) struct UnstructuredPass {
 pub(crate) struct MeshTransfer {
     buf: wgpu::Buffer,
     opaque: Option<(ComponentTransfer, OpaqueBits)>,
+    /// The opacity row's running integral (lib/mesh.wgsl `depth_prefix`), written with it.
+    depth: wgpu::Buffer,
 }
 
 impl MeshTransfer {
@@ -54,15 +56,32 @@ impl MeshTransfer {
             "mesh uniforms",
             std::mem::size_of::<MeshUniforms>() as u64,
         );
-        MeshTransfer { buf, opaque: None }
+        let depth = buffer(
+            ctx,
+            "mesh opacity integral",
+            (TABLE_SIZE * 4) as u64,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        MeshTransfer {
+            buf,
+            opaque: None,
+            depth,
+        }
     }
 
-    /// `opaque_entries` of `ct`, from the last frame's when its transfer is the same.
-    fn opaque_bits(&mut self, ct: &ComponentTransfer) -> OpaqueBits {
+    /// `opaque_entries` of `ct`, from the last frame's when its transfer is the same (the
+    /// opacity row's running integral written then).
+    fn opaque_bits(&mut self, ctx: &Context, ct: &ComponentTransfer) -> OpaqueBits {
         match &self.opaque {
             Some((last, bits)) if last == ct => *bits,
             _ => {
-                let bits = opaque_entries(ct);
+                let row = opacity_row(ct);
+                let bits = opaque_entries(&row);
+                ctx.queue.write_buffer(
+                    &self.depth,
+                    0,
+                    bytemuck::cast_slice(&running_integral(&row)),
+                );
                 self.opaque = Some((ct.clone(), bits));
                 bits
             }
@@ -75,7 +94,7 @@ impl MeshTransfer {
         let mut mu = mesh.uniforms;
         mu.unit[0] = (1.0 / ct.unit_distance) as f32;
         set_knots(&mut mu, ct);
-        mu.opaque = self.opaque_bits(ct);
+        mu.opaque = self.opaque_bits(ctx, ct);
         ctx.queue
             .write_buffer(&self.buf, 0, bytemuck::bytes_of(&mu));
     }
@@ -87,7 +106,7 @@ impl MeshTransfer {
     }
 
     /// The mesh's bindings (lib/mesh.wgsl).
-    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 10] {
+    pub fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 11] {
         use wgpu::BufferBindingType as B;
         let read = B::Storage { read_only: true };
         [
@@ -101,11 +120,12 @@ impl MeshTransfer {
             buffer_entry(slots::MESH_NODES, read),
             buffer_entry(slots::MESH_BOUNDARY, read),
             buffer_entry(slots::MESH_GRADIENTS, read),
+            buffer_entry(slots::MESH_DEPTH, read),
         ]
     }
 
     /// What they bind.
-    pub fn entries<'a>(&'a self, mesh: &'a GpuMesh) -> [wgpu::BindGroupEntry<'a>; 10] {
+    pub fn entries<'a>(&'a self, mesh: &'a GpuMesh) -> [wgpu::BindGroupEntry<'a>; 11] {
         [
             bind(slots::MESH, self.buf.as_entire_binding()),
             bind(slots::MESH_POINTS, mesh.points.as_entire_binding()),
@@ -126,6 +146,7 @@ impl MeshTransfer {
             bind(slots::MESH_NODES, mesh.nodes.as_entire_binding()),
             bind(slots::MESH_BOUNDARY, mesh.boundary.as_entire_binding()),
             bind(slots::MESH_GRADIENTS, mesh.gradients.as_entire_binding()),
+            bind(slots::MESH_DEPTH, self.depth.as_entire_binding()),
         ]
     }
 }
@@ -278,17 +299,37 @@ fn set_knots(mu: &mut MeshUniforms, ct: &ComponentTransfer) {
     }
 }
 
-/// The table entries whose opacity is above 0, read from the opacity row of the tables the
-/// shader integrates: a tetrahedron whose scalars reach none of them adds nothing to a
-/// composite, and the shader skips its integral.
-fn opaque_entries(ct: &ComponentTransfer) -> OpaqueBits {
+/// The opacity row of the tables the mesh passes read (row 1 of `build_tables`).
+fn opacity_row(ct: &ComponentTransfer) -> Vec<f32> {
+    build_tables(ct, 1.0)[TABLE_SIZE..2 * TABLE_SIZE]
+        .iter()
+        .map(|e| e[0])
+        .collect()
+}
+
+/// The table entries whose opacity is above 0: a tetrahedron whose scalars reach none of
+/// them adds nothing to a composite, and the shader skips its integral.
+fn opaque_entries(row: &[f32]) -> OpaqueBits {
     let mut bits = [[0; 4]; MESH_OPAQUE_WORDS / 4];
-    for (i, e) in build_tables(ct, 1.0)[TABLE_SIZE..].iter().enumerate() {
-        if e[0] > 0.0 {
+    for (i, a) in row.iter().enumerate() {
+        if *a > 0.0 {
             bits[i / 128][i / 32 % 4] |= 1 << (i % 32);
         }
     }
     bits
+}
+
+/// ∫₀ⁱ of the row at each entry i (entry units; linear between entries), summed in f64.
+fn running_integral(row: &[f32]) -> Vec<f32> {
+    let mut sum = 0.0f64;
+    let mut out = Vec::with_capacity(row.len());
+    for (i, a) in row.iter().enumerate() {
+        if i > 0 {
+            sum += 0.5 * (row[i - 1] as f64 + *a as f64);
+        }
+        out.push(sum as f32);
+    }
+    out
 }
 
 /// The frame uniforms of a frame of the renderer's mesh: the camera, the mesh's coordinates
