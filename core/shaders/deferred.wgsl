@@ -1,5 +1,5 @@
-// Deferred shading of the G-buffer firsthit.wgsl (or, for a mesh, firsthit_mesh.wgsl) wrote. Per
-// pixel, its surface layers front to back, each
+// Deferred shading of the G-buffer firsthit.wgsl (for a mesh, firsthit_mesh.wgsl) wrote.
+// Per pixel, its surface layers front to back, each
 //   - lit by the scene's lights (Blinn–Phong, lib/surface.wgsl), ambient scaled by AO;
 //   - lit by the environment: diffuse from the irradiance cube at the normal, specular from
 //     the environment cube on the Phong lobe cos^s around the reflection vector (the simple

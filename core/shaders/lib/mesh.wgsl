@@ -253,8 +253,9 @@ fn gradient_in(k: Tet, x: vec3<f32>) -> vec3<f32> {
 // The faces (1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1) are outward (resources/mesh orients
 // every tetrahedron positively), and the ray leaves through the one whose three edges'
 // products are ≥ 0, which are then its exit point's barycentric weights. Of the faces but
-// f_in and those whose products do not sum above 0, the one whose least product is largest (ties at an edge or rounding: the nearest
-// miss); tf NO_HIT where the ray does not leave through it (a ray along a face).
+// f_in and those whose products do not sum above 0, the one whose least product is largest
+// (ties at an edge or rounding: the nearest miss); tf NO_HIT where the ray does not leave
+// through it (a ray along a face).
 fn exit_of(o: vec3<f32>, d: vec3<f32>, k: Tet, t: u32, f_in: u32, t_in: f32) -> Hit {
     let e = o + t_in * d;
     let r0 = k.p0.xyz - e;

@@ -16,7 +16,7 @@ use crate::gpu::binding::{
     bind, bind_view, buffer_entry, group_layout, storage_texture_entry, texture_entry,
 };
 use crate::gpu::buffers::{buffer, uniform_buffer};
-use crate::gpu::pipeline::PipelineCache;
+use crate::gpu::pipeline::{encode_single_group, PipelineCache};
 use crate::gpu::slots;
 use crate::gpu::uniforms::{
     flag_bits, mat, FrameUniforms, MeshUniforms, FLAG_DEPTH_INPUT, FLAG_EXTREMUM_DEPTH,
@@ -222,20 +222,16 @@ impl UnstructuredPass {
         let depth_in_view = t.depth_in.create_view(&Default::default());
         let color_view = t.color.create_view(&Default::default());
         let depth_view = t.depth.create_view(&Default::default());
-        let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("unstructured"),
-            layout: &self.bgl,
-            entries: &[
-                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind_view(slots::TABLES, &tables.view),
-                bind_view(slots::DEPTH_IN, &depth_in_view),
-                bind_view(slots::OUT_COLOR, &color_view),
-                bind_view(slots::OUT_DEPTH, &depth_view),
-            ]
-            .into_iter()
-            .chain(self.transfer.entries(mesh))
-            .collect::<Vec<_>>(),
-        });
+        let entries: Vec<_> = [
+            bind(slots::FRAME, res.frame_buf.as_entire_binding()),
+            bind_view(slots::TABLES, &tables.view),
+            bind_view(slots::DEPTH_IN, &depth_in_view),
+            bind_view(slots::OUT_COLOR, &color_view),
+            bind_view(slots::OUT_DEPTH, &depth_view),
+        ]
+        .into_iter()
+        .chain(self.transfer.entries(mesh))
+        .collect();
         let rect = u.rect;
         let gr = groups(rect);
         let mut enc = ctx
@@ -246,15 +242,14 @@ impl UnstructuredPass {
         if rect != [0, 0, view.width, view.height] {
             clear_outputs(&mut enc, &color_view, &depth_view);
         }
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("unstructured"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(gr[0], gr[1], 1);
-        }
+        encode_single_group(
+            ctx,
+            &mut enc,
+            "unstructured",
+            (&self.bgl, &pipeline),
+            &entries,
+            [gr[0], gr[1], 1],
+        );
         ctx.submit([enc.finish()]);
         res.stats.frames += 1;
         Ok(())

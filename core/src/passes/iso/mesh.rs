@@ -8,7 +8,7 @@ use super::{iso_uniforms, lit, required, IsoPass, GBUFFER_FORMAT};
 use crate::error::{Error, Result};
 use crate::gpu::binding::texture_entry;
 use crate::gpu::binding::{bind, bind_view, buffer_entry, group_layout, storage_texture_entry};
-use crate::gpu::pipeline::PipelineCache;
+use crate::gpu::pipeline::{encode_single_group, PipelineCache};
 use crate::gpu::slots;
 use crate::gpu::Context;
 use crate::params::{IsoParams, ScalarLocation};
@@ -131,22 +131,18 @@ impl IsoPass {
         let t = res.targets.as_ref().expect("allocated above");
         let gb = self.gbuffer.as_ref().expect("allocated above").views();
         let depth_in_view = t.depth_in.create_view(&Default::default());
-        let firsthit_bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("first hit (mesh)"),
-            layout: &surfaces.bgl,
-            entries: &[
-                bind(slots::FRAME, res.frame_buf.as_entire_binding()),
-                bind(2, t.state(ctx).as_entire_binding()),
-                bind_view(slots::DEPTH_IN, &depth_in_view),
-                bind(slots::ISO, self.iso_buf.as_entire_binding()),
-                bind_view(8, &gb.position),
-                bind_view(9, &gb.normal),
-                bind_view(10, &gb.extra),
-            ]
-            .into_iter()
-            .chain(surfaces.transfer.entries(mesh))
-            .collect::<Vec<_>>(),
-        });
+        let firsthit_entries: Vec<_> = [
+            bind(slots::FRAME, res.frame_buf.as_entire_binding()),
+            bind(2, t.state(ctx).as_entire_binding()),
+            bind_view(slots::DEPTH_IN, &depth_in_view),
+            bind(slots::ISO, self.iso_buf.as_entire_binding()),
+            bind_view(8, &gb.position),
+            bind_view(9, &gb.normal),
+            bind_view(10, &gb.extra),
+        ]
+        .into_iter()
+        .chain(surfaces.transfer.entries(mesh))
+        .collect();
         let shading = self.deferred_inputs(
             ctx,
             res,
@@ -159,16 +155,15 @@ impl IsoPass {
                 label: Some("isosurface frame (mesh)"),
             });
         shading.clear_outside(&mut enc, u.shade_rect, full);
-        {
-            let gr = groups(frame.rect);
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("first hit (mesh)"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&firsthit);
-            pass.set_bind_group(0, &firsthit_bg, &[]);
-            pass.dispatch_workgroups(gr[0], gr[1], 1);
-        }
+        let gr = groups(frame.rect);
+        encode_single_group(
+            ctx,
+            &mut enc,
+            "first hit (mesh)",
+            (&surfaces.bgl, &firsthit),
+            &firsthit_entries,
+            [gr[0], gr[1], 1],
+        );
         shading.dispatch(&mut enc, &deferred, None, u.shade_rect);
         ctx.checked("rendering the mesh's isosurfaces", || {
             ctx.submit([enc.finish()]);
